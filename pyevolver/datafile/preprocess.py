@@ -1,0 +1,215 @@
+"""Lexical preprocessing of a datafile (spec §1).
+
+Line endings (LF, CRLF, CR) are normalised, comments are blanked (keeping
+line and column positions), spliced lines are joined, ``#define`` macros are
+expanded on whole tokens (rescanned) and ``#include`` files are inserted.
+The result is split into the top section, the element sections and the
+``read`` section, each with the source line number of its first line.
+"""
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+
+from ..errors import DatafileError
+
+_COMMENT_RE = re.compile(r'"(?:\\.|[^"\\\n])*"|/\*.*?\*/|//[^\n]*', re.S)
+_SECTION_RE = re.compile(
+    r"^[ \t]*(vertices|edges|faces|facets|bodies|read)\b[ \t]*:?", re.I | re.M)
+_IDENT_RE = re.compile(r'"(?:\\.|[^"\\\n])*"|[A-Za-z_][A-Za-z0-9_]*')
+_DIRECTIVE_RE = re.compile(r"^[ \t]*#[ \t]*(define|include)\b(.*)$", re.I | re.M)
+
+
+@dataclass
+class Section:
+    """A part of the datafile: its kind, text and first source line."""
+
+    kind: str
+    text: str
+    line: int
+    lines: list = field(default_factory=list)  # source line of each text line
+
+
+def normalise_newlines(text):
+    if "\r" in text:
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    if "\x1a" in text:
+        text = text.replace("\x1a", " ")
+    return text
+
+
+def blank_comments(text, filename):
+    """Replace comments by spaces, keeping newlines (positions are kept)."""
+    if "/" not in text:
+        return text
+
+    def repl(m):
+        s = m.group(0)
+        if s[0] == '"':
+            return s
+        return re.sub(r"[^\n]", " ", s)
+
+    out = _COMMENT_RE.sub(repl, text)
+    k = out.find("/*")
+    if k >= 0:
+        # check it is not inside a string
+        for m in re.finditer(r'"(?:\\.|[^"\\\n])*"|/\*', out):
+            if m.group(0) == "/*":
+                line = out.count("\n", 0, m.start()) + 1
+                col = m.start() - (out.rfind("\n", 0, m.start()) + 1) + 1
+                raise DatafileError("unterminated comment: '/*' has no closing '*/'",
+                                    filename, line, col, text.split("\n")[line - 1])
+    return out
+
+
+def read_source(path):
+    with open(path, "rb") as fh:
+        data = fh.read()
+    return data.decode("latin-1")
+
+
+def preprocess(text, filename="<datafile>", include_depth=0):
+    """Return ``(sections, macros)`` for the datafile text.
+
+    ``sections`` is a list of :class:`Section`: the first is always the top
+    section (kind ``"top"``); element sections follow in file order, and
+    ``read`` (raw command text) comes last if present.
+    """
+    text = normalise_newlines(text)
+    clean = blank_comments(text, filename)
+    # find the read section first: macros do not apply after it
+    read_text = None
+    read_line = None
+    m_read = None
+    for m in _SECTION_RE.finditer(clean):
+        if m.group(1).lower() == "read":
+            m_read = m
+            break
+    if m_read is not None:
+        read_line = clean.count("\n", 0, m_read.start()) + 1
+        read_text = text[m_read.end():]      # raw: the command lexer handles comments
+        clean = clean[:m_read.start()]
+    src_lines = None
+    if "\\\n" in clean:
+        clean, src_lines = _splice(clean)
+    macros = {}
+    if "#" in clean:
+        clean, src_lines = _directives(clean, filename, macros, src_lines, include_depth)
+    sections = _split(clean, src_lines)
+    if read_text is not None:
+        sections.append(Section("read", read_text, read_line))
+    return sections, macros
+
+
+def _splice(text):
+    """Join lines ending in a backslash; returns text and source line map."""
+    lines = text.split("\n")
+    out, src = [], []
+    i = 0
+    while i < len(lines):
+        start = i + 1
+        cur = lines[i]
+        while cur.endswith("\\") and i + 1 < len(lines):
+            i += 1
+            cur = cur[:-1] + " " + lines[i]
+        out.append(cur)
+        src.append(start)
+        i += 1
+    return "\n".join(out), src
+
+
+def _directives(text, filename, macros, src_lines, depth):
+    lines = text.split("\n")
+    if src_lines is None:
+        src_lines = list(range(1, len(lines) + 1))
+    out, src = [], []
+    for ln, line in zip(src_lines, lines):
+        m = _DIRECTIVE_RE.match(line)
+        if m:
+            kind = m.group(1).lower()
+            rest = m.group(2).strip()
+            if kind == "define":
+                mm = re.match(r"([A-Za-z_][A-Za-z0-9_]*)(.*)$", rest)
+                if not mm:
+                    raise DatafileError("expected a macro name after #define",
+                                        filename, ln, line.find("define") + 7, line)
+                macros[mm.group(1)] = mm.group(2).strip()[:500]
+                out.append("")
+                src.append(ln)
+                continue
+            # include
+            mm = re.match(r'"([^"]*)"', rest)
+            if not mm:
+                raise DatafileError('expected a quoted file name after #include',
+                                    filename, ln, line.find("include") + 8, line)
+            if depth >= 10:
+                raise DatafileError("#include nested more than 10 deep", filename, ln, 1, line)
+            inc = _find_include(mm.group(1), filename)
+            if inc is None:
+                raise DatafileError(f"cannot open include file '{mm.group(1)}'",
+                                    filename, ln, line.find('"') + 1, line)
+            inc_text = blank_comments(normalise_newlines(read_source(inc)), inc)
+            inc_text, _ = _directives(inc_text, inc, macros, None, depth + 1)
+            for l2 in inc_text.split("\n"):
+                out.append(l2)
+                src.append(ln)
+            continue
+        if macros:
+            line = expand_macros(line, macros)
+        out.append(line)
+        src.append(ln)
+    return "\n".join(out), src
+
+
+def _find_include(name, filename):
+    cands = [name, os.path.join(os.path.dirname(filename or "."), name)]
+    for d in os.environ.get("EVOLVERPATH", "").split(os.pathsep):
+        if d:
+            cands.append(os.path.join(d, name))
+    for c in cands:
+        if os.path.isfile(c):
+            return c
+    return None
+
+
+def expand_macros(line, macros):
+    """Textual replacement of whole tokens, rescanned (at most 100 passes)."""
+    for _ in range(100):
+        changed = False
+
+        def repl(m):
+            nonlocal changed
+            s = m.group(0)
+            if s[0] != '"' and s in macros:
+                changed = True
+                return macros[s]
+            return s
+
+        new = _IDENT_RE.sub(repl, line)
+        if not changed:
+            return new
+        line = new
+    return line
+
+
+def _split(text, src_lines):
+    sections = []
+    matches = list(_SECTION_RE.finditer(text))
+    starts = [0] + [m.start() for m in matches]
+    kinds = ["top"] + [m.group(1).lower() for m in matches]
+    ends = [m.start() for m in matches] + [len(text)]
+    bodies = [0] + [m.end() for m in matches]
+    for kind, s, b, e in zip(kinds, starts, bodies, ends):
+        if kind == "facets":
+            kind = "faces"
+        line0 = text.count("\n", 0, s) + 1 if s else 1
+        body = text[b:e]
+        # the header line's remainder belongs to the section; keep its line
+        if src_lines is not None:
+            n = body.count("\n") + 1
+            lines = src_lines[line0 - 1: line0 - 1 + n]
+            sections.append(Section(kind, body, lines[0] if lines else line0, lines))
+        else:
+            sections.append(Section(kind, body, line0))
+    return sections

@@ -1,0 +1,651 @@
+"""Datafile reader: text -> :class:`pyevolver.scene.Scene`.
+
+The top section and non-trivial element lines are parsed by the LALR
+grammar ``fe.lark`` (with the shared expression grammar); element lines made
+only of plain numbers take a fast path that gives the same result.
+"""
+from __future__ import annotations
+
+import functools
+import os
+import re
+
+import numpy as np
+from lark import Lark, Token, v_args
+from lark.exceptions import UnexpectedInput, UnexpectedCharacters, UnexpectedToken, VisitError
+
+from ..errors import DatafileError, UnsupportedError, ExpressionError, PyEvolverError
+from ..expr import nodes as N
+from ..expr.transform import ExprTransformer, expr_grammar
+from ..scene import (Scene, ConstraintDecl, BoundaryDecl, QuantityDecl, MethodDecl,
+                     ElementBlock)
+from .preprocess import preprocess, read_source
+
+_HERE = os.path.dirname(__file__)
+
+_NUMERIC_LINE = re.compile(
+    r"[ \t]*\d+(?:[ \t]+[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)*[ \t]*\Z")
+
+
+class _Unsupported(Exception):
+    pass
+
+
+def _refuse(tok):
+    raise _Unsupported(tok)
+
+
+@functools.lru_cache(maxsize=1)
+def top_parser():
+    """LALR parser of the top section (``fe_top.lark`` + ``expr.lark``)."""
+    with open(os.path.join(_HERE, "fe_top.lark")) as fh:
+        grammar = expr_grammar() + "\n" + fh.read()
+    return Lark(grammar, parser="lalr", lexer="contextual", start="start",
+                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse})
+
+
+@functools.lru_cache(maxsize=1)
+def line_parser():
+    """LALR parser of one element line (``fe_elements.lark`` + ``expr.lark``)."""
+    with open(os.path.join(_HERE, "fe_elements.lark")) as fh:
+        grammar = expr_grammar() + "\n" + fh.read()
+    return Lark(grammar, parser="lalr", lexer="contextual",
+                start=["vertex_line", "edge_line", "face_line", "body_line"],
+                maybe_placeholders=False)
+
+
+_MATRIX_RE = re.compile(r"\b(torus_periods|periods|view_matrix|view_transforms|"
+                        r"view_transform_generators)\b", re.I)
+_NUMTOK_RE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)(?=\s|$)")
+
+
+@v_args(inline=True)
+class _TopTransformer(ExprTransformer):
+    """Top-section declarations -> tuples consumed by :func:`_fill_scene`."""
+
+    def start(self, *decls):
+        return list(decls)
+
+    def parameter(self, kw, name, value):
+        return ("parameter", str(name).lower(), value, kw.line)
+
+    def level_expr(self, a, b=None):
+        return a if b is None else N.Bin("-", a, b)
+
+    def constraint_opt(self, tok):
+        return str(tok).lower()
+
+    def comp(self, kw, e):
+        return (str(kw).rstrip(":").lower(), e)
+
+    def energy_block(self, _kw, *comps):
+        return ("energy", list(comps))
+
+    def content_block(self, _kw, *comps):
+        return ("content", list(comps))
+
+    def constraint(self, kw, cid, *rest):
+        opts = []
+        formula = None
+        blocks = []
+        for r in rest:
+            if isinstance(r, str):
+                opts.append(r)
+            elif isinstance(r, Token):
+                continue
+            elif isinstance(r, tuple):
+                blocks.append(r)
+            else:
+                formula = r
+        return ("constraint", int(cid), opts, formula, blocks, kw.line)
+
+    def boundary_opt(self, tok):
+        return str(tok).lower()
+
+    def boundary(self, kw, bid, _pk, nparams, *rest):
+        opts, comps, blocks = [], [], []
+        for r in rest:
+            if isinstance(r, str):
+                opts.append(r)
+            elif isinstance(r, tuple) and r[0] in ("energy", "content"):
+                blocks.append(r)
+            elif isinstance(r, tuple):
+                comps.append(r)
+        return ("boundary", int(bid), int(nparams), opts, comps, blocks, kw.line)
+
+    def q_energy(self, _t):
+        return ("kind", "energy", None)
+
+    def q_fixed(self, _t, e):
+        return ("kind", "fixed", e)
+
+    def q_conserved(self, _t):
+        return ("kind", "conserved", None)
+
+    def q_info(self, _t):
+        return ("kind", "info_only", None)
+
+    def q_modulus(self, _t, e):
+        return ("modulus", e)
+
+    def q_lagrange(self, _t, e):
+        return ("lagrange_multiplier", e)
+
+    def q_tolerance(self, _t, e):
+        return ("tolerance", e)
+
+    def m_global(self, _t):
+        return ("global", None)
+
+    def m_scalar(self, _t, e):
+        return ("scalar", e)
+
+    def m_vector(self, _t, *comps):
+        return ("vector", list(comps))
+
+    def m_modulus(self, _t, e):
+        return ("modulus", e)
+
+    def m_ignore_fixed(self, _t):
+        return ("ignore_fixed", None)
+
+    def m_ignore_constraints(self, _t):
+        return ("ignore_constraints", None)
+
+    def q_method(self, _t, name, *opts):
+        return ("method", str(name).lower(), False, list(opts))
+
+    def q_global_method(self, _t, name, *opts):
+        return ("method", str(name).lower(), True, list(opts))
+
+    def q_function(self, _t, e):
+        return ("function", e)
+
+    def quantity(self, kw, name, kind, *rest):
+        return ("quantity", str(name).lower(), kind, list(rest), kw.line)
+
+    def method_instance(self, kw, name, _m, mname, *opts):
+        return ("method_instance", str(name).lower(), str(mname).lower(), list(opts), kw.line)
+
+    def dims(self, *ints):
+        return [int(i) for i in ints]
+
+    def define_attr(self, kw, etype, _a, name, atype, dims=None):
+        return ("attribute", str(etype).lower(), str(name).lower(), str(atype).lower(),
+                dims or [], kw.line)
+
+    def flag_decl(self, kw):
+        return ("flag", str(kw).lower(), kw.line)
+
+    def value_decl(self, kw, e, fixed=None):
+        return ("value", str(kw).lower(), e, fixed is not None, kw.line)
+
+    def periods(self, kw):
+        return ("periods", [], kw.line)
+
+    def view_matrix(self, kw):
+        return ("ignored", str(kw).lower())
+
+    def evolver_version(self, kw, s):
+        return ("ignored", "evolver_version")
+
+    def unsupported(self, kw):
+        raise _Unsupported(kw)
+
+
+@v_args(inline=True)
+class _LineTransformer(ExprTransformer):
+    def _line(self, idtok, *items):
+        return (int(idtok), list(items))
+
+    vertex_line = edge_line = face_line = body_line = _line
+
+    def kw(self, tok):
+        return ("kw", str(tok).lower(), tok.column)
+
+    def name_neg(self, tok):
+        return ("name_neg", str(tok)[:-1].lower(), tok.column)
+
+
+_TOP = _TopTransformer()
+_LINE = _LineTransformer()
+
+VALUE_NAMES = {
+    "square_curvature": "squared_curvature",
+    "spring_constant": "gap_constant",
+    "integral_order": "integral_order",
+}
+
+
+class Reader:
+    """Reads one datafile into a :class:`Scene`."""
+
+    def __init__(self, filename, text=None):
+        self.filename = filename
+        self.text = read_source(filename) if text is None else text
+        self.scene = Scene(filename=filename)
+        self.src_lines = self.text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+
+    # -- errors -----------------------------------------------------------
+    def error(self, msg, line, col=None):
+        excerpt = self.src_lines[line - 1] if line and 0 < line <= len(self.src_lines) else None
+        return DatafileError(msg, self.filename, line, col, excerpt)
+
+    def read(self):
+        sections, self.macros = preprocess(self.text, self.filename)
+        top = sections[0]
+        self._top(top)
+        seen = []
+        for sec in sections[1:]:
+            if sec.kind == "read":
+                self.scene.read_text = sec.text
+                self.scene.read_line = sec.line
+                continue
+            if sec.kind in seen:
+                raise self.error(f"section '{sec.kind}' appears twice", sec.line, 1)
+            seen.append(sec.kind)
+            self._elements(sec)
+        if "vertices" not in seen:
+            last = len(self.src_lines)
+            raise self.error("unexpected end of file: expected a 'vertices' section",
+                             last, 1)
+        return self.scene
+
+    # -- top section --------------------------------------------------------
+    def _describe(self, exc, text):
+        if isinstance(exc, UnexpectedCharacters):
+            ch = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+            word = re.match(r"[A-Za-z_]\w*", text[exc.pos_in_stream:])
+            if word:
+                return (f"unexpected '{word.group(0)}': not a keyword, parameter or "
+                        f"value allowed here")
+            return f"unexpected character {ch!r}"
+        if isinstance(exc, UnexpectedToken):
+            tok = exc.token
+            if tok.type == "$END":
+                exp = _expected(exc.expected)
+                return f"unexpected end of line: expected {exp}"
+            exp = _expected(exc.expected)
+            return f"unexpected '{tok}': expected {exp}"
+        return str(exc).split("\n")[0]
+
+    def _extract_matrices(self, text):
+        """Take the numbers of PERIODS / VIEW_* matrices out of the text."""
+        out = text
+        for m in _MATRIX_RE.finditer(text):
+            pos = m.end()
+            vals = []
+            limit = None
+            if m.group(1).lower().endswith("periods"):
+                sd = self._peek_space_dimension(text[:m.start()])
+                limit = sd * sd
+            while limit is None or len(vals) < limit:
+                mm = _NUMTOK_RE.match(text, pos)
+                if not mm:
+                    break
+                vals.append(float(mm.group(1).replace("d", "e").replace("D", "e")))
+                pos = mm.end()
+            out = out[:m.end()] + re.sub(r"[^\n]", " ", out[m.end():pos]) + out[pos:]
+            if limit is not None:
+                if len(vals) != limit:
+                    line = text.count("\n", 0, m.start()) + 1
+                    raise _MatrixError(line, f"PERIODS needs {limit} numbers, found {len(vals)}")
+                self.scene.values["_periods"] = vals
+        return out
+
+    def _peek_space_dimension(self, text):
+        m = re.search(r"\bspace_dimension\s+(\d+)", text, re.I)
+        return int(m.group(1)) if m else 3
+
+    def _top(self, sec):
+        text = sec.text.replace(",", " ")
+        try:
+            if _MATRIX_RE.search(text):
+                text = self._extract_matrices(text)
+            tree = top_parser().parse(text, start="start")
+            decls = _TOP.transform(tree)
+        except _MatrixError as exc:
+            raise self.error(exc.args[1], self._src(sec, exc.args[0]), 1) from None
+        except _Unsupported as exc:
+            kw = exc.args[0]
+            raise self.error(f"not supported in pyevolver: {str(kw).upper()}",
+                             self._src(sec, kw.line), kw.column) from None
+        except UnexpectedInput as exc:
+            line = exc.line if exc.line not in (None, -1) else 1
+            srcline = sec.lines[line - 1] if sec.lines else line
+            raise self.error(self._describe(exc, text), srcline,
+                             exc.column if exc.column not in (None, -1) else None) from None
+        except VisitError as exc:
+            orig = exc.orig_exc
+            if isinstance(orig, _Unsupported):
+                kw = orig.args[0]
+                srcline = sec.lines[kw.line - 1] if sec.lines else kw.line
+                raise self.error(f"not supported in pyevolver: {str(kw).upper()}",
+                                 srcline, kw.column) from None
+            if isinstance(orig, PyEvolverError):
+                raise self.error(str(orig), None) from None
+            raise
+        self._fill_scene(decls, sec)
+
+    def _src(self, sec, line):
+        return sec.lines[line - 1] if sec.lines else line
+
+    def _const(self, expr, line, what):
+        try:
+            v = expr.ev(self.param_env)
+        except ExpressionError as exc:
+            raise self.error(f"{exc} in {what}", line, getattr(expr, "column", None)) from None
+        if isinstance(v, str):
+            raise self.error(f"expected a number for {what}, got a string", line)
+        return float(v)
+
+    @property
+    def param_env(self):
+        return N.MapEnv(self.scene.parameters)
+
+    def _formula(self, expr, text=""):
+        self._check_names(expr)
+        return N.Formula(expr, text)
+
+    def _check_names(self, expr, allowed=("x", "y", "z", "w", "x1", "x2", "x3", "x4",
+                                           "p1", "p2", "p3", "g")):
+        for name in expr.names():
+            if (name in allowed or name in self.scene.parameters or name in N.CONSTANTS
+                    or any(name == a[1] for a in self.scene.attributes)):
+                continue
+            line = None
+            for node in _walk(expr):
+                if isinstance(node, N.Var) and node.name == name:
+                    line = node.line
+                    col = node.column
+                    break
+            raise _LocatedName(name, line, col)
+
+    def _fill_scene(self, decls, sec):
+        sc = self.scene
+        for d in decls:
+            kind = d[0]
+            try:
+                self._decl(d, sc, sec)
+            except _LocatedName as exc:
+                raise self.error(f"undefined parameter '{exc.name}'",
+                                 self._src(sec, exc.line) if exc.line else None,
+                                 exc.col) from None
+
+    def _decl(self, d, sc, sec):
+        kind = d[0]
+        if kind == "parameter":
+            _, name, expr, line = d
+            sc.parameters[name] = self._const(expr, self._src(sec, line), f"parameter {name}")
+        elif kind == "flag":
+            flag = d[1]
+            if flag == "string":
+                raise self.error("not supported in pyevolver: STRING (the string model)",
+                                 self._src(sec, d[2]), 1)
+            sc.flags.add(flag)
+        elif kind == "value":
+            _, name, expr, fixed, line = d
+            name = VALUE_NAMES.get(name, name)
+            sc.values[name] = self._const(expr, self._src(sec, line), name)
+            if fixed:
+                sc.values[name + "_fixed"] = 1.0
+        elif kind == "constraint":
+            _, cid, opts, formula, blocks, line = d
+            if cid in sc.constraints:
+                raise self.error(f"constraint {cid} defined twice", self._src(sec, line))
+            c = ConstraintDecl(cid, self._formula(formula), set(opts), line=self._src(sec, line))
+            for bname, comps in blocks:
+                setattr(c, bname, self._components(comps, "ec"[bname == "content"], sec, line))
+            sc.constraints[cid] = c
+        elif kind == "boundary":
+            _, bid, npar, opts, comps, blocks, line = d
+            coords = self._components(comps, "x", sec, line)
+            b = BoundaryDecl(bid, npar, coords, set(opts), line=self._src(sec, line))
+            for bname, bcomps in blocks:
+                setattr(b, bname, self._components(bcomps, "ec"[bname == "content"], sec, line))
+            sc.boundaries[bid] = b
+        elif kind == "quantity":
+            _, name, kindt, rest, line = d
+            q = QuantityDecl(name, kindt[1], line=self._src(sec, line))
+            if kindt[2] is not None:
+                q.target = self._const(kindt[2], q.line, f"quantity {name} target")
+            for r in rest:
+                if r[0] in ("modulus", "tolerance", "lagrange_multiplier"):
+                    setattr(q, r[0], self._const(r[1], q.line, f"quantity {name} {r[0]}"))
+                elif r[0] == "method":
+                    q.methods.append(self._method(r[1], r[2], r[3], sec, line, name))
+                elif r[0] == "function":
+                    raise self.error("not supported in pyevolver: quantity FUNCTION "
+                                     "(combinations of method instances)", q.line)
+            sc.quantities[name] = q
+        elif kind == "method_instance":
+            _, name, mname, opts, line = d
+            m = self._method(mname, False, opts, sec, line, name)
+            sc.method_instances[name] = m
+        elif kind == "attribute":
+            _, etype, name, atype, dims, line = d
+            size = int(np.prod(dims)) if dims else 1
+            sc.attributes[(etype, name)] = (atype, size, dims)
+        elif kind == "periods":
+            pass    # numbers taken by _extract_matrices
+        elif kind == "ignored":
+            pass
+
+    def _method(self, mname, is_global, opts, sec, line, qname):
+        m = MethodDecl(mname, is_global, name=qname)
+        for o in opts:
+            if o[0] == "global":
+                m.is_global = True
+            elif o[0] == "scalar":
+                m.scalar = self._formula(o[1])
+            elif o[0] == "vector":
+                m.vector = self._components(o[1], "q", sec, line)
+            elif o[0] == "modulus":
+                m.modulus = self._const(o[1], self._src(sec, line), "modulus")
+            elif o[0] == "ignore_fixed":
+                m.ignore_fixed = True
+            elif o[0] == "ignore_constraints":
+                m.ignore_constraints = True
+        return m
+
+    def _components(self, comps, letter, sec, line):
+        out = {}
+        for key, expr in comps:
+            if key[0] != letter:
+                raise self.error(f"unexpected component '{key.upper()}': expected "
+                                 f"{letter.upper()}1, {letter.upper()}2, ...",
+                                 self._src(sec, line))
+            out[int(key[1:])] = self._formula(expr)
+        n = max(out) if out else 0
+        return [out.get(i + 1, N.Formula(N.Num(0.0))) for i in range(n)]
+
+    # -- element sections ----------------------------------------------------
+    def _elements(self, sec):
+        kind = sec.kind
+        block = getattr(self.scene, kind)
+        start = {"vertices": "vertex_line", "edges": "edge_line", "faces": "face_line",
+                 "bodies": "body_line"}[kind]
+        lines = sec.text.split("\n")
+        torus = self.scene.torus
+        sdim = self.scene.space_dimension
+        nums = _NUMERIC_LINE
+        ids = block.ids
+        data = block.data
+        srcs = block.lines
+        for k, raw in enumerate(lines):
+            if not raw or raw.isspace():
+                continue
+            srcline = sec.lines[k] if sec.lines else sec.line + k
+            if nums.match(raw):
+                toks = raw.split()
+                ids.append(int(toks[0]))
+                if kind == "vertices":
+                    data.append([float(t) for t in toks[1:]])
+                else:
+                    data.append([int(float(t)) for t in toks[1:]])
+                srcs.append(srcline)
+                continue
+            line = raw.replace(",", " ").replace(":", " ")
+            if kind == "edges" and torus:
+                line = self._strip_wraps(line, len(ids), sdim, srcline)
+            if kind == "vertices" and ";" in line:
+                raise self.error("unexpected ';': one element per line", srcline,
+                                 line.index(";") + 1)
+            try:
+                tree = line_parser().parse(line, start=start)
+                eid, items = _LINE.transform(tree)
+            except UnexpectedInput as exc:
+                col = exc.column if exc.column not in (None, -1) else None
+                raise self.error(self._describe(exc, line) + f" in {kind[:-1] if kind != 'bodies' else 'body'} line",
+                                 srcline, col) from None
+            except VisitError as exc:
+                if isinstance(exc.orig_exc, PyEvolverError):
+                    raise self.error(str(exc.orig_exc), srcline) from None
+                raise
+            self._element(kind, block, eid, items, srcline)
+
+    def _strip_wraps(self, line, pos, sdim, srcline):
+        toks = line.split()
+        if len(toks) >= 3 + sdim and all(t in ("*", "+", "-") for t in toks[3:3 + sdim]):
+            self.scene.wraps[pos] = [{"*": 0, "+": 1, "-": -1}[t] for t in toks[3:3 + sdim]]
+            return " ".join(toks[:3] + toks[3 + sdim:])
+        return line
+
+    def _element(self, kind, block, eid, items, srcline):
+        sc = self.scene
+        etype = {"vertices": "vertex", "edges": "edge", "faces": "facet", "bodies": "body"}[kind]
+        qnames = set(sc.quantities) | set(sc.method_instances)
+        data = []
+        attrs = []
+        i = 0
+        n = len(items)
+        # leading data expressions
+        while i < n:
+            it = items[i]
+            if isinstance(it, tuple):
+                break
+            if isinstance(it, N.Var) and (it.name in qnames or (etype, it.name) in sc.attributes):
+                break
+            data.append(it)
+            i += 1
+        while i < n:
+            it = items[i]
+            i += 1
+            if isinstance(it, tuple) and it[0] == "kw":
+                kw = it[1]
+                args = []
+                while i < n and not isinstance(items[i], tuple) and not (
+                        isinstance(items[i], N.Var) and (items[i].name in qnames or
+                                                         (etype, items[i].name) in sc.attributes)):
+                    args.append(items[i])
+                    i += 1
+                attrs.append((kw, args, it[2]))
+            elif isinstance(it, tuple) and it[0] == "name_neg":
+                if it[1] not in qnames:
+                    raise self.error(f"'{it[1]}-' is not a quantity or method instance",
+                                     srcline, it[2])
+                attrs.append(("quantity", [it[1], -1], it[2]))
+            elif isinstance(it, N.Var) and it.name in qnames:
+                attrs.append(("quantity", [it.name, 1], it.column))
+            elif isinstance(it, N.Var) and (etype, it.name) in sc.attributes:
+                size = sc.attributes[(etype, it.name)][1]
+                vals = items[i:i + size]
+                i += size
+                attrs.append(("attribute", [it.name] + vals, it.column))
+            else:
+                col = getattr(it, "column", None)
+                raise self.error(f"unexpected value after the attributes of {etype} {eid}",
+                                 srcline, col)
+        # evaluate
+        try:
+            values = [self._value(e, srcline, f"{etype} {eid}") for e in data]
+        except _LocatedName as exc:
+            raise self.error(f"undefined parameter '{exc.name}'", srcline, exc.col) from None
+        if kind != "vertices":
+            for v in values:
+                if v != int(v):
+                    raise self.error(f"expected an integer id in {etype} {eid}, got {v:g}", srcline)
+            values = [int(v) for v in values]
+        cooked = []
+        for kw, args, col in attrs:
+            if kw == "quantity":
+                cooked.append((kw, args))
+                continue
+            vals = []
+            for a in args:
+                if isinstance(a, (N.Node,)):
+                    try:
+                        vals.append(self._value(a, srcline, f"{kw} of {etype} {eid}"))
+                    except _LocatedName as exc:
+                        raise self.error(f"undefined parameter '{exc.name}'", srcline,
+                                         exc.col) from None
+                else:
+                    vals.append(a)
+            if kw == "attribute":
+                cooked.append((kw, [args[0]] + vals[1:] if False else [args[0]] + [
+                    self._value(a, srcline, args[0]) for a in args[1:]]))
+            else:
+                cooked.append((kw, vals))
+        block.ids.append(eid)
+        block.data.append(values)
+        block.lines.append(srcline)
+        if cooked:
+            block.attrs[len(block.ids) - 1] = cooked
+
+    def _value(self, expr, line, what):
+        if isinstance(expr, N.Num):
+            return expr.value
+        for name in expr.names():
+            if name not in self.scene.parameters and name not in N.CONSTANTS:
+                col = None
+                for node in _walk(expr):
+                    if isinstance(node, N.Var) and node.name == name:
+                        col = node.column
+                raise _LocatedName(name, line, col)
+        return self._const(expr, line, what)
+
+
+class _MatrixError(Exception):
+    pass
+
+
+class _LocatedName(Exception):
+    def __init__(self, name, line, col):
+        super().__init__(name)
+        self.name = name
+        self.line = line
+        self.col = col
+
+
+def _walk(node):
+    yield node
+    for c in node.children():
+        yield from _walk(c)
+
+
+_TERMINAL_NAMES = {
+    "NUMBER": "a number", "NAME": "a name", "INT": "an integer", "MINUS": "'-'",
+    "PLUS": "'+'", "LPAR": "'('", "RPAR": "')'", "FORMULA_KW": "FORMULA",
+    "COMPKW": "a component such as E1: or X1:", "EQUAL": "'='",
+}
+
+
+def _expected(exp):
+    names = []
+    for e in sorted(exp):
+        if e.startswith("__") or e in ("LIST_NEG", "LIST_PLUS", "ON_NEVER", "NAME_NEG"):
+            continue
+        names.append(_TERMINAL_NAMES.get(e, e.replace("_KW", "").lower()))
+    if not names:
+        return "something else"
+    if len(names) > 6:
+        names = names[:6] + ["..."]
+    return ", ".join(names)
+
+
+def read_datafile(filename, text=None):
+    """Read a datafile into a :class:`Scene` (raises :class:`DatafileError`)."""
+    try:
+        return Reader(filename, text).read()
+    except OSError as exc:
+        raise DatafileError(f"cannot read datafile: {exc.strerror}", filename) from None

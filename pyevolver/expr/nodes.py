@@ -1,0 +1,639 @@
+"""Expression trees of the Evolver expression language.
+
+The same tree serves two purposes:
+
+* *formulas* (constraint level sets, boundary parametrisations, integrands)
+  are evaluated over whole numpy arrays of coordinates at once;
+* *command expressions* are evaluated on scalars inside the interpreter.
+
+An environment object supplies names: ``env.lookup(name)`` returns a number,
+a string or an array.  The command interpreter extends the tree with element
+references and aggregates (see :mod:`pyevolver.commands.nodes`), which share
+the :class:`Node` interface.
+
+Derivatives (:func:`diff`) are symbolic, as the Evolver differentiates its
+expression trees; they are used for constraint gradients and projections.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import ExpressionError
+
+# ---------------------------------------------------------------------------
+# constants and functions
+
+COLOURS = {
+    "clear": -1, "transparent": -1, "black": 0, "blue": 1, "green": 2,
+    "cyan": 3, "red": 4, "magenta": 5, "brown": 6, "lightgray": 7,
+    "darkgray": 8, "lightblue": 9, "lightgreen": 10, "lightcyan": 11,
+    "lightred": 12, "lightmagenta": 13, "yellow": 14, "white": 15,
+}
+
+CONSTANTS = {"pi": math.pi, "e": math.e, **{k: float(v) for k, v in COLOURS.items()}}
+
+
+def _acos(a):
+    return np.arccos(np.clip(a, -1.0, 1.0))
+
+
+def _asin(a):
+    return np.arcsin(np.clip(a, -1.0, 1.0))
+
+
+FUNC1 = {
+    "abs": np.abs, "sqr": lambda a: a * a, "sqrt": np.sqrt, "sin": np.sin,
+    "cos": np.cos, "tan": np.tan, "asin": _asin, "acos": _acos,
+    "atan": np.arctan, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh,
+    "asinh": np.arcsinh, "acosh": np.arccosh, "atanh": np.arctanh,
+    "exp": np.exp, "log": np.log, "ceil": np.ceil, "floor": np.floor,
+}
+FUNC2 = {
+    "atan2": np.arctan2, "pow": np.power, "maximum": np.maximum,
+    "minimum": np.minimum,
+}
+# recognised but refused
+UNSUPPORTED_FUNCS = {
+    "elliptick", "elliptice", "incompleteellipticf", "incompleteelliptice",
+    "wrap_compose", "wrap_inverse", "usr1", "usr2", "usr3", "usr4", "usr5",
+    "usr6", "usr7", "usr8", "usr9", "usr10",
+}
+
+
+def _num(v):
+    """Python float for scalars, array otherwise."""
+    if isinstance(v, np.ndarray) and v.ndim == 0:
+        return float(v)
+    return v
+
+
+def _mod(a, b):
+    return a - np.floor(a / b) * b
+
+
+def _idiv(a, b):
+    a = np.trunc(a)
+    b = np.trunc(b)
+    return np.trunc(a / b)
+
+
+BINOPS = {
+    "+": lambda a, b: a + b,
+    "-": lambda a, b: a - b,
+    "*": lambda a, b: a * b,
+    "/": lambda a, b: a / b,
+    "^": lambda a, b: np.power(a, b) if isinstance(a, np.ndarray) or isinstance(b, np.ndarray) else _pow(a, b),
+    "%": _mod,
+    "mod": _mod,
+    "imod": lambda a, b: _mod(np.trunc(a), np.trunc(b)),
+    "idiv": _idiv,
+}
+
+
+def _pow(a, b):
+    a = float(a)
+    b = float(b)
+    try:
+        r = a ** b
+    except ZeroDivisionError:
+        return math.inf
+    except OverflowError:
+        return math.inf
+    if isinstance(r, complex):
+        return math.nan
+    return r
+
+
+CMPOPS = {
+    "==": lambda a, b: a == b, "!=": lambda a, b: a != b,
+    "<": lambda a, b: a < b, ">": lambda a, b: a > b,
+    "<=": lambda a, b: a <= b, ">=": lambda a, b: a >= b,
+}
+
+
+def _bool(v):
+    if isinstance(v, np.ndarray):
+        return v.astype(float)
+    return 1.0 if v else 0.0
+
+
+# ---------------------------------------------------------------------------
+# nodes
+
+
+class Node:
+    """Base class of expression nodes (immutable)."""
+
+    __slots__ = ()
+    pos = None  # (line, column) of the node, when known
+
+    def ev(self, env):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def is_const(self):
+        return False
+
+    def names(self):
+        """Set of variable names used by the expression."""
+        out = set()
+        self._names(out)
+        return out
+
+    def _names(self, out):
+        for c in self.children():
+            c._names(out)
+
+    def children(self):
+        return ()
+
+
+class Num(Node):
+    __slots__ = ("value",)
+
+    def __init__(self, value):
+        self.value = float(value)
+
+    def ev(self, env):
+        return self.value
+
+    def is_const(self):
+        return True
+
+    def __repr__(self):
+        return f"Num({self.value!r})"
+
+
+class Str(Node):
+    __slots__ = ("value",)
+
+    def __init__(self, value):
+        self.value = value
+
+    def ev(self, env):
+        return self.value
+
+    def __repr__(self):
+        return f"Str({self.value!r})"
+
+
+class Var(Node):
+    """A name: parameter, variable, internal variable, coordinate, attribute."""
+
+    __slots__ = ("name", "line", "column")
+
+    def __init__(self, name, line=None, column=None):
+        self.name = name.lower()
+        self.line = line
+        self.column = column
+
+    def ev(self, env):
+        return env.lookup(self.name)
+
+    def _names(self, out):
+        out.add(self.name)
+
+    def __repr__(self):
+        return f"Var({self.name!r})"
+
+
+class Neg(Node):
+    __slots__ = ("a",)
+
+    def __init__(self, a):
+        self.a = a
+
+    def ev(self, env):
+        return -self.a.ev(env)
+
+    def children(self):
+        return (self.a,)
+
+    def is_const(self):
+        return self.a.is_const()
+
+
+class Not(Node):
+    __slots__ = ("a",)
+
+    def __init__(self, a):
+        self.a = a
+
+    def ev(self, env):
+        v = self.a.ev(env)
+        if isinstance(v, np.ndarray):
+            return (v == 0).astype(float)
+        return 1.0 if v == 0 else 0.0
+
+    def children(self):
+        return (self.a,)
+
+
+class Bin(Node):
+    __slots__ = ("op", "a", "b")
+
+    def __init__(self, op, a, b):
+        self.op = op
+        self.a = a
+        self.b = b
+
+    def ev(self, env):
+        a = self.a.ev(env)
+        b = self.b.ev(env)
+        if isinstance(a, str) or isinstance(b, str):
+            raise ExpressionError(f"operator '{self.op}' needs numbers, got a string")
+        with np.errstate(all="ignore"):
+            if self.op == "/" and not isinstance(b, np.ndarray) and b == 0 \
+                    and not isinstance(a, np.ndarray):
+                return math.copysign(math.inf, a) if a != 0 else math.nan
+            return _num(BINOPS[self.op](a, b))
+
+    def children(self):
+        return (self.a, self.b)
+
+    def is_const(self):
+        return self.a.is_const() and self.b.is_const()
+
+    def __repr__(self):
+        return f"Bin({self.op!r}, {self.a!r}, {self.b!r})"
+
+
+class Cmp(Node):
+    __slots__ = ("op", "a", "b")
+
+    def __init__(self, op, a, b):
+        self.op = op
+        self.a = a
+        self.b = b
+
+    def ev(self, env):
+        a = self.a.ev(env)
+        b = self.b.ev(env)
+        if isinstance(a, str) and isinstance(b, str):
+            return _bool(CMPOPS[self.op](a, b))
+        return _bool(CMPOPS[self.op](a, b))
+
+    def children(self):
+        return (self.a, self.b)
+
+
+class And(Node):
+    __slots__ = ("a", "b")
+
+    def __init__(self, a, b):
+        self.a = a
+        self.b = b
+
+    def ev(self, env):
+        a = self.a.ev(env)
+        if isinstance(a, np.ndarray):
+            return np.logical_and(a != 0, self.b.ev(env) != 0).astype(float)
+        if not a:
+            return 0.0
+        return _bool(self.b.ev(env) != 0)
+
+    def children(self):
+        return (self.a, self.b)
+
+
+class Or(Node):
+    __slots__ = ("a", "b")
+
+    def __init__(self, a, b):
+        self.a = a
+        self.b = b
+
+    def ev(self, env):
+        a = self.a.ev(env)
+        if isinstance(a, np.ndarray):
+            return np.logical_or(a != 0, self.b.ev(env) != 0).astype(float)
+        if a:
+            return 1.0
+        return _bool(self.b.ev(env) != 0)
+
+    def children(self):
+        return (self.a, self.b)
+
+
+class Cond(Node):
+    __slots__ = ("c", "a", "b")
+
+    def __init__(self, c, a, b):
+        self.c = c
+        self.a = a
+        self.b = b
+
+    def ev(self, env):
+        c = self.c.ev(env)
+        if isinstance(c, np.ndarray):
+            return np.where(c != 0, self.a.ev(env), self.b.ev(env))
+        return self.a.ev(env) if c else self.b.ev(env)
+
+    def children(self):
+        return (self.c, self.a, self.b)
+
+
+class Func(Node):
+    __slots__ = ("name", "args")
+
+    def __init__(self, name, args):
+        self.name = name.lower()
+        self.args = tuple(args)
+
+    def ev(self, env):
+        vals = [a.ev(env) for a in self.args]
+        for v in vals:
+            if isinstance(v, str):
+                raise ExpressionError(f"{self.name}() needs a number, got a string")
+        with np.errstate(all="ignore"):
+            if len(vals) == 1:
+                return _num(FUNC1[self.name](vals[0]))
+            return _num(FUNC2[self.name](vals[0], vals[1]))
+
+    def children(self):
+        return self.args
+
+    def is_const(self):
+        return all(a.is_const() for a in self.args)
+
+    def __repr__(self):
+        return f"Func({self.name!r}, {list(self.args)!r})"
+
+
+# ---------------------------------------------------------------------------
+# symbolic differentiation
+
+ZERO = Num(0.0)
+ONE = Num(1.0)
+
+
+def _is(n, v):
+    return isinstance(n, Num) and n.value == v
+
+
+def add(a, b):
+    if _is(a, 0):
+        return b
+    if _is(b, 0):
+        return a
+    if isinstance(a, Num) and isinstance(b, Num):
+        return Num(a.value + b.value)
+    return Bin("+", a, b)
+
+
+def sub(a, b):
+    if _is(b, 0):
+        return a
+    if _is(a, 0):
+        return neg(b)
+    if isinstance(a, Num) and isinstance(b, Num):
+        return Num(a.value - b.value)
+    return Bin("-", a, b)
+
+
+def mul(a, b):
+    if _is(a, 0) or _is(b, 0):
+        return ZERO
+    if _is(a, 1):
+        return b
+    if _is(b, 1):
+        return a
+    if isinstance(a, Num) and isinstance(b, Num):
+        return Num(a.value * b.value)
+    return Bin("*", a, b)
+
+
+def div(a, b):
+    if _is(a, 0):
+        return ZERO
+    if _is(b, 1):
+        return a
+    return Bin("/", a, b)
+
+
+def neg(a):
+    if isinstance(a, Num):
+        return Num(-a.value)
+    if isinstance(a, Neg):
+        return a.a
+    return Neg(a)
+
+
+def diff(node, var):
+    """Symbolic derivative of ``node`` with respect to the variable ``var``.
+
+    ``var`` is a lower-case name ("x", "y", "z", "p1", ...).  Coordinate
+    aliases (``x1`` = ``x``) are resolved by the caller through
+    :func:`canonical_coords`.  Piecewise constructs differentiate branchwise.
+    """
+    d = _DIFF.get(type(node))
+    if d is None:
+        if node.names().isdisjoint({var}):
+            return ZERO
+        raise ExpressionError(f"cannot differentiate {type(node).__name__}")
+    return d(node, var)
+
+
+def _d_func(n, var):
+    args = n.args
+    if len(args) == 2:
+        a, b = args
+        da, db = diff(a, var), diff(b, var)
+        if n.name == "atan2":  # atan2(y, x): (x dy - y dx)/(x^2+y^2)
+            den = add(mul(a, a), mul(b, b))
+            return div(sub(mul(b, da), mul(a, db)), den)
+        if n.name == "pow":
+            return diff(Bin("^", a, b), var)
+        if n.name in ("maximum", "minimum"):
+            cmpop = ">=" if n.name == "maximum" else "<="
+            return Cond(Cmp(cmpop, a, b), da, db)
+        raise ExpressionError(f"cannot differentiate {n.name}")
+    a = args[0]
+    da = diff(a, var)
+    if _is(da, 0):
+        return ZERO
+    nm = n.name
+    if nm == "sqrt":
+        g = div(Num(0.5), n)
+    elif nm == "sin":
+        g = Func("cos", [a])
+    elif nm == "cos":
+        g = neg(Func("sin", [a]))
+    elif nm == "tan":
+        c = Func("cos", [a])
+        g = div(ONE, mul(c, c))
+    elif nm == "exp":
+        g = n
+    elif nm == "log":
+        g = div(ONE, a)
+    elif nm == "abs":
+        g = Cond(Cmp(">=", a, ZERO), ONE, Num(-1.0))
+    elif nm == "sqr":
+        g = mul(Num(2.0), a)
+    elif nm == "sinh":
+        g = Func("cosh", [a])
+    elif nm == "cosh":
+        g = Func("sinh", [a])
+    elif nm == "tanh":
+        c = Func("cosh", [a])
+        g = div(ONE, mul(c, c))
+    elif nm == "atan":
+        g = div(ONE, add(ONE, mul(a, a)))
+    elif nm == "asin":
+        g = div(ONE, Func("sqrt", [sub(ONE, mul(a, a))]))
+    elif nm == "acos":
+        g = neg(div(ONE, Func("sqrt", [sub(ONE, mul(a, a))])))
+    elif nm == "asinh":
+        g = div(ONE, Func("sqrt", [add(mul(a, a), ONE)]))
+    elif nm == "acosh":
+        g = div(ONE, Func("sqrt", [sub(mul(a, a), ONE)]))
+    elif nm == "atanh":
+        g = div(ONE, sub(ONE, mul(a, a)))
+    elif nm in ("ceil", "floor"):
+        return ZERO
+    else:
+        raise ExpressionError(f"cannot differentiate {nm}")
+    return mul(g, da)
+
+
+def _d_bin(n, var):
+    a, b, op = n.a, n.b, n.op
+    da, db = diff(a, var), diff(b, var)
+    if op == "+":
+        return add(da, db)
+    if op == "-":
+        return sub(da, db)
+    if op == "*":
+        return add(mul(da, b), mul(a, db))
+    if op == "/":
+        if _is(db, 0):
+            return div(da, b)
+        return div(sub(mul(da, b), mul(a, db)), mul(b, b))
+    if op == "^":
+        if _is(db, 0):
+            if isinstance(b, Num):
+                if b.value == 0:
+                    return ZERO
+                return mul(mul(Num(b.value), Bin("^", a, Num(b.value - 1.0))), da)
+            return mul(mul(b, Bin("^", a, sub(b, ONE))), da)
+        # general a^b = exp(b log a)
+        return mul(n, add(mul(db, Func("log", [a])), div(mul(b, da), a)))
+    if op in ("%", "mod", "imod", "idiv"):
+        if op in ("%", "mod"):
+            return da
+        return ZERO
+    raise ExpressionError(f"cannot differentiate operator {op}")
+
+
+_DIFF = {
+    Num: lambda n, v: ZERO,
+    Str: lambda n, v: ZERO,
+    Var: lambda n, v: ONE if n.name == v else ZERO,
+    Neg: lambda n, v: neg(diff(n.a, v)),
+    Bin: _d_bin,
+    Func: _d_func,
+    Cond: lambda n, v: Cond(n.c, diff(n.a, v), diff(n.b, v)),
+    Cmp: lambda n, v: ZERO,
+    Not: lambda n, v: ZERO,
+    And: lambda n, v: ZERO,
+    Or: lambda n, v: ZERO,
+}
+
+COORD_ALIASES = {"x1": "x", "x2": "y", "x3": "z", "x4": "w"}
+
+
+class _Rename:
+    pass
+
+
+def canonical_coords(node):
+    """Rewrite ``x1 x2 x3`` to ``x y z`` so derivatives see one name."""
+    if isinstance(node, Var):
+        if node.name in COORD_ALIASES:
+            return Var(COORD_ALIASES[node.name])
+        return node
+    if isinstance(node, (Num, Str)):
+        return node
+    if isinstance(node, Neg):
+        return Neg(canonical_coords(node.a))
+    if isinstance(node, Not):
+        return Not(canonical_coords(node.a))
+    if isinstance(node, Bin):
+        return Bin(node.op, canonical_coords(node.a), canonical_coords(node.b))
+    if isinstance(node, Cmp):
+        return Cmp(node.op, canonical_coords(node.a), canonical_coords(node.b))
+    if isinstance(node, And):
+        return And(canonical_coords(node.a), canonical_coords(node.b))
+    if isinstance(node, Or):
+        return Or(canonical_coords(node.a), canonical_coords(node.b))
+    if isinstance(node, Cond):
+        return Cond(canonical_coords(node.c), canonical_coords(node.a), canonical_coords(node.b))
+    if isinstance(node, Func):
+        return Func(node.name, [canonical_coords(a) for a in node.args])
+    return node
+
+
+# ---------------------------------------------------------------------------
+# environments
+
+
+class MapEnv:
+    """Environment over a dict of names with a fallback environment."""
+
+    def __init__(self, values, parent=None):
+        self.values = values
+        self.parent = parent
+
+    def lookup(self, name):
+        v = self.values.get(name)
+        if v is not None:
+            return v
+        if self.parent is not None:
+            return self.parent.lookup(name)
+        if name in CONSTANTS:
+            return CONSTANTS[name]
+        raise ExpressionError(f"undefined name '{name}'")
+
+
+class Formula:
+    """A formula of coordinates (and parameters), evaluated over arrays.
+
+    Parameters
+    ----------
+    node : Node
+        The expression tree.
+    text : str
+        Source text, for messages and ``print`` of formulas.
+    """
+
+    def __init__(self, node, text=""):
+        self.node = canonical_coords(node)
+        self.text = text
+        self._grads = {}
+
+    def __call__(self, env):
+        return self.node.ev(env)
+
+    def grad(self, var):
+        g = self._grads.get(var)
+        if g is None:
+            g = self._grads[var] = diff(self.node, var)
+        return g
+
+    def values(self, params, coords, n):
+        """Evaluate at ``n`` points; returns an (n,) array.
+
+        ``coords`` maps ``x, y, z`` (and ``p1`` ...) to (n,) arrays;
+        ``params`` is the parameter environment.
+        """
+        v = self.node.ev(MapEnv(coords, params))
+        return np.broadcast_to(np.asarray(v, dtype=float), (n,))
+
+    def gradient(self, params, coords, n, names=("x", "y", "z")):
+        """(n, len(names)) array of partial derivatives."""
+        env = MapEnv(coords, params)
+        out = np.empty((n, len(names)))
+        for k, nm in enumerate(names):
+            out[:, k] = np.broadcast_to(np.asarray(self.grad(nm).ev(env), dtype=float), (n,))
+        return out

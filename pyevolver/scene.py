@@ -1,0 +1,102 @@
+"""The Scene: what a datafile declares, before any geometry is built.
+
+Text -> :class:`Scene` (this module, filled by :mod:`pyevolver.datafile.reader`)
+-> :class:`pyevolver.surface.Surface` (arrays) -> methods, constraints ->
+evolve / remesh -> outputs.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class ConstraintDecl:
+    id: int
+    formula: object                  # Formula: phi(x) (level set phi = 0)
+    flags: set = field(default_factory=set)   # global convex nonwall nonnegative nonpositive
+    energy: list | None = None       # [Formula]*3 (E1 E2 E3) or None
+    content: list | None = None      # [Formula]*3 or None
+    line: int = 0
+
+
+@dataclass
+class BoundaryDecl:
+    id: int
+    nparams: int
+    coords: list                     # [Formula] x1.. x_sdim of p1..pk
+    flags: set = field(default_factory=set)
+    energy: list | None = None
+    content: list | None = None
+    line: int = 0
+
+
+@dataclass
+class MethodDecl:
+    method: str
+    is_global: bool = False
+    scalar: object = None            # Formula
+    vector: list | None = None       # [Formula]*3
+    modulus: float = 1.0
+    name: str = ""                   # instance name
+    ignore_fixed: bool = False
+    ignore_constraints: bool = False
+
+
+@dataclass
+class QuantityDecl:
+    name: str
+    kind: str                        # energy fixed conserved info_only
+    target: float = 0.0
+    modulus: float = 1.0
+    tolerance: float = -1.0
+    lagrange_multiplier: float = 0.0
+    methods: list = field(default_factory=list)   # [MethodDecl]
+    line: int = 0
+
+
+@dataclass
+class ElementBlock:
+    """The lines of one element section.
+
+    ``ids`` are datafile ids in reading order; ``data`` the defining numbers
+    of each element (coordinates, endpoint ids, edge ids, facet ids);
+    ``attrs`` maps the position of an element to its attribute list
+    ``[(keyword, [values]), ...]`` (only elements that have attributes);
+    ``lines`` the source line of each element.
+    """
+
+    ids: list = field(default_factory=list)
+    data: list = field(default_factory=list)
+    attrs: dict = field(default_factory=dict)
+    lines: list = field(default_factory=list)
+
+
+@dataclass
+class Scene:
+    filename: str = "<datafile>"
+    parameters: dict = field(default_factory=dict)     # name -> value (ordered)
+    flags: set = field(default_factory=set)
+    values: dict = field(default_factory=dict)         # top-section numeric settings
+    constraints: dict = field(default_factory=dict)    # id -> ConstraintDecl
+    boundaries: dict = field(default_factory=dict)     # id -> BoundaryDecl
+    quantities: dict = field(default_factory=dict)     # name -> QuantityDecl
+    method_instances: dict = field(default_factory=dict)  # name -> MethodDecl
+    attributes: dict = field(default_factory=dict)     # (etype, name) -> (type, size)
+    periods: np.ndarray | None = None
+    vertices: ElementBlock = field(default_factory=ElementBlock)
+    edges: ElementBlock = field(default_factory=ElementBlock)
+    faces: ElementBlock = field(default_factory=ElementBlock)
+    bodies: ElementBlock = field(default_factory=ElementBlock)
+    read_text: str | None = None
+    read_line: int = 0
+    wraps: dict = field(default_factory=dict)          # edge position -> wrap list
+
+    @property
+    def space_dimension(self):
+        return int(self.values.get("space_dimension", 3))
+
+    @property
+    def torus(self):
+        return "torus" in self.flags or "torus_filled" in self.flags

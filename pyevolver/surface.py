@@ -1,0 +1,1015 @@
+"""The Surface: coordinates and topology as numpy arrays, built from a Scene.
+
+Element indices are 0-based internally; the Evolver's ids are index + 1
+(elements are renumbered consecutively in reading order, the datafile id is
+kept as ``original``).  Attributes, constraints, boundaries and quantities
+exist only when the datafile declares them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import geometry as G
+from .errors import DatafileError, UnsupportedError, ExpressionError
+from .expr import nodes as N
+from .methods import method_info
+
+
+@dataclass
+class Quantity:
+    """A named quantity at run time."""
+
+    name: str
+    kind: str                      # energy fixed conserved info_only
+    target: float = 0.0
+    modulus: float = 1.0
+    tolerance: float = -1.0
+    methods: list = field(default_factory=list)    # [(MethodDecl, etype, idx, sign)]
+    value: float = 0.0
+    pressure: float = 0.0
+
+
+@dataclass
+class Bodies:
+    n: int = 0
+    facet_matrix: object = None      # sparse (nb, nf) with +-1 entries
+    target: np.ndarray = None        # nan where no volume constraint
+    volconst: np.ndarray = None
+    pressure: np.ndarray = None      # prescribed pressure (nan = none)
+    density: np.ndarray = None
+    volume: np.ndarray = None        # last computed
+    lagrange: np.ndarray = None      # reported pressures (multipliers)
+    original: np.ndarray = None
+    occurrences: tuple = None        # (body, facet, sign) as listed (duplicates kept)
+
+
+class Surface:
+    """Arrays of one surface (soapfilm model, linear elements)."""
+
+    def __init__(self):
+        self.sdim = 3
+        self.X = np.zeros((0, 3))
+        self.E = np.zeros((0, 2), dtype=np.int64)
+        self.FE = np.zeros((0, 3), dtype=np.int64)
+        self.vattr = {}
+        self.eattr = {}
+        self.fattr = {}
+        self.vcon = {}      # constraint id -> bool (nv,)
+        self.econ = {}      # constraint id -> int8 (ne,) (+1 / -1 orientation)
+        self.fcon = {}      # constraint id -> bool (nf,)
+        self.extra = {}     # (etype, name) -> array
+        self.bodies = Bodies()
+        self.quantities = {}
+        self.constraints = {}
+        self.boundaries = {}
+        self.periods = None
+        self.symmetric_content = False
+        self.torus_filled = False
+        self.params = {}
+        self.gravity_constant = 1.0
+        self.gap_constant = 1.0
+
+    # -- topology helpers ---------------------------------------------------
+    @property
+    def nv(self):
+        return len(self.X)
+
+    @property
+    def ne(self):
+        return len(self.E)
+
+    @property
+    def nf(self):
+        return len(self.FE)
+
+    @property
+    def F(self):
+        """(nf, 3) vertices of each facet (tails of its oriented edges)."""
+        idx, sgn = G.edge_index(self.FE)
+        tails = np.where(sgn > 0, self.E[idx, 0], self.E[idx, 1])
+        return tails
+
+    @property
+    def facet_tension(self):
+        return self.fattr["tension"]
+
+    @property
+    def edge_tension(self):
+        return self.eattr.get("tension", np.zeros(self.ne))
+
+    def wrap_shift(self):
+        w = self.eattr.get("wrap")
+        if w is None or self.periods is None:
+            return None
+        return w @ self.periods
+
+    def param_env(self):
+        env = dict(self.params)
+        env.setdefault("g", self.gravity_constant)
+        return N.MapEnv(env)
+
+    # -- evaluation --------------------------------------------------------
+    def evaluate(self):
+        """Compute energy, area, volumes and quantity values (a :class:`Totals`)."""
+        return Totals(self)
+
+
+class Totals:
+    """Energies, area and volumes of a surface at its current coordinates.
+
+    Derived geometry (edge vectors, facet normals, areas) is computed once per
+    evaluation and shared by every energy term and method.
+    """
+
+    def __init__(self, s):
+        self.surface = s
+        X = s.X
+        self.edge_vec = G.edge_vectors(X, s.E, s.wrap_shift())
+        self.edge_length = np.sqrt(np.einsum("ij,ij->i", self.edge_vec, self.edge_vec))
+        self.facet_S = G.facet_sides(self.edge_vec, s.FE)
+        self.facet_x0 = X[s.F[:, 0]] if s.nf else np.zeros((0, 3))
+        self.facet_N2 = G.facet_normals(self.facet_S)
+        self.facet_area = G.facet_areas(self.facet_N2)
+        self.facet_volume = G.facet_volumes(self.facet_x0, self.facet_S, s.symmetric_content)
+        self.total_area = float(self.facet_area.sum())
+        self.total_length = float(self.edge_length.sum())
+        self.terms = {}
+        energy = float(self.facet_area @ s.facet_tension)
+        self.terms["facet_tension"] = energy
+        et = s.eattr.get("tension")
+        if et is not None:
+            e = float(self.edge_length @ et)
+            self.terms["edge_tension"] = e
+            energy += e
+        self.con_energy, self.con_content = self._integrals()
+        energy += self.con_energy
+        gap = self._gap_energy()
+        if gap:
+            self.terms["gap"] = gap
+            energy += gap
+        self.volumes = self._volumes()
+        b = s.bodies
+        if b.n:
+            grav = self._gravity()
+            if grav:
+                self.terms["gravity"] = grav
+                energy += grav
+            pmask = ~np.isnan(b.pressure)
+            if pmask.any():
+                energy -= float(b.pressure[pmask] @ self.volumes[pmask])
+        self.quantity_values = {}
+        for q in s.quantities.values():
+            v = self.quantity_value(q)
+            self.quantity_values[q.name] = v
+            if q.kind == "energy":
+                energy += v
+        self.energy = energy
+
+    # ---- pieces -----------------------------------------------------------
+    def eval_points(self, formula, P, etype=None, idx=None):
+        """Evaluate a formula at points ``P (n, sdim)``."""
+        s = self.surface
+        coords = {"x": P[:, 0], "y": P[:, 1]}
+        if P.shape[1] > 2:
+            coords["z"] = P[:, 2]
+        if P.shape[1] > 3:
+            coords["w"] = P[:, 3]
+        if etype is not None and idx is not None:
+            for (et, name), arr in s.extra.items():
+                if et == etype and arr.ndim == 1:
+                    coords[name] = arr[idx]
+        return formula.values(s.param_env(), coords, len(P))
+
+    def edge_vector_integral(self, comps, idx):
+        """Sum of Gauss-Legendre line integrals of a vector field along edges."""
+        s = self.surface
+        x0 = s.X[s.E[idx, 0]]
+        d = self.edge_vec[idx]
+        pts = G.edge_quadrature_points(x0, d)
+        n = len(idx)
+        flat = pts.reshape(-1, pts.shape[-1])
+        rep = np.repeat(idx, 2)
+        total = np.zeros(n)
+        for k, comp in enumerate(comps):
+            if k >= d.shape[1]:
+                break
+            q = self.eval_points(comp, flat, "edge", rep).reshape(n, 2) @ G.GL2_W
+            total += q * d[:, k]
+        return total
+
+    def _integrals(self):
+        """Constraint and boundary ENERGY / CONTENT edge integrals."""
+        s = self.surface
+        energy = 0.0
+        content = np.zeros(s.ne) if (s.econ or s.boundaries) else None
+        efixed = s.eattr["fixed"]
+        for cid, sign in s.econ.items():
+            c = s.constraints[cid]
+            if c.energy is None and c.content is None:
+                continue
+            # the manual: integrals are not evaluated over FIXED edges
+            idx = np.nonzero((sign != 0) & ~efixed)[0]
+            if not len(idx):
+                continue
+            sg = sign[idx].astype(float)
+            if c.energy is not None:
+                energy += float(sg @ self.edge_vector_integral(c.energy, idx))
+            if c.content is not None:
+                content[idx] += sg * self.edge_vector_integral(c.content, idx)
+        eb = s.eattr.get("boundary")
+        if eb is not None:
+            for bid, b in s.boundaries.items():
+                if b.energy is None and b.content is None:
+                    continue
+                idx = np.nonzero(eb == bid)[0]
+                if not len(idx):
+                    continue
+                if b.energy is not None:
+                    energy += float(self.edge_vector_integral(b.energy, idx).sum())
+                if b.content is not None:
+                    # REF adds boundary content with the opposite sign to
+                    # constraint content (checked on column.fe with the
+                    # boundary edges reversed: the volume is unchanged)
+                    content[idx] -= self.edge_vector_integral(b.content, idx)
+        return energy, content
+
+    def _gap_energy(self):
+        """Gap energy of edges on CONVEX constraints (spec §4.1.7)."""
+        s = self.surface
+        total = 0.0
+        for cid, sign in s.econ.items():
+            c = s.constraints[cid]
+            if "convex" not in c.flags:
+                continue
+            idx = np.nonzero(sign)[0]
+            if not len(idx):
+                continue
+            d = self.edge_vec[idx]
+            L = self.edge_length[idx]
+            for end in (0, 1):
+                P = s.X[s.E[idx, end]]
+                g = self.constraint_gradient(c, P)
+                gn = np.sqrt(np.einsum("ij,ij->i", g, g))
+                sg = np.abs(np.einsum("ij,ij->i", d, g))
+                with np.errstate(all="ignore"):
+                    total += float(np.sum(np.where(gn > 0, sg * L / (12.0 * gn), 0.0)))
+        return s.gap_constant * total
+
+    def constraint_gradient(self, c, P):
+        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        return c.formula.gradient(self.surface.param_env(), coords, len(P))
+
+    def _volumes(self):
+        s = self.surface
+        b = s.bodies
+        if not b.n:
+            return np.zeros(0)
+        vols = b.facet_matrix @ self.facet_volume
+        if self.con_content is not None:
+            # edge content counts toward the bodies of the facets the edge is on
+            vols = vols + b.facet_matrix @ self.facet_edge_sum(self.con_content)
+        vols = vols + b.volconst
+        if s.periods is not None:
+            D = torus_lift_shifts(s)                  # (nb, nf, 3)
+            N2 = self.facet_N2
+            if s.symmetric_content:
+                vols = vols + np.einsum("bfk,fk->b", D, N2) / 6.0
+            else:
+                vols = vols + D[:, :, 2] @ (N2[:, 2] / 2.0)
+            cell = abs(np.linalg.det(s.periods))
+            ref = np.where(np.isnan(b.target), b.volume if b.volume is not None else vols,
+                           b.target)
+            ref = np.where(np.isnan(ref), vols, ref)
+            shift = np.round((ref - vols) / cell) * cell
+            vols = vols + shift
+        return vols
+
+    def facet_edge_sum(self, per_edge):
+        """For each facet, sum of oriented per-edge values over its edges."""
+        idx, sgn = G.edge_index(self.surface.FE)
+        return np.sum(per_edge[idx] * sgn, axis=1)
+
+    def _gravity(self):
+        s = self.surface
+        b = s.bodies
+        G_ = s.gravity_constant
+        if G_ == 0 or not np.any(b.density):
+            return 0.0
+        per_facet = G.facet_gravity(self.facet_x0, self.facet_S)
+        return float(G_ * (b.density @ (b.facet_matrix @ per_facet)))
+
+    def quantity_value(self, q):
+        total = 0.0
+        for m, etype, idx, sign in q.methods:
+            _, fn = method_info(m.method)
+            vals = fn(self, m, idx)
+            if sign is not None:
+                vals = vals * sign
+            total += m.modulus * float(np.sum(vals))
+        return q.modulus * total
+
+
+# ---------------------------------------------------------------------------
+# building
+
+
+class _Builder:
+    def __init__(self, scene):
+        self.sc = scene
+        self.s = Surface()
+
+    def error(self, msg, line=None):
+        return DatafileError(msg, self.sc.filename, line)
+
+    def build(self):
+        sc, s = self.sc, self.s
+        s.params = dict(sc.parameters)
+        s.sdim = sc.space_dimension
+        if s.sdim != 3:
+            raise UnsupportedError(f"SPACE_DIMENSION {s.sdim}", "only 3 is supported")
+        s.constraints = dict(sc.constraints)
+        s.boundaries = dict(sc.boundaries)
+        s.symmetric_content = "symmetric_content" in sc.flags
+        s.torus_filled = "torus_filled" in sc.flags
+        s.gravity_constant = sc.values.get("gravity_constant", 1.0)
+        s.gap_constant = sc.values.get("gap_constant", 1.0)
+        if sc.torus:
+            vals = sc.values.get("_periods")
+            P = np.eye(3) if vals is None else np.array(vals).reshape(3, 3)
+            s.periods = P
+        self._vertices()
+        self._edges()
+        self._faces()
+        self._bodies()
+        self._quantities()
+        self._project()
+        return s
+
+    # -- vertices -----------------------------------------------------------
+    def _vertices(self):
+        sc, s = self.sc, self.s
+        blk = sc.vertices
+        n = len(blk.ids)
+        self.vid = _IdMap(blk.ids, "vertex", sc.filename, blk.lines)
+        X = np.zeros((n, 3))
+        fixed = np.zeros(n, bool)
+        bnd = None
+        params = None
+        simple = [k for k, d in enumerate(blk.data) if len(d) == 3]
+        if len(simple) == n and n:
+            X[:] = np.array(blk.data, dtype=float)
+        for pos, attrs in blk.attrs.items():
+            for kw, vals in attrs:
+                if kw == "fixed":
+                    fixed[pos] = True
+                elif kw in ("constraint", "constraints"):
+                    for c in vals:
+                        cid = int(abs(c))
+                        if cid not in sc.constraints:
+                            raise self.error(f"vertex {blk.ids[pos]}: constraint {cid} is not "
+                                             f"defined", blk.lines[pos])
+                        s.vcon.setdefault(cid, np.zeros(n, bool))[pos] = True
+                elif kw == "boundary":
+                    bid = int(vals[0]) if vals else 0
+                    if bid not in sc.boundaries:
+                        raise self.error(f"vertex {blk.ids[pos]}: boundary {bid} is not defined",
+                                         blk.lines[pos])
+                    if bnd is None:
+                        bnd = np.zeros(n, np.int64)
+                        params = np.zeros((n, max(b.nparams for b in sc.boundaries.values())))
+                    bnd[pos] = bid
+                elif kw == "quantity":
+                    self._member("vertex", pos, vals)
+                elif kw == "attribute":
+                    self._attr("vertex", n, pos, vals)
+                elif kw in ("bare", "original", "tag", "axial_point", "triple_point",
+                            "tetra_point", "no_hessian_normal", "hessian_normal_one"):
+                    pass
+                else:
+                    raise self.error(f"vertex {blk.ids[pos]}: '{kw}' is not a vertex attribute",
+                                     blk.lines[pos])
+        for pos, d in enumerate(blk.data):
+            if bnd is not None and bnd[pos]:
+                b = sc.boundaries[bnd[pos]]
+                if len(d) != b.nparams:
+                    raise self.error(f"vertex {blk.ids[pos]}: boundary {b.id} needs "
+                                     f"{b.nparams} parameter(s), got {len(d)}", blk.lines[pos])
+                params[pos, :len(d)] = d
+            elif len(d) != 3:
+                raise self.error(f"vertex {blk.ids[pos]}: expected 3 coordinates, got {len(d)}",
+                                 blk.lines[pos])
+            elif len(simple) != n:
+                X[pos] = d
+        for cid, c in sc.constraints.items():
+            if "global" in c.flags:
+                s.vcon[cid] = np.ones(n, bool)
+        s.X = X
+        s.vattr["fixed"] = fixed
+        s.vattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        if bnd is not None:
+            s.vattr["boundary"] = bnd
+            s.vattr["params"] = params
+            self._boundary_coords(np.nonzero(bnd)[0])
+
+    def _boundary_coords(self, idx):
+        s = self.s
+        for bid, b in s.boundaries.items():
+            sel = idx[s.vattr["boundary"][idx] == bid]
+            if not len(sel):
+                continue
+            P = s.vattr["params"][sel]
+            env = {f"p{k + 1}": P[:, k] for k in range(b.nparams)}
+            for k, f in enumerate(b.coords[:3]):
+                s.X[sel, k] = f.values(s.param_env(), env, len(sel))
+
+    # -- edges ----------------------------------------------------------------
+    def _edges(self):
+        sc, s = self.sc, self.s
+        blk = sc.edges
+        n = len(blk.ids)
+        self.eid = _IdMap(blk.ids, "edge", sc.filename, blk.lines)
+        E = np.zeros((n, 2), np.int64)
+        bad = [k for k, d in enumerate(blk.data) if len(d) != 2]
+        if bad:
+            k = bad[0]
+            raise self.error(f"edge {blk.ids[k]}: expected two vertex ids, got "
+                             f"{len(blk.data[k])}", blk.lines[k])
+        if n:
+            raw = np.array(blk.data, dtype=np.int64)
+            E[:] = self.vid.lookup(raw, blk.lines, "edge", blk.ids)
+        fixed = np.zeros(n, bool)
+        tension = None
+        bnd = None
+        no_refine = np.zeros(n, bool)
+        for pos, attrs in blk.attrs.items():
+            for kw, vals in attrs:
+                if kw == "fixed":
+                    fixed[pos] = True
+                elif kw in ("constraint", "constraints"):
+                    for c in vals:
+                        cid = int(abs(c))
+                        if cid not in sc.constraints:
+                            raise self.error(f"edge {blk.ids[pos]}: constraint {cid} is not "
+                                             f"defined", blk.lines[pos])
+                        s.econ.setdefault(cid, np.zeros(n, np.int8))[pos] = -1 if c < 0 else 1
+                elif kw == "boundary":
+                    bid = int(vals[0]) if vals else 0
+                    if bid not in sc.boundaries:
+                        raise self.error(f"edge {blk.ids[pos]}: boundary {bid} is not defined",
+                                         blk.lines[pos])
+                    if bnd is None:
+                        bnd = np.zeros(n, np.int64)
+                    bnd[pos] = bid
+                elif kw in ("tension", "density"):
+                    if tension is None:
+                        tension = np.zeros(n)
+                    tension[pos] = vals[0]
+                elif kw == "no_refine":
+                    no_refine[pos] = True
+                elif kw in ("color", "colour"):
+                    s.eattr.setdefault("color", np.zeros(n, np.int64))[pos] = int(vals[0])
+                elif kw == "quantity":
+                    self._member("edge", pos, vals)
+                elif kw == "attribute":
+                    self._attr("edge", n, pos, vals)
+                elif kw in ("bare", "original", "orientation"):
+                    pass
+                else:
+                    raise self.error(f"edge {blk.ids[pos]}: '{kw}' is not an edge attribute",
+                                     blk.lines[pos])
+        s.E = E
+        s.eattr["fixed"] = fixed
+        s.eattr["no_refine"] = no_refine
+        s.eattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        if tension is not None:
+            s.eattr["tension"] = tension
+        if bnd is not None:
+            s.eattr["boundary"] = bnd
+        if s.periods is not None:
+            w = np.zeros((n, 3))
+            for pos, wr in sc.wraps.items():
+                w[pos] = wr
+            s.eattr["wrap"] = w
+        for cid, c in sc.constraints.items():
+            if "global" in c.flags:
+                s.econ[cid] = np.ones(n, np.int8)
+
+    # -- faces ------------------------------------------------------------------
+    def _faces(self):
+        sc, s = self.sc, self.s
+        blk = sc.faces
+        nface = len(blk.ids)
+        self.fid = _IdMap(blk.ids, "face", sc.filename, blk.lines)
+        ne0 = s.ne
+        # per-face attributes
+        fixed = np.zeros(nface, bool)
+        tension = np.ones(nface)
+        no_refine = np.zeros(nface, bool)
+        fcon = {}
+        fbnd = np.zeros(nface, np.int64)
+        colors = {}
+        for pos, attrs in blk.attrs.items():
+            for kw, vals in attrs:
+                if kw == "fixed":
+                    fixed[pos] = True
+                elif kw in ("tension", "density"):
+                    tension[pos] = vals[0]
+                elif kw == "no_refine":
+                    no_refine[pos] = True
+                elif kw in ("constraint", "constraints"):
+                    for c in vals:
+                        cid = int(abs(c))
+                        if cid not in sc.constraints:
+                            raise self.error(f"face {blk.ids[pos]}: constraint {cid} is not "
+                                             f"defined", blk.lines[pos])
+                        fcon.setdefault(cid, np.zeros(nface, bool))[pos] = True
+                elif kw == "boundary":
+                    bid = int(vals[0])
+                    if bid not in sc.boundaries:
+                        raise self.error(f"face {blk.ids[pos]}: boundary {bid} is not defined",
+                                         blk.lines[pos])
+                    fbnd[pos] = bid
+                elif kw in ("color", "colour", "frontcolor", "frontcolour", "backcolor",
+                            "backcolour"):
+                    key = kw.replace("colour", "color")
+                    colors.setdefault(key, np.zeros(nface, np.int64))[pos] = int(vals[0])
+                elif kw == "quantity":
+                    self._member("facet", pos, vals)
+                elif kw == "attribute":
+                    self._attr("facet", nface, pos, vals)
+                elif kw in ("nodisplay", "no_display", "opacity", "original", "phase", "tag"):
+                    pass
+                else:
+                    raise self.error(f"face {blk.ids[pos]}: '{kw}' is not a facet attribute",
+                                     blk.lines[pos])
+        # validate edge loops
+        tri_rows = []
+        E = s.E
+        lengths = np.array([len(d) for d in blk.data], dtype=np.int64)
+        if nface:
+            short = np.nonzero(lengths < 3)[0]
+            if len(short):
+                k = short[0]
+                raise self.error(f"face {blk.ids[k]}: a facet needs at least 3 edges, got "
+                                 f"{lengths[k]}", blk.lines[k])
+            flat = np.fromiter((e for d in blk.data for e in d), np.int64, int(lengths.sum()))
+            owner = np.repeat(np.arange(nface), lengths)
+            if np.any(flat == 0):
+                k = owner[np.nonzero(flat == 0)[0][0]]
+                raise self.error(f"face {blk.ids[k]}: edge id 0 does not exist", blk.lines[k])
+            lines_per = [blk.lines[k] for k in range(nface)]
+            eidx = self.eid.lookup(np.abs(flat), [lines_per[k] for k in owner], "face",
+                                   [blk.ids[k] for k in owner])
+            rev = flat < 0
+            tails = np.where(rev, E[eidx, 1], E[eidx, 0])
+            heads = np.where(rev, E[eidx, 0], E[eidx, 1])
+            starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+            nxt = np.arange(len(flat)) + 1
+            ends = starts + lengths - 1
+            nxt[ends] = starts
+            badloop = np.nonzero(heads != tails[nxt])[0]
+            if len(badloop):
+                j = badloop[0]
+                k = owner[j]
+                raise self.error(
+                    f"face {blk.ids[k]}: the edge loop is not closed: edge {flat[j]} ends at "
+                    f"vertex {s.vattr['original'][heads[j]]} but the next edge "
+                    f"{flat[nxt[j]]} starts at vertex {s.vattr['original'][tails[nxt[j]]]}",
+                    blk.lines[k])
+            enc = np.where(rev, ~eidx, eidx)
+        else:
+            enc = np.zeros(0, np.int64)
+            starts = lengths = np.zeros(0, np.int64)
+            tails = np.zeros(0, np.int64)
+        # triangulate
+        FE = np.zeros((nface, 3), np.int64)
+        tri3 = lengths == 3
+        if nface:
+            st = starts[tri3]
+            FE[tri3] = np.stack([enc[st], enc[st + 1], enc[st + 2]], axis=1)
+        big = np.nonzero(~tri3)[0]
+        new_X = []
+        new_E = []
+        new_F = []            # (FE row, parent face position)
+        self.face_children = {k: [k] for k in range(nface)}
+        nv = s.nv
+        ne = ne0
+        nf = nface
+        center_parent = []
+        spoke_parent = []
+        for k in big:
+            st, n = starts[k], lengths[k]
+            loop = enc[st:st + n]
+            rim = tails[st:st + n]
+            c = nv + len(new_X)
+            new_X.append(self._face_center(rim))
+            center_parent.append(k)
+            spokes = ne + np.arange(n)
+            for j in range(n):
+                new_E.append((rim[j], c))
+                spoke_parent.append(k)
+            ne += n
+            kids = []
+            for j in range(n):
+                row = (~spokes[j], loop[j], spokes[(j + 1) % n])
+                if j == n - 1:
+                    FE[k] = row
+                else:
+                    new_F.append((row, k))
+                    kids.append(nf)
+                    nf += 1
+            self.face_children[k] = [k] + kids
+        if new_X:
+            s.X = np.vstack([s.X, np.array(new_X)])
+            s.E = np.vstack([s.E, np.array(new_E, dtype=np.int64)])
+            FE = np.vstack([FE, np.array([r for r, _ in new_F], dtype=np.int64).reshape(-1, 3)])
+        parent = np.concatenate([np.arange(nface), np.array([p for _, p in new_F], np.int64)])
+        s.FE = FE
+        self.facet_parent = parent
+        # facet attributes
+        s.fattr["fixed"] = fixed[parent]
+        s.fattr["tension"] = tension[parent]
+        s.fattr["no_refine"] = no_refine[parent]
+        s.fattr["original"] = np.asarray(blk.ids, dtype=np.int64)[parent] if nface else \
+            np.zeros(0, np.int64)
+        for key, arr in colors.items():
+            s.fattr[key] = arr[parent]
+        for cid, m in fcon.items():
+            s.fcon[cid] = m[parent]
+        if fbnd.any():
+            s.fattr["boundary"] = fbnd[parent]
+        # new vertices and edges inherit from their face
+        cpar = np.array(center_parent, np.int64)
+        spar = np.array(spoke_parent, np.int64)
+        nnew_v = len(cpar)
+        nnew_e = len(spar)
+        if nnew_v:
+            s.vattr["fixed"] = np.concatenate([s.vattr["fixed"], fixed[cpar]])
+            s.vattr["original"] = np.concatenate([s.vattr["original"], np.zeros(nnew_v, np.int64)])
+            for cid in list(s.vcon):
+                add = fcon[cid][cpar] if cid in fcon else np.zeros(nnew_v, bool)
+                if "global" in s.constraints[cid].flags:
+                    add = np.ones(nnew_v, bool)
+                s.vcon[cid] = np.concatenate([s.vcon[cid], add])
+            for cid in fcon:
+                if cid not in s.vcon:
+                    s.vcon[cid] = np.concatenate([np.zeros(s.nv - nnew_v, bool), fcon[cid][cpar]])
+            if "boundary" in s.vattr:
+                if fbnd[cpar].any():
+                    raise UnsupportedError("BOUNDARY on a face with more than 3 edges")
+                s.vattr["boundary"] = np.concatenate([s.vattr["boundary"], np.zeros(nnew_v, np.int64)])
+                s.vattr["params"] = np.vstack([s.vattr["params"],
+                                               np.zeros((nnew_v, s.vattr["params"].shape[1]))])
+            for key in list(s.extra):
+                if key[0] == "vertex":
+                    arr = s.extra[key]
+                    s.extra[key] = np.concatenate([arr, np.zeros((nnew_v,) + arr.shape[1:])])
+        if nnew_e:
+            s.eattr["fixed"] = np.concatenate([s.eattr["fixed"], fixed[spar]])
+            s.eattr["no_refine"] = np.concatenate([s.eattr["no_refine"], no_refine[spar]])
+            s.eattr["original"] = np.concatenate([s.eattr["original"], np.zeros(nnew_e, np.int64)])
+            if "tension" in s.eattr:
+                s.eattr["tension"] = np.concatenate([s.eattr["tension"], np.zeros(nnew_e)])
+            if "color" in s.eattr:
+                s.eattr["color"] = np.concatenate([s.eattr["color"], np.zeros(nnew_e, np.int64)])
+            if "boundary" in s.eattr or fbnd.any():
+                eb = s.eattr.get("boundary", np.zeros(ne0, np.int64))
+                s.eattr["boundary"] = np.concatenate([eb, fbnd[spar]])
+            if "wrap" in s.eattr:
+                s.eattr["wrap"] = np.vstack([s.eattr["wrap"], np.zeros((nnew_e, 3))])
+            for cid in list(s.econ):
+                add = fcon[cid][spar].astype(np.int8) if cid in fcon else np.zeros(nnew_e, np.int8)
+                if "global" in s.constraints[cid].flags:
+                    add = np.ones(nnew_e, np.int8)
+                s.econ[cid] = np.concatenate([s.econ[cid], add])
+            for cid in fcon:
+                if cid not in s.econ:
+                    s.econ[cid] = np.concatenate([np.zeros(ne0, np.int8),
+                                                  fcon[cid][spar].astype(np.int8)])
+            for key in list(s.extra):
+                if key[0] == "edge":
+                    arr = s.extra[key]
+                    s.extra[key] = np.concatenate([arr, np.zeros((nnew_e,) + arr.shape[1:])])
+        for key in list(s.extra):
+            if key[0] == "facet":
+                s.extra[key] = s.extra[key][parent]
+        if s.periods is not None and nnew_v:
+            self._torus_centers(big, starts, lengths, enc, nface)
+
+    def _face_center(self, rim):
+        return self.s.X[rim].mean(axis=0)
+
+    def _torus_centers(self, big, starts, lengths, enc, nface):
+        """Torus: the centre is the mean of the unwrapped rim; spokes get wraps."""
+        s = self.s
+        P = s.periods
+        wrap = s.eattr["wrap"]
+        nv0 = s.nv - len(big)
+        ne_spoke = s.ne - int(lengths[big].sum())
+        for j, k in enumerate(big):
+            st, n = starts[k], lengths[k]
+            loop = enc[st:st + n]
+            idx, sgn = G.edge_index(loop)
+            # unwrapped offsets (in periods) of rim vertices relative to the first
+            offs = np.zeros((n, 3))
+            for m in range(1, n):
+                offs[m] = offs[m - 1] + wrap[idx[m - 1]] * sgn[m - 1]
+            rim = np.where(sgn > 0, s.E[idx, 0], s.E[idx, 1])
+            pts = s.X[rim] + offs @ P
+            c = nv0 + j
+            s.X[c] = pts.mean(axis=0)
+            for m in range(n):
+                e = ne_spoke + m
+                # spoke from rim m (at offset offs[m]) to centre (offset 0)
+                wrap[e] = -offs[m]
+            ne_spoke += n
+
+    # -- bodies -------------------------------------------------------------------
+    def _bodies(self):
+        sc, s = self.sc, self.s
+        blk = sc.bodies
+        nb = len(blk.ids)
+        b = s.bodies
+        b.n = nb
+        b.target = np.full(nb, np.nan)
+        b.volconst = np.zeros(nb)
+        b.pressure = np.full(nb, np.nan)
+        b.density = np.zeros(nb)
+        b.lagrange = np.zeros(nb)
+        b.original = np.asarray(blk.ids, dtype=np.int64)
+        rows, cols, vals = [], [], []
+        for k, d in enumerate(blk.data):
+            for f in d:
+                if f == 0:
+                    raise self.error(f"body {blk.ids[k]}: facet id 0 does not exist", blk.lines[k])
+                pos = self.fid.lookup(np.array([abs(f)]), [blk.lines[k]], "body", [blk.ids[k]])[0]
+                for child in self.face_children[pos]:
+                    rows.append(k)
+                    cols.append(child)
+                    vals.append(1.0 if f > 0 else -1.0)
+        for pos, attrs in blk.attrs.items():
+            for kw, v in attrs:
+                if kw == "volume":
+                    b.target[pos] = v[0]
+                elif kw == "volconst":
+                    b.volconst[pos] = v[0]
+                elif kw == "pressure":
+                    b.pressure[pos] = v[0]
+                elif kw == "density":
+                    b.density[pos] = v[0]
+                elif kw in ("actual_volume", "lagrange_multiplier"):
+                    pass
+                elif kw == "attribute":
+                    self._attr("body", nb, pos, v)
+                else:
+                    raise self.error(f"body {blk.ids[pos]}: '{kw}' is not a body attribute",
+                                     blk.lines[pos])
+            kws = [kw for kw, _ in attrs]
+            if "volume" in kws and "pressure" in kws:
+                raise self.error(f"body {blk.ids[pos]}: VOLUME and PRESSURE exclude each other",
+                                 blk.lines[pos])
+        b.facet_matrix = sp.csr_matrix((vals, (rows, cols)), shape=(nb, s.nf))
+        b.occurrences = (np.array(rows, np.int64), np.array(cols, np.int64), np.array(vals))
+        b.volume = None
+
+    # -- quantities -----------------------------------------------------------------
+    def _member(self, etype, pos, vals):
+        name, sign = vals
+        self.members = getattr(self, "members", {})
+        self.members.setdefault((name, etype), []).append((pos, sign))
+
+    def _attr(self, etype, n, pos, vals):
+        name = vals[0]
+        atype, size, dims = self.sc.attributes[(etype, name)]
+        key = (etype, name)
+        if key not in self.s.extra:
+            self.s.extra[key] = np.zeros(n if size == 1 else (n, size))
+        arr = self.s.extra[key]
+        v = vals[1:]
+        if size == 1:
+            arr[pos] = v[0] if v else 0.0
+        else:
+            arr[pos, :len(v)] = v
+
+    def _quantities(self):
+        sc, s = self.sc, self.s
+        members = getattr(self, "members", {})
+        for name, qd in sc.quantities.items():
+            q = Quantity(name, qd.kind, qd.target, qd.modulus, qd.tolerance)
+            for m in qd.methods:
+                etype, _ = method_info(m.method)
+                q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
+            s.quantities[name] = q
+        for name, m in sc.method_instances.items():
+            raise UnsupportedError("METHOD_INSTANCE", "method instances outside quantities")
+        # declared attributes that no element set still exist
+        for (etype, name), (atype, size, dims) in sc.attributes.items():
+            if (etype, name) not in s.extra:
+                n = {"vertex": s.nv, "edge": s.ne, "facet": s.nf, "body": s.bodies.n}[etype]
+                s.extra[(etype, name)] = np.zeros(n if size == 1 else (n, size))
+
+    def _instance(self, m, etype, mem):
+        s = self.s
+        n = {"vertex": s.nv, "edge": s.ne, "facet": s.nf}[etype]
+        if m.is_global:
+            return (m, etype, np.arange(n), None)
+        idx, sgn = [], []
+        for pos, sign in mem:
+            kids = self.face_children[pos] if etype == "facet" else [pos]
+            for kid in kids:
+                idx.append(kid)
+                sgn.append(float(sign))
+        return (m, etype, np.array(idx, np.int64), np.array(sgn))
+
+    # -- projection -------------------------------------------------------------------
+    def _project(self):
+        project_to_constraints(self.s, np.arange(self.s.nv))
+
+
+def torus_lift_shifts(s):
+    """Per body, the period shift of each facet that makes its facets a
+    consistently lifted surface (so the divergence theorem gives its volume).
+
+    Each facet is unwrapped from its first vertex; across every edge shared
+    by two facets of a body the two lifts of the edge must coincide, which
+    fixes the relative shift (a breadth-first walk over the body's facets).
+    Depends on topology and wraps only, so it is cached.
+    Returns ``(nb, nf, 3)`` shifts already multiplied by the body's facet sign.
+    """
+    key = (s.nf, s.ne, id(s.FE), id(s.eattr.get("wrap")))
+    cache = getattr(s, "_lift_cache", None)
+    if cache is not None and cache[0] == key:
+        return cache[1]
+    from collections import deque
+    P = s.periods
+    wrap = s.eattr["wrap"]
+    idx, sgn = G.edge_index(s.FE)
+    wv = wrap @ P                                   # (ne, 3)
+    # offset of the tail of each oriented edge in the facet's own lift
+    A = np.zeros((s.nf, 3, 3))
+    A[:, 1] = wv[idx[:, 0]] * sgn[:, 0, None]
+    A[:, 2] = A[:, 1] + wv[idx[:, 1]] * sgn[:, 1, None]
+    # offset of the edge's own tail in the facet's lift
+    O = A - np.where(sgn[..., None] < 0, wv[idx], 0.0)
+    occ_b, occ_f, occ_s = s.bodies.occurrences
+    ev = G.edge_vectors(s.X, s.E, wv)
+    dvec = ev[idx] * sgn[..., None]                 # oriented edge vectors (nf, 3, 3)
+    N2 = np.cross(dvec[:, 0], dvec[:, 0] + dvec[:, 1])
+    out = np.zeros((s.bodies.n, s.nf, 3))
+    for b in range(s.bodies.n):
+        sel = np.nonzero(occ_b == b)[0]
+        facets = occ_f[sel]
+        signs = occ_s[sel]
+        # occurrences by (edge, direction in which the body's side traverses it)
+        by_edge = {}
+        for o, (f, sg) in enumerate(zip(facets, signs)):
+            for k in range(3):
+                by_edge.setdefault((idx[f, k], sgn[f, k] * sg > 0), []).append((o, k))
+        # pair the occurrences at every edge: going round the edge from a
+        # facet towards the body's side, the next facet of the body met is
+        # its partner (this separates a body's wall with its own image)
+        partner = {}
+        groups = {}
+        for (e, d), lst in by_edge.items():
+            groups.setdefault(e, []).extend(lst)
+        for e, lst in groups.items():
+            if len(lst) == 2:
+                (o, k), (o2, j) = lst
+                partner[(o, k)] = (o2, j)
+                partner[(o2, j)] = (o, k)
+                continue
+            t = ev[e] / np.linalg.norm(ev[e])
+            a = np.cross(t, [1.0, 0, 0] if abs(t[0]) < 0.9 else [0, 1.0, 0])
+            a /= np.linalg.norm(a)
+            bvec = np.cross(t, a)
+            ang = []
+            for o, k in lst:
+                f = facets[o]
+                w = -dvec[f, (k + 2) % 3]
+                u = w - (w @ t) * t
+                th = np.arctan2(u @ bvec, u @ a)
+                side = -signs[o] * N2[f]
+                rot = 1.0 if side @ np.cross(t, u) > 0 else -1.0
+                ang.append((th, rot))
+            for m, (o, k) in enumerate(lst):
+                th, rot = ang[m]
+                best, bestd = None, None
+                for m2, (o2, j) in enumerate(lst):
+                    if m2 == m or facets[o2] == facets[o] or ang[m2][1] != -rot:
+                        continue
+                    dth = ((ang[m2][0] - th) * rot) % (2 * np.pi)
+                    if bestd is None or dth < bestd:
+                        best, bestd = (o2, j), dth
+                if best is not None:
+                    partner[(o, k)] = best
+        D = [None] * len(facets)
+        for root in range(len(facets)):
+            if D[root] is not None:
+                continue
+            D[root] = np.zeros(3)
+            dq = deque([root])
+            while dq:
+                o = dq.popleft()
+                f = facets[o]
+                for k in range(3):
+                    p = partner.get((o, k))
+                    if p is None or D[p[0]] is not None:
+                        continue
+                    o2, j = p
+                    D[o2] = D[o] + O[f, k] - O[facets[o2], j]
+                    dq.append(o2)
+        for o, (f, sg) in enumerate(zip(facets, signs)):
+            out[b, f] += sg * D[o]
+    s._lift_cache = (key, out)
+    return out
+
+
+def project_to_constraints(s, idx, tol=None, maxit=20):
+    """Newton-project the vertices ``idx`` onto their level-set constraints.
+
+    Uses ``x <- x - G (G^T G)^{-1} phi(x)`` over the vertex's active
+    constraints (spec §6.1).  One-sided constraints are projected only when
+    violated.
+    """
+    if not s.vcon:
+        return
+    tol = tol if tol is not None else s.params.get("constraint_tolerance", 1e-12)
+    cids = sorted(s.vcon)
+    onmat = np.stack([s.vcon[c][idx] for c in cids], axis=1)
+    fixed = s.vattr["fixed"][idx]
+    keys = {}
+    for row, key in enumerate(map(tuple, onmat)):
+        if any(key):
+            keys.setdefault(key, []).append(row)
+    env = s.param_env()
+    for key, rows in keys.items():
+        sel = idx[np.array(rows)]
+        active = [c for c, on in zip(cids, key) if on]
+        for _ in range(maxit):
+            P = s.X[sel]
+            coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+            phis = []
+            grads = []
+            for cid in active:
+                c = s.constraints[cid]
+                phi = c.formula.values(env, coords, len(sel))
+                if "nonnegative" in c.flags:
+                    phi = np.minimum(phi, 0.0)
+                elif "nonpositive" in c.flags:
+                    phi = np.maximum(phi, 0.0)
+                phis.append(phi)
+                grads.append(c.formula.gradient(env, coords, len(sel)))
+            phi = np.stack(phis, axis=1)           # (n, k)
+            if np.max(np.abs(phi)) < tol:
+                break
+            Gm = np.stack(grads, axis=2)           # (n, 3, k)
+            GtG = np.einsum("nik,nil->nkl", Gm, Gm)
+            with np.errstate(all="ignore"):
+                lam = np.linalg.solve(GtG, phi[..., None])[..., 0]
+            step = np.einsum("nik,nk->ni", Gm, lam)
+            step = np.where(np.isfinite(step), step, 0.0)
+            s.X[sel] = P - step
+
+
+class _IdMap:
+    """Datafile ids -> positions (elements are renumbered in reading order)."""
+
+    def __init__(self, ids, what, filename, lines):
+        self.ids = np.asarray(ids, dtype=np.int64)
+        self.what = what
+        self.filename = filename
+        order = np.argsort(self.ids, kind="stable")
+        self.sorted = self.ids[order]
+        self.order = order
+        dup = np.nonzero(self.sorted[1:] == self.sorted[:-1])[0]
+        if len(dup):
+            k = order[dup[0] + 1]
+            raise DatafileError(f"{what} {self.ids[k]} is defined twice", filename, lines[k])
+
+    def lookup(self, raw, lines, user, user_ids):
+        raw = np.asarray(raw, dtype=np.int64)
+        if not len(self.sorted):
+            if raw.size:
+                raise DatafileError(f"{user} {user_ids[0]} refers to {self.what} "
+                                    f"{int(raw.flat[0])}, but there are no {self.what}s",
+                                    self.filename, lines[0])
+            return raw
+        pos = np.searchsorted(self.sorted, raw)
+        pos_c = np.minimum(pos, len(self.sorted) - 1)
+        ok = self.sorted[pos_c] == raw
+        if not ok.all():
+            flat = np.nonzero(~ok.reshape(len(ok), -1).all(axis=-1) if ok.ndim > 1 else ~ok)[0][0]
+            bad = raw[flat]
+            bad = int(np.asarray(bad).flat[np.nonzero(~np.asarray(ok[flat]).reshape(-1))[0][0]]) \
+                if np.ndim(bad) else int(bad)
+            raise DatafileError(f"{user} {user_ids[flat]} refers to {self.what} {bad}, "
+                                f"which is not defined", self.filename, lines[flat])
+        return self.order[pos_c]
+
+
+def build_surface(scene):
+    """Build a :class:`Surface` from a :class:`Scene` (datafile errors located)."""
+    return _Builder(scene).build()
