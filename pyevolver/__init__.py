@@ -1,0 +1,23 @@
+"""pyevolver: Surface Evolver datafiles and command scripts in Python.
+
+Data flows one way: text -> Scene -> Surface -> (methods, constraints) ->
+evolve / remesh -> outputs.  :class:`Session` is shared by the REPL, the CLI
+and the Python API.
+"""
+__version__ = "0.1.0"
+
+from .errors import (PyEvolverError, DatafileError, CommandError, UnsupportedError,  # noqa: E402
+                     ExpressionError, ConstraintError, ConvergenceWarning)
+from .datafile.reader import read_datafile  # noqa: E402
+from .surface import Surface, build_surface  # noqa: E402
+from .session import Session  # noqa: E402
+
+
+def load(filename):
+    """Load a datafile into a :class:`Session` (runs its ``read`` section)."""
+    return Session.load(filename)
+
+
+__all__ = ["Session", "Surface", "load", "read_datafile", "build_surface", "PyEvolverError",
+           "DatafileError", "CommandError", "UnsupportedError", "ExpressionError",
+           "ConstraintError", "ConvergenceWarning", "__version__"]

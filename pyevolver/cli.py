@@ -1,0 +1,148 @@
+"""Command-line interface that behaves like ``evolver``.
+
+``pyevolver FILE.fe`` loads the datafile (running its ``read`` section) and
+then reads commands from the terminal (prompt ``Enter command: ``) or from
+standard input when it is not a terminal; ``-f FILE`` runs a command file
+after loading.  Errors become messages and exit codes here only.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from . import __version__
+from .commands import interpreter as I
+from .errors import PyEvolverError
+from .session import Session
+
+PROMPT = "Enter command: "
+MORE = "more> "
+
+
+def build_parser():
+    p = argparse.ArgumentParser(
+        prog="pyevolver",
+        description="Surface Evolver datafiles and command scripts in Python.")
+    p.add_argument("datafile", help="Surface Evolver datafile (.fe)")
+    p.add_argument("-f", dest="command_file", help="command file to run after loading")
+    p.add_argument("-p", dest="threads", type=int, default=1,
+                   help="accepted for compatibility with evolver (ignored)")
+    p.add_argument("--version", action="version", version=f"pyevolver {__version__}")
+    return p
+
+
+def _find_datafile(name):
+    if os.path.isfile(name):
+        return name
+    if not name.endswith(".fe") and os.path.isfile(name + ".fe"):
+        return name + ".fe"
+    return None
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    path = _find_datafile(args.datafile)
+    if path is None:
+        sys.stderr.write(f"pyevolver: cannot open datafile '{args.datafile}': no such file\n")
+        return 1
+    try:
+        session = Session.load(path)
+    except PyEvolverError as exc:
+        sys.stderr.write(f"{exc}\n")
+        return 1
+    try:
+        if args.command_file:
+            try:
+                with open(args.command_file, encoding="latin-1") as fh:
+                    text = fh.read()
+            except OSError as exc:
+                sys.stderr.write(f"pyevolver: cannot read command file "
+                                 f"'{args.command_file}': {exc.strerror}\n")
+                return 1
+            session.run(text, where=args.command_file, stop_on_error=False)
+        return repl(session)
+    except I.Quit as q:
+        sys.stdout.flush()
+        return q.code
+
+
+def repl(session, stdin=None):
+    """Read commands until ``q`` or end of input; returns the exit code."""
+    stdin = stdin or sys.stdin
+    interactive = stdin.isatty()
+    buf = ""
+    lineno = 0
+    while True:
+        if interactive:
+            sys.stdout.write(MORE if buf else PROMPT)
+            sys.stdout.flush()
+        try:
+            line = stdin.readline()
+        except KeyboardInterrupt:
+            sys.stdout.write("\n")
+            buf = ""
+            continue
+        if not line:
+            if buf.strip():
+                _run(session, buf, lineno)
+            return 0
+        lineno += 1
+        buf += line
+        chunks = I.split_commands(buf)
+        if chunks and _complete(buf):
+            try:
+                _run(session, buf, lineno)
+            finally:
+                buf = ""
+
+
+def _complete(text):
+    """True when the text holds only complete commands."""
+    chunks = I.split_commands(text)
+    if not chunks:
+        return True
+    # split_commands keeps an incomplete tail as the last chunk; it is
+    # complete when re-splitting with one more empty line changes nothing
+    last, _ = chunks[-1]
+    return I.split_commands(last + "\n") == [(last, 1)] and not _open(last)
+
+
+def _open(text):
+    depth = 0
+    in_str = False
+    i = 0
+    while i < len(text):
+        c = text[i]
+        if in_str:
+            if c == "\\":
+                i += 2
+                continue
+            if c == '"':
+                in_str = False
+        elif c == '"':
+            in_str = True
+        elif text.startswith("//", i):
+            j = text.find("\n", i)
+            i = len(text) if j < 0 else j
+            continue
+        elif c in "{(":
+            depth += 1
+        elif c in "})":
+            depth -= 1
+        i += 1
+    tail = text.rstrip()
+    return depth > 0 or in_str or tail.endswith(I._CONT_END)
+
+
+def _run(session, text, lineno):
+    try:
+        session.run(text, where="<stdin>", line=max(1, lineno - text.count("\n") + 1),
+                    stop_on_error=False)
+    except KeyboardInterrupt:
+        sys.stdout.write("\nInterrupted.\n")
+    sys.stdout.flush()
+
+
+if __name__ == "__main__":   # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,74 @@
+"""C ``printf`` semantics for the Evolver's ``printf`` and ``print``."""
+from __future__ import annotations
+
+import math
+import re
+
+from ..errors import CommandError
+
+_SPEC = re.compile(r"%([-+ #0]*)(\*|\d+)?(?:\.(\*|\d+))?(?:hh|h|ll|l|L|q|j|z|t)?([diouxXeEfFgGcs%])")
+
+
+def _to_int(v):
+    if isinstance(v, str):
+        raise CommandError(f"printf: expected a number, got string {v!r}")
+    v = float(v)
+    if math.isnan(v) or math.isinf(v):
+        return 0
+    return int(v)  # C conversion truncates toward zero
+
+
+def c_format(fmt, args):
+    """Format ``args`` with the C format string ``fmt``."""
+    out = []
+    pos = 0
+    ai = 0
+    args = list(args)
+
+    def take():
+        nonlocal ai
+        if ai >= len(args):
+            raise CommandError(f"printf: not enough arguments for format {fmt!r}")
+        v = args[ai]
+        ai += 1
+        return v
+
+    for m in _SPEC.finditer(fmt):
+        out.append(fmt[pos:m.start()])
+        pos = m.end()
+        flags, width, prec, conv = m.groups()
+        if conv == "%":
+            out.append("%")
+            continue
+        if width == "*":
+            width = str(_to_int(take()))
+        if prec == "*":
+            prec = str(_to_int(take()))
+        spec = "%" + flags + (width or "") + ("." + prec if prec is not None else "")
+        v = take()
+        if conv in "di":
+            out.append((spec + "d") % _to_int(v))
+        elif conv in "ouxX":
+            n = _to_int(v)
+            if n < 0:
+                n &= (1 << 32) - 1
+            out.append((spec + conv) % n)
+        elif conv == "c":
+            out.append((spec + "c") % chr(_to_int(v) & 0xFF))
+        elif conv == "s":
+            if not isinstance(v, str):
+                v = "%g" % v
+            out.append((spec + "s") % v)
+        else:
+            if isinstance(v, str):
+                raise CommandError(f"printf: expected a number for %{conv}, got string {v!r}")
+            out.append((spec + conv) % float(v))
+    out.append(fmt[pos:])
+    return "".join(out)
+
+
+def print_value(v):
+    """``print expr``: numbers with ``%20.15g``, strings as they are."""
+    if isinstance(v, str):
+        return v
+    return "%20.15g" % float(v)

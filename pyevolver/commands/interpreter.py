@@ -1,0 +1,714 @@
+"""Parser and interpreter of the Evolver command language (spec §9).
+
+Scripts are data: commands are parsed by ``commands.lark`` into tuples and
+expression trees and executed here; nothing reaches Python ``eval``/``exec``
+or a shell.
+"""
+from __future__ import annotations
+
+import functools
+import os
+
+import numpy as np
+from lark import Lark, v_args
+from lark.exceptions import UnexpectedInput, VisitError
+
+from ..errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
+from ..expr import nodes as N
+from ..expr.transform import ExprTransformer, expr_grammar, unescape
+from .cformat import c_format, print_value
+
+_HERE = os.path.dirname(__file__)
+
+
+@functools.lru_cache(maxsize=1)
+def command_parser():
+    with open(os.path.join(_HERE, "commands.lark")) as fh:
+        grammar = expr_grammar() + "\n" + fh.read()
+    return Lark(grammar, parser="lalr", lexer="contextual", start="start",
+                maybe_placeholders=False)
+
+
+# ---------------------------------------------------------------------------
+# splitting input into complete commands
+
+_CONT_END = ("+", "-", "*", "/", ",", "=", "&&", "||", "(", "{", "^", "?", ":")
+
+
+def split_commands(text):
+    """Cut text into complete commands: ``[(command_text, first_line), ...]``.
+
+    A command continues on the next line while braces or parentheses are
+    open, inside a string or block comment, or after a trailing binary
+    operator or comma (the Evolver's ``more>`` prompt).
+    """
+    text = text.replace("\r\n", "\n").replace("\r", "\n")
+    out = []
+    buf = []
+    depth = 0
+    in_str = False
+    in_comment = False
+    start = None
+    for lineno, line in enumerate(text.split("\n"), 1):
+        i = 0
+        n = len(line)
+        code_end = n
+        while i < n:
+            c = line[i]
+            if in_comment:
+                if line.startswith("*/", i):
+                    in_comment = False
+                    i += 2
+                    continue
+                i += 1
+                continue
+            if in_str:
+                if c == "\\":
+                    i += 2
+                    continue
+                if c == '"':
+                    in_str = False
+                i += 1
+                continue
+            if c == '"':
+                in_str = True
+            elif line.startswith("//", i):
+                code_end = i
+                break
+            elif line.startswith("/*", i):
+                in_comment = True
+                i += 2
+                continue
+            elif c in "{(":
+                depth += 1
+            elif c in "})":
+                depth -= 1
+            i += 1
+        if start is None:
+            if not line[:code_end].strip() and not in_comment:
+                continue
+            start = lineno
+        buf.append(line)
+        tail = line[:code_end].rstrip()
+        if depth > 0 or in_str or in_comment or tail.endswith(_CONT_END):
+            continue
+        out.append(("\n".join(buf), start))
+        buf = []
+        start = None
+        depth = 0
+    if buf:
+        out.append(("\n".join(buf), start))
+    return out
+
+
+# ---------------------------------------------------------------------------
+# expression nodes of the command language
+
+
+class ElemRef:
+    """A reference to one element: kind in vertex/edge/facet/body, 0-based."""
+
+    __slots__ = ("kind", "i", "sign")
+
+    def __init__(self, kind, i, sign=1):
+        self.kind = kind
+        self.i = i
+        self.sign = sign
+
+    def __repr__(self):
+        return f"{self.kind}[{self.i + 1}]"
+
+
+class QRef:
+    __slots__ = ("name",)
+
+    def __init__(self, name):
+        self.name = name
+
+
+_KIND = {"vertex": "vertex", "vertices": "vertex", "edge": "edge", "edges": "edge",
+         "facet": "facet", "facets": "facet", "face": "facet", "faces": "facet",
+         "body": "body", "bodies": "body"}
+
+
+class ElemIndex(N.Node):
+    __slots__ = ("kind", "index")
+
+    def __init__(self, kind, index):
+        self.kind = _KIND[kind.lower()]
+        self.index = index
+
+    def ev(self, env):
+        return env.session.element(self.kind, self.index.ev(env))
+
+    def children(self):
+        return (self.index,)
+
+
+class Attr(N.Node):
+    __slots__ = ("base", "name", "index")
+
+    def __init__(self, base, name, index=None):
+        self.base = base
+        self.name = name.lower()
+        self.index = index
+
+    def ev(self, env):
+        base = self.base.ev(env)
+        idx = None if self.index is None else self.index.ev(env)
+        return env.session.get_attr(base, self.name, idx)
+
+    def children(self):
+        return (self.base,) + ((self.index,) if self.index is not None else ())
+
+
+class Aggregate(N.Node):
+    __slots__ = ("op", "gen", "expr")
+
+    def __init__(self, op, gen, expr):
+        self.op = op.lower()
+        self.gen = gen
+        self.expr = expr
+
+    def ev(self, env):
+        vals = []
+        for el in env.session.generate(self.gen, env):
+            with env.element(el, self.gen.var):
+                vals.append(float(self.expr.ev(env)))
+        if self.op == "count":
+            return float(len(vals))
+        if not vals:
+            return 0.0
+        if self.op == "sum":
+            return float(sum(vals))
+        if self.op == "avg":
+            return float(sum(vals) / len(vals))
+        if self.op == "max":
+            return float(max(vals))
+        return float(min(vals))
+
+
+class OnTest(N.Node):
+    __slots__ = ("what", "arg")
+
+    def __init__(self, what, arg):
+        self.what = what.lower()
+        self.arg = arg
+
+    def ev(self, env):
+        el = env.current()
+        if el is None:
+            raise ExpressionError(f"{self.what} needs an element (use it in a where clause)")
+        return env.session.get_attr(el, self.what, self.arg.ev(env))
+
+
+class Generator:
+    """``vertex``, ``vertex[3]``, ``ee.vertex``, ``vertex[2].edge``, with an
+    optional loop variable and ``where`` condition."""
+
+    def __init__(self, base, var=None, where=None):
+        self.base = base            # ("all", kind) / ("index", kind, expr) / ("sub", base, kind, idx) / ("varsub", name, kind, idx)
+        self.var = var
+        self.where = where
+
+    @property
+    def kind(self):
+        b = self.base
+        return b[1] if b[0] in ("all", "index") else b[2]
+
+
+# ---------------------------------------------------------------------------
+# transformer
+
+
+@v_args(inline=True)
+class _CmdTransformer(ExprTransformer):
+    def start(self, seq):
+        return seq
+
+    def seq(self, *stmts):
+        return ("seq", [s for s in stmts if s is not None])
+
+    def compound(self, seq):
+        return seq
+
+    def repeat(self, body, count):
+        return ("repeat", body, count)
+
+    def if_(self, _i, cond, _t, then):
+        return ("if", cond, then, None)
+
+    def if_else(self, _i, cond, _t, then, _e, other):
+        return ("if", cond, then, other)
+
+    def while_(self, _w, cond, _d, body):
+        return ("while", cond, body)
+
+    def do_while(self, _d, body, _w, cond):
+        return ("dowhile", body, cond)
+
+    def for_(self, _f, init, cond, step, body):
+        return ("for", init, cond, step, body)
+
+    def foreach(self, _f, gen, _d, body):
+        return ("foreach", gen, body)
+
+    def define(self, lv, _a, body):
+        if lv[0] != "name":
+            raise CommandError("only a name can be defined as a command")
+        return ("define", lv[1], body)
+
+    def assign(self, lv, _a, expr):
+        return ("assign", lv, expr)
+
+    def opassign(self, lv, op, expr):
+        return ("opassign", lv, str(op)[0], expr)
+
+    def incr(self, lv, op):
+        return ("opassign", lv, str(op)[0], N.Num(1.0))
+
+    def lv_name(self, name):
+        return ("name", str(name))
+
+    def lv_attr(self, base, name):
+        return ("attr", base, name, None)
+
+    def lv_attr_index(self, base, name, idx):
+        return ("attr", base, name, idx)
+
+    def attr_name(self, tok):
+        return str(tok).lower()
+
+    def print_(self, _p, expr):
+        return ("print", expr)
+
+    def printf(self, _p, *args):
+        return ("printf", list(args), False)
+
+    def errprintf(self, _p, *args):
+        return ("printf", list(args), True)
+
+    def list_(self, _l, gen):
+        return ("list", gen)
+
+    def set_(self, _s, gen, attr, expr=None):
+        return ("set", gen, str(attr).lower(), expr)
+
+    def unset(self, _s, gen, attr, expr=None):
+        return ("unset", gen, str(attr).lower(), expr)
+
+    def refine(self, _r, gen):
+        return ("refine", gen)
+
+    def break_(self, _b, n=None):
+        return ("break", n)
+
+    def continue_(self, _c, n=None):
+        return ("continue", n)
+
+    def return_(self, _r, e=None):
+        return ("return", e)
+
+    def bare(self, name):
+        return ("bare", str(name), None)
+
+    def bare_arg(self, name, expr):
+        return ("bare", str(name), expr)
+
+    def unsupported(self, tok, body=None):
+        word = str(tok).split()[0].lower()
+        return ("unsupported", word)
+
+    def generator(self, base, *rest):
+        var = None
+        where = None
+        for r in rest:
+            if isinstance(r, N.Node):
+                where = r
+            elif r is not None and not isinstance(r, tuple):
+                s = str(r)
+                if s.lower() == "where":
+                    continue
+                var = s.lower()
+        return Generator(base, var, where)
+
+    def gen_index(self, kind, idx):
+        return ("index", _KIND[str(kind).lower()], idx)
+
+    def gen_all(self, kind):
+        return ("all", _KIND[str(kind).lower()])
+
+    def gen_sub(self, base, kind, idx=None):
+        return ("sub", base, _KIND[str(kind).lower()], idx)
+
+    def gen_var_sub(self, name, kind, idx=None):
+        return ("varsub", str(name).lower(), _KIND[str(kind).lower()], idx)
+
+    def attr(self, base, name):
+        return Attr(base, name)
+
+    def attr_index(self, base, name, idx):
+        return Attr(base, name, idx)
+
+    def elem_ref(self, kind, idx):
+        return ElemIndex(str(kind), idx)
+
+    def aggregate(self, op, gen, expr):
+        return Aggregate(str(op), gen, expr)
+
+    def on_test(self, kw, arg):
+        return OnTest(str(kw), arg)
+
+
+_TRANSFORMER = _CmdTransformer()
+
+
+def parse_command(text, where="<command>", line=1):
+    """Parse one complete command; raises :class:`CommandError` with location."""
+    try:
+        tree = command_parser().parse(text)
+        return _TRANSFORMER.transform(tree)
+    except UnexpectedInput as exc:
+        ln = (exc.line if exc.line not in (None, -1) else 1) + line - 1
+        col = exc.column if exc.column not in (None, -1) else 1
+        snippet = text.split("\n")[(exc.line or 1) - 1] if text else ""
+        tok = getattr(exc, "token", None)
+        what = f"unexpected '{tok}'" if tok is not None and tok.type != "$END" else \
+            "unexpected end of command" if tok is not None else "unexpected character"
+        raise CommandError(f"{where}:{ln}:{col}: syntax error: {what}\n    {snippet}\n    "
+                           + " " * (col - 1) + "^") from None
+    except VisitError as exc:
+        if isinstance(exc.orig_exc, PyEvolverError):
+            raise CommandError(f"{where}:{line}: {exc.orig_exc}") from None
+        raise
+
+
+# ---------------------------------------------------------------------------
+# control flow
+
+
+class _Break(Exception):
+    def __init__(self, n=1):
+        self.n = n
+
+
+class _Continue(Exception):
+    def __init__(self, n=1):
+        self.n = n
+
+
+class _Return(Exception):
+    pass
+
+
+class Quit(Exception):
+    def __init__(self, code=0):
+        self.code = code
+
+
+class Env:
+    """Name lookup for command expressions."""
+
+    def __init__(self, session):
+        self.session = session
+        self.frames = []        # [(var name or None, ElemRef)]
+
+    def current(self):
+        return self.frames[-1][1] if self.frames else None
+
+    def element(self, el, var):
+        env = self
+
+        class _Ctx:
+            def __enter__(self_):
+                env.frames.append((var, el))
+
+            def __exit__(self_, *a):
+                env.frames.pop()
+        return _Ctx()
+
+    def lookup(self, name):
+        for var, el in reversed(self.frames):
+            if var == name:
+                return el
+        s = self.session
+        if name in s.variables:
+            return s.variables[name]
+        if self.frames:
+            el = self.frames[-1][1]
+            try:
+                return s.get_attr(el, name, None)
+            except ExpressionError:
+                pass
+        return s.internal(name)
+
+
+# ---------------------------------------------------------------------------
+# the interpreter
+
+
+LETTER_LATER = {
+    "g": "g (iteration) comes with the evolve issue",
+    "r": "r (refinement) comes with the mesh-upkeep issue",
+    "u": "u (equiangulation) comes with the mesh-upkeep issue",
+    "V": "V (vertex averaging) comes with the mesh-upkeep issue",
+    "U": "U (conjugate gradient) comes with the evolve issue",
+    "m": "m (fixed scale) comes with the evolve issue",
+    "t": "t (edge weeding) comes with the mesh-upkeep issue",
+    "l": "l (edge division) comes with the mesh-upkeep issue",
+    "w": "w (area weeding) comes with the mesh-upkeep issue",
+    "K": "K (skinny triangles) comes with the mesh-upkeep issue",
+    "n": "n (notching) comes with the mesh-upkeep issue",
+    "j": "j (jiggle) comes with the mesh-upkeep issue",
+    "o": "o (vertex popping)", "O": "O (edge popping)",
+    "G": "G (gravity) comes with the evolve issue",
+    "e": "e (extrapolation)", "i": "i (information)", "Q": "Q (quantities)",
+    "C": "C (consistency check)", "c": "c (counts)", "N": "N",
+    "b": "b (interactive body targets)", "p": "p (ideal gas)", "y": "y (torus duplication)",
+    "Z": "Z (zoom)", "M": "M (model order)", "J": "J (jiggle toggle)",
+}
+WORD_LATER = {
+    "hessian", "hessian_seek", "saddle", "ritz", "eigenprobe", "lanczos", "hessian_menu",
+    "rawv", "rawestv", "vertex_average", "raw_vertex_average", "rawest_vertex_average",
+    "edgeweed", "edge_divide", "areaweed", "notch", "equiangulate", "pop", "edgeswap",
+    "t1_edgeswap", "delete", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
+    "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
+    "conj_grad_later", "fix", "unfix", "burchard", "zoom",
+}
+TOGGLES = {
+    "conj_grad", "check_increase", "autopop", "autochop", "quiet", "quietgo",
+    "hessian_normal", "normal_motion", "area_normalization", "effective_area",
+    "normal_curvature", "assume_oriented", "autorecalc", "estimate", "volgrads_every",
+    "verbose", "ribiere", "approximate_curvature", "runge_kutta", "kraynikpopvertex",
+    "kraynikpopedge", "hessian_diff", "linear_metric", "post_project", "gravity",
+    "keep_macros", "brief", "itdebug", "memdebug", "visibility_test", "clipped",
+    "connected", "thicken", "smooth_graph", "pscolorflag", "gridflag", "crossingflag",
+    "labelflag", "self_similar", "pinning", "diffusion", "sqgauss", "interp_bdry_param",
+    "h_inverse_metric", "jiggle", "break_after_warning", "full_bounding_box",
+    "show_all_quantities", "show_inner", "show_outer", "colormap", "bezier_basis",
+    "volgrads_every", "zener_drag", "backcull", "debug",
+}
+GRAPHICS = {"s", "P", "show", "show_expr", "transforms", "transform_expr", "geomview",
+            "postscript", "showq", "view_transforms", "ps", "oogl", "gv", "screen"}
+TOGGLE_DEFAULTS = {"hessian_normal": 1, "autorecalc": 1}
+
+
+class Interpreter:
+    """Executes parsed commands against a :class:`pyevolver.session.Session`."""
+
+    def __init__(self, session):
+        self.session = session
+        self.env = Env(session)
+
+    # -- statements -----------------------------------------------------------
+    def execute(self, node):
+        kind = node[0]
+        getattr(self, "_x_" + kind)(node)
+
+    def _x_seq(self, node):
+        for st in node[1]:
+            self.execute(st)
+
+    def _x_repeat(self, node):
+        n = self._count(node[2])
+        for _ in range(n):
+            self.execute(node[1])
+
+    def _count(self, expr):
+        v = self.value(expr)
+        if isinstance(v, str):
+            raise CommandError("a repetition count must be a number")
+        return max(0, int(v))
+
+    def _x_if(self, node):
+        if self.truth(node[1]):
+            self.execute(node[2])
+        elif node[3] is not None:
+            self.execute(node[3])
+
+    def _loop(self, body):
+        """Run one loop body; returns False to leave the loop."""
+        try:
+            self.execute(body)
+        except _Break as b:
+            if b.n > 1:
+                raise _Break(b.n - 1)
+            return False
+        except _Continue as c:
+            if c.n > 1:
+                raise _Continue(c.n - 1)
+        return True
+
+    def _x_while(self, node):
+        while self.truth(node[1]):
+            if not self._loop(node[2]):
+                break
+
+    def _x_dowhile(self, node):
+        while True:
+            if not self._loop(node[1]):
+                break
+            if not self.truth(node[2]):
+                break
+
+    def _x_for(self, node):
+        _, init, cond, step, body = node
+        if init is not None:
+            self.execute(init)
+        while self.truth(cond):
+            if not self._loop(body):
+                break
+            if step is not None:
+                self.execute(step)
+
+    def _x_foreach(self, node):
+        gen, body = node[1], node[2]
+        for el in list(self.session.generate(gen, self.env)):
+            with self.env.element(el, gen.var):
+                if not self._loop(body):
+                    break
+
+    def _x_define(self, node):
+        name = node[1].lower()
+        if len(node[1]) < 2:
+            raise UnsupportedError(f"redefining the single-letter command '{node[1]}'",
+                                   "use :::= (Tier 2)")
+        if name in self.session.variables:
+            del self.session.variables[name]
+        self.session.commands[name] = node[2]
+
+    def _x_assign(self, node):
+        self._store(node[1], self.value(node[2]))
+
+    def _x_opassign(self, node):
+        lv, op, expr = node[1], node[2], node[3]
+        old = self._load(lv)
+        v = self.value(expr)
+        if isinstance(old, str) or isinstance(v, str):
+            raise CommandError(f"'{op}=' needs numbers")
+        new = {"+": old + v, "-": old - v, "*": old * v, "/": old / v if v else np.inf}[op]
+        self._store(lv, new)
+
+    def _load(self, lv):
+        if lv[0] == "name":
+            return self.env.lookup(lv[1].lower())
+        base = lv[1].ev(self.env)
+        idx = None if lv[3] is None else self.value(lv[3])
+        return self.session.get_attr(base, lv[2], idx)
+
+    def _store(self, lv, value):
+        s = self.session
+        if lv[0] == "name":
+            name = lv[1].lower()
+            if len(lv[1]) < 2:
+                raise CommandError(f"'{lv[1]}' is a single-letter command, not a variable "
+                                   f"(variable names need two or more characters)")
+            for var, el in self.env.frames:
+                if var == name:
+                    raise CommandError(f"cannot assign to loop variable '{name}'")
+            s.set_variable(name, value)
+            return
+        base = lv[1].ev(self.env)
+        idx = None if lv[3] is None else self.value(lv[3])
+        s.set_attr(base, lv[2], idx, value)
+
+    def _x_print(self, node):
+        v = self.value(node[1])
+        self.session.write(print_value(v) + "\n")
+
+    def _x_printf(self, node):
+        args = [self.value(a) for a in node[1]]
+        if not args or not isinstance(args[0], str):
+            raise CommandError("printf needs a format string first")
+        text = c_format(args[0], args[1:])
+        if node[2]:
+            self.session.write_err(text)
+        else:
+            self.session.write(text)
+
+    def _x_list(self, node):
+        self.session.list_elements(node[1], self.env)
+
+    def _x_set(self, node):
+        self.session.set_elements(node[1], node[2], node[3], self.env, unset=False)
+
+    def _x_unset(self, node):
+        self.session.set_elements(node[1], node[2], node[3], self.env, unset=True)
+
+    def _x_refine(self, node):
+        raise UnsupportedError("refine", "refinement comes with the mesh-upkeep issue")
+
+    def _x_break(self, node):
+        raise _Break(1 if node[1] is None else int(self.value(node[1])))
+
+    def _x_continue(self, node):
+        raise _Continue(1 if node[1] is None else int(self.value(node[1])))
+
+    def _x_return(self, node):
+        raise _Return()
+
+    def _x_unsupported(self, node):
+        raise UnsupportedError(node[1])
+
+    def _x_bare(self, node):
+        raw, arg = node[1], node[2]
+        name = raw.lower()
+        s = self.session
+        if name in s.commands and len(raw) > 1:
+            n = 1 if arg is None else self._count(arg)
+            for _ in range(n):
+                try:
+                    self.execute(s.commands[name])
+                except _Return:
+                    pass
+            return
+        if raw in ("q",) or name in ("quit", "bye", "exit"):
+            raise Quit(0 if arg is None else int(self.value(arg)))
+        if raw == "v" or name == "show_vol":
+            s.write(s.show_vol())
+            return
+        if name == "recalc":
+            s.recalc()
+            return
+        if raw in GRAPHICS or name in GRAPHICS:
+            return
+        if name in TOGGLES:
+            self._toggle(name, arg)
+            return
+        if name == "linear":
+            return        # a no-op on a linear surface, as in REF
+        if len(raw) == 1 and raw in LETTER_LATER:
+            raise UnsupportedError(f"command {LETTER_LATER[raw]}")
+        if name in WORD_LATER:
+            raise UnsupportedError(f"command {name}")
+        if name in s.variables and arg is None:
+            raise CommandError(f"'{raw}' is a variable, not a command (use print {raw})")
+        raise CommandError(f"unknown command '{raw}'")
+
+    def _toggle(self, name, arg):
+        s = self.session
+        if arg is None:
+            new = 1
+        elif isinstance(arg, N.Var) and arg.name in ("on", "off"):
+            new = 1 if arg.name == "on" else 0
+        else:
+            v = self.value(arg)
+            new = 1 if v else 0
+        old = s.toggles.get(name, TOGGLE_DEFAULTS.get(name, 0))
+        s.toggles[name] = new
+        s.write(f"{name} {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
+
+    # -- expressions ------------------------------------------------------------
+    def value(self, expr):
+        v = expr.ev(self.env)
+        if isinstance(v, np.ndarray):
+            v = float(v)
+        if isinstance(v, (ElemRef, QRef)):
+            raise CommandError("an element or quantity is not a value here")
+        return v
+
+    def truth(self, expr):
+        v = self.value(expr)
+        if isinstance(v, str):
+            return bool(v)
+        return v != 0

@@ -1,0 +1,591 @@
+"""The Session: one surface, its variables and commands.
+
+The REPL, the CLI and the Python API share this object::
+
+    from pyevolver import Session
+    s = Session.load("cube.fe")
+    s.total_energy          # 6.0
+    s.run("print total_area")
+"""
+from __future__ import annotations
+
+import copy
+import math
+import random
+import sys
+import time
+
+import numpy as np
+
+from .commands import interpreter as I
+from .commands.cformat import print_value
+from .datafile.reader import read_datafile
+from .errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
+from .expr import nodes as N
+from .surface import build_surface, project_to_constraints
+
+READ_ONLY = {
+    "total_energy", "total_area", "total_length", "vertex_count", "edge_count",
+    "facet_count", "body_count", "facetedge_count", "space_dimension",
+    "surface_dimension", "torus", "datafilename", "equi_count", "edge_delete_count",
+    "vertex_pop_count", "edge_pop_count", "notch_count", "refine_count", "where_count",
+    "iteration_counter", "total_time", "random", "quantity_count",
+}
+DEFAULTS = {
+    "scale": 0.1, "scale_limit": 1.0, "scale_scale": 1.0, "target_tolerance": 1e-4,
+    "constraint_tolerance": 1e-12, "jiggle_temperature": 0.05, "random_seed": 1.0,
+    "autochop_length": 0.0, "integral_order_1d": 3.0, "integral_order_2d": 6.0,
+    "hessian_epsilon": 1e-8, "sq_mean_mix": 0.0,
+}
+
+
+class Session:
+    """A loaded surface with its variables, commands and output streams."""
+
+    def __init__(self, out=None, err=None):
+        self.out = out or sys.stdout
+        self.err = err or sys.stderr
+        self.surface = None
+        self.totals = None
+        self.variables = {}
+        self.commands = {}
+        self.toggles = {}
+        self.settings = dict(DEFAULTS)
+        self.filename = ""
+        self.start_time = time.time()
+        self.interp = I.Interpreter(self)
+
+    # -- loading ---------------------------------------------------------------
+    @classmethod
+    def load(cls, filename, out=None, err=None, run_read=True):
+        s = cls(out, err)
+        s.load_file(filename, run_read)
+        return s
+
+    def load_file(self, filename, run_read=True):
+        scene = read_datafile(filename)
+        surface = build_surface(scene)
+        self.filename = filename
+        self.surface = surface
+        self.variables = surface.params        # parameters and variables share one namespace
+        for k in ("scale_limit", "constraint_tolerance"):
+            if k in scene.values:
+                self.settings[k] = scene.values[k]
+        if "scale" in scene.values:
+            self.settings["scale"] = scene.values["scale"]
+        self.commands = {}
+        self.recalc()
+        if run_read and scene.read_text:
+            self.run(scene.read_text, where=filename, line=scene.read_line + 1,
+                     stop_on_error=False)
+        return self
+
+    # -- output -----------------------------------------------------------------
+    def write(self, text):
+        self.out.write(text)
+
+    def write_err(self, text):
+        self.err.write(text)
+
+    # -- running commands ----------------------------------------------------------
+    def run(self, text, where="<command>", line=1, stop_on_error=True):
+        """Run command text (any number of commands).
+
+        Each complete command is parsed then executed; a failing command
+        leaves the surface and variables as they were, prints its error and
+        (``stop_on_error``) raises :class:`CommandError`.
+        """
+        for chunk, ln in I.split_commands(text):
+            try:
+                self.run_one(chunk, where, line + ln - 1)
+            except I.Quit:
+                raise
+            except PyEvolverError as exc:
+                if stop_on_error:
+                    raise
+                self.write_err(f"{exc}\n")
+
+    def run_one(self, text, where="<command>", line=1):
+        ast = I.parse_command(text, where, line)
+        snap = self._snapshot()
+        try:
+            self.interp.execute(ast)
+        except I.Quit:
+            self.refresh()
+            raise
+        except (I._Break, I._Continue, I._Return):
+            pass
+        except PyEvolverError as exc:
+            self._restore(snap)
+            if isinstance(exc, CommandError) and str(exc).startswith(where):
+                raise
+            raise CommandError(f"{where}:{line}: {exc}") from None
+        except (ArithmeticError, ValueError, TypeError, IndexError) as exc:
+            self._restore(snap)
+            raise CommandError(f"{where}:{line}: {type(exc).__name__}: {exc}") from None
+        except RecursionError:
+            self._restore(snap)
+            raise CommandError(f"{where}:{line}: recursion too deep") from None
+        self.refresh()
+
+    def _snapshot(self):
+        s = self.surface
+        b = s.bodies if s is not None else None
+        return (dict(self.variables), dict(self.commands), dict(self.toggles),
+                dict(self.settings),
+                None if s is None else s.X.copy(),
+                None if b is None or not b.n else (b.target.copy(), b.pressure.copy(),
+                                                    b.volconst.copy(), b.density.copy()),
+                None if s is None else {k: (q.target, q.modulus, q.kind)
+                                        for k, q in s.quantities.items()},
+                None if s is None else {k: v.copy() for k, v in s.extra.items()},
+                None if s is None else {k: v.copy() for k, v in s.vattr.items()})
+
+    def _restore(self, snap):
+        vars_, cmds, toggles, settings, X, bod, qs, extra, vattr = snap
+        self.variables.clear()
+        self.variables.update(vars_)
+        self.commands = cmds
+        self.toggles = toggles
+        self.settings = settings
+        s = self.surface
+        if s is not None:
+            s.X = X
+            if bod is not None:
+                b = s.bodies
+                b.target, b.pressure, b.volconst, b.density = bod
+            for k, (t, m, kind) in qs.items():
+                q = s.quantities[k]
+                q.target, q.modulus, q.kind = t, m, kind
+            s.extra = extra
+            s.vattr = vattr
+
+    # -- evaluation ------------------------------------------------------------------
+    def recalc(self):
+        """Recompute energies, areas and volumes."""
+        s = self.surface
+        if s is None:
+            return
+        s.gravity_constant = self.variables.get("gravity_constant", s.gravity_constant)
+        t = s.evaluate()
+        s.bodies.volume = t.volumes
+        self.totals = t
+
+    def refresh(self):
+        if self.toggles.get("autorecalc", 1):
+            self.recalc()
+
+    @property
+    def total_energy(self):
+        return self.totals.energy
+
+    @property
+    def total_area(self):
+        return self.totals.total_area
+
+    # -- variables ----------------------------------------------------------------------
+    def set_variable(self, name, value):
+        if name in READ_ONLY:
+            raise CommandError(f"'{name}' is read-only")
+        if name in self.commands:
+            del self.commands[name]
+        if name in self.settings:
+            self.settings[name] = value
+            return
+        if name == "gravity_constant":
+            self.surface.gravity_constant = float(value)
+        if self.surface is not None and name in self.surface.quantities:
+            raise CommandError(f"'{name}' is a quantity; assign to {name}.target or "
+                               f"{name}.modulus")
+        self.variables[name] = value
+
+    def internal(self, name):
+        s = self.surface
+        t = self.totals
+        if name in self.settings:
+            return self.settings[name]
+        if name in N.CONSTANTS:
+            return N.CONSTANTS[name]
+        if s is not None and name in s.quantities:
+            return I.QRef(name)
+        if name in self.toggles or name in I.TOGGLES:
+            return float(self.toggles.get(name, I.TOGGLE_DEFAULTS.get(name, 0)))
+        if s is None:
+            raise ExpressionError(f"undefined name '{name}' (no surface loaded)")
+        simple = {
+            "total_energy": lambda: t.energy,
+            "total_area": lambda: t.total_area,
+            "total_length": lambda: t.total_length,
+            "vertex_count": lambda: s.nv, "edge_count": lambda: s.ne,
+            "facet_count": lambda: s.nf, "body_count": lambda: s.bodies.n,
+            "facetedge_count": lambda: 3 * s.nf,
+            "space_dimension": lambda: s.sdim, "surface_dimension": lambda: 2,
+            "torus": lambda: 1 if s.periods is not None else 0,
+            "datafilename": lambda: self.filename,
+            "gravity_constant": lambda: s.gravity_constant,
+            "g": lambda: s.gravity_constant,
+            "iteration_counter": lambda: 0, "total_time": lambda: 0.0,
+            "equi_count": lambda: 0, "edge_delete_count": lambda: 0,
+            "vertex_pop_count": lambda: 0, "edge_pop_count": lambda: 0,
+            "notch_count": lambda: 0, "refine_count": lambda: 0, "where_count": lambda: 0,
+            "random": lambda: random.random(),
+            "quantity_count": lambda: len(s.quantities),
+        }
+        fn = simple.get(name)
+        if fn is None:
+            raise ExpressionError(f"undefined name '{name}'")
+        v = fn()
+        return v if isinstance(v, str) else float(v)
+
+    # -- elements ------------------------------------------------------------------------
+    def count(self, kind):
+        s = self.surface
+        return {"vertex": s.nv, "edge": s.ne, "facet": s.nf, "body": s.bodies.n}[kind]
+
+    def element(self, kind, index):
+        if isinstance(index, str):
+            raise ExpressionError(f"{kind} index must be a number")
+        k = int(index)
+        n = self.count(kind)
+        if k == 0 or abs(k) > n:
+            raise ExpressionError(f"{kind}[{k}] does not exist ({kind} ids are 1..{n})")
+        return I.ElemRef(kind, abs(k) - 1, -1 if k < 0 else 1)
+
+    def generate(self, gen, env):
+        """Elements of a generator, with its ``where`` filter applied."""
+        els = self._gen_base(gen.base, env)
+        if gen.where is None:
+            return els
+        out = []
+        for el in els:
+            with env.element(el, gen.var):
+                v = gen.where.ev(env)
+            if not isinstance(v, str) and v:
+                out.append(el)
+        return out
+
+    def _gen_base(self, base, env):
+        s = self.surface
+        tag = base[0]
+        if tag == "all":
+            return [I.ElemRef(base[1], i) for i in range(self.count(base[1]))]
+        if tag == "index":
+            return [self.element(base[1], env.session.interp.value(base[2]))]
+        if tag == "sub":
+            parents = self._gen_base(base[1], env)
+        else:
+            parent = env.lookup(base[1])
+            if not isinstance(parent, I.ElemRef):
+                raise ExpressionError(f"'{base[1]}' is not an element")
+            parents = [parent]
+        kind, idx = base[2], base[3]
+        out = []
+        for p in parents:
+            subs = self.sub_elements(p, kind)
+            if idx is not None:
+                k = int(env.session.interp.value(idx))
+                if k < 1 or k > len(subs):
+                    raise ExpressionError(f"{p}.{kind}[{k}] does not exist")
+                subs = [subs[k - 1]]
+            out.extend(subs)
+        return out
+
+    def sub_elements(self, el, kind):
+        s = self.surface
+        i = el.i
+        if el.kind == "vertex":
+            if kind == "edge":
+                return [I.ElemRef("edge", int(e)) for e in np.nonzero((s.E == i).any(axis=1))[0]]
+            if kind == "facet":
+                return [I.ElemRef("facet", int(f)) for f in np.nonzero((s.F == i).any(axis=1))[0]]
+        if el.kind == "edge":
+            if kind == "vertex":
+                a, b = s.E[i]
+                if el.sign < 0:
+                    a, b = b, a
+                return [I.ElemRef("vertex", int(a)), I.ElemRef("vertex", int(b))]
+            if kind == "facet":
+                from .geometry import edge_index
+                idx, _ = edge_index(s.FE)
+                return [I.ElemRef("facet", int(f)) for f in np.nonzero((idx == i).any(axis=1))[0]]
+        if el.kind == "facet":
+            from .geometry import edge_index
+            if kind == "vertex":
+                return [I.ElemRef("vertex", int(v)) for v in s.F[i]]
+            if kind == "edge":
+                idx, sgn = edge_index(s.FE[i])
+                return [I.ElemRef("edge", int(e), int(g)) for e, g in zip(idx, sgn)]
+            if kind == "body":
+                col = s.bodies.facet_matrix[:, i].tocoo()
+                return [I.ElemRef("body", int(b)) for b in col.row]
+        if el.kind == "body" and kind == "facet":
+            row = s.bodies.facet_matrix.getrow(i).tocoo()
+            return [I.ElemRef("facet", int(f), int(np.sign(v))) for f, v in zip(row.col, row.data)]
+        raise ExpressionError(f"{el.kind} has no {kind}s")
+
+    # -- attributes ------------------------------------------------------------------------
+    def get_attr(self, base, name, idx):
+        if isinstance(base, I.QRef):
+            return self._quantity_attr(base.name, name)
+        if not isinstance(base, I.ElemRef):
+            raise ExpressionError(f"'.{name}' needs an element or a quantity")
+        s = self.surface
+        t = self.totals
+        k, i = base.kind, base.i
+        if name in ("id",):
+            return float(i + 1)
+        if name == "oid":
+            return float((i + 1) * base.sign)
+        if name == "original":
+            arr = {"vertex": s.vattr, "edge": s.eattr, "facet": s.fattr}.get(k, {}).get("original")
+            if k == "body":
+                return float(s.bodies.original[i])
+            return float(arr[i]) if arr is not None and arr[i] else float(i + 1)
+        if (k, name) in s.extra:
+            arr = s.extra[(k, name)]
+            if arr.ndim == 1:
+                return float(arr[i])
+            j = int(idx) if idx is not None else 1
+            return float(arr[i, j - 1])
+        if k == "vertex":
+            coords = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}
+            if name in coords:
+                return float(s.X[i, coords[name]])
+            if name == "__x" and idx is not None:
+                return float(s.X[i, int(idx) - 1])
+            if name == "fixed":
+                return float(s.vattr["fixed"][i])
+            if name in ("on_constraint", "hit_constraint"):
+                m = s.vcon.get(int(idx))
+                return float(m[i]) if m is not None else 0.0
+            if name == "on_boundary":
+                b = s.vattr.get("boundary")
+                return float(b is not None and b[i] == int(idx))
+            if name == "valence":
+                return float(np.count_nonzero((s.E == i).any(axis=1)))
+            if name in ("p1", "p2") and "params" in s.vattr:
+                return float(s.vattr["params"][i, int(name[1]) - 1])
+        elif k == "edge":
+            if name == "length":
+                return float(t.edge_length[i])
+            if name in ("x", "y", "z"):
+                return float(t.edge_vec[i, "xyz".index(name)] * base.sign)
+            if name in ("tension", "density"):
+                return float(s.edge_tension[i])
+            if name == "fixed":
+                return float(s.eattr["fixed"][i])
+            if name == "no_refine":
+                return float(s.eattr["no_refine"][i])
+            if name in ("on_constraint", "hit_constraint"):
+                m = s.econ.get(int(idx))
+                return float(m[i] != 0) if m is not None else 0.0
+            if name == "on_boundary":
+                b = s.eattr.get("boundary")
+                return float(b is not None and b[i] == int(idx))
+            if name == "valence":
+                return float(len(self.sub_elements(base, "facet")))
+            if name in ("color", "colour"):
+                c = s.eattr.get("color")
+                return float(c[i]) if c is not None else 0.0
+        elif k == "facet":
+            if name == "area":
+                return float(t.facet_area[i])
+            if name in ("x", "y", "z"):
+                return float(0.5 * t.facet_N2[i, "xyz".index(name)] * base.sign)
+            if name in ("tension", "density"):
+                return float(s.facet_tension[i])
+            if name == "fixed":
+                return float(s.fattr["fixed"][i])
+            if name in ("on_constraint", "hit_constraint"):
+                m = s.fcon.get(int(idx))
+                return float(m[i]) if m is not None else 0.0
+            if name in ("color", "colour", "frontcolor", "backcolor"):
+                c = s.fattr.get(name.replace("colour", "color"))
+                return float(c[i]) if c is not None else 0.0
+            if name == "valence":
+                return 3.0
+        elif k == "body":
+            b = s.bodies
+            if name == "volume":
+                return float(t.volumes[i])
+            if name == "target":
+                return float(b.target[i]) if not math.isnan(b.target[i]) else 0.0
+            if name == "volconst":
+                return float(b.volconst[i])
+            if name == "pressure":
+                if not math.isnan(b.pressure[i]):
+                    return float(b.pressure[i])
+                return float(b.lagrange[i])
+            if name == "density":
+                return float(b.density[i])
+            if name == "fixed":
+                return float(not math.isnan(b.target[i]))
+        if name in s.quantities:
+            raise UnsupportedError(f"per-element quantity values ({k}.{name})")
+        raise ExpressionError(f"{k} has no attribute '{name}'")
+
+    def _quantity_attr(self, qname, name):
+        q = self.surface.quantities[qname]
+        if name == "value":
+            return float(self.totals.quantity_values[qname])
+        if name == "target":
+            return float(q.target)
+        if name == "modulus":
+            return float(q.modulus)
+        if name == "pressure":
+            return float(q.pressure)
+        if name == "tolerance":
+            return float(q.tolerance)
+        raise ExpressionError(f"quantity has no attribute '{name}'")
+
+    def set_attr(self, base, name, idx, value):
+        if isinstance(value, str):
+            raise CommandError(f"cannot assign a string to '.{name}'")
+        value = float(value)
+        s = self.surface
+        if isinstance(base, I.QRef):
+            q = s.quantities[base.name]
+            if name in ("target", "modulus", "tolerance"):
+                setattr(q, name, value)
+                return
+            raise CommandError(f"quantity attribute '{name}' is read-only")
+        if not isinstance(base, I.ElemRef):
+            raise CommandError(f"'.{name}' needs an element or a quantity")
+        k, i = base.kind, base.i
+        if (k, name) in s.extra:
+            arr = s.extra[(k, name)]
+            if arr.ndim == 1:
+                arr[i] = value
+            else:
+                arr[i, (int(idx) if idx is not None else 1) - 1] = value
+            return
+        if k == "vertex" and name in ("x", "y", "z", "x1", "x2", "x3"):
+            j = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}[name]
+            s.X[i, j] = value
+            return
+        if k == "body":
+            b = s.bodies
+            if name == "target":
+                b.target[i] = value
+                b.pressure[i] = np.nan
+                return
+            if name == "volconst":
+                b.volconst[i] = value
+                return
+            if name == "pressure":
+                b.pressure[i] = value
+                b.target[i] = np.nan
+                return
+            if name == "density":
+                b.density[i] = value
+                return
+        if k == "facet" and name in ("tension", "density"):
+            s.fattr["tension"][i] = value
+            return
+        if k == "edge" and name in ("tension", "density"):
+            s.eattr.setdefault("tension", np.zeros(s.ne))[i] = value
+            return
+        raise CommandError(f"cannot assign to {k} attribute '{name}'")
+
+    def set_elements(self, gen, attr, expr, env, unset):
+        els = self.generate(gen, env)
+        if unset:
+            raise UnsupportedError(f"unset {attr}", "comes with the evolve issue")
+        if expr is None:
+            raise UnsupportedError(f"set {gen.kind} {attr} (without a value)")
+        # compute every value first, then assign (like the Evolver's set)
+        vals = []
+        for el in els:
+            with env.element(el, gen.var):
+                vals.append(self.interp.value(expr))
+        for el, v in zip(els, vals):
+            self.set_attr(el, attr, None, v)
+        if gen.kind == "vertex" and attr in ("x", "y", "z"):
+            project_to_constraints(self.surface, np.array([e.i for e in els], np.int64))
+
+    # -- listing ---------------------------------------------------------------------------------
+    def list_elements(self, gen, env):
+        s = self.surface
+        els = self.generate(gen, env)
+        kind = gen.kind
+        t = self.totals
+        w = self.write
+        if kind == "vertex":
+            w("// Id               X                Y               Z\n")
+            for el in els:
+                x = s.X[el.i]
+                line = f"{el.i + 1:3d}  {x[0]:17.15g} {x[1]:17.15g} {x[2]:17.15g}"
+                cons = [c for c in sorted(s.vcon) if s.vcon[c][el.i]]
+                if cons:
+                    line += "  constraints " + " ".join(map(str, cons)) + " "
+                if s.vattr["fixed"][el.i]:
+                    line += " fixed "
+                w(line + "\n")
+        elif kind == "edge":
+            w("// Id    endpoints\n")
+            for el in els:
+                a, b = s.E[el.i] + 1
+                line = f"{el.i + 1:3d}   {a:5d} {b:4d}     /*length {t.edge_length[el.i]:.15g}*/"
+                if s.eattr["fixed"][el.i]:
+                    line += " fixed"
+                w(line + "\n")
+        elif kind == "facet":
+            from .geometry import edge_index
+            w("// Id    edges\n")
+            for el in els:
+                idx, sgn = edge_index(s.FE[el.i])
+                es = " ".join(str(int((e + 1) * g)) for e, g in zip(idx, sgn))
+                orig = s.fattr["original"][el.i]
+                line = f"{el.i + 1:3d}   {es} /*area {t.facet_area[el.i]:.15g}*/"
+                if orig and orig != el.i + 1:
+                    line += f" original {orig}"
+                w(line + "\n")
+        elif kind == "body":
+            w("// Id   facets\n")
+            b = s.bodies
+            for el in els:
+                line = f"{el.i + 1:3d}"
+                if not math.isnan(b.target[el.i]):
+                    line += f"   volume {b.target[el.i]:.15g}"
+                line += f" /*actual: {t.volumes[el.i]:.15g}*/ lagrange_multiplier {b.lagrange[el.i]:.15g}"
+                w(line + "\n")
+
+    # -- reports ------------------------------------------------------------------------------------
+    def show_vol(self):
+        """The ``v`` report (spec §9.3 formats)."""
+        s = self.surface
+        t = self.totals
+        b = s.bodies
+        lines = []
+        qs = [q for q in s.quantities.values()]
+        if not b.n and not qs:
+            return "No bodies or quantities.\n"
+        if b.n:
+            lines.append("")
+            lines.append("Body          target volume           actual volume          pressure")
+            for i in range(b.n):
+                name = str(i + 1)
+                if not math.isnan(b.target[i]):
+                    lines.append("%3s  %22.15g  %22.15g %17.15g" % (name, b.target[i], t.volumes[i],
+                                                                   b.lagrange[i]))
+                elif not math.isnan(b.pressure[i]):
+                    lines.append("%3s            ------------     %22.15g %17.15g" % (
+                        name, t.volumes[i], b.pressure[i]))
+                else:
+                    lines.append("%3s            ------------     %22.15g " % (name, t.volumes[i]))
+        if qs:
+            wdt = max([20] + [len(q.name) for q in qs])
+            lines.append("")
+            lines.append("%*s       target value           actual value                 pressure"
+                         % (wdt, "Quantity"))
+            for q in qs:
+                v = t.quantity_values[q.name]
+                if q.kind == "fixed":
+                    lines.append("%*s  %22.15g  %22.15g  %17.15g" % (wdt, q.name, q.target, v,
+                                                                    q.pressure))
+                elif q.kind == "conserved":
+                    lines.append("%*s     (conserved)     ----------------   %17.15g" % (
+                        wdt, q.name, q.pressure))
+                else:
+                    lines.append("%*s         ---------      %22.15g" % (wdt, q.name, v))
+        return "\n".join(lines) + "\n"
