@@ -525,7 +525,7 @@ class Session:
             w("// Id    endpoints\n")
             for el in els:
                 a, b = s.E[el.i] + 1
-                line = f"{el.i + 1:3d}   {a:5d} {b:4d}     /*length {t.edge_length[el.i]:.15g}*/"
+                line = f"{el.i + 1:3d}   {a:5d} {b:4d}     /*length {t.edge_length[el.i]:g}*/"
                 if s.eattr["fixed"][el.i]:
                     line += " fixed"
                 w(line + "\n")
@@ -536,7 +536,7 @@ class Session:
                 idx, sgn = edge_index(s.FE[el.i])
                 es = " ".join(str(int((e + 1) * g)) for e, g in zip(idx, sgn))
                 orig = s.fattr["original"][el.i]
-                line = f"{el.i + 1:3d}   {es} /*area {t.facet_area[el.i]:.15g}*/"
+                line = f"{el.i + 1:3d}   {es} /*area {t.facet_area[el.i]:g}*/"
                 if orig and orig != el.i + 1:
                     line += f" original {orig}"
                 w(line + "\n")

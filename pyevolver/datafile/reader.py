@@ -23,6 +23,9 @@ from .preprocess import preprocess, read_source
 
 _HERE = os.path.dirname(__file__)
 
+# numbers with two decimal points or an exponent without digits
+_BAD_NUMBER = re.compile(r"(?<![\w.])(\d*\.\d*\.[\d.]*|\d+\.?\d*[eEdD][+-]?(?![\d+-]))")
+
 _NUMERIC_LINE = re.compile(
     r"[ \t]*\d+(?:[ \t]+[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)*[ \t]*\Z")
 
@@ -299,6 +302,11 @@ class Reader:
 
     def _top(self, sec):
         text = sec.text.replace(",", " ")
+        bad = _BAD_NUMBER.search(text)
+        if bad:
+            line = text.count("\n", 0, bad.start()) + 1
+            col = bad.start() - (text.rfind("\n", 0, bad.start()) + 1) + 1
+            raise self.error(f"malformed number '{bad.group(0)}'", self._src(sec, line), col)
         try:
             if _MATRIX_RE.search(text):
                 text = self._extract_matrices(text)
@@ -486,6 +494,9 @@ class Reader:
                 srcs.append(srcline)
                 continue
             line = raw.replace(",", " ").replace(":", " ")
+            bad = _BAD_NUMBER.search(line)
+            if bad:
+                raise self.error(f"malformed number '{bad.group(0)}'", srcline, bad.start() + 1)
             if kind == "edges" and torus:
                 line = self._strip_wraps(line, len(ids), sdim, srcline)
             if kind == "vertices" and ";" in line:
@@ -496,7 +507,7 @@ class Reader:
                 eid, items = _LINE.transform(tree)
             except UnexpectedInput as exc:
                 col = exc.column if exc.column not in (None, -1) else None
-                raise self.error(self._describe(exc, line) + f" in {kind[:-1] if kind != 'bodies' else 'body'} line",
+                raise self.error(self._describe(exc, line) + " in " + {"vertices": "vertex", "edges": "edge", "faces": "face", "bodies": "body"}[kind] + " line",
                                  srcline, col) from None
             except VisitError as exc:
                 if isinstance(exc.orig_exc, PyEvolverError):
