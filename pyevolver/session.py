@@ -267,6 +267,11 @@ class Session:
     def _gen_base(self, base, env):
         s = self.surface
         tag = base[0]
+        if tag == "var":
+            el = env.lookup(base[1])
+            if not isinstance(el, I.ElemRef):
+                raise ExpressionError(f"'{base[1]}' is not an element")
+            return [el]
         if tag == "all":
             return [I.ElemRef(base[1], i) for i in range(self.count(base[1]))]
         if tag == "index":

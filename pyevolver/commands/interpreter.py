@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import functools
 import os
+import re
 
 import numpy as np
 from lark import Lark, v_args
@@ -90,7 +91,8 @@ def split_commands(text):
             start = lineno
         buf.append(line)
         tail = line[:code_end].rstrip()
-        if depth > 0 or in_str or in_comment or tail.endswith(_CONT_END):
+        if depth > 0 or in_str or in_comment or tail.endswith(_CONT_END) or \
+                _ends_with_keyword(tail):
             continue
         out.append(("\n".join(buf), start))
         buf = []
@@ -98,7 +100,27 @@ def split_commands(text):
         depth = 0
     if buf:
         out.append(("\n".join(buf), start))
-    return out
+    # an 'else' at the start of a command belongs to the previous 'if'
+    merged = []
+    for chunk, ln in out:
+        if merged and _starts_with_else(chunk):
+            prev, pln = merged[-1]
+            merged[-1] = (prev + "\n" + chunk, pln)
+        else:
+            merged.append((chunk, ln))
+    return merged
+
+
+_KW_END = re.compile(r"(?:^|[^A-Za-z0-9_])(then|else|do)$", re.I)
+_ELSE_START = re.compile(r"\s*else\b", re.I)
+
+
+def _ends_with_keyword(tail):
+    return bool(_KW_END.search(tail))
+
+
+def _starts_with_else(chunk):
+    return bool(_ELSE_START.match(chunk))
 
 
 # ---------------------------------------------------------------------------
@@ -214,6 +236,8 @@ class Generator:
     @property
     def kind(self):
         b = self.base
+        if b[0] == "var":
+            return None
         return b[1] if b[0] in ("all", "index") else b[2]
 
 
@@ -247,7 +271,27 @@ class _CmdTransformer(ExprTransformer):
     def do_while(self, _d, body, _w, cond):
         return ("dowhile", body, cond)
 
-    def for_(self, _f, init, cond, step, body):
+    def for_(self, _f, *parts):
+        # FOR "(" seq_item ";" expr? ";" seq_item ")" stmt; the optional parts
+        # are told apart by position
+        items = list(parts)
+        body = items.pop()
+        init = cond = step = None
+        rest = [x for x in items]
+        # seq_item is a statement tuple or absent; expr is a Node
+        stmts = [x for x in rest if isinstance(x, tuple)]
+        exprs = [x for x in rest if isinstance(x, N.Node)]
+        cond = exprs[0] if exprs else N.Num(1.0)
+        if len(stmts) == 2:
+            init, step = stmts
+        elif len(stmts) == 1:
+            # decide by position relative to the condition
+            if exprs and rest.index(stmts[0]) < rest.index(exprs[0]):
+                init = stmts[0]
+            elif exprs:
+                step = stmts[0]
+            else:
+                init = stmts[0]
         return ("for", init, cond, step, body)
 
     def foreach(self, _f, gen, _d, body):
@@ -291,11 +335,45 @@ class _CmdTransformer(ExprTransformer):
     def list_(self, _l, gen):
         return ("list", gen)
 
-    def set_(self, _s, gen, attr, expr=None):
-        return ("set", gen, str(attr).lower(), expr)
+    def where(self, _w, expr):
+        return ("where", expr)
 
-    def unset(self, _s, gen, attr, expr=None):
-        return ("unset", gen, str(attr).lower(), expr)
+    @staticmethod
+    def _split_where(rest):
+        where = None
+        out = []
+        for r in rest:
+            if isinstance(r, tuple) and r and r[0] == "where":
+                where = r[1]
+            else:
+                out.append(r)
+        return out, where
+
+    def set_(self, _s, base, attr, *rest):
+        rest, where = self._split_where(rest)
+        return ("set", Generator(base, None, where), str(attr).lower(), rest[0] if rest else None)
+
+    def set_var(self, _s, base, var, attr, *rest):
+        rest, where = self._split_where(rest)
+        return ("set", Generator(base, str(var).lower(), where), str(attr).lower(),
+                rest[0] if rest else None)
+
+    def set_elemvar(self, _s, var, attr, *rest):
+        rest, where = self._split_where(rest)
+        return ("set", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
+                rest[0] if rest else None)
+
+    def unset(self, _s, base, attr, *rest):
+        rest, where = self._split_where(rest)
+        return ("unset", Generator(base, None, where), str(attr).lower(), rest[0] if rest else None)
+
+    def unset_elemvar(self, _s, var, attr, *rest):
+        rest, where = self._split_where(rest)
+        return ("unset", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
+                rest[0] if rest else None)
+
+    def sprintf_assign(self, lv, _a, _s, *args):
+        return ("sprintf", lv, list(args))
 
     def refine(self, _r, gen):
         return ("refine", gen)
@@ -315,6 +393,14 @@ class _CmdTransformer(ExprTransformer):
     def bare_arg(self, name, expr):
         return ("bare", str(name), expr)
 
+    def graphics(self, tok):
+        return ("seq", [])
+
+    def define_graphics(self, lv, _a, tok):
+        if lv[0] != "name":
+            raise CommandError("only a name can be defined as a command")
+        return ("define", lv[1], ("seq", []))
+
     def unsupported(self, tok, body=None):
         word = str(tok).split()[0].lower()
         return ("unsupported", word)
@@ -323,13 +409,10 @@ class _CmdTransformer(ExprTransformer):
         var = None
         where = None
         for r in rest:
-            if isinstance(r, N.Node):
-                where = r
-            elif r is not None and not isinstance(r, tuple):
-                s = str(r)
-                if s.lower() == "where":
-                    continue
-                var = s.lower()
+            if isinstance(r, tuple) and r and r[0] == "where":
+                where = r[1]
+            elif r is not None:
+                var = str(r).lower()
         return Generator(base, var, where)
 
     def gen_index(self, kind, idx):
@@ -611,6 +694,12 @@ class Interpreter:
         base = lv[1].ev(self.env)
         idx = None if lv[3] is None else self.value(lv[3])
         s.set_attr(base, lv[2], idx, value)
+
+    def _x_sprintf(self, node):
+        args = [self.value(a) for a in node[2]]
+        if not args or not isinstance(args[0], str):
+            raise CommandError("sprintf needs a format string first")
+        self._store(node[1], c_format(args[0], args[1:]))
 
     def _x_print(self, node):
         v = self.value(node[1])
