@@ -6,6 +6,7 @@ evolve / remesh -> outputs.
 """
 from __future__ import annotations
 
+from array import array
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -70,7 +71,7 @@ class ElementBlock:
     ids: list = field(default_factory=list)
     data: list = field(default_factory=list)
     attrs: dict = field(default_factory=dict)
-    lines: list = field(default_factory=list)
+    lines: object = field(default_factory=lambda: array("l"))
 
 
 @dataclass

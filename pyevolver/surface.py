@@ -358,9 +358,17 @@ class _Builder:
         fixed = np.zeros(n, bool)
         bnd = None
         params = None
-        simple = [k for k, d in enumerate(blk.data) if len(d) == 3]
-        if len(simple) == n and n:
-            X[:] = np.array(blk.data, dtype=float)
+        table = isinstance(blk.data, np.ndarray)
+        if table:
+            if blk.data.shape[1] != 3:
+                raise self.error(f"vertex {blk.ids[0]}: expected 3 coordinates, got "
+                                 f"{blk.data.shape[1]}", blk.lines[0])
+            X[:] = blk.data
+            simple = range(n)
+        else:
+            simple = [k for k, d in enumerate(blk.data) if len(d) == 3]
+            if len(simple) == n and n:
+                X[:] = np.array(blk.data, dtype=float)
         for pos, attrs in blk.attrs.items():
             for kw, vals in attrs:
                 if kw == "fixed":
@@ -391,7 +399,7 @@ class _Builder:
                 else:
                     raise self.error(f"vertex {blk.ids[pos]}: '{kw}' is not a vertex attribute",
                                      blk.lines[pos])
-        for pos, d in enumerate(blk.data):
+        for pos, d in enumerate(() if table else blk.data):
             if bnd is not None and bnd[pos]:
                 b = sc.boundaries[bnd[pos]]
                 if len(d) != b.nparams:
@@ -432,7 +440,10 @@ class _Builder:
         n = len(blk.ids)
         self.eid = _IdMap(blk.ids, "edge", sc.filename, blk.lines)
         E = np.zeros((n, 2), np.int64)
-        bad = [k for k, d in enumerate(blk.data) if len(d) != 2]
+        if isinstance(blk.data, np.ndarray):
+            bad = [0] if blk.data.shape[1] != 2 else []
+        else:
+            bad = [k for k, d in enumerate(blk.data) if len(d) != 2]
         if bad:
             k = bad[0]
             raise self.error(f"edge {blk.ids[k]}: expected two vertex ids, got "
@@ -548,21 +559,28 @@ class _Builder:
         # validate edge loops
         tri_rows = []
         E = s.E
-        lengths = np.array([len(d) for d in blk.data], dtype=np.int64)
+        table = isinstance(blk.data, np.ndarray)
+        if table:
+            lengths = np.full(nface, blk.data.shape[1], dtype=np.int64)
+        else:
+            lengths = np.array([len(d) for d in blk.data], dtype=np.int64)
         if nface:
             short = np.nonzero(lengths < 3)[0]
             if len(short):
                 k = short[0]
                 raise self.error(f"face {blk.ids[k]}: a facet needs at least 3 edges, got "
                                  f"{lengths[k]}", blk.lines[k])
-            flat = np.fromiter((e for d in blk.data for e in d), np.int64, int(lengths.sum()))
+            if table:
+                flat = blk.data.astype(np.int64).ravel()
+            else:
+                flat = np.fromiter((e for d in blk.data for e in d), np.int64,
+                                   int(lengths.sum()))
             owner = np.repeat(np.arange(nface), lengths)
             if np.any(flat == 0):
                 k = owner[np.nonzero(flat == 0)[0][0]]
                 raise self.error(f"face {blk.ids[k]}: edge id 0 does not exist", blk.lines[k])
-            lines_per = [blk.lines[k] for k in range(nface)]
-            eidx = self.eid.lookup(np.abs(flat), [lines_per[k] for k in owner], "face",
-                                   [blk.ids[k] for k in owner])
+            eidx = self.eid.lookup(np.abs(flat), _Lazy(lambda j: blk.lines[owner[j]]), "face",
+                                   _Lazy(lambda j: blk.ids[owner[j]]))
             rev = flat < 0
             tails = np.where(rev, E[eidx, 1], E[eidx, 0])
             heads = np.where(rev, E[eidx, 0], E[eidx, 1])
@@ -594,7 +612,7 @@ class _Builder:
         new_X = []
         new_E = []
         new_F = []            # (FE row, parent face position)
-        self.face_children = {k: [k] for k in range(nface)}
+        self.split_children = {}     # face position -> its triangles (faces split on load)
         nv = s.nv
         ne = ne0
         nf = nface
@@ -621,7 +639,7 @@ class _Builder:
                     new_F.append((row, k))
                     kids.append(nf)
                     nf += 1
-            self.face_children[k] = [k] + kids
+            self.split_children[k] = [k] + kids
         if new_X:
             s.X = np.vstack([s.X, np.array(new_X)])
             s.E = np.vstack([s.E, np.array(new_E, dtype=np.int64)])
@@ -699,6 +717,9 @@ class _Builder:
         if s.periods is not None and nnew_v:
             self._torus_centers(big, starts, lengths, enc, nface)
 
+    def children(self, pos):
+        return self.split_children.get(pos, [pos])
+
     def _face_center(self, rim):
         return self.s.X[rim].mean(axis=0)
 
@@ -740,16 +761,28 @@ class _Builder:
         b.density = np.zeros(nb)
         b.lagrange = np.zeros(nb)
         b.original = np.asarray(blk.ids, dtype=np.int64)
-        rows, cols, vals = [], [], []
-        for k, d in enumerate(blk.data):
-            for f in d:
-                if f == 0:
-                    raise self.error(f"body {blk.ids[k]}: facet id 0 does not exist", blk.lines[k])
-                pos = self.fid.lookup(np.array([abs(f)]), [blk.lines[k]], "body", [blk.ids[k]])[0]
-                for child in self.face_children[pos]:
-                    rows.append(k)
-                    cols.append(child)
-                    vals.append(1.0 if f > 0 else -1.0)
+        lens = [len(d) for d in blk.data]
+        flat = np.concatenate([np.asarray(d, dtype=np.int64) for d in blk.data]) if nb else \
+            np.zeros(0, np.int64)
+        owner = np.repeat(np.arange(nb), lens)
+        if np.any(flat == 0):
+            k = owner[np.nonzero(flat == 0)[0][0]]
+            raise self.error(f"body {blk.ids[k]}: facet id 0 does not exist", blk.lines[k])
+        pos = self.fid.lookup(np.abs(flat), _Lazy(lambda j: blk.lines[owner[j]]), "body",
+                              _Lazy(lambda j: blk.ids[owner[j]]))
+        sign = np.where(flat > 0, 1.0, -1.0)
+        # faces split on load contribute all their triangles
+        if self.split_children:
+            nkids = np.ones(len(self.facet_parent), np.int64)
+            for p, kids in self.split_children.items():
+                nkids[p] = len(kids)
+            reps = nkids[pos]
+            kids = np.concatenate([self.children(p) for p in pos]) if len(pos) else pos
+            rows = np.repeat(owner, reps)
+            cols = kids
+            vals = np.repeat(sign, reps)
+        else:
+            rows, cols, vals = owner, pos, sign
         for pos, attrs in blk.attrs.items():
             for kw, v in attrs:
                 if kw == "volume":
@@ -772,7 +805,8 @@ class _Builder:
                 raise self.error(f"body {blk.ids[pos]}: VOLUME and PRESSURE exclude each other",
                                  blk.lines[pos])
         b.facet_matrix = sp.csr_matrix((vals, (rows, cols)), shape=(nb, s.nf))
-        b.occurrences = (np.array(rows, np.int64), np.array(cols, np.int64), np.array(vals))
+        b.occurrences = (np.asarray(rows, np.int64), np.asarray(cols, np.int64),
+                         np.asarray(vals, float))
         b.volume = None
 
     # -- quantities -----------------------------------------------------------------
@@ -818,7 +852,7 @@ class _Builder:
             return (m, etype, np.arange(n), None)
         idx, sgn = [], []
         for pos, sign in mem:
-            kids = self.face_children[pos] if etype == "facet" else [pos]
+            kids = self.children(pos) if etype == "facet" else [pos]
             for kid in kids:
                 idx.append(kid)
                 sgn.append(float(sign))
@@ -972,6 +1006,16 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
             step = np.einsum("nik,nk->ni", Gm, lam)
             step = np.where(np.isfinite(step), step, 0.0)
             s.X[sel] = P - step
+
+
+class _Lazy:
+    """Index-computed sequence (line numbers for error messages only)."""
+
+    def __init__(self, fn):
+        self.fn = fn
+
+    def __getitem__(self, j):
+        return self.fn(int(j))
 
 
 class _IdMap:

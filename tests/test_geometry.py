@@ -100,3 +100,16 @@ def test_gravity_of_unit_cube(tmp_path):
     t = s.evaluate()
     assert t.terms["gravity"] == pytest.approx(0.5, rel=1e-14)
     assert t.energy == pytest.approx(6.5, rel=1e-14)
+
+
+def test_long_body_line_with_attributes(tmp_path):
+    """A body listing thousands of facets followed by attributes loads fast
+    (regression: the numeric-line regex used to backtrack exponentially)."""
+    text = icosahedron_fe()
+    body = " ".join(str(i + 1) for i in range(20)) + " 1 -1" * 3000
+    text = text.replace(" ".join(str(i + 1) for i in range(20)), body + " volume 2.5 density 0")
+    s = load_text(text, tmp_path)
+    t = s.evaluate()
+    a = 4 / math.sqrt(10 + 2 * math.sqrt(5))
+    assert t.volumes[0] == pytest.approx(5 / 12 * (3 + math.sqrt(5)) * a ** 3, rel=1e-13)
+    assert s.bodies.target[0] == 2.5

@@ -27,7 +27,7 @@ def command_parser():
     with open(os.path.join(_HERE, "commands.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
     return Lark(grammar, parser="lalr", lexer="contextual", start="start",
-                maybe_placeholders=False)
+                maybe_placeholders=False, cache=True)
 
 
 # ---------------------------------------------------------------------------

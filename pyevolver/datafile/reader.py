@@ -26,8 +26,39 @@ _HERE = os.path.dirname(__file__)
 # numbers with two decimal points or an exponent without digits
 _BAD_NUMBER = re.compile(r"(?<![\w.])(\d*\.\d*\.[\d.]*|\d+\.?\d*[eEdD][+-]?(?![\d+-]))")
 
-_NUMERIC_LINE = re.compile(
-    r"[ \t]*\d+(?:[ \t]+[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)*[ \t]*\Z")
+# an element line made of plain numbers (no alternative can match a digit
+# run in two ways, so a failing match cannot backtrack exponentially)
+_NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
+_NUMERIC_LINE = re.compile(r"[ \t]*\d+(?:[ \t]+" + _NUMBER + r")*[ \t]*\Z")
+# the numeric head of a line followed by attributes that start with a letter
+_NUMERIC_HEAD = re.compile(r"[ \t]*\d+(?:[ \t]+" + _NUMBER + r")*(?=[ \t]+[A-Za-z_])")
+# long lines (a body's facet list) avoid regexes with repeated groups, whose
+# backtracking state grows with the number of repetitions
+_LONG = 2000
+_FIRST_WORD = re.compile(r"[A-CF-Za-cf-z_]|(?<![\d.])[DdEe]")
+_NUM_CHARS = re.compile(r"[ \t\d.eE+-]*")
+
+
+class _Head:
+    def __init__(self, end):
+        self._end = end
+
+    def end(self):
+        return self._end
+
+
+def _long_numeric(line):
+    """For a long line: ``("all", None)`` if it is plain numbers, ``("head",
+    m)`` if plain numbers are followed by a word, else ``(None, None)``."""
+    m = _FIRST_WORD.search(line)
+    end = m.start() if m else len(line)
+    head = line[:end]
+    if not _NUM_CHARS.fullmatch(head) or (m and end and not line[end - 1].isspace()):
+        return None, None
+    vals = np.fromstring(head, dtype=float, sep=" ")
+    if vals.size != len(head.split()) or not vals.size or vals[0] != int(vals[0]):
+        return None, None
+    return ("all", None) if m is None else ("head", _Head(len(head.rstrip())))
 
 
 class _Unsupported(Exception):
@@ -44,7 +75,8 @@ def top_parser():
     with open(os.path.join(_HERE, "fe_top.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
     return Lark(grammar, parser="lalr", lexer="contextual", start="start",
-                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse})
+                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse},
+                cache=True)
 
 
 @functools.lru_cache(maxsize=1)
@@ -54,7 +86,7 @@ def line_parser():
         grammar = expr_grammar() + "\n" + fh.read()
     return Lark(grammar, parser="lalr", lexer="contextual",
                 start=["vertex_line", "edge_line", "face_line", "body_line"],
-                maybe_placeholders=False)
+                maybe_placeholders=False, cache=True)
 
 
 _MATRIX_RE = re.compile(r"\b(torus_periods|periods|view_matrix|view_transforms|"
@@ -227,7 +259,13 @@ class Reader:
         self.filename = filename
         self.text = read_source(filename) if text is None else text
         self.scene = Scene(filename=filename)
-        self.src_lines = self.text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        self._src_lines = None
+
+    @property
+    def src_lines(self):
+        if self._src_lines is None:
+            self._src_lines = self.text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        return self._src_lines
 
     # -- errors -----------------------------------------------------------
     def error(self, msg, line, col=None):
@@ -239,7 +277,9 @@ class Reader:
         top = sections[0]
         self._top(top)
         seen = []
-        for sec in sections[1:]:
+        for k in range(1, len(sections)):
+            sec = sections[k]
+            sections[k] = None           # let each section's text go once read
             if sec.kind == "read":
                 self.scene.read_text = sec.text
                 self.scene.read_line = sec.line
@@ -469,6 +509,12 @@ class Reader:
 
     # -- element sections ----------------------------------------------------
     def _elements(self, sec):
+        """Parse one element section.
+
+        Lines of plain numbers are converted in bulk with numpy; a line whose
+        numbers are followed by attributes sends only the attributes to the
+        grammar; anything else is parsed whole by ``fe_elements.lark``.
+        """
         kind = sec.kind
         block = getattr(self.scene, kind)
         start = {"vertices": "vertex_line", "edges": "edge_line", "faces": "face_line",
@@ -476,44 +522,87 @@ class Reader:
         lines = sec.text.split("\n")
         torus = self.scene.torus
         sdim = self.scene.space_dimension
-        nums = _NUMERIC_LINE
-        ids = block.ids
-        data = block.data
-        srcs = block.lines
+        nums = _NUMERIC_LINE.match
+        head_re = _NUMERIC_HEAD.match
+        numeric_pos = []       # positions in the block of pure numeric lines
+        numeric_txt = []
+        entries = 0
         for k, raw in enumerate(lines):
             if not raw or raw.isspace():
                 continue
             srcline = sec.lines[k] if sec.lines else sec.line + k
-            if nums.match(raw):
-                toks = raw.split()
-                ids.append(int(toks[0]))
-                if kind == "vertices":
-                    data.append([float(t) for t in toks[1:]])
-                else:
-                    data.append([int(float(t)) for t in toks[1:]])
-                srcs.append(srcline)
+            long_kind = long_head = None
+            if len(raw) > _LONG:
+                long_kind, long_head = _long_numeric(raw.replace(",", " ").replace(":", " "))
+            if long_kind == "all" or (long_kind is None and len(raw) <= _LONG and nums(raw)):
+                block.ids.append(None)
+                block.data.append(None)
+                block.lines.append(srcline)
+                numeric_pos.append(entries)
+                numeric_txt.append(raw)
+                entries += 1
                 continue
             line = raw.replace(",", " ").replace(":", " ")
             bad = _BAD_NUMBER.search(line)
             if bad:
                 raise self.error(f"malformed number '{bad.group(0)}'", srcline, bad.start() + 1)
             if kind == "edges" and torus:
-                line = self._strip_wraps(line, len(ids), sdim, srcline)
-            if kind == "vertices" and ";" in line:
+                line = self._strip_wraps(line, entries, sdim, srcline)
+            if ";" in line:
                 raise self.error("unexpected ';': one element per line", srcline,
                                  line.index(";") + 1)
+            head = long_head if long_kind == "head" else (
+                head_re(line) if len(line) <= _LONG else None)
             try:
-                tree = line_parser().parse(line, start=start)
-                eid, items = _LINE.transform(tree)
+                if head is not None and kind != "edges" or (head is not None and not torus):
+                    nums_ = np.fromstring(line[:head.end()], dtype=float, sep=" ")
+                    tail = line[head.end():]
+                    tree = line_parser().parse("0" + " " * (head.end() - 1) + tail, start=start)
+                    _, items = _LINE.transform(tree)
+                    eid = int(nums_[0])
+                    items = nums_[1:].tolist() + items
+                else:
+                    tree = line_parser().parse(line, start=start)
+                    eid, items = _LINE.transform(tree)
             except UnexpectedInput as exc:
                 col = exc.column if exc.column not in (None, -1) else None
-                raise self.error(self._describe(exc, line) + " in " + {"vertices": "vertex", "edges": "edge", "faces": "face", "bodies": "body"}[kind] + " line",
-                                 srcline, col) from None
+                what = {"vertices": "vertex", "edges": "edge", "faces": "face",
+                        "bodies": "body"}[kind]
+                raise self.error(self._describe(exc, line) + f" in {what} line", srcline,
+                                 col) from None
             except VisitError as exc:
                 if isinstance(exc.orig_exc, PyEvolverError):
                     raise self.error(str(exc.orig_exc), srcline) from None
                 raise
             self._element(kind, block, eid, items, srcline)
+            entries += 1
+        if numeric_txt:
+            self._bulk(kind, block, numeric_pos, numeric_txt)
+
+    def _bulk(self, kind, block, positions, texts):
+        """Convert pure-numeric lines with one numpy call (no token list)."""
+        lens = np.fromiter((len(t.split()) for t in texts), np.int64, len(texts))
+        vals = np.fromstring(" ".join(texts), dtype=float, sep=" ")
+        if vals.size != int(lens.sum()):       # cannot happen for lines that matched
+            raise self.error("could not read the numbers of this section", block.lines[positions[0]])
+        if kind != "vertices":
+            frac = np.nonzero(vals != np.round(vals))[0]
+            if len(frac):
+                row = int(np.searchsorted(np.cumsum(lens), frac[0], side="right"))
+                raise self.error(f"expected an integer id, got {vals[frac[0]]:g}",
+                                 block.lines[positions[row]])
+            vals = vals.astype(np.int64)
+        starts = np.concatenate([[0], np.cumsum(lens)[:-1]])
+        ids = vals[starts].astype(np.int64)
+        uniform = bool(np.all(lens == lens[0]))
+        if uniform and len(positions) == len(block.ids):
+            # the whole section is one table: keep it as arrays
+            block.ids = ids
+            block.data = vals.reshape(len(texts), int(lens[0]))[:, 1:]
+            return
+        for p, i, st, n in zip(positions, ids.tolist(), starts.tolist(), lens.tolist()):
+            block.ids[p] = i
+            block.data[p] = vals[st + 1: st + n]
 
     def _strip_wraps(self, line, pos, sdim, srcline):
         toks = line.split()
@@ -533,12 +622,15 @@ class Reader:
         # leading data expressions
         while i < n:
             it = items[i]
+            if isinstance(it, float):
+                i += 1
+                continue
             if isinstance(it, tuple):
                 break
             if isinstance(it, N.Var) and (it.name in qnames or (etype, it.name) in sc.attributes):
                 break
-            data.append(it)
             i += 1
+        data = items[:i]
         while i < n:
             it = items[i]
             i += 1
@@ -604,6 +696,8 @@ class Reader:
             block.attrs[len(block.ids) - 1] = cooked
 
     def _value(self, expr, line, what):
+        if isinstance(expr, float):
+            return expr
         if isinstance(expr, N.Num):
             return expr.value
         for name in expr.names():
