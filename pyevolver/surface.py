@@ -329,7 +329,8 @@ class _Builder:
         s.params = dict(sc.parameters)
         s.sdim = sc.space_dimension
         if s.sdim != 3:
-            raise UnsupportedError(f"SPACE_DIMENSION {s.sdim}", "only 3 is supported")
+            raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
+                             f"(only 3 is supported)")
         s.constraints = dict(sc.constraints)
         s.boundaries = dict(sc.boundaries)
         s.symmetric_content = "symmetric_content" in sc.flags
@@ -834,11 +835,15 @@ class _Builder:
         for name, qd in sc.quantities.items():
             q = Quantity(name, qd.kind, qd.target, qd.modulus, qd.tolerance)
             for m in qd.methods:
-                etype, _ = method_info(m.method)
+                try:
+                    etype, _ = method_info(m.method)
+                except UnsupportedError as exc:
+                    raise self.error(f"quantity {name}: {exc}", qd.line) from None
                 q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
             s.quantities[name] = q
         for name, m in sc.method_instances.items():
-            raise UnsupportedError("METHOD_INSTANCE", "method instances outside quantities")
+            raise self.error("not supported in pyevolver: METHOD_INSTANCE (method instances "
+                             "outside quantities)")
         # declared attributes that no element set still exist
         for (etype, name), (atype, size, dims) in sc.attributes.items():
             if (etype, name) not in s.extra:
@@ -1056,4 +1061,16 @@ class _IdMap:
 
 def build_surface(scene):
     """Build a :class:`Surface` from a :class:`Scene` (datafile errors located)."""
-    return _Builder(scene).build()
+    try:
+        return _Builder(scene).build()
+    except DatafileError as exc:
+        if exc.excerpt is None and exc.line:
+            try:
+                with open(scene.filename, encoding="latin-1") as fh:
+                    for k, text in enumerate(fh, 1):
+                        if k == exc.line:
+                            raise DatafileError(exc.message, exc.filename, exc.line,
+                                                exc.column, text) from None
+            except OSError:
+                pass
+        raise
