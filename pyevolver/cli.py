@@ -89,50 +89,11 @@ def repl(session, stdin=None):
             return 0
         lineno += 1
         buf += line
-        chunks = I.split_commands(buf)
-        if chunks and _complete(buf):
+        if not I.needs_more(buf):
             try:
                 _run(session, buf, lineno)
             finally:
                 buf = ""
-
-
-def _complete(text):
-    """True when the text holds only complete commands."""
-    chunks = I.split_commands(text)
-    if not chunks:
-        return True
-    # split_commands keeps an incomplete tail as the last chunk; it is
-    # complete when re-splitting with one more empty line changes nothing
-    last, _ = chunks[-1]
-    return I.split_commands(last + "\n") == [(last, 1)] and not _open(last)
-
-
-def _open(text):
-    depth = 0
-    in_str = False
-    i = 0
-    while i < len(text):
-        c = text[i]
-        if in_str:
-            if c == "\\":
-                i += 2
-                continue
-            if c == '"':
-                in_str = False
-        elif c == '"':
-            in_str = True
-        elif text.startswith("//", i):
-            j = text.find("\n", i)
-            i = len(text) if j < 0 else j
-            continue
-        elif c in "{(":
-            depth += 1
-        elif c in "})":
-            depth -= 1
-        i += 1
-    tail = text.rstrip()
-    return depth > 0 or in_str or tail.endswith(I._CONT_END)
 
 
 def _run(session, text, lineno):

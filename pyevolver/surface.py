@@ -349,6 +349,17 @@ class _Builder:
         self._project()
         return s
 
+    def _constraint_ids(self, vals, what, blk, pos):
+        """``(id, orientation sign)`` of the constraints named on an element."""
+        out = []
+        for c in vals:
+            cid = int(abs(c))
+            if cid not in self.sc.constraints:
+                raise self.error(f"{what} {blk.ids[pos]}: constraint {cid} is not defined",
+                                 blk.lines[pos])
+            out.append((cid, -1 if c < 0 else 1))
+        return out
+
     # -- vertices -----------------------------------------------------------
     def _vertices(self):
         sc, s = self.sc, self.s
@@ -375,11 +386,7 @@ class _Builder:
                 if kw == "fixed":
                     fixed[pos] = True
                 elif kw in ("constraint", "constraints"):
-                    for c in vals:
-                        cid = int(abs(c))
-                        if cid not in sc.constraints:
-                            raise self.error(f"vertex {blk.ids[pos]}: constraint {cid} is not "
-                                             f"defined", blk.lines[pos])
+                    for cid, sign in self._constraint_ids(vals, "vertex", blk, pos):
                         s.vcon.setdefault(cid, np.zeros(n, bool))[pos] = True
                 elif kw == "boundary":
                     bid = int(vals[0]) if vals else 0
@@ -461,12 +468,8 @@ class _Builder:
                 if kw == "fixed":
                     fixed[pos] = True
                 elif kw in ("constraint", "constraints"):
-                    for c in vals:
-                        cid = int(abs(c))
-                        if cid not in sc.constraints:
-                            raise self.error(f"edge {blk.ids[pos]}: constraint {cid} is not "
-                                             f"defined", blk.lines[pos])
-                        s.econ.setdefault(cid, np.zeros(n, np.int8))[pos] = -1 if c < 0 else 1
+                    for cid, sign in self._constraint_ids(vals, "edge", blk, pos):
+                        s.econ.setdefault(cid, np.zeros(n, np.int8))[pos] = sign
                 elif kw == "boundary":
                     bid = int(vals[0]) if vals else 0
                     if bid not in sc.boundaries:
@@ -532,11 +535,7 @@ class _Builder:
                 elif kw == "no_refine":
                     no_refine[pos] = True
                 elif kw in ("constraint", "constraints"):
-                    for c in vals:
-                        cid = int(abs(c))
-                        if cid not in sc.constraints:
-                            raise self.error(f"face {blk.ids[pos]}: constraint {cid} is not "
-                                             f"defined", blk.lines[pos])
+                    for cid, sign in self._constraint_ids(vals, "face", blk, pos):
                         fcon.setdefault(cid, np.zeros(nface, bool))[pos] = True
                 elif kw == "boundary":
                     bid = int(vals[0])

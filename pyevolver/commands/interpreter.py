@@ -41,8 +41,19 @@ def split_commands(text):
 
     A command continues on the next line while braces or parentheses are
     open, inside a string or block comment, or after a trailing binary
-    operator or comma (the Evolver's ``more>`` prompt).
+    operator, comma or ``then``/``else``/``do`` (the Evolver's ``more>``
+    prompt).  An unfinished command at the end is returned as the last item.
     """
+    chunks, pending = _scan(text)
+    return chunks + ([pending] if pending else [])
+
+
+def needs_more(text):
+    """True when ``text`` ends inside an unfinished command."""
+    return _scan(text)[1] is not None
+
+
+def _scan(text):
     text = text.replace("\r\n", "\n").replace("\r", "\n")
     out = []
     buf = []
@@ -85,9 +96,9 @@ def split_commands(text):
             elif c in "})":
                 depth -= 1
             i += 1
+        if not line[:code_end].strip() and not in_comment and not in_str and depth == 0:
+            continue            # blank lines neither start nor end a command
         if start is None:
-            if not line[:code_end].strip() and not in_comment:
-                continue
             start = lineno
         buf.append(line)
         tail = line[:code_end].rstrip()
@@ -98,8 +109,7 @@ def split_commands(text):
         buf = []
         start = None
         depth = 0
-    if buf:
-        out.append(("\n".join(buf), start))
+    pending = ("\n".join(buf), start) if buf else None
     # an 'else' at the start of a command belongs to the previous 'if'
     merged = []
     for chunk, ln in out:
@@ -108,7 +118,7 @@ def split_commands(text):
             merged[-1] = (prev + "\n" + chunk, pln)
         else:
             merged.append((chunk, ln))
-    return merged
+    return merged, pending
 
 
 _KW_END = re.compile(r"(?:^|[^A-Za-z0-9_])(then|else|do)$", re.I)
