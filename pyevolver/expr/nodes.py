@@ -630,6 +630,20 @@ class Formula:
         v = self.node.ev(MapEnv(coords, params))
         return np.broadcast_to(np.asarray(v, dtype=float), (n,))
 
+    def hessian(self, params, coords, n, names=("x", "y", "z")):
+        """(n, k, k) second derivatives (symbolic, cached)."""
+        env = MapEnv(coords, params)
+        k = len(names)
+        out = np.empty((n, k, k))
+        for i, a in enumerate(names):
+            for j, b in enumerate(names):
+                key = (a, b)
+                h = self._grads.get(key)
+                if h is None:
+                    h = self._grads[key] = diff(self.grad(a), b)
+                out[:, i, j] = np.broadcast_to(np.asarray(h.ev(env), dtype=float), (n,))
+        return out
+
     def gradient(self, params, coords, n, names=("x", "y", "z")):
         """(n, len(names)) array of partial derivatives."""
         env = MapEnv(coords, params)
