@@ -54,6 +54,9 @@ class Session:
         self.filename = ""
         self.start_time = time.time()
         self.interp = I.Interpreter(self)
+        self._iterator = None
+        self.iteration_counter = 0
+        self.total_time = 0.0
 
     # -- loading ---------------------------------------------------------------
     @classmethod
@@ -161,8 +164,9 @@ class Session:
             s.vattr = vattr
 
     # -- evaluation ------------------------------------------------------------------
-    def recalc(self):
-        """Recompute energies, areas and volumes."""
+    def recalc(self, keep_cg=False):
+        """Recompute energies, areas and volumes (and reset the CG history,
+        as the Evolver's recalc does, unless ``keep_cg``)."""
         s = self.surface
         if s is None:
             return
@@ -170,10 +174,53 @@ class Session:
         t = s.evaluate()
         s.bodies.volume = t.volumes
         self.totals = t
+        if not keep_cg:
+            self.reset_cg()
+
+    # -- evolution -------------------------------------------------------------------
+    @property
+    def iterator(self):
+        if self._iterator is None:
+            from .evolve.iterate import Iterator
+            self._iterator = Iterator(self)
+        return self._iterator
+
+    def reset_cg(self):
+        if self._iterator is not None:
+            self._iterator.cg_history = None
+
+    def g(self, n=1, callback=None, echo=False):
+        """Run ``n`` iteration steps; returns the list of step results.
+
+        ``callback(result)`` is called after each step; returning True stops
+        the run.  With ``echo`` the Evolver's progress lines are printed.
+        """
+        from .evolve.iterate import progress_line
+        results = []
+        for k in range(n, 0, -1):
+            r = self.iterator.step()
+            results.append(r)
+            if echo:
+                for w in r.warnings:
+                    self.write(w + "\n")
+                if r.printed and not self.toggles.get("quiet") and not self.toggles.get("quietgo"):
+                    self.write(progress_line(k, r) + "\n")
+            if r.message == "increase":
+                break
+            if callback is not None and callback(r):
+                break
+        return results
+
+    def go(self, n):
+        """``g n`` at the prompt: steps with progress lines."""
+        try:
+            self.g(n, echo=True)
+        except KeyboardInterrupt:
+            self.write("Interrupted; the surface is as after the last full step.\n")
 
     def refresh(self):
         if self.toggles.get("autorecalc", 1):
-            self.recalc()
+            self.recalc(keep_cg=True)
 
     @property
     def total_energy(self):
@@ -224,7 +271,8 @@ class Session:
             "datafilename": lambda: self.filename,
             "gravity_constant": lambda: s.gravity_constant,
             "g": lambda: s.gravity_constant,
-            "iteration_counter": lambda: 0, "total_time": lambda: 0.0,
+            "iteration_counter": lambda: self.iteration_counter,
+            "total_time": lambda: self.total_time,
             "equi_count": lambda: 0, "edge_delete_count": lambda: 0,
             "vertex_pop_count": lambda: 0, "edge_pop_count": lambda: 0,
             "notch_count": lambda: 0, "refine_count": lambda: 0, "where_count": lambda: 0,

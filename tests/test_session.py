@@ -24,7 +24,7 @@ def test_failing_command_leaves_state():
     assert s.total_energy == 6
 
 
-@pytest.mark.parametrize("cmd,word", [("g 10", "g"), ("r", "r"), ("hessian", "hessian"),
+@pytest.mark.parametrize("cmd,word", [("u", "u"), ("r", "r"), ("V", "V"), ("hessian", "hessian"),
                                       ("lagrange 2", "lagrange"), ("quadratic", "quadratic"),
                                       ("refine edges where on_constraint 1", "refine")])
 def test_later_features_refused_by_name(cmd, word):

@@ -776,6 +776,38 @@ class Interpreter:
             return
         if name == "linear":
             return        # a no-op on a linear surface, as in REF
+        if raw == "g" or re.fullmatch(r"g\d+", raw):
+            n = int(raw[1:]) if len(raw) > 1 else (1 if arg is None else self._count(arg))
+            s.go(n)
+            return
+        if raw == "m":
+            if arg is None:
+                raise CommandError("m needs a scale value (for example: m 0.1)")
+            v = float(self.value(arg))
+            s.settings["scale"] = v
+            s.toggles["_fixed_scale"] = 1
+            s.write("Scale fixed at %g.\n" % v)
+            return
+        if name in ("optimize", "optimise"):
+            if arg is not None:
+                s.settings["scale_limit"] = float(self.value(arg))
+            s.toggles["_fixed_scale"] = 0
+            s.write("Scale optimizing with bound %g.\n" % s.settings["scale_limit"])
+            return
+        if raw == "U":
+            old = s.toggles.get("conj_grad", 0)
+            s.toggles["conj_grad"] = 0 if old else 1
+            s.reset_cg()
+            s.write(f"Conjugate gradient now {'OFF' if old else 'ON'}. (was {'on' if old else 'off'})\n")
+            return
+        if raw == "G":
+            old_on = s.surface.gravity_constant != 0
+            if arg is not None:
+                s.surface.gravity_constant = float(self.value(arg))
+            s.write("Gravity is now ON with gravitational constant %g. (was %s)\n"
+                    % (s.surface.gravity_constant, "on" if old_on else "off"))
+            s.recalc()
+            return
         if len(raw) == 1 and raw in LETTER_LATER:
             raise UnsupportedError(f"command {LETTER_LATER[raw]}")
         if name in WORD_LATER:
@@ -786,6 +818,8 @@ class Interpreter:
 
     def _toggle(self, name, arg):
         s = self.session
+        if name == "conj_grad":
+            s.reset_cg()
         if arg is None:
             new = 1
         elif isinstance(arg, N.Var) and arg.name in ("on", "off"):
@@ -795,7 +829,13 @@ class Interpreter:
             new = 1 if v else 0
         old = s.toggles.get(name, TOGGLE_DEFAULTS.get(name, 0))
         s.toggles[name] = new
-        s.write(f"{name} {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
+        if name == "check_increase":
+            s.write(f"Increase check {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
+        elif name == "conj_grad":
+            s.write(f"Conjugate gradient now {'ON' if new else 'OFF'}. "
+                    f"(was {'on' if old else 'off'})\n")
+        else:
+            s.write(f"{name} {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
 
     # -- expressions ------------------------------------------------------------
     def value(self, expr):

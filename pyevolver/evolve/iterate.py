@@ -1,0 +1,359 @@
+"""The ``g`` iteration: one gradient-descent step under constraints (spec §7).
+
+Per step: forces from every energy; fixed vertices held; level-set
+constraints by tangent projection and Newton projection back; fixed body
+volumes and FIXED quantities through Lagrange multipliers with the
+restoring loop; the optimizing-scale line search or a fixed scale.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import UnsupportedError
+from ..surface import project_to_constraints
+from . import gradient as GR
+
+
+@dataclass
+class StepResult:
+    """What one ``g`` step did (``scipy.optimize``-style result)."""
+
+    energy: float
+    area: float
+    scale: float
+    pressures: np.ndarray
+    quantity_pressures: dict
+    printed: bool = True
+    message: str = ""
+    warnings: list = field(default_factory=list)
+
+
+class _Constraints:
+    """Fixed global values: body volumes and FIXED quantities."""
+
+    def __init__(self, surface):
+        s = surface
+        b = s.bodies
+        self.bodies = [i for i in range(b.n) if not math.isnan(b.target[i])]
+        if s.torus_filled and self.bodies:
+            self.bodies = self.bodies[1:]      # one body is redundant in a filled torus
+        self.quantities = [q for q in s.quantities.values() if q.kind == "fixed"]
+
+    def __len__(self):
+        return len(self.bodies) + len(self.quantities)
+
+    def values(self, t):
+        return np.array([t.volumes[i] for i in self.bodies] +
+                        [t.quantity_values[q.name] for q in self.quantities])
+
+    def targets(self, s):
+        return np.array([s.bodies.target[i] for i in self.bodies] +
+                        [q.target for q in self.quantities])
+
+    def scales(self, t):
+        """Sum of absolute element contributions (for the tolerance test)."""
+        s = t.surface
+        out = []
+        if self.bodies:
+            absm = abs(s.bodies.facet_matrix)
+            per = absm @ np.abs(t.facet_volume)
+            out += [max(per[i], 1e-300) for i in self.bodies]
+        for q in self.quantities:
+            out.append(max(abs(t.quantity_values[q.name]), 1e-300))
+        return np.array(out)
+
+    def gradients(self, t):
+        s = t.surface
+        gs = []
+        if self.bodies:
+            vg = GR.body_volume_gradients(t)
+            gs += [vg[i] for i in self.bodies]
+        for q in self.quantities:
+            gs.append(GR.quantity_gradient(t, q))
+        return gs
+
+
+class Iterator:
+    """Runs ``g`` steps on a session's surface."""
+
+    def __init__(self, session):
+        self.session = session
+        self.cg_history = None
+        self.cg_S_old = 0.0
+
+    # -- helpers ----------------------------------------------------------------
+    @property
+    def surface(self):
+        return self.session.surface
+
+    def _mobile(self):
+        s = self.surface
+        mobile = ~s.vattr["fixed"]
+        bnd = s.vattr.get("boundary")
+        if bnd is not None and np.any((bnd != 0) & mobile):
+            raise UnsupportedError("motion of vertices on parametric boundaries that are not "
+                                   "FIXED", "comes later in the evolve issue")
+        return mobile
+
+    def _project_tangent(self, vecs):
+        """Project vectors (list of (nv,3)) onto the constraint tangent spaces."""
+        s = self.surface
+        if not s.vcon:
+            return vecs
+        cids = sorted(s.vcon)
+        on = np.stack([s.vcon[c] for c in cids], axis=1)
+        rows = np.nonzero(on.any(axis=1))[0]
+        if not len(rows):
+            return vecs
+        env = s.param_env()
+        groups = {}
+        for r in rows:
+            groups.setdefault(tuple(on[r]), []).append(r)
+        out = [v.copy() for v in vecs]
+        for key, rr in groups.items():
+            rr = np.array(rr)
+            P = s.X[rr]
+            coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+            Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(rr))
+                           for c, k in zip(cids, key) if k], axis=2)     # (n, 3, k)
+            GtG = np.einsum("nik,nil->nkl", Gm, Gm)
+            for v in out:
+                w = v[rr]
+                rhs = np.einsum("nik,ni->nk", Gm, w)
+                with np.errstate(all="ignore"):
+                    lam = np.linalg.solve(GtG, rhs[..., None])[..., 0]
+                lam = np.nan_to_num(lam)
+                v[rr] = w - np.einsum("nik,nk->ni", Gm, lam)
+        return out
+
+    def _constrained_dirs(self, t, cons, mobile):
+        gs = cons.gradients(t)
+        for g in gs:
+            g[~mobile] = 0.0
+        us = self._project_tangent(gs)
+        k = len(gs)
+        A = np.empty((k, k))
+        for i in range(k):
+            for j in range(k):
+                A[i, j] = float(np.sum(gs[i] * us[j]))
+        for i in range(k):
+            if A[i, i] == 0:
+                A[i, i] = 1.0
+        return gs, us, A
+
+    # -- one move ------------------------------------------------------------------
+    def _move(self, X0, vel, scale, cons, us, A, mobile, targets, report):
+        """Trial move M(scale) from X0: step, project, restore constraint values."""
+        s = self.surface
+        s.X = X0 + scale * vel
+        moved = np.nonzero(mobile)[0]
+        project_to_constraints(s, moved)
+        if not len(cons):
+            return s.evaluate()
+        tol = self.session.settings.get("target_tolerance", 1e-4)
+        t = s.evaluate()
+        scales = cons.scales(t)
+        d = targets - cons.values(t)
+        err = float(np.sum(np.abs(d) / (tol * scales)))
+        cur_us, cur_A = us, A
+        for it in range(10):
+            try:
+                delta = np.linalg.solve(cur_A, d)
+            except np.linalg.LinAlgError:
+                delta = np.linalg.lstsq(cur_A, d, rcond=None)[0]
+            Xprev = s.X.copy()
+            shift = sum(dl * u for dl, u in zip(delta, cur_us))
+            s.X = s.X + shift
+            project_to_constraints(s, moved)
+            t_new = s.evaluate()
+            d_new = targets - cons.values(t_new)
+            err_new = float(np.sum(np.abs(d_new) / (tol * scales)))
+            if err_new > 100 * err and err > 0 and it > 0:
+                if report:
+                    report.append(f"Total constraint difference would increase by factor of "
+                                  f"{err_new / err:f}.")
+                    report.append("Aborting constraint adjustment.")
+                s.X = Xprev
+                t = s.evaluate()
+                return t
+            if err_new > 1.01 * err and it > 0:
+                # undo and take half the correction
+                s.X = Xprev + 0.5 * shift
+                project_to_constraints(s, moved)
+                t_new = s.evaluate()
+                d_new = targets - cons.values(t_new)
+                err_new = float(np.sum(np.abs(d_new) / (tol * scales)))
+            improved = err_new < 0.5 * err
+            t, d, err = t_new, d_new, err_new
+            if err <= 1.0:
+                return t
+            if not improved:
+                gs, cur_us, cur_A = self._constrained_dirs(t, cons, mobile)
+        if report is not None:
+            report.append("WARNING 1055: Volume or quantity constraints don't converge in "
+                          "10 projections.")
+            report.append(f"Total difference {err:g} times tolerance")
+            self.cg_history = None
+        return t
+
+    # -- the step --------------------------------------------------------------------
+    def step(self):
+        sess = self.session
+        s = self.surface
+        settings = sess.settings
+        mobile = self._mobile()
+        cons = _Constraints(s)
+        t0 = s.evaluate()
+        f = -GR.energy_gradient(t0)
+        f[~mobile] = 0.0
+        (f,) = self._project_tangent([f])
+        targets = cons.targets(s)
+        lam = np.zeros(len(cons))
+        if len(cons):
+            gs, us, A = self._constrained_dirs(t0, cons, mobile)
+            b = np.array([float(np.sum(f * g)) for g in gs])
+            try:
+                lam = np.linalg.solve(A, b)
+            except np.linalg.LinAlgError:
+                lam = np.linalg.lstsq(A, b, rcond=None)[0]
+            vel = f - sum(l * u for l, u in zip(lam, us))
+        else:
+            us, A = [], np.zeros((0, 0))
+            vel = f
+        # conjugate gradient
+        if sess.toggles.get("conj_grad", 0):
+            S = float(np.sum(vel[mobile] * f[mobile]))
+            if self.cg_history is None or self.cg_S_old < 1e-15:
+                gamma = 0.0
+            else:
+                gamma = S / self.cg_S_old
+                if gamma > 10:
+                    gamma = 0.0
+            h = vel if self.cg_history is None else vel + gamma * self.cg_history
+            self.cg_history = h
+            self.cg_S_old = S
+            vel = h
+        X0 = s.X.copy()
+        warnings = []
+
+        def E(scale, report=None):
+            t = self._move(X0, vel, scale, cons, us, A, mobile, targets, report)
+            e = t.energy
+            return e if math.isfinite(e) else math.inf
+
+        smax = settings["scale_limit"]
+        fixed_scale = sess.toggles.get("_fixed_scale", 0)
+        if fixed_scale:
+            scale = settings["scale"]
+            E0 = None
+        else:
+            scale, E0, s1 = self._line_search(E, settings["scale"], smax)
+        # actual move
+        report = []
+        t = self._move(X0, vel, settings.get("scale_scale", 1.0) * scale, cons, us, A, mobile,
+                       targets, report)
+        e = t.energy
+        if not math.isfinite(e):
+            s.X = X0
+            sess.recalc()
+            warnings.append("WARNING 1864: energy is not finite; coordinates restored.")
+            return StepResult(t0.energy, t0.total_area, scale, lam, {}, False,
+                              warnings=report + warnings)
+        if E0 is None:
+            E0 = t0.energy
+        if sess.toggles.get("check_increase", 0) and e > E0:
+            s.X = X0
+            sess.recalc()
+            warnings.append("WARNING 1865: Motion would have increased energy. Restoring "
+                            "coordinates.")
+            return StepResult(t0.energy, t0.total_area, scale, lam, {}, False,
+                              message="increase", warnings=report + warnings)
+        if not fixed_scale and e > E0 and scale > 0:
+            scale = s1
+            report = []
+            t = self._move(X0, vel, scale, cons, us, A, mobile, targets, report)
+            self.cg_history = None
+        if not fixed_scale:
+            settings["scale"] = scale
+        # reported pressures: P = -lambda
+        b = s.bodies
+        qp = {}
+        k = 0
+        if b.n:
+            b.lagrange[:] = 0.0
+        for i in cons.bodies:
+            b.lagrange[i] = -lam[k]
+            k += 1
+        for q in cons.quantities:
+            q.pressure = -lam[k]
+            qp[q.name] = q.pressure
+            k += 1
+        sess.recalc(keep_cg=True)
+        sess.iteration_counter = getattr(sess, "iteration_counter", 0) + 1
+        sess.total_time = getattr(sess, "total_time", 0.0) + scale
+        return StepResult(sess.totals.energy, sess.totals.total_area, scale,
+                          b.lagrange.copy() if b.n else np.zeros(0), qp, True,
+                          warnings=report + warnings)
+
+    def _line_search(self, E, scale, smax):
+        """The optimizing-scale search of spec §7.6; returns (s, E0, s1)."""
+        s = min(scale, smax)
+        if s <= 0:
+            s = 1e-6 * smax
+        E1 = E(s)
+        s1 = s
+        E0 = E(0.0)
+        s0 = 0.0
+        E2 = s2 = None
+        final = False
+        if E1 < E0:
+            while True:
+                s = 2 * s
+                E2 = E(s)
+                s2 = s
+                if not math.isfinite(E2):
+                    s = s / 2
+                    final = True
+                    break
+                if E2 > E1:
+                    s = s / 2
+                    break
+                E1, s1 = E2, s2
+                if s >= smax:
+                    break
+        else:
+            n = 0
+            while True:
+                n += 1
+                if n > 20:
+                    s = 0.0
+                    break
+                E2, s2 = E1, s1
+                s = s / 2
+                if s < 1e-12 * smax:
+                    s = 0.0
+                    break
+                E1 = E(s)
+                s1 = s
+                if E1 <= E0:
+                    break
+            s = 2 * s
+        if not final:
+            if s > smax:
+                s = smax
+            elif s > 0:
+                den = E0 * (s1 - s2) + E1 * (s2 - s0) + E2 * (s0 - s1)
+                if den == 0:
+                    s = 0.0
+                else:
+                    s = ((E0 - E2) * s1 * s1 + (E1 - E0) * s2 * s2 + (E2 - E1) * s0 * s0) / (2 * den)
+        s = min(s, smax)
+        return s, E0, s1
+
+
+def progress_line(k, result, string_model=False):
+    return "%3d. %s: %#17.15g energy: %#17.15g  scale: %#g" % (
+        k, "length" if string_model else "area", result.area, result.energy, result.scale)
