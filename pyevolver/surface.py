@@ -204,36 +204,13 @@ class Totals:
         """Constraint and boundary ENERGY / CONTENT edge integrals."""
         s = self.surface
         energy = 0.0
-        content = np.zeros(s.ne) if (s.econ or s.boundaries) else None
-        efixed = s.eattr["fixed"]
-        for cid, sign in s.econ.items():
-            c = s.constraints[cid]
-            if c.energy is None and c.content is None:
-                continue
-            # the manual: integrals are not evaluated over FIXED edges
-            idx = np.nonzero((sign != 0) & ~efixed)[0]
-            if not len(idx):
-                continue
-            sg = sign[idx].astype(float)
-            if c.energy is not None:
-                energy += float(sg @ self.edge_vector_integral(c.energy, idx))
-            if c.content is not None:
-                content[idx] += sg * self.edge_vector_integral(c.content, idx)
-        eb = s.eattr.get("boundary")
-        if eb is not None:
-            for bid, b in s.boundaries.items():
-                if b.energy is None and b.content is None:
-                    continue
-                idx = np.nonzero(eb == bid)[0]
-                if not len(idx):
-                    continue
-                if b.energy is not None:
-                    energy += float(self.edge_vector_integral(b.energy, idx).sum())
-                if b.content is not None:
-                    # REF adds boundary content with the opposite sign to
-                    # constraint content (checked on column.fe with the
-                    # boundary edges reversed: the volume is unchanged)
-                    content[idx] -= self.edge_vector_integral(b.content, idx)
+        for comps, idx, sign in integral_edges(s, "energy"):
+            energy += float(sign @ self.edge_vector_integral(comps, idx))
+        content = None
+        for comps, idx, sign in integral_edges(s, "content"):
+            if content is None:
+                content = np.zeros(s.ne)
+            content[idx] += sign * self.edge_vector_integral(comps, idx)
         return energy, content
 
     def _gap_energy(self):
@@ -865,6 +842,35 @@ class _Builder:
     # -- projection -------------------------------------------------------------------
     def _project(self):
         project_to_constraints(self.s, np.arange(self.s.nv))
+
+
+def integral_edges(s, which):
+    """Edges carrying ENERGY (``which="energy"``) or CONTENT integrands.
+
+    Returns ``[(components, edge indices, signs), ...]``.  Constraint
+    integrals skip FIXED edges (manual) and take the edge's constraint
+    orientation; boundary content enters with the opposite sign (REF,
+    checked on column.fe with its boundary edges reversed).
+    """
+    out = []
+    efixed = s.eattr["fixed"]
+    for cid, sign in s.econ.items():
+        comps = getattr(s.constraints[cid], which)
+        if comps is None:
+            continue
+        idx = np.nonzero((sign != 0) & ~efixed)[0]
+        if len(idx):
+            out.append((comps, idx, sign[idx].astype(float)))
+    eb = s.eattr.get("boundary")
+    if eb is not None:
+        for bid, b in s.boundaries.items():
+            comps = getattr(b, which)
+            if comps is None:
+                continue
+            idx = np.nonzero(eb == bid)[0]
+            if len(idx):
+                out.append((comps, idx, np.full(len(idx), -1.0 if which == "content" else 1.0)))
+    return out
 
 
 def torus_lift_shifts(s):

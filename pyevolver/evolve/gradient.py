@@ -165,26 +165,9 @@ def edge_length_grad(t, idx, weights):
 
 
 def content_edge_terms(t):
-    """Per-edge (constraint id or boundary, comps, idx, sign) content integrals."""
-    s = t.surface
-    out = []
-    efixed = s.eattr["fixed"]
-    for cid, sign in s.econ.items():
-        c = s.constraints[cid]
-        if c.content is None:
-            continue
-        idx = np.nonzero((sign != 0) & ~efixed)[0]
-        if len(idx):
-            out.append((c.content, idx, sign[idx].astype(float)))
-    eb = s.eattr.get("boundary")
-    if eb is not None:
-        for bid, b in s.boundaries.items():
-            if b.content is None:
-                continue
-            idx = np.nonzero(eb == bid)[0]
-            if len(idx):
-                out.append((b.content, idx, -np.ones(len(idx))))
-    return out
+    """Per-edge content integrals: ``[(components, edge indices, signs)]``."""
+    from ..surface import integral_edges
+    return integral_edges(t.surface, "content")
 
 
 def energy_gradient(t):
@@ -195,18 +178,9 @@ def energy_gradient(t):
     if et is not None and np.any(et):
         nz = np.nonzero(et)[0]
         g += edge_length_grad(t, nz, et[nz])
-    efixed = s.eattr["fixed"]
-    for cid, sign in s.econ.items():
-        c = s.constraints[cid]
-        if c.energy is None:
-            continue
-        idx = np.nonzero((sign != 0) & ~efixed)[0]
-        g += edge_vector_integral_grad(t, c.energy, idx, sign[idx].astype(float))
-    eb = s.eattr.get("boundary")
-    if eb is not None:
-        for bid, b in s.boundaries.items():
-            if b.energy is not None:
-                g += edge_vector_integral_grad(t, b.energy, np.nonzero(eb == bid)[0])
+    from ..surface import integral_edges
+    for comps, idx, sign in integral_edges(s, "energy"):
+        g += edge_vector_integral_grad(t, comps, idx, sign)
     if "gap" in t.terms:
         g += gap_energy_grad(t)
     b = s.bodies
