@@ -217,13 +217,7 @@ class Totals:
         """Gap energy of edges on CONVEX constraints (spec §4.1.7)."""
         s = self.surface
         total = 0.0
-        for cid, sign in s.econ.items():
-            c = s.constraints[cid]
-            if "convex" not in c.flags:
-                continue
-            idx = np.nonzero(sign)[0]
-            if not len(idx):
-                continue
+        for c, idx in convex_edges(s):
             d = self.edge_vec[idx]
             L = self.edge_length[idx]
             for end in (0, 1):
@@ -842,6 +836,17 @@ class _Builder:
     # -- projection -------------------------------------------------------------------
     def _project(self):
         project_to_constraints(self.s, np.arange(self.s.nv))
+
+
+def convex_edges(s):
+    """``[(constraint, edge indices)]`` of edges on CONVEX constraints (gap energy)."""
+    out = []
+    for cid, sign in s.econ.items():
+        c = s.constraints[cid]
+        idx = np.nonzero(sign)[0]
+        if "convex" in c.flags and len(idx):
+            out.append((c, idx))
+    return out
 
 
 def integral_edges(s, which):

@@ -615,7 +615,6 @@ class Reader:
         sc = self.scene
         etype = {"vertices": "vertex", "edges": "edge", "faces": "facet", "bodies": "body"}[kind]
         qnames = set(sc.quantities) | set(sc.method_instances)
-        data = []
         attrs = []
         i = 0
         n = len(items)

@@ -205,15 +205,10 @@ def gap_energy_grad(t):
     ``T_e = k |s.g_e| |s| / (12 |g_e|)``; differentiated through s and
     through g_e (the symbolic Hessian of the constraint function).
     """
+    from ..surface import convex_edges
     s = t.surface
     out = np.zeros((s.nv, 3))
-    for cid, sign in s.econ.items():
-        c = s.constraints[cid]
-        if "convex" not in c.flags:
-            continue
-        idx = np.nonzero(sign)[0]
-        if not len(idx):
-            continue
+    for c, idx in convex_edges(s):
         d = t.edge_vec[idx]
         L = t.edge_length[idx]
         params = s.param_env()

@@ -543,9 +543,6 @@ _DIFF = {
 COORD_ALIASES = {"x1": "x", "x2": "y", "x3": "z", "x4": "w"}
 
 
-class _Rename:
-    pass
-
 
 def canonical_coords(node):
     """Rewrite ``x1 x2 x3`` to ``x y z`` so derivatives see one name."""
