@@ -41,6 +41,18 @@ def _find_datafile(name):
 
 
 def main(argv=None):
+    try:
+        return _main(argv)
+    except BrokenPipeError:
+        # the reader of our output went away (e.g. `| head`): exit quietly
+        try:
+            sys.stdout = open(os.devnull, "w")
+        except OSError:
+            pass
+        return 0
+
+
+def _main(argv=None):
     args = build_parser().parse_args(argv)
     path = _find_datafile(args.datafile)
     if path is None:
