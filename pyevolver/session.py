@@ -142,10 +142,12 @@ class Session:
                 None if s is None else {k: (q.target, q.modulus, q.kind)
                                         for k, q in s.quantities.items()},
                 None if s is None else {k: v.copy() for k, v in s.extra.items()},
-                None if s is None else {k: v.copy() for k, v in s.vattr.items()})
+                None if s is None else {k: v.copy() for k, v in s.vattr.items()},
+                s)
 
     def _restore(self, snap):
-        vars_, cmds, toggles, settings, X, bod, qs, extra, vattr = snap
+        vars_, cmds, toggles, settings, X, bod, qs, extra, vattr, surface = snap
+        self.surface = surface
         self.variables.clear()
         self.variables.update(vars_)
         self.commands = cmds
@@ -212,11 +214,125 @@ class Session:
         return results
 
     def go(self, n):
-        """``g n`` at the prompt: steps with progress lines."""
+        """``g n`` at the prompt: steps with progress lines.
+
+        Ctrl-C (SIGINT) during the run is deferred to the end of the current
+        step: the step completes, the run stops and the surface is the one
+        after that step."""
+        import signal
+        import threading
+        flag = {"hit": False}
+        installed = False
+        if threading.current_thread() is threading.main_thread():
+            def handler(signum, frame):
+                flag["hit"] = True
+            try:
+                old = signal.signal(signal.SIGINT, handler)
+                installed = True
+            except (ValueError, OSError):
+                installed = False
         try:
-            self.g(n, echo=True)
-        except KeyboardInterrupt:
-            self.write("Interrupted; the surface is as after the last full step.\n")
+            self.g(n, echo=True, callback=lambda r: flag["hit"])
+        finally:
+            if installed:
+                signal.signal(signal.SIGINT, old)
+        if flag["hit"]:
+            self.write("Interrupted: stopped after a complete iteration.\n")
+
+    def hessian(self, seek=False, max_scale=None, echo=True):
+        """``hessian``: one Newton step on the constrained problem;
+        ``hessian_seek [max]``: a line search along the Newton direction
+        (scale at most ``max``, default 1).  Returns a :class:`StepResult`."""
+        from .evolve.hessian import newton_direction
+        from .evolve.iterate import StepResult
+        it = self.iterator
+        s = self.surface
+        dx, lam, cons, mobile = newton_direction(it)
+        t0 = s.evaluate()
+        targets = cons.targets(s)
+        if len(cons):
+            _, us, A = it._constrained_dirs(t0, cons, mobile)
+        else:
+            us, A = [], np.zeros((0, 0))
+        X0 = s.X.copy()
+
+        def E(scale, report=None):
+            e = it._move(X0, dx, scale, cons, us, A, mobile, targets, report).energy
+            return e if math.isfinite(e) else math.inf
+        scale = 1.0
+        if seek:
+            smax = 1.0 if max_scale is None else max_scale
+            scale, _, _ = it._line_search(E, smax, smax)
+        report = []
+        t = it._move(X0, dx, scale, cons, us, A, mobile, targets, report)
+        if not math.isfinite(t.energy):
+            s.X = X0
+            self.recalc()
+            raise CommandError("hessian: the Newton step gives a non-finite energy; "
+                               "the surface is unchanged")
+        b = s.bodies
+        qp = {}
+        if b.n:
+            b.lagrange[:] = 0.0
+        for k, i in enumerate(cons.bodies):
+            b.lagrange[i] = lam[k]
+        for k, q in enumerate(cons.quantities):
+            q.pressure = lam[len(cons.bodies) + k]
+            qp[q.name] = q.pressure
+        self.recalc()
+        r = StepResult(self.totals.energy, self.totals.total_area, scale,
+                       b.lagrange.copy() if b.n else np.zeros(0), qp, True, warnings=report)
+        if echo:
+            for w in report:
+                self.write(w + "\n")
+            if not self.toggles.get("quiet"):
+                what = "length" if s.sdim == 2 and False else "area"
+                self.write("%3d. %s: %#17.15g energy: %#17.15g\n"
+                           % (1, what, r.area, r.energy))
+        return r
+
+    # -- mesh upkeep ------------------------------------------------------------------
+    def _replace_surface(self, new):
+        self.surface = new
+        self.recalc()
+
+    def refine(self, echo=True):
+        """``r``: refine every edge and facet (spec §8.1)."""
+        from .mesh import refine
+        self._replace_surface(refine(self.surface))
+        if "edge_divide_length" in self.settings:
+            self.settings["edge_divide_length"] /= 2
+        if "areaweed_area" in self.settings:
+            self.settings["areaweed_area"] /= 4
+        if echo:
+            s = self.surface
+            self.write(f"Vertices: {s.nv}  Edges: {s.ne}  Facets: {s.nf}  "
+                       f"Bodies: {s.bodies.n}  Facetedges: {3 * s.nf}\n")
+
+    def refine_edges(self, edges, echo=True):
+        """``refine edges where ...``: bisect the given edges (spec §8)."""
+        from .mesh.edge_divide import edge_divide
+        new, n = edge_divide(self.surface, np.asarray(edges, np.int64))
+        self._replace_surface(new)
+        if echo:
+            self.write(f"Edges refined: {n}\n")
+
+    def refine_facets(self, facets, echo=True):
+        """``refine facets where ...``: split facets at their centres."""
+        from .mesh.notch import split_facets
+        new = split_facets(self.surface, np.asarray(facets, np.int64))
+        self._replace_surface(new)
+        if echo:
+            self.write(f"Facets refined: {len(facets)}\n")
+
+    def equiangulate(self, echo=True):
+        """``u``: one equiangulation sweep (spec §8.2)."""
+        from .mesh.equiangulate import equiangulate
+        new, n = equiangulate(self.surface)
+        self._replace_surface(new)
+        if echo:
+            self.write(f"Edges switched in equiangulation: {n}\n")
+        return n
 
     def refresh(self):
         if self.toggles.get("autorecalc", 1):

@@ -542,8 +542,6 @@ class Env:
 
 LETTER_LATER = {
     "g": "g (iteration) comes with the evolve issue",
-    "r": "r (refinement) comes with the mesh-upkeep issue",
-    "u": "u (equiangulation) comes with the mesh-upkeep issue",
     "V": "V (vertex averaging) comes with the mesh-upkeep issue",
     "U": "U (conjugate gradient) comes with the evolve issue",
     "m": "m (fixed scale) comes with the evolve issue",
@@ -561,9 +559,9 @@ LETTER_LATER = {
     "Z": "Z (zoom)", "M": "M (model order)", "J": "J (jiggle toggle)",
 }
 WORD_LATER = {
-    "hessian", "hessian_seek", "saddle", "ritz", "eigenprobe", "lanczos", "hessian_menu",
+    "saddle", "ritz", "eigenprobe", "lanczos", "hessian_menu",
     "rawv", "rawestv", "vertex_average", "raw_vertex_average", "rawest_vertex_average",
-    "edgeweed", "edge_divide", "areaweed", "notch", "equiangulate", "pop", "edgeswap",
+    "edgeweed", "edge_divide", "areaweed", "notch", "pop", "edgeswap",
     "t1_edgeswap", "delete", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
     "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
     "conj_grad_later", "fix", "unfix", "burchard", "zoom",
@@ -735,7 +733,13 @@ class Interpreter:
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=True)
 
     def _x_refine(self, node):
-        raise UnsupportedError("refine", "refinement comes with the mesh-upkeep issue")
+        s = self.session
+        els = s.generate(node[1], self.env)
+        kinds = {el.kind for el in els}
+        if kinds - {"edge"}:
+            raise UnsupportedError("refine of " + ", ".join(sorted(kinds - {"edge"})) + "s",
+                                   "only 'refine edges' is supported")
+        s.refine_edges([el.i for el in els])
 
     def _x_break(self, node):
         raise _Break(1 if node[1] is None else int(self.value(node[1])))
@@ -793,6 +797,19 @@ class Interpreter:
                 s.settings["scale_limit"] = float(self.value(arg))
             s.toggles["_fixed_scale"] = 0
             s.write("Scale optimizing with bound %g.\n" % s.settings["scale_limit"])
+            return
+        if raw == "r":
+            for _ in range(1 if arg is None else self._count(arg)):
+                s.refine()
+            return
+        if raw == "u" or name == "equiangulate":
+            s.equiangulate()
+            return
+        if name in ("hessian", "hessian_seek"):
+            if name == "hessian_seek" and arg is not None:
+                s.hessian(seek=True, max_scale=float(self.value(arg)))
+            else:
+                s.hessian(seek=name == "hessian_seek")
             return
         if raw == "U":
             old = s.toggles.get("conj_grad", 0)

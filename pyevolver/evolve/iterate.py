@@ -53,17 +53,14 @@ class _Constraints:
         return np.array([s.bodies.target[i] for i in self.bodies] +
                         [q.target for q in self.quantities])
 
-    def scales(self, t):
-        """Sum of absolute element contributions (for the tolerance test)."""
-        s = t.surface
-        out = []
-        if self.bodies:
-            absm = abs(s.bodies.facet_matrix)
-            per = absm @ np.abs(t.facet_volume)
-            out += [max(per[i], 1e-300) for i in self.bodies]
+    def tolerances(self, default):
+        """Absolute tolerance of each constrained value: the quantity's
+        TOLERANCE when set (>= 0), else ``target_tolerance`` (manual,
+        "Tolerance"; REF's itdebug prints Σ|d_i|/tol_i as "Diff")."""
+        out = [default] * len(self.bodies)
         for q in self.quantities:
-            out.append(max(abs(t.quantity_values[q.name]), 1e-300))
-        return np.array(out)
+            out.append(q.tolerance if q.tolerance is not None and q.tolerance >= 0 else default)
+        return np.array(out, dtype=float)
 
     def gradients(self, t):
         s = t.surface
@@ -155,9 +152,9 @@ class Iterator:
             return s.evaluate()
         tol = self.session.settings.get("target_tolerance", 1e-4)
         t = s.evaluate()
-        scales = cons.scales(t)
+        tols = cons.tolerances(tol)
         d = targets - cons.values(t)
-        err = float(np.sum(np.abs(d) / (tol * scales)))
+        err = float(np.sum(np.abs(d) / tols))
         cur_us, cur_A = us, A
         for it in range(10):
             try:
@@ -170,7 +167,7 @@ class Iterator:
             project_to_constraints(s, moved)
             t_new = s.evaluate()
             d_new = targets - cons.values(t_new)
-            err_new = float(np.sum(np.abs(d_new) / (tol * scales)))
+            err_new = float(np.sum(np.abs(d_new) / tols))
             if err_new > 100 * err and err > 0 and it > 0:
                 if report:
                     report.append(f"Total constraint difference would increase by factor of "
@@ -185,7 +182,7 @@ class Iterator:
                 project_to_constraints(s, moved)
                 t_new = s.evaluate()
                 d_new = targets - cons.values(t_new)
-                err_new = float(np.sum(np.abs(d_new) / (tol * scales)))
+                err_new = float(np.sum(np.abs(d_new) / tols))
             improved = err_new < 0.5 * err
             t, d, err = t_new, d_new, err_new
             if err <= 1.0:

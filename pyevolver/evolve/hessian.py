@@ -1,0 +1,452 @@
+"""``hessian`` / ``hessian_seek``: Newton steps on the constrained problem.
+
+The step solves the bordered (KKT) system
+
+    [ Tᵀ H T   Tᵀ C ] [ dy ]   [ −Tᵀ ∇E ]
+    [ Cᵀ T      0   ] [ −λ ] = [ t − v  ]
+
+where ``H`` is the Hessian of the Lagrangian ``E − Σ λ_i g_i − Σ μ_v φ(x_v)``
+(energy, fixed body volumes / FIXED quantities ``g_i`` with targets ``t``,
+level-set constraints φ), ``C`` holds the gradients of the ``g_i`` and
+``T`` maps the free coordinates ``dy`` of each mobile vertex (its tangent
+space to its level-set constraints) to ``dx = T dy``.  Everything is a
+sparse matrix; the system is solved with a sparse LU factorization
+(``scipy.sparse.linalg.splu``).  After the move, vertices are projected
+back onto their constraints and the fixed values restored as in ``g``.
+
+Hessians: facet area (tension), edge length, and facet volume (z-flux and
+symmetric) are analytic (per-element 9×9 / 6×6 blocks); every other term
+(gravity, constraint and boundary integrals, quantities, torus lifts) is
+differentiated by central differences of its analytic gradient, with a
+distance-2 vertex colouring so that one gradient pair per colour and
+coordinate gives all columns (Curtis–Powell–Reid 1974; Coleman–Moré 1983).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..errors import UnsupportedError
+from ..surface import project_to_constraints
+from . import gradient as GR
+
+
+def _skew(v):
+    """(n, 3) vectors -> (n, 3, 3) cross-product matrices [v]x."""
+    z = np.zeros(len(v))
+    return np.stack([np.stack([z, -v[:, 2], v[:, 1]], 1),
+                     np.stack([v[:, 2], z, -v[:, 0]], 1),
+                     np.stack([-v[:, 1], v[:, 0], z], 1)], 1)
+
+
+def _assemble(nv, verts, blocks):
+    """Sparse (3nv, 3nv) matrix from per-element blocks.
+
+    verts : (m, k) vertex indices of each element; blocks : (m, k, k, 3, 3).
+    """
+    m, k = verts.shape
+    rows = (3 * verts[:, :, None, None, None] + np.arange(3)[None, None, None, :, None])
+    cols = (3 * verts[:, None, :, None, None] + np.arange(3)[None, None, None, None, :])
+    rows = np.broadcast_to(rows, (m, k, k, 3, 3)).ravel()
+    cols = np.broadcast_to(cols, (m, k, k, 3, 3)).ravel()
+    return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(3 * nv, 3 * nv))
+
+
+def facet_area_hessian(t, weights):
+    """Hessian of ``Σ_f w_f A_f`` (3nv, 3nv).
+
+    With ``N = (x1−x0)×(x2−x0)``, ``n = N/|N|`` and ``e_a`` the side opposite
+    corner a (``e_0 = x2−x1`` cyclic), ``∂A/∂x_a = ½ n × e_a`` and
+
+        ∂²A/∂x_a∂x_b = ½ ε_ab [n]x + [e_a]xᵀ (I − n nᵀ) [e_b]x / (2|N|)
+
+    with ε_ab = +1 if b = a+2, −1 if b = a+1 (mod 3), 0 if a = b.
+    """
+    s = t.surface
+    P = GR._facet_points(t)
+    N2 = t.facet_N2
+    L = np.linalg.norm(N2, axis=1)
+    ok = (L > 0) & (weights != 0)
+    P, N2, L, w = P[ok], N2[ok], L[ok], weights[ok]
+    n = N2 / L[:, None]
+    e = np.stack([P[:, 2] - P[:, 1], P[:, 0] - P[:, 2], P[:, 1] - P[:, 0]], 1)
+    Ex = np.stack([_skew(e[:, a]) for a in range(3)], 1)          # (m, 3, 3, 3)
+    Pn = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
+    B = np.einsum("maji,mjk,mbkl->mabil", Ex, Pn, Ex) / (2 * L)[:, None, None, None, None]
+    nx = _skew(n)
+    eps = np.zeros((3, 3))
+    for a in range(3):
+        eps[a, (a + 2) % 3] = 1.0
+        eps[a, (a + 1) % 3] = -1.0
+    B += 0.5 * eps[None, :, :, None, None] * nx[:, None, None]
+    B *= w[:, None, None, None, None]
+    return _assemble(s.nv, s.F[ok], B)
+
+
+def edge_length_hessian(t, idx, weights):
+    """Hessian of ``Σ_e w_e L_e``: blocks ``±(I − t tᵀ)/L``."""
+    s = t.surface
+    d = t.edge_vec[idx]
+    L = t.edge_length[idx]
+    ok = L > 0
+    d, L, w, idx = d[ok], L[ok], np.asarray(weights)[ok], idx[ok]
+    u = d / L[:, None]
+    K = (np.eye(3)[None] - u[:, :, None] * u[:, None, :]) * (w / L)[:, None, None]
+    B = np.stack([np.stack([K, -K], 1), np.stack([-K, K], 1)], 1)
+    return _assemble(s.nv, s.E[idx], B)
+
+
+def facet_volume_hessian(t, weights, symmetric):
+    """Hessian of ``Σ_f w_f v_f`` for the z-flux or symmetric facet volume."""
+    s = t.surface
+    P = GR._facet_points(t)
+    m = len(P)
+    B = np.zeros((m, 3, 3, 3, 3))
+    if symmetric:
+        # v = det[x0, x1, x2]/6: d²v/dx_a^i dx_b^j = ±ε_ijk x_c^k / 6
+        for a in range(3):
+            for b in range(3):
+                if a == b:
+                    continue
+                c = 3 - a - b
+                sign = 1.0 if (a, b, c) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) else -1.0
+                B[:, a, b] = sign * _skew(P[:, c]).transpose(0, 2, 1) / 6.0
+                # eps_ijk x^k = -[x]x_ij
+    else:
+        # v = (z0+z1+z2) cz / 6, cz bilinear in x and y
+        C = np.array([[0, 1, -1], [-1, 0, 1], [1, -1, 0]], float)
+        Z = P[:, :, 2].sum(axis=1)
+        dcz = GR._cz_grad(P)                      # (m, 3, 3): d cz / d corner
+        for a in range(3):
+            for b in range(3):
+                B[:, a, b, 0, 1] = Z * C[a, b] / 6.0
+                B[:, a, b, 1, 0] = Z * C[b, a] / 6.0
+                B[:, a, b, 2, 0] = dcz[:, b, 0] / 6.0
+                B[:, a, b, 2, 1] = dcz[:, b, 1] / 6.0
+                B[:, a, b, 0, 2] = dcz[:, a, 0] / 6.0
+                B[:, a, b, 1, 2] = dcz[:, a, 1] / 6.0
+    B *= np.asarray(weights)[:, None, None, None, None]
+    return _assemble(s.nv, s.F, B)
+
+
+def distance2_coloring(s, seed=0):
+    """Colour vertices so that no two of a colour share a facet or an edge
+    neighbour (Jones–Plassmann rounds on the square of the vertex graph).
+    Returns (nv,) colour numbers."""
+    nv = s.nv
+    F = s.F
+    r = np.concatenate([s.E[:, 0], s.E[:, 1]] + [F[:, i] for i in range(3)])
+    c = np.concatenate([s.E[:, 1], s.E[:, 0]] + [F[:, (i + 1) % 3] for i in range(3)])
+    A = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(nv, nv))
+    A = ((A + A.T + sp.identity(nv)) != 0).astype(np.float64)
+    A2 = (A @ A).tocsr()
+    A2.setdiag(0)
+    A2.eliminate_zeros()
+    rng = np.random.default_rng(seed)
+    weight = rng.permutation(nv).astype(float) + 1.0
+    color = np.full(nv, -1, np.int64)
+    k = 0
+    rows = np.repeat(np.arange(nv), np.diff(A2.indptr))
+    while (color < 0).any():
+        live = color < 0
+        wl = np.where(live, weight, 0.0)
+        # max live-neighbour weight of each vertex
+        nbw = np.zeros(nv)
+        np.maximum.at(nbw, rows, wl[A2.indices])
+        pick = live & (weight > nbw)
+        color[pick] = k
+        k += 1
+    return color
+
+
+def fd_hessian(fun, s, h=None):
+    """Sparse Hessian of a gradient function ``fun(X) -> (nv, 3)`` by central
+    differences over a distance-2 colouring."""
+    X0 = s.X.copy()
+    scale = float(np.max(np.ptp(X0, axis=0))) if len(X0) else 1.0
+    h = h if h is not None else 1e-5 * max(scale, 1e-12)
+    color = distance2_coloring(s)
+    F = s.F
+    r = np.concatenate([s.E[:, 0], s.E[:, 1]] + [F[:, i] for i in range(3)] +
+                       [np.arange(s.nv)])
+    c = np.concatenate([s.E[:, 1], s.E[:, 0]] + [F[:, (i + 1) % 3] for i in range(3)] +
+                       [np.arange(s.nv)])
+    A = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(s.nv, s.nv))
+    A = (A + A.T).tocoo()
+    nb_r, nb_c = A.row, A.col                   # pairs (z, u) with z near u
+    rows, cols, vals = [], [], []
+    try:
+        for col in range(color.max() + 1):
+            members = color == col
+            sel = members[nb_c]
+            zr, uc = nb_r[sel], nb_c[sel]
+            for k in range(3):
+                s.X = X0.copy()
+                s.X[members, k] += h
+                gp = fun(s.X)
+                s.X = X0.copy()
+                s.X[members, k] -= h
+                gm = fun(s.X)
+                D = (gp - gm) / (2 * h)             # (nv, 3)
+                for i in range(3):
+                    rows.append(3 * zr + i)
+                    cols.append(3 * uc + k)
+                    vals.append(D[zr, i])
+    finally:
+        s.X = X0
+    H = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(3 * s.nv, 3 * s.nv))
+    return 0.5 * (H + H.T)
+
+
+def _analytic_parts(s, t, cons, lam):
+    """Analytic Hessian and gradient of the parts that have closed forms,
+    and whether they cover the whole Lagrangian."""
+    H = facet_area_hessian(t, s.facet_tension)
+    g = GR.corner_scatter(t, GR.facet_area_grad(t), s.facet_tension)
+    complete = set(t.terms) <= {"facet_tension", "edge_tension"}
+    et = s.eattr.get("tension")
+    if et is not None and np.any(et):
+        nz = np.nonzero(et)[0]
+        H = H + edge_length_hessian(t, nz, et[nz])
+        g = g + GR.edge_length_grad(t, nz, et[nz])
+    if getattr(t, "con_energy", 0.0):
+        complete = False
+    b = s.bodies
+    plain_volume = s.periods is None and not GR.content_edge_terms(t)
+    if cons.quantities or (b.n and not np.all(np.isnan(b.pressure))):
+        complete = False
+    if cons.bodies:
+        if plain_volume:
+            w = np.zeros(b.n)
+            for k, i in enumerate(cons.bodies):
+                w[i] = -lam[k]
+            fw = b.facet_matrix.T @ w
+            H = H + facet_volume_hessian(t, fw, s.symmetric_content)
+            g = g + GR.corner_scatter(t, GR.facet_volume_grad(t, s.symmetric_content), fw)
+        else:
+            complete = False
+    return H, g, complete
+
+
+def lagrangian_hessian(s, cons, lam, grad_fn):
+    """Sparse (3nv, 3nv) Hessian of E − Σ λ_i g_i (level-set terms excluded)."""
+    t = s.evaluate()
+    H, g_an, complete = _analytic_parts(s, t, cons, lam)
+    if complete:
+        return H
+
+    def rest(X):
+        tt = s.evaluate()
+        _, ga, _ = _analytic_parts(s, tt, cons, lam)
+        return grad_fn(tt) - ga
+    return H + fd_hessian(rest, s)
+
+
+def vertex_normals(s, t):
+    """(nv, 3) unit vertex normals: the sum of the adjacent facets' area
+    vectors (the volume gradient at a vertex whose star is closed)."""
+    N = np.zeros((s.nv, 3))
+    F = s.F
+    for k in range(3):
+        for i in range(3):
+            N[:, i] += np.bincount(F[:, k], weights=t.facet_N2[:, i], minlength=s.nv)
+    L = np.linalg.norm(N, axis=1)
+    with np.errstate(all="ignore"):
+        return np.where(L[:, None] > 0, N / L[:, None], 0.0)
+
+
+def _junction_vertices(s):
+    """Vertices on edges with three or more facets, and their count of such edges."""
+    from .. import geometry as G
+    idx, _ = G.edge_index(s.FE)
+    val = np.bincount(idx.ravel(), minlength=s.ne)
+    trip = val >= 3
+    cnt = np.bincount(s.E[trip].ravel(), minlength=s.nv)
+    return cnt
+
+
+def tangent_basis(s, mobile, normal=True):
+    """Sparse (3nv, ndof) map ``T`` from free coordinates to vertex motions.
+
+    Unconstrained vertices move freely (3 dof), or with ``normal`` (the
+    Evolver's default ``hessian_normal``) only along their vertex normal;
+    vertices on triple junction lines move perpendicular to the line and
+    points where several junction lines meet keep all 3 dof.  Vertices on
+    level-set constraints move in the constraint's tangent space (with
+    ``normal``: along the normal projected onto it).  Also returns the
+    constraint gradients per group, for :func:`constraint_curvature`.
+    """
+    nv = s.nv
+    cids = sorted(s.vcon)
+    ncon = np.zeros(nv, np.int64)
+    for c in cids:
+        ncon += s.vcon[c]
+    basis = [None] * 0
+    rows, cols, vals = [], [], []
+    ndof_v = np.where(mobile, 3 - np.minimum(ncon, 3), 0)
+    if normal:
+        t = s.evaluate()
+        nrm = vertex_normals(s, t)
+        jcnt = _junction_vertices(s)
+        plain = mobile & (ncon == 0) & (jcnt == 0) & (np.linalg.norm(nrm, axis=1) > 0)
+        line = mobile & (ncon == 0) & (jcnt == 2)
+        ndof_v = np.where(plain, 1, ndof_v)
+        ndof_v = np.where(line, 2, ndof_v)
+        ndof_v = np.where(mobile & (ncon > 0) & (ncon < 3), 1, ndof_v)
+    start = np.concatenate([[0], np.cumsum(ndof_v)[:-1]])
+    if normal:
+        sel = np.nonzero(plain)[0]
+        for i in range(3):
+            rows.append(3 * sel + i)
+            cols.append(start[sel])
+            vals.append(nrm[sel, i])
+        sel = np.nonzero(line)[0]
+        if len(sel):
+            from .. import geometry as G
+            idx, _ = G.edge_index(s.FE)
+            val = np.bincount(idx.ravel(), minlength=s.ne)
+            trip = np.nonzero(val >= 3)[0]
+            d = t.edge_vec[trip]
+            D = np.zeros((nv, 3))
+            for end, sg in ((0, 1.0), (1, -1.0)):
+                for i in range(3):
+                    D[:, i] += np.bincount(s.E[trip, end], weights=sg * d[:, i], minlength=nv)
+            # direction of the line: the two edges' directions point opposite ways at v,
+            # so use an edge direction directly
+            dirs = np.zeros((nv, 3))
+            for i in range(3):
+                dirs[:, i] = np.bincount(s.E[trip, 0], weights=d[:, i], minlength=nv) + \
+                    np.bincount(s.E[trip, 1], weights=d[:, i], minlength=nv)
+            u = dirs[sel]
+            u /= np.maximum(np.linalg.norm(u, axis=1), 1e-300)[:, None]
+            Uu, _, _ = np.linalg.svd(u[:, :, None], full_matrices=True)
+            for j in range(2):
+                for i in range(3):
+                    rows.append(3 * sel + i)
+                    cols.append(start[sel] + j)
+                    vals.append(Uu[:, i, 1 + j])
+        free = np.nonzero(mobile & (ncon == 0) & ~plain & ~line)[0]
+    else:
+        free = np.nonzero(mobile & (ncon == 0))[0]
+    for k in range(3):
+        rows.append(3 * free + k)
+        cols.append(start[free] + k)
+        vals.append(np.ones(len(free)))
+    con = np.nonzero(mobile & (ncon > 0))[0]
+    grads = {}
+    if len(con):
+        env = s.param_env()
+        on = np.stack([s.vcon[c][con] for c in cids], axis=1)
+        keys, inv = np.unique(on, axis=0, return_inverse=True)
+        inv = inv.ravel()
+        for gi, key in enumerate(keys):
+            sel = con[inv == gi]
+            P = s.X[sel]
+            coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+            active = [c for c, k in zip(cids, key) if k]
+            Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(sel))
+                           for c in active], axis=2)            # (n, 3, k)
+            U, S_, Vt = np.linalg.svd(Gm, full_matrices=True)
+            kk = len(active)
+            Tb = U[:, :, kk:]                                    # (n, 3, 3-k)
+            if normal and kk < 3:
+                # the normal projected on the tangent space (when it has a part there)
+                nt = np.einsum("nij,ni->nj", Tb, nrm[sel])          # (n, 3-k)
+                nn = np.linalg.norm(nt, axis=1)
+                v = np.where(nn[:, None] > 1e-12, nt / np.maximum(nn, 1e-300)[:, None],
+                             np.eye(3 - kk)[0][None, :])
+                Tb = np.einsum("nij,nj->ni", Tb, v)[:, :, None]
+            for j in range(Tb.shape[2]):
+                for i in range(3):
+                    rows.append(3 * sel + i)
+                    cols.append(start[sel] + j)
+                    vals.append(Tb[:, i, j])
+            grads[tuple(key)] = (sel, active, Gm)
+    T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(3 * nv, int(ndof_v.sum())))
+    return T, grads
+
+
+def constraint_curvature(s, grads, force_grad):
+    """Σ_v μ_v ∇²φ_c(x_v) with μ from the normal part of ``force_grad``
+    (the Lagrangian gradient, (nv, 3)); sparse (3nv, 3nv) block diagonal."""
+    rows, cols, vals = [], [], []
+    env = s.param_env()
+    for key, (sel, active, Gm) in grads.items():
+        P = s.X[sel]
+        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        GtG = np.einsum("nik,nil->nkl", Gm, Gm)
+        rhs = np.einsum("nik,ni->nk", Gm, force_grad[sel])
+        mu = np.linalg.solve(GtG, rhs[..., None])[..., 0]       # (n, k)
+        Hs = np.zeros((len(sel), 3, 3))
+        for j, c in enumerate(active):
+            Hs += mu[:, j, None, None] * s.constraints[c].formula.hessian(env, coords, len(sel))
+        for i in range(3):
+            for k in range(3):
+                rows.append(3 * sel + i)
+                cols.append(3 * sel + k)
+                vals.append(Hs[:, i, k])
+    if not rows:
+        return None
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(3 * s.nv, 3 * s.nv))
+
+
+def newton_direction(it):
+    """The Newton motion (nv, 3) and new multipliers for the iterator's surface.
+
+    Returns ``(dx, lam_new, cons, mobile)``.
+    """
+    from .iterate import _Constraints
+    s = it.surface
+    mobile = it._mobile()
+    cons = _Constraints(s)
+    t = s.evaluate()
+    gE = GR.energy_gradient(t)
+    lam = np.zeros(len(cons))
+    gs = []
+    if len(cons):
+        f = -gE.copy()
+        f[~mobile] = 0.0
+        (f,) = it._project_tangent([f])
+        gs, us, A = it._constrained_dirs(t, cons, mobile)
+        bb = np.array([float(np.sum(f * g)) for g in gs])
+        lam = -np.linalg.lstsq(A, bb, rcond=None)[0]      # ∇E ≈ Σ λ ∇g
+        gs = cons.gradients(t)
+
+    def grad_L(tt):
+        g = GR.energy_gradient(tt)
+        if len(cons):
+            for l, gg in zip(lam, cons.gradients(tt)):
+                g = g - l * gg
+        return g
+    H = lagrangian_hessian(s, cons, lam, grad_L)
+    T, grads = tangent_basis(s, mobile, normal=bool(it.session.toggles.get("hessian_normal", 1)))
+    gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))
+    Hc = constraint_curvature(s, grads, gL)
+    if Hc is not None:
+        H = H - Hc
+    K = (T.T @ H @ T).tocsc()
+    rhs = -(T.T @ gE.ravel())
+    ncons = len(cons)
+    if ncons:
+        Cm = np.stack([g.ravel() for g in gs], axis=1)          # (3nv, k)
+        B = sp.csc_matrix(T.T @ Cm)
+        M = sp.bmat([[K, B], [B.T, None]], format="csc")
+        d = cons.targets(s) - cons.values(t)
+        rhs = np.concatenate([rhs, d])
+    else:
+        M = K
+    try:
+        sol = spla.splu(M).solve(rhs)
+    except RuntimeError as exc:
+        raise UnsupportedError("hessian on a singular Hessian",
+                               f"the bordered Hessian could not be factored ({exc})") from None
+    dy = sol[:K.shape[0]]
+    lam_new = -sol[K.shape[0]:] if ncons else lam
+    dx = (T @ dy).reshape(-1, 3)
+    return dx, lam_new, cons, mobile

@@ -1,0 +1,195 @@
+"""Append elements to a surface with the Evolver's inheritance rules.
+
+Every topology-changing operation (``r``, ``refine edges``, ``notch``, ...)
+builds a *new* :class:`~pyevolver.surface.Surface` with :func:`grow` and
+then fills in the coordinates and connectivity of the new elements.  The old
+surface object is left untouched, so a failing command can hand the session
+back its previous surface (spec §6.2 for the inheritance).
+"""
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import scipy.sparse as sp
+
+
+def _zeros_like_rows(arr, n):
+    return np.zeros((n,) + arr.shape[1:], dtype=arr.dtype)
+
+
+def _append_rows(arr, rows):
+    return np.concatenate([arr, rows]) if len(rows) else arr.copy()
+
+
+def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
+         f_from_facet=()):
+    """A copy of ``s`` with new vertices, edges and facets appended.
+
+    Parameters
+    ----------
+    s : Surface
+    v_from_edge, v_from_facet : (k,) int arrays
+        Parents of the new vertices (new vertices are appended in this
+        order: edge-born first, then facet-born).
+    e_from_edge, e_from_facet : (k,) int arrays
+        Parents of the new edges (same ordering rule).
+    f_from_facet : (k,) int array
+        Parents of the new facets.
+
+    Returns
+    -------
+    Surface
+        New surface.  Coordinates of new vertices are zero, connectivity rows
+        of new edges/facets are zero: the caller fills them in.  Attributes,
+        constraints, boundaries, quantity memberships and body memberships
+        are inherited (spec §6.2): a vertex or edge born inside a facet takes
+        the facet's FIXED, NO_REFINE, constraints and boundary; a vertex born
+        on an edge takes the edge's FIXED, constraints and boundary; a new
+        edge or facet born from one of its own kind copies everything.
+    """
+    ve = np.asarray(v_from_edge, np.int64)
+    vf = np.asarray(v_from_facet, np.int64)
+    ee = np.asarray(e_from_edge, np.int64)
+    ef = np.asarray(e_from_facet, np.int64)
+    ff = np.asarray(f_from_facet, np.int64)
+    nv_new, ne_new, nf_new = len(ve) + len(vf), len(ee) + len(ef), len(ff)
+    t = copy.copy(s)
+    for name in ("_lift_cache",):
+        t.__dict__.pop(name, None)
+    t.X = _append_rows(s.X, np.zeros((nv_new, 3)))
+    t.E = _append_rows(s.E, np.zeros((ne_new, 2), np.int64))
+    t.FE = _append_rows(s.FE, np.zeros((nf_new, 3), np.int64))
+    efixed = s.eattr["fixed"]
+    ffixed = s.fattr["fixed"]
+
+    # -- vertices
+    va = {}
+    for key, arr in s.vattr.items():
+        rows = _zeros_like_rows(arr, nv_new)
+        if key == "fixed":
+            rows[:len(ve)] = efixed[ve]
+            rows[len(ve):] = ffixed[vf]
+        elif key == "boundary":
+            rows[:len(ve)] = s.eattr["boundary"][ve] if "boundary" in s.eattr else 0
+            rows[len(ve):] = s.fattr["boundary"][vf] if "boundary" in s.fattr else 0
+        va[key] = _append_rows(arr, rows)
+    if "boundary" not in va and "boundary" in s.eattr and s.eattr["boundary"][ve].any():
+        raise AssertionError("edge boundary without vertex boundary")
+    t.vattr = va
+    t.vcon = {}
+    for cid, on in s.vcon.items():
+        if "global" in s.constraints[cid].flags:
+            add = np.ones(nv_new, bool)
+        else:
+            add = np.concatenate([
+                s.econ[cid][ve] != 0 if cid in s.econ else np.zeros(len(ve), bool),
+                s.fcon[cid][vf] if cid in s.fcon else np.zeros(len(vf), bool)])
+        t.vcon[cid] = _append_rows(on, add)
+    for cid in set(s.econ) | set(s.fcon):
+        if cid not in t.vcon:
+            add = np.concatenate([
+                s.econ[cid][ve] != 0 if cid in s.econ else np.zeros(len(ve), bool),
+                s.fcon[cid][vf] if cid in s.fcon else np.zeros(len(vf), bool)])
+            if add.any():
+                t.vcon[cid] = np.concatenate([np.zeros(s.nv, bool), add])
+
+    # -- edges
+    ea = {}
+    for key, arr in s.eattr.items():
+        rows = _zeros_like_rows(arr, ne_new)
+        rows[:len(ee)] = arr[ee]
+        if key == "fixed":
+            rows[len(ee):] = ffixed[ef]
+        elif key == "no_refine":
+            rows[len(ee):] = s.fattr["no_refine"][ef]
+        elif key == "boundary" and "boundary" in s.fattr:
+            rows[len(ee):] = s.fattr["boundary"][ef]
+        elif key == "original":
+            rows[:] = 0
+        ea[key] = _append_rows(arr, rows)
+    t.eattr = ea
+    t.econ = {}
+    for cid, sign in s.econ.items():
+        if "global" in s.constraints[cid].flags:
+            add = np.ones(ne_new, np.int8)
+        else:
+            add = np.concatenate([
+                sign[ee],
+                s.fcon[cid][ef].astype(np.int8) if cid in s.fcon else np.zeros(len(ef), np.int8)])
+        t.econ[cid] = _append_rows(sign, add)
+    for cid, on in s.fcon.items():
+        if cid not in t.econ and on[ef].any():
+            t.econ[cid] = np.concatenate([np.zeros(len(ee) + s.ne, np.int8),
+                                          on[ef].astype(np.int8)])
+
+    # -- facets
+    fa = {}
+    for key, arr in s.fattr.items():
+        rows = arr[ff].copy()
+        if key == "original":
+            rows[:] = 0
+        fa[key] = _append_rows(arr, rows)
+    t.fattr = fa
+    t.fcon = {cid: _append_rows(on, on[ff]) for cid, on in s.fcon.items()}
+
+    # -- extra attributes
+    extra = {}
+    for (etype, name), arr in s.extra.items():
+        if etype == "vertex":
+            extra[(etype, name)] = _append_rows(arr, _zeros_like_rows(arr, nv_new))
+        elif etype == "edge":
+            rows = _zeros_like_rows(arr, ne_new)
+            rows[:len(ee)] = arr[ee]
+            extra[(etype, name)] = _append_rows(arr, rows)
+        elif etype == "facet":
+            extra[(etype, name)] = _append_rows(arr, arr[ff])
+        else:
+            extra[(etype, name)] = arr.copy()
+    t.extra = extra
+
+    # -- bodies
+    b = copy.copy(s.bodies)
+    if b.n:
+        M = s.bodies.facet_matrix.tocsc()
+        b.facet_matrix = sp.hstack([M, M[:, ff]]).tocsr() if nf_new else M.tocsr()
+        ob, of, osg = s.bodies.occurrences
+        if nf_new:
+            # every occurrence of a parent facet gains one of each child
+            order = np.argsort(ff, kind="stable")
+            fs = ff[order]
+            lo = np.searchsorted(fs, of, "left")
+            hi = np.searchsorted(fs, of, "right")
+            cnt = hi - lo
+            rep = np.repeat(np.arange(len(of)), cnt)
+            kid = order[np.concatenate([np.arange(l, h) for l, h in zip(lo, hi)])] \
+                if len(rep) else np.zeros(0, np.int64)
+            b.occurrences = (np.concatenate([ob, ob[rep]]),
+                             np.concatenate([of, s.nf + kid]),
+                             np.concatenate([osg, osg[rep]]))
+        b.volume = None
+    t.bodies = b
+
+    # -- quantities
+    t.quantities = {}
+    sizes = {"vertex": t.nv, "edge": t.ne, "facet": t.nf}
+    parents = {"edge": (ee, s.ne), "facet": (ff, s.nf)}
+    for name, q in s.quantities.items():
+        q2 = copy.copy(q)
+        q2.methods = []
+        for (m, etype, idx, sgn) in q.methods:
+            if sgn is None:
+                q2.methods.append((m, etype, np.arange(sizes[etype]), None))
+                continue
+            if etype in parents and len(parents[etype][0]):
+                par, base = parents[etype]
+                where = np.full(base, -1, np.int64)
+                where[idx] = np.arange(len(idx))
+                hit = where[par]
+                kids = np.nonzero(hit >= 0)[0]
+                idx = np.concatenate([idx, base + kids])
+                sgn = np.concatenate([sgn, sgn[hit[kids]]])
+            q2.methods.append((m, etype, idx, sgn))
+        t.quantities[name] = q2
+    t.topology_version = getattr(s, "topology_version", 0) + 1
+    return t

@@ -1,0 +1,218 @@
+"""``r``: refine every edge and facet (spec §8.1), vectorized over the arrays.
+
+Every edge without NO_REFINE is bisected (the original edge keeps the tail
+half, the head half is a new edge); every facet is split across its refined
+sides: into 4 triangles when all three are refined, 3 when two are, 2 when
+one is.  New vertices on boundary edges are placed on the boundary curve
+(:func:`boundary_midpoints`), new vertices on constraints are projected.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import geometry as G
+from ..surface import project_to_constraints
+from .grow import grow
+
+
+def _enc(e, forward):
+    """Encoded oriented edge: e forwards, ~e backwards."""
+    return np.where(forward, e, ~e)
+
+
+def boundary_midpoints(s, tails, heads, vnew):
+    """Place the new vertices ``vnew`` (midpoints of ``edges``) on their
+    parametric boundary: the curve point nearest the chord midpoint, by
+    damped Gauss-Newton in parameter space started from the head vertex's
+    parameters (at most 5 outer steps, spec §6.3).  Vertices not on a
+    boundary are left as they are."""
+    if "boundary" not in s.vattr:
+        return
+    bnd = s.vattr["boundary"]
+    env0 = s.param_env()
+    for bid, b in s.boundaries.items():
+        sel = np.nonzero(bnd[vnew] == bid)[0]
+        if not len(sel):
+            continue
+        v, head, tail = vnew[sel], heads[sel], tails[sel]
+        target = 0.5 * (s.X[tail] + s.X[head])
+        names = tuple(f"p{k + 1}" for k in range(b.nparams))
+
+        def curve(P):
+            env = {nm: P[:, k] for k, nm in enumerate(names)}
+            X = np.stack([f.values(env0, env, len(P)) for f in b.coords[:3]], axis=1)
+            J = np.stack([f.gradient(env0, env, len(P), names) for f in b.coords[:3]], axis=1)
+            return X, J
+
+        P = s.vattr["params"][head][:, :b.nparams].copy()
+        X, J = curve(P)
+        r = X - target
+        for _ in range(5):
+            JtJ = np.einsum("nik,nil->nkl", J, J)
+            Jtr = np.einsum("nik,ni->nk", J, r)
+            with np.errstate(all="ignore"):
+                dp = -np.linalg.solve(JtJ, Jtr[..., None])[..., 0]
+            dp = np.where(np.isfinite(dp), dp, 0.0)
+            lam = np.ones(len(P))
+            cur = np.einsum("ni,ni->n", r, r)
+            for _ in range(10):               # damping: halve until the distance drops
+                Pn = P + lam[:, None] * dp
+                Xn, Jn = curve(Pn)
+                rn = Xn - target
+                worse = np.einsum("ni,ni->n", rn, rn) > cur * (1 + 1e-15) + 1e-300
+                if not worse.any():
+                    break
+                lam = np.where(worse, lam * 0.5, lam)
+            P, X, J, r = Pn, Xn, Jn, rn
+        s.vattr["params"][v, :b.nparams] = P
+        s.X[v] = X
+
+
+def refine(s):
+    """Return the refined copy of surface ``s`` (spec §8.1).
+
+    Parameters
+    ----------
+    s : Surface
+
+    Returns
+    -------
+    Surface
+        ``V' = V + E``, ``E' = 2E + 3F``, ``F' = 4F`` when no element has
+        NO_REFINE.
+    """
+    return split_edges(s, ~s.eattr["no_refine"])
+
+
+def split_edges(s, ref):
+    """Bisect the edges where ``ref`` (a (ne,) bool mask) is true and split
+    every facet across its bisected sides (4, 3 or 2 triangles).
+
+    A facet with one bisected side is cut from the midpoint to the opposite
+    corner; with two, the corner between them is cut off first and the rest
+    is cut from the first midpoint to the opposite corner (what bisecting
+    the two sides one after the other gives).
+    """
+    nv, ne, nf = s.nv, s.ne, s.nf
+    ref = np.asarray(ref, bool)
+    R = np.nonzero(ref)[0]
+    k = len(R)
+    mid = np.full(ne, -1, np.int64)
+    mid[R] = nv + np.arange(k)
+    half = np.full(ne, -1, np.int64)
+    half[R] = ne + np.arange(k)
+
+    idx, sgn = G.edge_index(s.FE)                  # (nf, 3)
+    fwd = sgn > 0
+    rs = ref[idx]
+    nref = rs.sum(axis=1)
+    # rotate each facet so that the sides to refine come first:
+    # 1 refined side -> it is side 0; 2 -> the unrefined one is side 2
+    rot = np.zeros(nf, np.int64)
+    one = nref == 1
+    rot[one] = np.argmax(rs[one], axis=1)
+    two = nref == 2
+    rot[two] = (np.argmin(rs[two], axis=1) + 1) % 3
+    cols = (np.arange(3)[None, :] + rot[:, None]) % 3
+    I = np.take_along_axis(idx, cols, 1)
+    FW = np.take_along_axis(fwd, cols, 1)
+    S = np.take_along_axis(s.FE, cols, 1)
+    RS = np.take_along_axis(rs, cols, 1)
+    Mv = np.where(RS, mid[I], -1)                  # midpoint vertex of each side
+    first = np.where(FW, I, ~np.where(RS, half[I], 0))     # corner j -> M_j
+    second = np.where(FW, np.where(RS, half[I], 0), ~I)    # M_j -> corner j+1
+
+    # interior edges and facets, case by case
+    f3 = np.nonzero(nref == 3)[0]
+    f2 = np.nonzero(two)[0]
+    f1 = np.nonzero(one)[0]
+    e_par = np.concatenate([np.repeat(f3, 3), np.repeat(f2, 2), f1])
+    ne2 = ne + k
+    base3 = ne2 + 3 * np.arange(len(f3))
+    base2 = ne2 + 3 * len(f3) + 2 * np.arange(len(f2))
+    base1 = ne2 + 3 * len(f3) + 2 * len(f2) + np.arange(len(f1))
+    f_par = np.concatenate([np.repeat(f3, 3), np.repeat(f2, 2), f1])
+    fb3 = nf + 3 * np.arange(len(f3))
+    fb2 = nf + 3 * len(f3) + 2 * np.arange(len(f2))
+    fb1 = nf + 3 * len(f3) + 2 * len(f2) + np.arange(len(f1))
+
+    t = grow(s, v_from_edge=R, e_from_edge=R, e_from_facet=e_par, f_from_facet=f_par)
+
+    # -- geometry of midpoints (torus: in the tail's cell)
+    wv = s.wrap_shift()
+    ev = G.edge_vectors(s.X, s.E, wv)
+    t.X[nv:nv + k] = s.X[s.E[R, 0]] + 0.5 * ev[R]
+    # -- edge halves
+    t.E[R, 1] = mid[R]
+    t.E[ne:ne + k, 0] = mid[R]
+    t.E[ne:ne + k, 1] = s.E[R, 1]
+    if "wrap" in t.eattr:
+        t.eattr["wrap"][R] = 0.0          # tail half stays in the tail's cell
+        # (the head half copied the whole wrap from its parent)
+
+    E = t.E
+    FE = t.FE
+    new_edges = []       # (index array, from-vertex, to-vertex, facets, kind)
+
+    # case 3: a0: M2->M0, a1: M0->M1, a2: M1->M2
+    if len(f3):
+        a0, a1, a2 = base3, base3 + 1, base3 + 2
+        m0, m1, m2 = Mv[f3, 0], Mv[f3, 1], Mv[f3, 2]
+        E[a0] = np.stack([m2, m0], 1)
+        E[a1] = np.stack([m0, m1], 1)
+        E[a2] = np.stack([m1, m2], 1)
+        fi, se = first[f3], second[f3]
+        FE[f3] = np.stack([fi[:, 0], ~a0, se[:, 2]], 1)
+        FE[fb3] = np.stack([fi[:, 1], ~a1, se[:, 0]], 1)
+        FE[fb3 + 1] = np.stack([fi[:, 2], ~a2, se[:, 1]], 1)
+        FE[fb3 + 2] = np.stack([a1, a2, a0], 1)
+        new_edges += [(a0, f3, ("m", 2), ("m", 0)), (a1, f3, ("m", 0), ("m", 1)),
+                      (a2, f3, ("m", 1), ("m", 2))]
+    # case 2 (sides 0, 1 refined): a: M0->M1 cuts corner 1, d: M0->c2
+    if len(f2):
+        a, d = base2, base2 + 1
+        m0, m1 = Mv[f2, 0], Mv[f2, 1]
+        c2 = np.where(FW[f2, 2], s.E[I[f2, 2], 0], s.E[I[f2, 2], 1])
+        E[a] = np.stack([m0, m1], 1)
+        E[d] = np.stack([m0, c2], 1)
+        fi, se = first[f2], second[f2]
+        FE[f2] = np.stack([fi[:, 0], d, S[f2, 2]], 1)
+        FE[fb2] = np.stack([se[:, 0], fi[:, 1], ~a], 1)
+        FE[fb2 + 1] = np.stack([a, se[:, 1], ~d], 1)
+        new_edges += [(a, f2, ("m", 0), ("m", 1)), (d, f2, ("m", 0), ("c", 2))]
+    # case 1 (side 0 refined): d: M0->c2
+    if len(f1):
+        d = base1
+        m0 = Mv[f1, 0]
+        c2 = np.where(FW[f1, 2], s.E[I[f1, 2], 0], s.E[I[f1, 2], 1])
+        E[d] = np.stack([m0, c2], 1)
+        fi, se = first[f1], second[f1]
+        FE[f1] = np.stack([fi[:, 0], d, S[f1, 2]], 1)
+        FE[fb1] = np.stack([se[:, 0], S[f1, 1], ~d], 1)
+        new_edges += [(d, f1, ("m", 0), ("c", 2))]
+
+    if "wrap" in t.eattr and new_edges:
+        W = s.eattr["wrap"]
+        # period offsets (in cells) of corners and midpoints in the facet's own lift
+        off = np.zeros((nf, 3, W.shape[1]))
+        sw = W[I] * np.where(FW, 1.0, -1.0)[..., None]
+        off[:, 1] = sw[:, 0]
+        off[:, 2] = sw[:, 0] + sw[:, 1]
+        offc = off
+        offm = np.where(FW[..., None], off, np.roll(off, -1, axis=1))
+
+        def offset(kind, j, f):
+            return (offc if kind == "c" else offm)[f, j]
+        for eidx, f, p, q in new_edges:
+            t.eattr["wrap"][eidx] = offset(q[0], q[1], f) - offset(p[0], p[1], f)
+
+    new_v = np.arange(nv, nv + k)
+    boundary_midpoints(t, s.E[R, 0], s.E[R, 1], new_v)
+    if t.vcon:
+        on = np.zeros(t.nv, bool)
+        for m in t.vcon.values():
+            on |= m
+        sel = new_v[on[new_v]]
+        if len(sel):
+            project_to_constraints(t, sel)
+    return t
