@@ -85,17 +85,30 @@ def edge_vectors(X, E, wrap_shift=None):
     return d
 
 
-def facet_sides(edge_vec, FE):
-    """Side vectors (nf, 2, 3) of each facet from its first vertex."""
-    idx, sgn = edge_index(FE)
-    d0 = edge_vec[idx[:, 0]] * sgn[:, 0, None]
-    d1 = edge_vec[idx[:, 1]] * sgn[:, 1, None]
-    return np.stack([d0, d0 + d1], axis=1)
+def facet_sides(edge_vec, FE, index=None):
+    """Side vectors (nf, 2, 3) of each facet from its first vertex.
+
+    ``index`` optionally gives the precomputed ``edge_index(FE)``."""
+    idx, sgn = edge_index(FE) if index is None else index
+    S = np.empty((len(idx), 2, 3))
+    np.multiply(edge_vec[idx[:, 0]], sgn[:, 0, None], out=S[:, 0])
+    np.multiply(edge_vec[idx[:, 1]], sgn[:, 1, None], out=S[:, 1])
+    S[:, 1] += S[:, 0]
+    return S
+
+
+def cross(a, b):
+    """Row-wise cross product of (n, 3) arrays (cheaper than np.cross)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
 
 
 def facet_normals(S):
     """Area vectors times two: s1 x s2, shape (nf, 3)."""
-    return np.cross(S[:, 0], S[:, 1])
+    return cross(S[:, 0], S[:, 1])
 
 
 def facet_areas(N2):

@@ -85,12 +85,24 @@ class Surface:
     def nf(self):
         return len(self.FE)
 
+    def topology(self):
+        """Topology-derived arrays, cached while ``E`` and ``FE`` are the same
+        array objects: ``(idx, sgn, F)`` = edge index (nf, 3), orientation
+        sign (nf, 3) and facet vertices (nf, 3).  Operations that change the
+        connectivity build new arrays, which invalidates the cache."""
+        c = self.__dict__.get("_topo")
+        if c is not None and c[0] is self.FE and c[1] is self.E:
+            return c[2]
+        idx, sgn = G.edge_index(self.FE)
+        tails = np.where(sgn > 0, self.E[idx, 0], self.E[idx, 1])
+        val = (idx, sgn, tails)
+        self._topo = (self.FE, self.E, val)
+        return val
+
     @property
     def F(self):
         """(nf, 3) vertices of each facet (tails of its oriented edges)."""
-        idx, sgn = G.edge_index(self.FE)
-        tails = np.where(sgn > 0, self.E[idx, 0], self.E[idx, 1])
-        return tails
+        return self.topology()[2]
 
     @property
     def facet_tension(self):
@@ -129,8 +141,9 @@ class Totals:
         X = s.X
         self.edge_vec = G.edge_vectors(X, s.E, s.wrap_shift())
         self.edge_length = np.sqrt(np.einsum("ij,ij->i", self.edge_vec, self.edge_vec))
-        self.facet_S = G.facet_sides(self.edge_vec, s.FE)
-        self.facet_x0 = X[s.F[:, 0]] if s.nf else np.zeros((0, 3))
+        idx, sgn, F = s.topology()
+        self.facet_S = G.facet_sides(self.edge_vec, s.FE, (idx, sgn))
+        self.facet_x0 = X[F[:, 0]] if s.nf else np.zeros((0, 3))
         self.facet_N2 = G.facet_normals(self.facet_S)
         self.facet_area = G.facet_areas(self.facet_N2)
         self.facet_volume = G.facet_volumes(self.facet_x0, self.facet_S, s.symmetric_content)

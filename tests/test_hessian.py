@@ -1,0 +1,121 @@
+"""Hessians and the hessian command.
+
+Analytic element Hessians are checked against central differences of the
+analytic gradients; the Newton step against evolver-nox-d (reference check
+06: cube r r g20 hessian hessian) and against its own optimality condition.
+"""
+import io
+
+import numpy as np
+import pytest
+
+from conftest import example
+from reference import run_reference
+from pyevolver import Session
+from pyevolver.evolve import gradient as GR
+from pyevolver.evolve import hessian as H
+
+
+@pytest.fixture(scope="module")
+def rough_cube():
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.refine(echo=False)
+    rng = np.random.default_rng(7)
+    s.surface.X += 0.05 * rng.standard_normal(s.surface.X.shape)
+    return s.surface
+
+
+def _fd(S, gfun, h=1e-6):
+    X0 = S.X.copy()
+    n = S.nv
+    out = np.zeros((3 * n, 3 * n))
+    try:
+        for j in range(3 * n):
+            S.X = X0.copy()
+            S.X.flat[j] += h
+            gp = gfun(S.evaluate()).ravel()
+            S.X = X0.copy()
+            S.X.flat[j] -= h
+            gm = gfun(S.evaluate()).ravel()
+            out[:, j] = (gp - gm) / (2 * h)
+    finally:
+        S.X = X0
+    return out
+
+
+def test_area_hessian(rough_cube):
+    S = rough_cube
+    w = np.linspace(0.5, 2.0, S.nf)
+    Hm = H.facet_area_hessian(S.evaluate(), w).toarray()
+    Hf = _fd(S, lambda t: GR.corner_scatter(t, GR.facet_area_grad(t), w))
+    assert np.abs(Hm - Hf).max() <= 1e-7 * np.abs(Hf).max()
+    assert np.allclose(Hm, Hm.T, atol=1e-13)
+
+
+@pytest.mark.parametrize("symmetric", [False, True])
+def test_volume_hessian(rough_cube, symmetric):
+    S = rough_cube
+    w = np.ones(S.nf)
+    Hm = H.facet_volume_hessian(S.evaluate(), w, symmetric).toarray()
+    Hf = _fd(S, lambda t: GR.corner_scatter(t, GR.facet_volume_grad(t, symmetric), w))
+    assert np.abs(Hm - Hf).max() <= 1e-7 * np.abs(Hf).max()
+
+
+def test_edge_length_hessian(rough_cube):
+    S = rough_cube
+    idx = np.arange(0, S.ne, 2)
+    w = np.linspace(1.0, 3.0, len(idx))
+    Hm = H.edge_length_hessian(S.evaluate(), idx, w).toarray()
+    Hf = _fd(S, lambda t: GR.edge_length_grad(t, idx, w))
+    assert np.abs(Hm - Hf).max() <= 1e-7 * np.abs(Hf).max()
+
+
+def test_coloured_fd_hessian_equals_analytic(rough_cube):
+    S = rough_cube
+    w = S.facet_tension
+    col = H.distance2_coloring(S)
+    # no two vertices of one colour are adjacent or share a neighbour
+    F = S.F
+    for k in range(3):
+        assert np.all(col[F[:, k]] != col[F[:, (k + 1) % 3]])
+    Ha = H.facet_area_hessian(S.evaluate(), w).toarray()
+    Hd = H.fd_hessian(lambda X: GR.corner_scatter(S.evaluate(), GR.facet_area_grad(
+        S.evaluate()), w), S).toarray()
+    assert np.abs(Ha - Hd).max() <= 1e-6 * np.abs(Ha).max()
+
+
+def test_hessian_matches_reference_check_06(evolver, tmp_path):
+    cmds = "r\nr\ng 20\nhessian\nhessian\nhessian\nhessian\n"
+    exprs = ["total_energy", "body[1].volume", "body[1].pressure"]
+    text = cmds + "".join(f'printf "RESULT %.17g\\n", {e}\n' for e in exprs)
+    lines = run_reference(evolver, example("cube.fe"), text, cwd=str(tmp_path))
+    ref = [float(l.split()[1]) for l in lines if l.startswith("RESULT")]
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.run(cmds)
+    assert abs(s.total_energy - ref[0]) <= 1e-8 * ref[0]
+    assert abs(s.surface.bodies.volume[0] - ref[1]) <= 1e-12
+    assert abs(s.surface.bodies.lagrange[0] - ref[2]) <= 1e-6 * ref[2]
+
+
+def test_hessian_step_is_a_constrained_critical_point():
+    """After Newton steps the volume is on target and the Lagrangian
+    gradient has no component along the vertex normals (hessian_normal)."""
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.run("r\ng 10\nhessian\nhessian\nhessian")
+    S = s.surface
+    t = S.evaluate()
+    assert abs(t.volumes[0] - 1.0) <= 1e-12
+    P = S.bodies.lagrange[0]
+    gL = GR.energy_gradient(t) - P * GR.body_volume_gradients(t)[0]
+    n = H.vertex_normals(S, t)
+    scale = np.abs(GR.energy_gradient(t)).max()
+    assert np.abs(np.einsum("ij,ij->i", gL, n)).max() <= 1e-6 * scale
+
+
+def test_hessian_seek_does_not_increase_energy():
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.run("r\ng 3")
+    e0 = s.total_energy
+    r = s.hessian(seek=True, echo=False)
+    assert r.energy <= e0
+    assert 0 < r.scale <= 1.0
