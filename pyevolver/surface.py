@@ -1002,13 +1002,14 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
     cids = sorted(s.vcon)
     onmat = np.stack([s.vcon[c][idx] for c in cids], axis=1)
     fixed = s.vattr["fixed"][idx]
-    keys = {}
-    for row, key in enumerate(map(tuple, onmat)):
-        if any(key):
-            keys.setdefault(key, []).append(row)
+    anyon = np.nonzero(onmat.any(axis=1))[0]
+    if not len(anyon):
+        return
+    ukeys, inv = np.unique(onmat[anyon], axis=0, return_inverse=True)
+    inv = inv.ravel()
     env = s.param_env()
-    for key, rows in keys.items():
-        sel = idx[np.array(rows)]
+    for gi, key in enumerate(ukeys):
+        sel = idx[anyon[inv == gi]]
         active = [c for c, on in zip(cids, key) if on]
         for _ in range(maxit):
             P = s.X[sel]

@@ -106,12 +106,11 @@ class Iterator:
         if not len(rows):
             return vecs
         env = s.param_env()
-        groups = {}
-        for r in rows:
-            groups.setdefault(tuple(on[r]), []).append(r)
+        keys, inv = np.unique(on[rows], axis=0, return_inverse=True)
+        inv = inv.ravel()
         out = [v.copy() for v in vecs]
-        for key, rr in groups.items():
-            rr = np.array(rr)
+        for gi, key in enumerate(keys):
+            rr = rows[inv == gi]
             P = s.X[rr]
             coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
             Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(rr))
