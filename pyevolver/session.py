@@ -247,13 +247,8 @@ class Session:
         from .evolve.iterate import StepResult
         it = self.iterator
         s = self.surface
-        dx, lam, cons, mobile = newton_direction(it)
-        t0 = s.evaluate()
+        dx, lam, cons, mobile, us, A = newton_direction(it)
         targets = cons.targets(s)
-        if len(cons):
-            _, us, A = it._constrained_dirs(t0, cons, mobile)
-        else:
-            us, A = [], np.zeros((0, 0))
         X0 = s.X.copy()
 
         def E(scale, report=None):
@@ -286,9 +281,7 @@ class Session:
             for w in report:
                 self.write(w + "\n")
             if not self.toggles.get("quiet"):
-                what = "length" if s.sdim == 2 and False else "area"
-                self.write("%3d. %s: %#17.15g energy: %#17.15g\n"
-                           % (1, what, r.area, r.energy))
+                self.write("%3d. area: %#17.15g energy: %#17.15g\n" % (1, r.area, r.energy))
         return r
 
     # -- mesh upkeep ------------------------------------------------------------------
@@ -316,14 +309,6 @@ class Session:
         self._replace_surface(new)
         if echo:
             self.write(f"Edges refined: {n}\n")
-
-    def refine_facets(self, facets, echo=True):
-        """``refine facets where ...``: split facets at their centres."""
-        from .mesh.notch import split_facets
-        new = split_facets(self.surface, np.asarray(facets, np.int64))
-        self._replace_surface(new)
-        if echo:
-            self.write(f"Facets refined: {len(facets)}\n")
 
     def equiangulate(self, echo=True):
         """``u``: one equiangulation sweep (spec §8.2)."""

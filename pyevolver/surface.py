@@ -414,6 +414,15 @@ class _Builder:
             s.vattr["params"] = params
             self._boundary_coords(np.nonzero(bnd)[0])
 
+    def _signed_refs(self, blk, flat, owner, idmap, what, target):
+        """Indices of the signed ``target`` ids ``flat`` listed on the lines
+        of ``blk`` (``owner`` = line of each id); id 0 is an error."""
+        if np.any(flat == 0):
+            k = owner[np.nonzero(flat == 0)[0][0]]
+            raise self.error(f"{what} {blk.ids[k]}: {target} id 0 does not exist", blk.lines[k])
+        return idmap.lookup(np.abs(flat), _Lazy(lambda j: blk.lines[owner[j]]), what,
+                            _Lazy(lambda j: blk.ids[owner[j]]))
+
     def _boundary_coords(self, idx):
         s = self.s
         for bid, b in s.boundaries.items():
@@ -560,11 +569,7 @@ class _Builder:
                 flat = np.fromiter((e for d in blk.data for e in d), np.int64,
                                    int(lengths.sum()))
             owner = np.repeat(np.arange(nface), lengths)
-            if np.any(flat == 0):
-                k = owner[np.nonzero(flat == 0)[0][0]]
-                raise self.error(f"face {blk.ids[k]}: edge id 0 does not exist", blk.lines[k])
-            eidx = self.eid.lookup(np.abs(flat), _Lazy(lambda j: blk.lines[owner[j]]), "face",
-                                   _Lazy(lambda j: blk.ids[owner[j]]))
+            eidx = self._signed_refs(blk, flat, owner, self.eid, "face", "edge")
             rev = flat < 0
             tails = np.where(rev, E[eidx, 1], E[eidx, 0])
             heads = np.where(rev, E[eidx, 0], E[eidx, 1])
@@ -749,11 +754,7 @@ class _Builder:
         flat = np.concatenate([np.asarray(d, dtype=np.int64) for d in blk.data]) if nb else \
             np.zeros(0, np.int64)
         owner = np.repeat(np.arange(nb), lens)
-        if np.any(flat == 0):
-            k = owner[np.nonzero(flat == 0)[0][0]]
-            raise self.error(f"body {blk.ids[k]}: facet id 0 does not exist", blk.lines[k])
-        pos = self.fid.lookup(np.abs(flat), _Lazy(lambda j: blk.lines[owner[j]]), "body",
-                              _Lazy(lambda j: blk.ids[owner[j]]))
+        pos = self._signed_refs(blk, flat, owner, self.fid, "body", "facet")
         sign = np.where(flat > 0, 1.0, -1.0)
         # faces split on load contribute all their triangles
         if self.split_children:

@@ -257,7 +257,7 @@ def body_volume_gradients(t):
                 out[i] += corner_scatter(t, _n2_grad_dot(P, Dz) / 2.0)
         if content:
             # an edge's content counts for the body through each facet it is on
-            idx, sgn = G.edge_index(s.FE)
+            idx, sgn, _ = s.topology()
             per_edge = np.zeros(s.ne)
             np.add.at(per_edge, idx.ravel(), (sgn * w[:, None]).ravel())
             for comps, eidx, sign in content:

@@ -259,14 +259,10 @@ def vertex_normals(s, t):
         return np.where(L[:, None] > 0, N / L[:, None], 0.0)
 
 
-def _junction_vertices(s):
-    """Vertices on edges with three or more facets, and their count of such edges."""
-    from .. import geometry as G
-    idx, _ = G.edge_index(s.FE)
-    val = np.bincount(idx.ravel(), minlength=s.ne)
-    trip = val >= 3
-    cnt = np.bincount(s.E[trip].ravel(), minlength=s.nv)
-    return cnt
+def _triple_edges(s):
+    """Indices of edges with three or more facets (junction lines)."""
+    idx = s.topology()[0]
+    return np.nonzero(np.bincount(idx.ravel(), minlength=s.ne) >= 3)[0]
 
 
 def tangent_basis(s, mobile, normal=True):
@@ -285,13 +281,13 @@ def tangent_basis(s, mobile, normal=True):
     ncon = np.zeros(nv, np.int64)
     for c in cids:
         ncon += s.vcon[c]
-    basis = [None] * 0
     rows, cols, vals = [], [], []
     ndof_v = np.where(mobile, 3 - np.minimum(ncon, 3), 0)
     if normal:
         t = s.evaluate()
         nrm = vertex_normals(s, t)
-        jcnt = _junction_vertices(s)
+        trip = _triple_edges(s)
+        jcnt = np.bincount(s.E[trip].ravel(), minlength=nv)
         plain = mobile & (ncon == 0) & (jcnt == 0) & (np.linalg.norm(nrm, axis=1) > 0)
         line = mobile & (ncon == 0) & (jcnt == 2)
         ndof_v = np.where(plain, 1, ndof_v)
@@ -306,23 +302,15 @@ def tangent_basis(s, mobile, normal=True):
             vals.append(nrm[sel, i])
         sel = np.nonzero(line)[0]
         if len(sel):
-            from .. import geometry as G
-            idx, _ = G.edge_index(s.FE)
-            val = np.bincount(idx.ravel(), minlength=s.ne)
-            trip = np.nonzero(val >= 3)[0]
+            # line direction: principal axis of the junction edges at the
+            # vertex (Σ d dᵀ, independent of the edges' orientations)
             d = t.edge_vec[trip]
-            D = np.zeros((nv, 3))
-            for end, sg in ((0, 1.0), (1, -1.0)):
-                for i in range(3):
-                    D[:, i] += np.bincount(s.E[trip, end], weights=sg * d[:, i], minlength=nv)
-            # direction of the line: the two edges' directions point opposite ways at v,
-            # so use an edge direction directly
-            dirs = np.zeros((nv, 3))
-            for i in range(3):
-                dirs[:, i] = np.bincount(s.E[trip, 0], weights=d[:, i], minlength=nv) + \
-                    np.bincount(s.E[trip, 1], weights=d[:, i], minlength=nv)
-            u = dirs[sel]
-            u /= np.maximum(np.linalg.norm(u, axis=1), 1e-300)[:, None]
+            dd = (d[:, :, None] * d[:, None, :]).reshape(-1, 9)
+            M = np.zeros((nv, 9))
+            for i in range(9):
+                M[:, i] = np.bincount(s.E[trip].ravel(), weights=np.repeat(dd[:, i], 2),
+                                      minlength=nv)
+            u = np.linalg.eigh(M[sel].reshape(-1, 3, 3))[1][:, :, 2]
             Uu, _, _ = np.linalg.svd(u[:, :, None], full_matrices=True)
             for j in range(2):
                 for i in range(3):
@@ -399,7 +387,9 @@ def constraint_curvature(s, grads, force_grad):
 def newton_direction(it):
     """The Newton motion (nv, 3) and new multipliers for the iterator's surface.
 
-    Returns ``(dx, lam_new, cons, mobile)``.
+    Returns ``(dx, lam_new, cons, mobile, us, A)``; ``us``/``A`` are the
+    projected constraint gradients and their Gram matrix, which the
+    restoring loop of the move reuses.
     """
     from .iterate import _Constraints
     s = it.surface
@@ -408,7 +398,7 @@ def newton_direction(it):
     t = s.evaluate()
     gE = GR.energy_gradient(t)
     lam = np.zeros(len(cons))
-    gs = []
+    gs, us, A = [], [], np.zeros((0, 0))
     if len(cons):
         f = -gE.copy()
         f[~mobile] = 0.0
@@ -416,7 +406,7 @@ def newton_direction(it):
         gs, us, A = it._constrained_dirs(t, cons, mobile)
         bb = np.array([float(np.sum(f * g)) for g in gs])
         lam = -np.linalg.lstsq(A, bb, rcond=None)[0]      # ∇E ≈ Σ λ ∇g
-        gs = cons.gradients(t)
+        # gs are zero on fixed vertices, which T does not move anyway
 
     def grad_L(tt):
         g = GR.energy_gradient(tt)
@@ -449,4 +439,4 @@ def newton_direction(it):
     dy = sol[:K.shape[0]]
     lam_new = -sol[K.shape[0]:] if ncons else lam
     dx = (T @ dy).reshape(-1, 3)
-    return dx, lam_new, cons, mobile
+    return dx, lam_new, cons, mobile, us, A

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import geometry as G
 from .refine import split_edges
 
 
@@ -23,7 +22,7 @@ def edge_divide(s, edges):
     todo = np.unique(np.asarray(edges, np.int64))
     count = len(todo)
     while len(todo):
-        idx, _ = G.edge_index(s.FE)
+        idx = s.topology()[0]
         sel = np.zeros(s.ne, bool)
         sel[todo] = True
         # each facet is claimed by its lowest-numbered chosen side

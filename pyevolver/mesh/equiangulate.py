@@ -22,7 +22,7 @@ from .. import geometry as G
 
 def _edge_facets(s):
     """(ne, 2) the two facets of each edge and their sides, valence (ne,)."""
-    idx, sgn = G.edge_index(s.FE)
+    idx, sgn, _ = s.topology()
     flat_e = idx.ravel()
     flat_f = np.repeat(np.arange(s.nf), 3)
     flat_k = np.tile(np.arange(3), s.nf)
@@ -97,7 +97,7 @@ def equiangulate(s, threshold=-0.001):
     ok[ok] &= (fsig[f0[ok]] == esig[ok]) & (fsig[f1[ok]] == esig[ok])
     cand = np.nonzero(ok)[0]
     if len(cand):
-        idx, _ = G.edge_index(FE)
+        idx = t.topology()[0]
 
         def sides(fs, ks):
             return (lengths[idx[fs, (ks + 1) % 3]], lengths[idx[fs, (ks + 2) % 3]])
@@ -171,5 +171,6 @@ def equiangulate(s, threshold=-0.001):
                 i = int(x if x >= 0 else ~x)
                 if i > ed and i not in seen:
                     heapq.heappush(heap, i)
+    t.__dict__.pop("_topo", None)          # E and FE were changed in place
     t.topology_version = getattr(s, "topology_version", 0) + 1
     return t, flips

@@ -55,7 +55,7 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     ff = np.asarray(f_from_facet, np.int64)
     nv_new, ne_new, nf_new = len(ve) + len(vf), len(ee) + len(ef), len(ff)
     t = copy.copy(s)
-    for name in ("_lift_cache",):
+    for name in ("_lift_cache", "_topo"):
         t.__dict__.pop(name, None)
     t.X = _append_rows(s.X, np.zeros((nv_new, 3)))
     t.E = _append_rows(s.E, np.zeros((ne_new, 2), np.int64))
@@ -64,8 +64,13 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     ffixed = s.fattr["fixed"]
 
     # -- vertices
+    vattr = dict(s.vattr)
+    if "boundary" not in vattr and ("boundary" in s.eattr or "boundary" in s.fattr):
+        npar = max((b.nparams for b in s.boundaries.values()), default=1)
+        vattr["boundary"] = np.zeros(s.nv, np.int64)
+        vattr["params"] = np.zeros((s.nv, npar))
     va = {}
-    for key, arr in s.vattr.items():
+    for key, arr in vattr.items():
         rows = _zeros_like_rows(arr, nv_new)
         if key == "fixed":
             rows[:len(ve)] = efixed[ve]
@@ -74,8 +79,6 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
             rows[:len(ve)] = s.eattr["boundary"][ve] if "boundary" in s.eattr else 0
             rows[len(ve):] = s.fattr["boundary"][vf] if "boundary" in s.fattr else 0
         va[key] = _append_rows(arr, rows)
-    if "boundary" not in va and "boundary" in s.eattr and s.eattr["boundary"][ve].any():
-        raise AssertionError("edge boundary without vertex boundary")
     t.vattr = va
     t.vcon = {}
     for cid, on in s.vcon.items():

@@ -102,7 +102,7 @@ def split_edges(s, ref):
     half = np.full(ne, -1, np.int64)
     half[R] = ne + np.arange(k)
 
-    idx, sgn = G.edge_index(s.FE)                  # (nf, 3)
+    idx, sgn, _ = s.topology()                     # (nf, 3)
     fwd = sgn > 0
     rs = ref[idx]
     nref = rs.sum(axis=1)
