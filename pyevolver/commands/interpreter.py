@@ -581,7 +581,7 @@ TOGGLES = {
 }
 GRAPHICS = {"s", "P", "show", "show_expr", "transforms", "transform_expr", "geomview",
             "postscript", "showq", "view_transforms", "ps", "oogl", "gv", "screen"}
-TOGGLE_DEFAULTS = {"hessian_normal": 1, "autorecalc": 1}
+TOGGLE_DEFAULTS = {"hessian_normal": 1, "autorecalc": 1, "ribiere": 1}
 
 
 class Interpreter:
@@ -835,7 +835,7 @@ class Interpreter:
 
     def _toggle(self, name, arg):
         s = self.session
-        if name == "conj_grad":
+        if name in ("conj_grad", "ribiere"):      # both erase the CG history (REF)
             s.reset_cg()
         if arg is None:
             new = 1
@@ -850,6 +850,9 @@ class Interpreter:
             s.write(f"Increase check {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
         elif name == "conj_grad":
             s.write(f"Conjugate gradient now {'ON' if new else 'OFF'}. "
+                    f"(was {'on' if old else 'off'})\n")
+        elif name == "ribiere":
+            s.write(f"Polak-Ribiere conjugate gradient {'ON' if new else 'OFF'}. "
                     f"(was {'on' if old else 'off'})\n")
         else:
             s.write(f"{name} {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")

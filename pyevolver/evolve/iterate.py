@@ -80,6 +80,7 @@ class Iterator:
         self.session = session
         self.cg_history = None
         self.cg_S_old = 0.0
+        self.cg_f_old = None
 
     # -- helpers ----------------------------------------------------------------
     @property
@@ -205,6 +206,7 @@ class Iterator:
         t0 = s.evaluate()
         f = -GR.energy_gradient(t0)
         f[~mobile] = 0.0
+        f_raw = f
         (f,) = self._project_tangent([f])
         targets = cons.targets(s)
         lam = np.zeros(len(cons))
@@ -221,16 +223,24 @@ class Iterator:
             vel = f
         # conjugate gradient
         if sess.toggles.get("conj_grad", 0):
+            # Fletcher-Reeves: gamma = S/S_old with S = sum vel.f; Polak-Ribiere
+            # (the Evolver's default, toggle `ribiere`) subtracts sum vel.f_old;
+            # a negative gamma restarts (PR+).  Found by printing v_velocity and
+            # v_force of evolver-nox-d on cube.fe and tankex.fe.
             S = float(np.sum(vel[mobile] * f[mobile]))
             if self.cg_history is None or self.cg_S_old < 1e-15:
                 gamma = 0.0
             else:
-                gamma = S / self.cg_S_old
-                if gamma > 10:
+                num = S
+                if sess.toggles.get("ribiere", 1):
+                    num -= float(np.sum(vel[mobile] * self.cg_f_old[mobile]))
+                gamma = num / self.cg_S_old
+                if gamma > 10 or gamma < 0:     # negative: restart (PR+)
                     gamma = 0.0
             h = vel if self.cg_history is None else vel + gamma * self.cg_history
             self.cg_history = h
             self.cg_S_old = S
+            self.cg_f_old = f_raw      # the Evolver keeps the unprojected force
             vel = h
         X0 = s.X.copy()
         warnings = []
