@@ -285,15 +285,32 @@ class Totals:
         per_facet = G.facet_gravity(self.facet_x0, self.facet_S)
         return float(G_ * (b.density @ (b.facet_matrix @ per_facet)))
 
-    def quantity_value(self, q):
+    def quantity_value(self, q, magnitude=False):
+        """Value of a named quantity; with ``magnitude=True`` the sum of the
+        absolute values of its element contributions instead (the scale of
+        its restoring tolerance)."""
         total = 0.0
         for m, etype, idx, sign in q.methods:
             _, fn = method_info(m.method)
             vals = fn(self, m, idx)
+            if magnitude:
+                total += abs(m.modulus) * float(np.sum(np.abs(vals)))
+                continue
             if sign is not None:
                 vals = vals * sign
             total += m.modulus * float(np.sum(vals))
-        return q.modulus * total
+        return abs(q.modulus) * total if magnitude else q.modulus * total
+
+    def volume_magnitudes(self):
+        """Per body, the sum of absolute element contributions to its volume:
+        facet contents and edge CONTENT integrals, shape (nbodies,)."""
+        s = self.surface
+        b = s.bodies
+        per_facet = np.abs(self.facet_volume)
+        if self.con_content is not None:
+            idx, _ = G.edge_index(s.FE)
+            per_facet = per_facet + np.abs(self.con_content)[idx].sum(axis=1)
+        return abs(b.facet_matrix) @ per_facet
 
 
 # ---------------------------------------------------------------------------

@@ -41,6 +41,8 @@ class _Constraints:
         if s.torus_filled and self.bodies:
             self.bodies = self.bodies[1:]      # one body is redundant in a filled torus
         self.quantities = [q for q in s.quantities.values() if q.kind == "fixed"]
+        self.named_bodies = any(bd.content is not None or bd.energy is not None
+                                for bd in s.boundaries.values())
 
     def __len__(self):
         return len(self.bodies) + len(self.quantities)
@@ -53,14 +55,34 @@ class _Constraints:
         return np.array([s.bodies.target[i] for i in self.bodies] +
                         [q.target for q in self.quantities])
 
-    def tolerances(self, default):
-        """Absolute tolerance of each constrained value: the quantity's
-        TOLERANCE when set (>= 0), else ``target_tolerance`` (manual,
-        "Tolerance"; REF's itdebug prints Σ|d_i|/tol_i as "Diff")."""
-        out = [default] * len(self.bodies)
+    def tolerances(self, t, default):
+        """Tolerance of each constrained value in the restoring loop, which
+        stops when sum |d_i| / tol_i <= 1 (REF's itdebug prints that sum as
+        "Diff").
+
+        A named quantity's tolerance is its TOLERANCE when set (>= 0), else
+        ``target_tolerance`` times the sum of the absolute values of its
+        element contributions.  A body's is ``target_tolerance`` itself,
+        unless the Evolver converts bodies to named quantities (it does so
+        when a boundary carries ENERGY or CONTENT integrals, e.g. column.fe),
+        when it is scaled like a quantity's.  Measured with itdebug on
+        tankex.fe and catbody.fe (absolute), qmound.fe and column.fe (scaled).
+        """
+        if self.bodies:
+            if self.named_bodies:
+                mag = t.volume_magnitudes()
+                out = [default * mag[i] for i in self.bodies]
+            else:
+                out = [default] * len(self.bodies)
+        else:
+            out = []
         for q in self.quantities:
-            out.append(q.tolerance if q.tolerance is not None and q.tolerance >= 0 else default)
-        return np.array(out, dtype=float)
+            if q.tolerance is not None and q.tolerance >= 0:
+                out.append(q.tolerance)
+            else:
+                out.append(default * t.quantity_value(q, magnitude=True))
+        out = np.array(out, dtype=float)
+        return np.where(out > 0, out, default)
 
     def gradients(self, t):
         s = t.surface
@@ -152,9 +174,8 @@ class Iterator:
             return s.evaluate()
         tol = self.session.settings.get("target_tolerance", 1e-4)
         t = s.evaluate()
-        tols = cons.tolerances(tol)
         d = targets - cons.values(t)
-        err = float(np.sum(np.abs(d) / tols))
+        err = float(np.sum(np.abs(d) / cons.tolerances(t, tol)))
         cur_us, cur_A = us, A
         for it in range(10):
             try:
@@ -167,7 +188,7 @@ class Iterator:
             project_to_constraints(s, moved)
             t_new = s.evaluate()
             d_new = targets - cons.values(t_new)
-            err_new = float(np.sum(np.abs(d_new) / tols))
+            err_new = float(np.sum(np.abs(d_new) / cons.tolerances(t_new, tol)))
             if err_new > 100 * err and err > 0 and it > 0:
                 if report:
                     report.append(f"Total constraint difference would increase by factor of "
@@ -182,7 +203,7 @@ class Iterator:
                 project_to_constraints(s, moved)
                 t_new = s.evaluate()
                 d_new = targets - cons.values(t_new)
-                err_new = float(np.sum(np.abs(d_new) / tols))
+                err_new = float(np.sum(np.abs(d_new) / cons.tolerances(t_new, tol)))
             improved = err_new < 0.5 * err
             t, d, err = t_new, d_new, err_new
             if err <= 1.0:
