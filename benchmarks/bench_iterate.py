@@ -8,7 +8,8 @@ For each level (default 4, 5, 6 = 5,120, 20,480, 81,920 facets; data made by
 * evolver-nox-d: wall time of ``load; g K; q`` minus that of ``load; q``
   (best of ``--repeat``), divided by K; the same with ``hessian``;
 * pyevolver: in one child process, load, one warm-up ``g 1``, then the wall
-  time of ``g K`` / K, then one ``hessian``.
+  time of ``g K`` / K, then one ``hessian`` (modules imported beforehand, as
+  start-up is subtracted from the Evolver's times too).
 
 Both programs' final energies after ``g K`` are printed; they agree to the
 first lines' 1e-9 on these files.  Prints a table with ratios
@@ -31,6 +32,7 @@ REPO = os.path.dirname(HERE)
 CHILD = r"""
 import io, sys, time
 from pyevolver import Session
+import pyevolver.evolve.hessian   # module import (scipy.sparse.linalg, ~0.1 s) is start-up
 s = Session.load(sys.argv[1], out=io.StringIO())
 k = int(sys.argv[2])
 s.g(1)

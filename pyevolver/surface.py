@@ -104,6 +104,17 @@ class Surface:
         """(nf, 3) vertices of each facet (tails of its oriented edges)."""
         return self.topology()[2]
 
+    def facet_corners(self):
+        """(3, nf) contiguous copy of ``F.T`` (cached with the topology), for
+        gathering one coordinate of every facet corner at once."""
+        topo = self.topology()
+        c = self.__dict__.get("_corners")
+        if c is not None and c[0] is topo:
+            return c[1]
+        Fc = np.ascontiguousarray(topo[2].T)
+        self._corners = (topo, Fc)
+        return Fc
+
     @property
     def facet_tension(self):
         return self.fattr["tension"]
@@ -139,16 +150,37 @@ class Totals:
     def __init__(self, s):
         self.surface = s
         X = s.X
-        self.edge_vec = G.edge_vectors(X, s.E, s.wrap_shift())
-        self.edge_length = np.sqrt(np.einsum("ij,ij->i", self.edge_vec, self.edge_vec))
-        idx, sgn, F = s.topology()
-        self.facet_S = G.facet_sides(self.edge_vec, s.FE, (idx, sgn))
-        self.facet_x0 = X[F[:, 0]] if s.nf else np.zeros((0, 3))
-        self.facet_N2 = G.facet_normals(self.facet_S)
-        self.facet_area = G.facet_areas(self.facet_N2)
-        self.facet_volume = G.facet_volumes(self.facet_x0, self.facet_S, s.symmetric_content)
+        wrap = s.wrap_shift()
+        if wrap is None and X.shape[1] == 3:
+            # corners gathered one coordinate at a time into contiguous
+            # (3, nf) arrays: several times faster than gathering edge vectors
+            XT = np.ascontiguousarray(X.T)
+            Fc = s.facet_corners()
+            P = [XT[k][Fc] for k in range(3)]                  # P[k][corner, facet]
+            a = [P[k][1] - P[k][0] for k in range(3)]
+            b = [P[k][2] - P[k][0] for k in range(3)]
+            N2T = np.empty((3, s.nf))
+            N2T[0] = a[1] * b[2] - a[2] * b[1]
+            N2T[1] = a[2] * b[0] - a[0] * b[2]
+            N2T[2] = a[0] * b[1] - a[1] * b[0]
+            self._corner_xyz = P
+            self.facet_N2 = N2T.T
+            self.facet_area = 0.5 * np.sqrt(N2T[0] * N2T[0] + N2T[1] * N2T[1] + N2T[2] * N2T[2])
+            if s.symmetric_content:
+                self.facet_volume = (P[0][0] * N2T[0] + P[1][0] * N2T[1]
+                                     + P[2][0] * N2T[2]) / 6.0
+            else:
+                self.facet_volume = (P[2][0] + P[2][1] + P[2][2]) / 6.0 * N2T[2]
+        else:
+            self.edge_vec = G.edge_vectors(X, s.E, wrap)
+            idx, sgn, F = s.topology()
+            self.facet_S = G.facet_sides(self.edge_vec, s.FE, (idx, sgn))
+            self.facet_x0 = X[F[:, 0]] if s.nf else np.zeros((0, X.shape[1]))
+            self.facet_N2 = G.facet_normals(self.facet_S)
+            self.facet_area = G.facet_areas(self.facet_N2)
+            self.facet_volume = G.facet_volumes(self.facet_x0, self.facet_S,
+                                                s.symmetric_content)
         self.total_area = float(self.facet_area.sum())
-        self.total_length = float(self.edge_length.sum())
         self.terms = {}
         energy = float(self.facet_area @ s.facet_tension)
         self.terms["facet_tension"] = energy
@@ -180,6 +212,43 @@ class Totals:
             if q.kind == "energy":
                 energy += v
         self.energy = energy
+
+    # ---- derived geometry computed on first use -------------------------------
+    def __getattr__(self, name):
+        # only reached for attributes not yet set: build and cache them
+        maker = Totals._LAZY.get(name)
+        if maker is None:
+            raise AttributeError(name)
+        val = maker(self)
+        setattr(self, name, val)
+        return val
+
+    def _make_edge_vec(self):
+        s = self.surface
+        return G.edge_vectors(s.X, s.E, s.wrap_shift())
+
+    def _make_edge_length(self):
+        d = self.edge_vec
+        return np.sqrt(np.einsum("ij,ij->i", d, d))
+
+    def _make_total_length(self):
+        return float(self.edge_length.sum())
+
+    def _make_facet_x0(self):
+        P = self._corner_xyz
+        return np.stack([P[0][0], P[1][0], P[2][0]], axis=1)
+
+    def _make_facet_S(self):
+        P = self._corner_xyz
+        S = np.empty((self.surface.nf, 2, 3))
+        for k in range(3):
+            S[:, 0, k] = P[k][1] - P[k][0]
+            S[:, 1, k] = P[k][2] - P[k][0]
+        return S
+
+    _LAZY = {"edge_vec": _make_edge_vec, "edge_length": _make_edge_length,
+             "total_length": _make_total_length, "facet_x0": _make_facet_x0,
+             "facet_S": _make_facet_S}
 
     # ---- pieces -----------------------------------------------------------
     def eval_points(self, formula, P, etype=None, idx=None):

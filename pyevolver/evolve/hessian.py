@@ -73,9 +73,13 @@ def facet_area_hessian(t, weights):
     P, N2, L, w = P[ok], N2[ok], L[ok], weights[ok]
     n = N2 / L[:, None]
     e = np.stack([P[:, 2] - P[:, 1], P[:, 0] - P[:, 2], P[:, 1] - P[:, 0]], 1)
-    Ex = np.stack([_skew(e[:, a]) for a in range(3)], 1)          # (m, 3, 3, 3)
-    Pn = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
-    B = np.einsum("maji,mjk,mbkl->mabil", Ex, Pn, Ex) / (2 * L)[:, None, None, None, None]
+    # [e_a]x^T (I - n n^T) [e_b]x = (e_a.e_b) I - e_b e_a^T - c_a c_b^T, c_a = n x e_a
+    c = np.cross(n[:, None, :], e)                                   # (m, 3, 3)
+    dots = np.einsum("mai,mbi->mab", e, e)
+    B = -(e[:, None, :, :, None] * e[:, :, None, None, :])           # (m, a, b, i, l)
+    B -= c[:, :, None, :, None] * c[:, None, :, None, :]
+    B[:, :, :, [0, 1, 2], [0, 1, 2]] += dots[:, :, :, None]
+    B /= (2 * L)[:, None, None, None, None]
     nx = _skew(n)
     eps = np.zeros((3, 3))
     for a in range(3):
