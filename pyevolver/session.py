@@ -319,6 +319,15 @@ class Session:
             self.write(f"Edges switched in equiangulation: {n}\n")
         return n
 
+    def vertex_average(self, mode="V", echo=True):
+        """``V``, ``rawv``, ``rawestv``: vertex averaging (spec §8.3)."""
+        from .mesh.vertex_average import vertex_average
+        if self.surface.nf == 0:
+            raise CommandError("vertex averaging needs facets (string model is not supported)")
+        self._replace_surface(vertex_average(self.surface, mode))
+        if echo:
+            self.write("Vertex averaging done.\n")
+
     def refresh(self):
         if self.toggles.get("autorecalc", 1):
             self.recalc(keep_cg=True)

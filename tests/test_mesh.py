@@ -74,6 +74,12 @@ CASES = [
     ("quad.fe", "r\nr\ng 10\nu"),                             # check 04
     ("qmound.fe", "re\nr"),
     ("sphere.fe", "r\nu"),
+    # vertex averaging (spec 8.3): check 05, constraints, torus, boundaries
+    ("cube.fe", "r\nV"), ("cube.fe", "r\nrawv"), ("cube.fe", "r\nV\nrawv\nrawestv"),
+    ("mound.fe", "re\ng 5\nV\nV"), ("mound.fe", "re\ng 5\nrawv"),
+    ("mound.fe", "re\ng 5\nrawestv"), ("tankex.fe", "g 3\nV"), ("tankex.fe", "g 3\nrawv"),
+    ("twointor.fe", "r\nV"), ("twointor.fe", "r\nrawestv"), ("column.fe", "r\ng 3\nV"),
+    ("sphere.fe", "r\nrawv"), ("quad.fe", "r\ng 5\nV"),
 ]
 
 
@@ -91,8 +97,9 @@ def test_mesh_ops_match_reference(evolver, name, cmds, tmp_path):
     for a, b in zip(ours[3:], ref[3:]):
         assert abs(a - b) <= 1e-12 * max(abs(b), 1.0), (ours, ref)
     # report lines ("Edges refined: 4", "Edges switched in equiangulation: 24", "Vertices: ...")
-    rep = [l.strip() for l in lines if l.startswith(("Edges", "Vertices:"))]
-    mine = [l.strip() for l in out.getvalue().splitlines() if l.startswith(("Edges", "Vertices:"))]
+    heads = ("Edges", "Vertices:", "Vertex averaging")
+    rep = [l.strip() for l in lines if l.startswith(heads)]
+    mine = [l.strip() for l in out.getvalue().splitlines() if l.startswith(heads)]
     assert rep == mine
 
 

@@ -542,7 +542,6 @@ class Env:
 
 LETTER_LATER = {
     "g": "g (iteration) comes with the evolve issue",
-    "V": "V (vertex averaging) comes with the mesh-upkeep issue",
     "U": "U (conjugate gradient) comes with the evolve issue",
     "m": "m (fixed scale) comes with the evolve issue",
     "t": "t (edge weeding) comes with the mesh-upkeep issue",
@@ -560,7 +559,7 @@ LETTER_LATER = {
 }
 WORD_LATER = {
     "saddle", "ritz", "eigenprobe", "lanczos", "hessian_menu",
-    "rawv", "rawestv", "vertex_average", "raw_vertex_average", "rawest_vertex_average",
+    "vertex_average", "raw_vertex_average", "rawest_vertex_average",
     "edgeweed", "edge_divide", "areaweed", "notch", "pop", "edgeswap",
     "t1_edgeswap", "delete", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
     "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
@@ -801,6 +800,9 @@ class Interpreter:
         if raw == "r":
             for _ in range(1 if arg is None else self._count(arg)):
                 s.refine()
+            return
+        if raw == "V" or name in ("rawv", "rawestv"):
+            s.vertex_average({"V": "V", "rawv": "raw", "rawestv": "rawest"}[raw])
             return
         if raw == "u" or name == "equiangulate":
             s.equiangulate()
