@@ -319,6 +319,36 @@ class Session:
             self.write(f"Edges switched in equiangulation: {n}\n")
         return n
 
+    def edge_divide_long(self, length, echo=True):
+        """``l L``: bisect every edge longer than ``L`` once (spec §8)."""
+        from .mesh.edge_divide import edge_divide, long_edges
+        new, n = edge_divide(self.surface, long_edges(self.surface, length))
+        self.settings["edge_divide_length"] = length
+        self._replace_surface(new)
+        if echo:
+            self.write(f"New edges: {n}\n")
+        return n
+
+    def skinny(self, angle, echo=True):
+        """``K θ``: bisect the longest edge of facets with an angle below θ."""
+        from .mesh.edge_divide import edge_divide, skinny_edges
+        new, n = edge_divide(self.surface, skinny_edges(self.surface, angle))
+        self._replace_surface(new)
+        if echo:
+            self.write(f"New edges: {n}\n")
+        return n
+
+    def notch(self, angle, echo=True):
+        """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""
+        from .mesh.notch import notch
+        if self.surface.nf == 0:
+            raise UnsupportedError("notch in the string model")
+        new, n = notch(self.surface, angle)
+        self._replace_surface(new)
+        if echo:
+            self.write(f"Number of edges notched: {n}\n")
+        return n
+
     def vertex_average(self, mode="V", echo=True):
         """``V``, ``rawv``, ``rawestv``: vertex averaging (spec §8.3)."""
         from .mesh.vertex_average import vertex_average

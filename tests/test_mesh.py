@@ -80,6 +80,10 @@ CASES = [
     ("mound.fe", "re\ng 5\nrawestv"), ("tankex.fe", "g 3\nV"), ("tankex.fe", "g 3\nrawv"),
     ("twointor.fe", "r\nV"), ("twointor.fe", "r\nrawestv"), ("column.fe", "r\ng 3\nV"),
     ("sphere.fe", "r\nrawv"), ("quad.fe", "r\ng 5\nV"),
+    # notching: report (facets subdivided), counts and geometry (then g 2)
+    ("cube.fe", "r\ng 5\nn 0.1\ng 2"), ("mound.fe", "re\ng 5\nn 0.2\ng 2"),
+    ("catbody.fe", "r\ng 5\nn 0.3\ng 2"), ("tankex.fe", "g 3\nn 0.3\ng 2"),
+    ("sphere.fe", "r\nn 0.2"), ("quad.fe", "r\nr\ng 10\nn 0.05"),
 ]
 
 
@@ -97,7 +101,7 @@ def test_mesh_ops_match_reference(evolver, name, cmds, tmp_path):
     for a, b in zip(ours[3:], ref[3:]):
         assert abs(a - b) <= 1e-12 * max(abs(b), 1.0), (ours, ref)
     # report lines ("Edges refined: 4", "Edges switched in equiangulation: 24", "Vertices: ...")
-    heads = ("Edges", "Vertices:", "Vertex averaging")
+    heads = ("Edges", "Vertices:", "Vertex averaging", "Number of edges notched", "New edges")
     rep = [l.strip() for l in lines if l.startswith(heads)]
     mine = [l.strip() for l in out.getvalue().splitlines() if l.startswith(heads)]
     assert rep == mine
@@ -155,3 +159,43 @@ def test_refine_edges_where_counts():
     s.run("refine edges where id <= 2")
     assert "Edges refined: 2" in s.out.getvalue()
     consistent(s.surface)
+
+
+def test_long_edges_counts_match_reference_check_16(evolver, tmp_path):
+    """``l 0.3`` after ``r; g 5`` on cube.fe: REF bisects 120 edges (V 170, E 504,
+    F 336).  Only counts are compared: which diagonal a facet with two long
+    sides gets depends on edge numbering, which is not part of the contract."""
+    cmds = "r\ng 5\nl 0.3"
+    ref, lines = _ref_values(evolver, "cube.fe", cmds, EXPRS[:3], tmp_path)
+    import io
+    out = io.StringIO()
+    s = Session.load(example("cube.fe"), out=out)
+    s.run(cmds)
+    consistent(s.surface)
+    assert _values(s, EXPRS[:3]) == ref
+    assert "New edges: 120" in out.getvalue() and any("New edges: 120" in l for l in lines)
+    assert s.surface.evaluate().edge_length.max() <= 0.3 + 0.3
+
+
+def test_skinny_bisects_the_longest_edge_of_skinny_facets():
+    """``K θ``: every facet with an angle below θ has its longest side bisected
+    (geometry is unchanged: the total area stays, no new skinny facet is
+    created from a non-skinny one's sides).  REF's count differs on check 16
+    (42 against 24) because it visits facets one by one in its own order."""
+    import io
+    from pyevolver.mesh.edge_divide import skinny_edges
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.run("r\ng 5\nl 0.3")
+    before = s.surface
+    want = skinny_edges(before, 0.5)
+    assert len(want) > 0
+    area = s.total_area
+    s.run("K 0.5")
+    after = s.surface
+    consistent(after)
+    assert after.nv == before.nv + len(want)
+    assert abs(s.total_area - area) <= 1e-12 * area
+    # each chosen edge is now two halves of half its length
+    L0 = before.evaluate().edge_length[want]
+    L1 = after.evaluate().edge_length[want]
+    assert np.allclose(L1, L0 / 2, rtol=1e-12)

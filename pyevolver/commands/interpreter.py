@@ -545,10 +545,7 @@ LETTER_LATER = {
     "U": "U (conjugate gradient) comes with the evolve issue",
     "m": "m (fixed scale) comes with the evolve issue",
     "t": "t (edge weeding) comes with the mesh-upkeep issue",
-    "l": "l (edge division) comes with the mesh-upkeep issue",
     "w": "w (area weeding) comes with the mesh-upkeep issue",
-    "K": "K (skinny triangles) comes with the mesh-upkeep issue",
-    "n": "n (notching) comes with the mesh-upkeep issue",
     "j": "j (jiggle) comes with the mesh-upkeep issue",
     "o": "o (vertex popping)", "O": "O (edge popping)",
     "G": "G (gravity) comes with the evolve issue",
@@ -560,7 +557,7 @@ LETTER_LATER = {
 WORD_LATER = {
     "saddle", "ritz", "eigenprobe", "lanczos", "hessian_menu",
     "vertex_average", "raw_vertex_average", "rawest_vertex_average",
-    "edgeweed", "edge_divide", "areaweed", "notch", "pop", "edgeswap",
+    "edgeweed", "areaweed", "pop", "edgeswap",
     "t1_edgeswap", "delete", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
     "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
     "conj_grad_later", "fix", "unfix", "burchard", "zoom",
@@ -800,6 +797,17 @@ class Interpreter:
         if raw == "r":
             for _ in range(1 if arg is None else self._count(arg)):
                 s.refine()
+            return
+        if raw in ("l", "K", "n") or name in ("edge_divide", "notch"):
+            if arg is None:
+                raise CommandError(f"{raw} needs a value (for example: {raw} 0.3)")
+            v = float(self.value(arg))
+            if raw == "l" or name == "edge_divide":
+                s.edge_divide_long(v)
+            elif raw == "K":
+                s.skinny(v)
+            else:
+                s.notch(v)
             return
         if raw == "V" or name in ("rawv", "rawestv"):
             s.vertex_average({"V": "V", "rawv": "raw", "rawestv": "rawest"}[raw])

@@ -37,3 +37,28 @@ def edge_divide(s, edges):
         s = split_edges(s, mask)
         todo = todo[~ok[todo]]
     return s, count
+
+
+def long_edges(s, length):
+    """``l L``: indices of the edges longer than ``length``."""
+    return np.nonzero(s.evaluate().edge_length > length)[0]
+
+
+def skinny_edges(s, angle):
+    """``K θ``: the longest edge of every facet whose smallest angle is below
+    ``angle`` (radians), as unique edge indices."""
+    if s.nf == 0:
+        return np.zeros(0, np.int64)
+    t = s.evaluate()
+    idx = s.topology()[0]                       # side k of facet joins corner k, k+1
+    L = t.edge_length[idx]                      # (nf, 3)
+    # the angle at corner k lies opposite side k+1 (mod 3): law of cosines
+    a, b, c = L[:, 0], L[:, 1], L[:, 2]
+    with np.errstate(all="ignore"):
+        cos = np.stack([(a * a + c * c - b * b) / (2 * a * c),
+                        (a * a + b * b - c * c) / (2 * a * b),
+                        (b * b + c * c - a * a) / (2 * b * c)], axis=1)
+    ang = np.arccos(np.clip(cos, -1.0, 1.0))
+    skinny = np.nanmin(ang, axis=1) < angle
+    longest = idx[np.arange(s.nf), np.argmax(L, axis=1)]
+    return np.unique(longest[skinny])
