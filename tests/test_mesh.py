@@ -179,8 +179,8 @@ def test_long_edges_counts_match_reference_check_16(evolver, tmp_path):
 
 def test_skinny_bisects_the_longest_edge_of_skinny_facets():
     """``K θ``: every facet with an angle below θ has its longest side bisected
-    (geometry is unchanged: the total area stays, no new skinny facet is
-    created from a non-skinny one's sides).  REF's count differs on check 16
+    at its midpoint (one new vertex per chosen edge, the total area unchanged,
+    the chosen edges halved).  REF's count differs on check 16
     (42 against 24) because it visits facets one by one in its own order."""
     import io
     from pyevolver.mesh.edge_divide import skinny_edges
