@@ -319,24 +319,25 @@ class Session:
             self.write(f"Edges switched in equiangulation: {n}\n")
         return n
 
-    def edge_divide_long(self, length, echo=True):
-        """``l L``: bisect every edge longer than ``L`` once (spec §8)."""
-        from .mesh.edge_divide import edge_divide, long_edges
-        new, n = edge_divide(self.surface, long_edges(self.surface, length))
-        self.settings["edge_divide_length"] = length
+    def _bisect(self, edges, echo):
+        from .mesh.edge_divide import edge_divide
+        new, n = edge_divide(self.surface, edges)
         self._replace_surface(new)
         if echo:
             self.write(f"New edges: {n}\n")
         return n
 
+    def edge_divide_long(self, length, echo=True):
+        """``l L``: bisect every edge longer than ``L`` once (spec §8)."""
+        from .mesh.edge_divide import long_edges
+        n = self._bisect(long_edges(self.surface, length), echo)
+        self.settings["edge_divide_length"] = length
+        return n
+
     def skinny(self, angle, echo=True):
         """``K θ``: bisect the longest edge of facets with an angle below θ."""
-        from .mesh.edge_divide import edge_divide, skinny_edges
-        new, n = edge_divide(self.surface, skinny_edges(self.surface, angle))
-        self._replace_surface(new)
-        if echo:
-            self.write(f"New edges: {n}\n")
-        return n
+        from .mesh.edge_divide import skinny_edges
+        return self._bisect(skinny_edges(self.surface, angle), echo)
 
     def notch(self, angle, echo=True):
         """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""

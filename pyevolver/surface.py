@@ -152,25 +152,12 @@ class Totals:
         X = s.X
         wrap = s.wrap_shift()
         if wrap is None and X.shape[1] == 3:
-            # corners gathered one coordinate at a time into contiguous
-            # (3, nf) arrays: several times faster than gathering edge vectors
-            XT = np.ascontiguousarray(X.T)
-            Fc = s.facet_corners()
-            P = [XT[k][Fc] for k in range(3)]                  # P[k][corner, facet]
-            a = [P[k][1] - P[k][0] for k in range(3)]
-            b = [P[k][2] - P[k][0] for k in range(3)]
-            N2T = np.empty((3, s.nf))
-            N2T[0] = a[1] * b[2] - a[2] * b[1]
-            N2T[1] = a[2] * b[0] - a[0] * b[2]
-            N2T[2] = a[0] * b[1] - a[1] * b[0]
+            # corners gathered one coordinate at a time (several times faster
+            # than gathering edge vectors); the torus needs the edge wraps
+            P, N2T, self.facet_area, self.facet_volume = G.corner_geometry(
+                np.ascontiguousarray(X.T), s.facet_corners(), s.symmetric_content)
             self._corner_xyz = P
             self.facet_N2 = N2T.T
-            self.facet_area = 0.5 * np.sqrt(N2T[0] * N2T[0] + N2T[1] * N2T[1] + N2T[2] * N2T[2])
-            if s.symmetric_content:
-                self.facet_volume = (P[0][0] * N2T[0] + P[1][0] * N2T[1]
-                                     + P[2][0] * N2T[2]) / 6.0
-            else:
-                self.facet_volume = (P[2][0] + P[2][1] + P[2][2]) / 6.0 * N2T[2]
         else:
             self.edge_vec = G.edge_vectors(X, s.E, wrap)
             idx, sgn, F = s.topology()
@@ -1073,6 +1060,49 @@ def torus_lift_shifts(s):
         for o, (f, sg) in enumerate(zip(facets, signs)):
             out[b, f] += sg * D[o]
     s._lift_cache = (key, out)
+    return out
+
+
+def project_tangent(s, vecs):
+    """Project vectors onto the tangent spaces of the vertices' level-set
+    constraints (all constraints of a vertex at once).
+
+    Parameters
+    ----------
+    s : Surface
+    vecs : list of (nv, 3) arrays
+
+    Returns
+    -------
+    list of (nv, 3) arrays
+        Copies with the components along the constraint gradients removed
+        (the input list itself when no vertex is constrained).
+    """
+    if not s.vcon:
+        return vecs
+    cids = sorted(s.vcon)
+    on = np.stack([s.vcon[c] for c in cids], axis=1)
+    rows = np.nonzero(on.any(axis=1))[0]
+    if not len(rows):
+        return vecs
+    env = s.param_env()
+    keys, inv = np.unique(on[rows], axis=0, return_inverse=True)
+    inv = inv.ravel()
+    out = [v.copy() for v in vecs]
+    for gi, key in enumerate(keys):
+        rr = rows[inv == gi]
+        P = s.X[rr]
+        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(rr))
+                       for c, k in zip(cids, key) if k], axis=2)     # (n, 3, k)
+        GtG = np.einsum("nik,nil->nkl", Gm, Gm)
+        for v in out:
+            w = v[rr]
+            rhs = np.einsum("nik,ni->nk", Gm, w)
+            with np.errstate(all="ignore"):
+                lam = np.linalg.solve(GtG, rhs[..., None])[..., 0]
+            lam = np.nan_to_num(lam)
+            v[rr] = w - np.einsum("nik,nk->ni", Gm, lam)
     return out
 
 

@@ -29,6 +29,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .. import geometry as G
 from ..errors import UnsupportedError
 from ..surface import project_to_constraints
 from . import gradient as GR
@@ -251,16 +252,8 @@ def lagrangian_hessian(s, cons, lam, grad_fn):
 
 
 def vertex_normals(s, t):
-    """(nv, 3) unit vertex normals: the sum of the adjacent facets' area
-    vectors (the volume gradient at a vertex whose star is closed)."""
-    N = np.zeros((s.nv, 3))
-    F = s.F
-    for k in range(3):
-        for i in range(3):
-            N[:, i] += np.bincount(F[:, k], weights=t.facet_N2[:, i], minlength=s.nv)
-    L = np.linalg.norm(N, axis=1)
-    with np.errstate(all="ignore"):
-        return np.where(L[:, None] > 0, N / L[:, None], 0.0)
+    """(nv, 3) unit vertex normals of hessian_normal (:func:`geometry.vertex_normals`)."""
+    return G.vertex_normals(s.F, t.facet_N2, s.nv)
 
 
 def _triple_edges(s):

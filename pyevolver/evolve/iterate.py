@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import UnsupportedError
-from ..surface import project_to_constraints
+from ..surface import project_tangent, project_to_constraints
 from . import gradient as GR
 
 
@@ -120,33 +120,7 @@ class Iterator:
 
     def _project_tangent(self, vecs):
         """Project vectors (list of (nv,3)) onto the constraint tangent spaces."""
-        s = self.surface
-        if not s.vcon:
-            return vecs
-        cids = sorted(s.vcon)
-        on = np.stack([s.vcon[c] for c in cids], axis=1)
-        rows = np.nonzero(on.any(axis=1))[0]
-        if not len(rows):
-            return vecs
-        env = s.param_env()
-        keys, inv = np.unique(on[rows], axis=0, return_inverse=True)
-        inv = inv.ravel()
-        out = [v.copy() for v in vecs]
-        for gi, key in enumerate(keys):
-            rr = rows[inv == gi]
-            P = s.X[rr]
-            coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
-            Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(rr))
-                           for c, k in zip(cids, key) if k], axis=2)     # (n, 3, k)
-            GtG = np.einsum("nik,nil->nkl", Gm, Gm)
-            for v in out:
-                w = v[rr]
-                rhs = np.einsum("nik,ni->nk", Gm, w)
-                with np.errstate(all="ignore"):
-                    lam = np.linalg.solve(GtG, rhs[..., None])[..., 0]
-                lam = np.nan_to_num(lam)
-                v[rr] = w - np.einsum("nik,nk->ni", Gm, lam)
-        return out
+        return project_tangent(self.surface, vecs)
 
     def _constrained_dirs(self, t, cons, mobile):
         gs = cons.gradients(t)

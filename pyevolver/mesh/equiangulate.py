@@ -20,7 +20,7 @@ import numpy as np
 from .. import geometry as G
 
 
-def _edge_facets(s):
+def edge_facets(s):
     """(ne, 2) the two facets of each edge and their sides, valence (ne,)."""
     idx, sgn, _ = s.topology()
     flat_e = idx.ravel()
@@ -74,7 +74,7 @@ def equiangulate(s, threshold=-0.001):
     t.__dict__.pop("_lift_cache", None)
     E, FE = t.E, t.FE
     wrap = t.eattr.get("wrap")
-    ef, ekk, val = _edge_facets(t)
+    ef, ekk, val = edge_facets(t)
     wv = t.wrap_shift()
     lengths = np.linalg.norm(G.edge_vectors(t.X, E, wv), axis=1)
     tension = t.fattr["tension"]

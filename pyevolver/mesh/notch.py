@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import UnsupportedError
 from ..surface import project_to_constraints
+from .equiangulate import edge_facets
 from .grow import grow
 
 
@@ -68,19 +69,12 @@ def split_facets_at_centre(s, facets):
 def notch_edges(s, angle):
     """Edges with two facets whose (orientation-aligned) normals differ by
     more than ``angle`` radians; returns (edge indices, their facets (n, 2))."""
-    idx, sgn, _ = s.topology()
-    t = s.evaluate()
-    ne = s.ne
-    flat = idx.ravel()
-    val = np.bincount(flat, minlength=ne)
-    order = np.argsort(flat, kind="stable")
+    _, sgn, _ = s.topology()
+    ef, ek, val = edge_facets(s)
     two = np.nonzero(val == 2)[0]
-    start = np.concatenate([[0], np.cumsum(val)[:-1]])
-    pos0 = order[start[two]]
-    pos1 = order[start[two] + 1]
-    f0, f1 = pos0 // 3, pos1 // 3
-    s0, s1 = sgn.ravel()[pos0], sgn.ravel()[pos1]
-    N = np.asarray(t.facet_N2)
+    f0, f1 = ef[two, 0], ef[two, 1]
+    s0, s1 = sgn[f0, ek[two, 0]], sgn[f1, ek[two, 1]]
+    N = np.asarray(s.evaluate().facet_N2)
     L = np.linalg.norm(N, axis=1)
     U = N / np.where(L > 0, L, 1.0)[:, None]
     # consistently oriented neighbours traverse the edge in opposite senses

@@ -27,34 +27,8 @@ import copy
 
 import numpy as np
 
-from ..surface import project_to_constraints
-
-
-def _tangent_project(s, idx, D):
-    """Project rows ``D`` (len(idx), 3) of vertices ``idx`` onto the tangent
-    spaces of their level-set constraints (all constraints of a vertex at once)."""
-    if not s.vcon or not len(idx):
-        return D
-    cids = sorted(s.vcon)
-    on = np.stack([s.vcon[c][idx] for c in cids], axis=1)
-    has = on.any(axis=1)
-    if not has.any():
-        return D
-    D = D.copy()
-    env = s.param_env()
-    keys, inv = np.unique(on[has], axis=0, return_inverse=True)
-    rows = np.nonzero(has)[0]
-    inv = inv.ravel()
-    for gi, key in enumerate(keys):
-        sel = rows[inv == gi]
-        P = s.X[idx[sel]]
-        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
-        G = np.stack([s.constraints[c].formula.gradient(env, coords, len(sel))
-                      for c, k in zip(cids, key) if k], axis=2)          # (n, 3, k)
-        # least-squares removal of the span of the constraint gradients
-        Q, _ = np.linalg.qr(G)
-        D[sel] -= np.einsum("nik,nk->ni", Q, np.einsum("nik,ni->nk", Q, D[sel]))
-    return D
+from .. import geometry as G
+from ..surface import project_tangent, project_to_constraints
 
 
 def vertex_average(s, mode="V"):
@@ -114,24 +88,17 @@ def vertex_average(s, mode="V"):
         movable &= bnd == 0
     if mode != "rawest":
         movable &= ~frozen
+    D[~movable] = 0.0
     mv = np.nonzero(movable)[0]
-    D = D[mv] / W[mv, None]
+    D[mv] /= W[mv, None]
     if mode == "V":
-        N = np.zeros((nv, 3))
-        F = s.F
-        for c in range(3):
-            for k in range(3):
-                N[:, k] += np.bincount(F[:, c], weights=t.facet_N2[:, k], minlength=nv)
-        n = N[mv]
-        L = np.linalg.norm(n, axis=1)
-        n = np.where(L[:, None] > 0, n / np.where(L > 0, L, 1.0)[:, None], 0.0)
-        D = _tangent_project(s, mv, D)
+        n = G.vertex_normals(s.F, t.facet_N2, nv)
+        (D,) = project_tangent(s, [D])
         D = D - np.einsum("ij,ij->i", D, n)[:, None] * n
-        D = _tangent_project(s, mv, D)
+        (D,) = project_tangent(s, [D])
     new = copy.copy(s)
     new.__dict__.pop("_lift_cache", None)
-    X = s.X.copy()
-    X[mv] += D / 4.0
+    X = s.X + D / 4.0
     new.X = X
     if new.vcon:
         project_to_constraints(new, mv)
