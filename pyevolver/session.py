@@ -70,6 +70,7 @@ class Session:
         surface = build_surface(scene)
         self.filename = filename
         self.surface = surface
+        self._iterator = None                  # no CG history, pressures not yet valid
         self.variables = surface.params        # parameters and variables share one namespace
         for k in ("scale_limit", "constraint_tolerance"):
             if k in scene.values:
@@ -244,22 +245,25 @@ class Session:
         ``hessian_seek [max]``: a line search along the Newton direction
         (scale at most ``max``, default 1).  Returns a :class:`StepResult`."""
         from .evolve.hessian import newton_direction
-        from .evolve.iterate import StepResult
+        from .evolve.iterate import StepResult, _Constraints
         it = self.iterator
         s = self.surface
-        dx, lam, cons, mobile, us, A = newton_direction(it)
+        if not it.pressures_valid and len(_Constraints(s)):
+            raise CommandError("Pressures invalid. Do regular iteration before Hessian "
+                               "to set pressures.")
+        dx, lam, cons, mobile = newton_direction(it)
         targets = cons.targets(s)
         X0 = s.X.copy()
 
         def E(scale, report=None):
-            e = it._move(X0, dx, scale, cons, us, A, mobile, targets, report).energy
+            e = it._move(X0, dx, scale, cons, None, None, mobile, targets, report).energy
             return e if math.isfinite(e) else math.inf
         scale = 1.0
         if seek:
             smax = 1.0 if max_scale is None else max_scale
             scale, _, _ = it._line_search(E, smax, smax)
         report = []
-        t = it._move(X0, dx, scale, cons, us, A, mobile, targets, report)
+        t = it._move(X0, dx, scale, cons, None, None, mobile, targets, report)
         if not math.isfinite(t.energy):
             s.X = X0
             self.recalc()

@@ -14,9 +14,9 @@ sparse matrix; the system is solved with a sparse LU factorization
 (``scipy.sparse.linalg.splu``).  After the move, vertices are projected
 back onto their constraints and the fixed values restored as in ``g``.
 
-Hessians: facet area (tension), edge length, and facet volume (z-flux and
-symmetric) are analytic (per-element 9×9 / 6×6 blocks); every other term
-(gravity, constraint and boundary integrals, quantities, torus lifts) is
+Hessians: facet area (tension), edge length, facet volume (z-flux and
+symmetric) and gravity are analytic (per-element 9×9 / 6×6 blocks); every
+other term (constraint and boundary integrals, quantities, torus lifts) is
 differentiated by central differences of its analytic gradient, with a
 distance-2 vertex colouring so that one gradient pair per colour and
 coordinate gives all columns (Curtis–Powell–Reid 1974; Coleman–Moré 1983).
@@ -137,6 +137,36 @@ def facet_volume_hessian(t, weights, symmetric):
     return _assemble(s.nv, s.F, B)
 
 
+def facet_gravity_hessian(t, weights):
+    """Hessian of ``Σ_f w_f g_f`` with ``g = S(z) cz / 24`` (see :mod:`.gradient`).
+
+    ``S = Σ z_a² + Σ_{a<b} z_a z_b`` is quadratic in the heights and ``cz``
+    bilinear in x and y, so the blocks are ``S/24 ∂²cz`` (xy-xy),
+    ``∂S/∂z_a ∂cz/∂(x,y)_b / 24`` (z-xy) and ``(1 + δ_ab) cz / 24`` (z-z).
+    """
+    s = t.surface
+    P = GR._facet_points(t)
+    m = len(P)
+    z = P[:, :, 2]
+    S = (z * z).sum(axis=1) + z[:, 0] * z[:, 1] + z[:, 1] * z[:, 2] + z[:, 0] * z[:, 2]
+    dS = z + z.sum(axis=1)[:, None]               # ∂S/∂z_a = 2 z_a + Σ_{b≠a} z_b
+    cz = t.facet_N2[:, 2]
+    dcz = GR._cz_grad(P)
+    C = np.array([[0, 1, -1], [-1, 0, 1], [1, -1, 0]], float)
+    B = np.zeros((m, 3, 3, 3, 3))
+    for a in range(3):
+        for b in range(3):
+            B[:, a, b, 0, 1] = S * C[a, b]
+            B[:, a, b, 1, 0] = S * C[b, a]
+            B[:, a, b, 2, 0] = dS[:, a] * dcz[:, b, 0]
+            B[:, a, b, 2, 1] = dS[:, a] * dcz[:, b, 1]
+            B[:, a, b, 0, 2] = dS[:, b] * dcz[:, a, 0]
+            B[:, a, b, 1, 2] = dS[:, b] * dcz[:, a, 1]
+            B[:, a, b, 2, 2] = (2.0 if a == b else 1.0) * cz
+    B *= (np.asarray(weights) / 24.0)[:, None, None, None, None]
+    return _assemble(s.nv, s.F, B)
+
+
 def distance2_coloring(s, seed=0):
     """Colour vertices so that no two of a colour share a facet or an edge
     neighbour (Jones–Plassmann rounds on the square of the vertex graph).
@@ -212,7 +242,7 @@ def _analytic_parts(s, t, cons, lam):
     and whether they cover the whole Lagrangian."""
     H = facet_area_hessian(t, s.facet_tension)
     g = GR.corner_scatter(t, GR.facet_area_grad(t), s.facet_tension)
-    complete = set(t.terms) <= {"facet_tension", "edge_tension"}
+    complete = set(t.terms) <= {"facet_tension", "edge_tension", "gravity"}
     et = s.eattr.get("tension")
     if et is not None and np.any(et):
         nz = np.nonzero(et)[0]
@@ -221,6 +251,13 @@ def _analytic_parts(s, t, cons, lam):
     if getattr(t, "con_energy", 0.0):
         complete = False
     b = s.bodies
+    if "gravity" in t.terms:
+        if s.periods is None:
+            w = s.gravity_constant * (b.facet_matrix.T @ b.density)
+            H = H + facet_gravity_hessian(t, w)
+            g = g + GR.corner_scatter(t, GR.facet_gravity_grad(t), w)
+        else:
+            complete = False
     plain_volume = s.periods is None and not GR.content_edge_terms(t)
     if cons.quantities or (b.n and not np.all(np.isnan(b.pressure))):
         complete = False
@@ -384,9 +421,8 @@ def constraint_curvature(s, grads, force_grad):
 def newton_direction(it):
     """The Newton motion (nv, 3) and new multipliers for the iterator's surface.
 
-    Returns ``(dx, lam_new, cons, mobile, us, A)``; ``us``/``A`` are the
-    projected constraint gradients and their Gram matrix, which the
-    restoring loop of the move reuses.
+    Returns ``(dx, lam_new, cons, mobile)``.  The move restores the fixed
+    values along the constraint gradients at the moved positions.
     """
     from .iterate import _Constraints
     s = it.surface
@@ -395,15 +431,16 @@ def newton_direction(it):
     t = s.evaluate()
     gE = GR.energy_gradient(t)
     lam = np.zeros(len(cons))
-    gs, us, A = [], [], np.zeros((0, 0))
+    gs = []
     if len(cons):
-        f = -gE.copy()
-        f[~mobile] = 0.0
-        (f,) = it._project_tangent([f])
-        gs, us, A = it._constrained_dirs(t, cons, mobile)
-        bb = np.array([float(np.sum(f * g)) for g in gs])
-        lam = -np.linalg.lstsq(A, bb, rcond=None)[0]      # ∇E ≈ Σ λ ∇g
-        # gs are zero on fixed vertices, which T does not move anyway
+        gs, _, _ = it._constrained_dirs(t, cons, mobile)     # zero on fixed vertices
+        # The Evolver's Hessian of the Lagrangian uses the multipliers stored
+        # by the previous g or hessian step (the printed pressures), not ones
+        # fitted to the current gradient: with these, hessian on mound.fe
+        # after g 10 agrees with it to 15 digits.
+        lam = np.array([s.bodies.lagrange[i] for i in cons.bodies] +
+                       [q.pressure for q in cons.quantities], dtype=float)
+        lam = np.nan_to_num(lam)
 
     def grad_L(tt):
         g = GR.energy_gradient(tt)
@@ -436,4 +473,4 @@ def newton_direction(it):
     dy = sol[:K.shape[0]]
     lam_new = -sol[K.shape[0]:] if ncons else lam
     dx = (T @ dy).reshape(-1, 3)
-    return dx, lam_new, cons, mobile, us, A
+    return dx, lam_new, cons, mobile

@@ -103,6 +103,8 @@ class Iterator:
         self.cg_history = None
         self.cg_S_old = 0.0
         self.cg_f_old = None
+        # the multipliers (pressures) are set by a g step; hessian needs them
+        self.pressures_valid = False
 
     # -- helpers ----------------------------------------------------------------
     @property
@@ -150,6 +152,9 @@ class Iterator:
         t = s.evaluate()
         d = targets - cons.values(t)
         err = float(np.sum(np.abs(d) / cons.tolerances(t, tol)))
+        if us is None:
+            # restore along the constraint gradients at the moved positions
+            _, us, A = self._constrained_dirs(t, cons, mobile)
         cur_us, cur_A = us, A
         for it in range(10):
             try:
@@ -292,6 +297,7 @@ class Iterator:
             q.pressure = -lam[k]
             qp[q.name] = q.pressure
             k += 1
+        self.pressures_valid = True
         sess.recalc(keep_cg=True)
         sess.iteration_counter = getattr(sess, "iteration_counter", 0) + 1
         sess.total_time = getattr(sess, "total_time", 0.0) + scale
