@@ -22,7 +22,7 @@ from .commands.cformat import print_value
 from .datafile.reader import read_datafile
 from .errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
 from .expr import nodes as N
-from .surface import build_surface, project_to_constraints
+from .surface import build_surface, project_to_constraints, restore_state, state
 
 READ_ONLY = {
     "total_energy", "total_area", "total_length", "vertex_count", "edge_count",
@@ -253,7 +253,7 @@ class Session:
                                "to set pressures.")
         dx, lam, cons, mobile = newton_direction(it)
         targets = cons.targets(s)
-        X0 = s.X.copy()
+        X0 = state(s)
 
         def E(scale, report=None):
             e = it._move(X0, dx, scale, cons, None, None, mobile, targets, report).energy
@@ -265,7 +265,7 @@ class Session:
         report = []
         t = it._move(X0, dx, scale, cons, None, None, mobile, targets, report)
         if not math.isfinite(t.energy):
-            s.X = X0
+            restore_state(s, X0)
             self.recalc()
             raise CommandError("hessian: the Newton step gives a non-finite energy; "
                                "the surface is unchanged")

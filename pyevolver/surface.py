@@ -1063,9 +1063,78 @@ def torus_lift_shifts(s):
     return out
 
 
+def boundary_eval(s, bid, P):
+    """Points and Jacobians of parametric boundary ``bid`` at parameters ``P``.
+
+    Returns ``X`` (n, 3) and ``J`` (n, 3, k) with ``J[:, i, j] = ∂x_i/∂p_j``.
+    """
+    b = s.boundaries[bid]
+    names = tuple(f"p{k + 1}" for k in range(b.nparams))
+    env0 = s.param_env()
+    P = P[:, :b.nparams]
+    env = {nm: P[:, k] for k, nm in enumerate(names)}
+    X = np.stack([f.values(env0, env, len(P)) for f in b.coords[:3]], axis=1)
+    J = np.stack([f.gradient(env0, env, len(P), names) for f in b.coords[:3]], axis=1)
+    return X, J
+
+
+def boundary_groups(s, mask=None):
+    """``(bid, rows)`` for each parametric boundary with vertices (among ``mask``)."""
+    bnd = s.vattr.get("boundary")
+    if bnd is None:
+        return []
+    out = []
+    for bid in s.boundaries:
+        sel = bnd == bid
+        if mask is not None:
+            sel &= mask
+        rows = np.nonzero(sel)[0]
+        if len(rows):
+            out.append((bid, rows))
+    return out
+
+
+def state(s):
+    """Snapshot of the coordinates (and boundary parameters) of ``s``."""
+    P = s.vattr.get("params")
+    return s.X.copy(), (None if P is None else P.copy())
+
+
+def restore_state(s, st):
+    s.X = st[0].copy()
+    if st[1] is not None:
+        s.vattr["params"] = st[1].copy()
+
+
+def displace(s, base, dX):
+    """Move the vertices of ``s`` from the snapshot ``base`` (see :func:`state`)
+    by the spatial displacements ``dX`` (nv, 3).
+
+    Vertices on a parametric boundary move in parameter space (spec §6.3):
+    ``p = p0 + (JᵀJ)⁻¹ Jᵀ dx`` with ``J = ∂X/∂p`` at ``p0``, then
+    ``x = X(p)``; the others move by ``dx``.
+    """
+    X0, P0 = base
+    s.X = X0 + dX
+    if P0 is None:
+        return
+    P = P0.copy()
+    for bid, rows in boundary_groups(s):
+        k = s.boundaries[bid].nparams
+        _, J = boundary_eval(s, bid, P0[rows])
+        JtJ = np.einsum("nik,nil->nkl", J, J)
+        rhs = np.einsum("nik,ni->nk", J, dX[rows])
+        with np.errstate(all="ignore"):
+            dp = np.linalg.solve(JtJ, rhs[..., None])[..., 0]
+        P[rows, :k] = P0[rows, :k] + np.nan_to_num(dp)
+        s.X[rows], _ = boundary_eval(s, bid, P[rows])
+    s.vattr["params"] = P
+
+
 def project_tangent(s, vecs):
     """Project vectors onto the tangent spaces of the vertices' level-set
-    constraints (all constraints of a vertex at once).
+    constraints (all constraints of a vertex at once) and, for vertices on a
+    parametric boundary, onto the boundary's tangent space (span of ∂X/∂p).
 
     Parameters
     ----------
@@ -1078,6 +1147,18 @@ def project_tangent(s, vecs):
         Copies with the components along the constraint gradients removed
         (the input list itself when no vertex is constrained).
     """
+    groups = boundary_groups(s)
+    if groups:
+        vecs = [v.copy() for v in vecs]
+        P = s.vattr["params"]
+        for bid, rr in groups:
+            _, J = boundary_eval(s, bid, P[rr])
+            JtJ = np.einsum("nik,nil->nkl", J, J)
+            for v in vecs:
+                rhs = np.einsum("nik,ni->nk", J, v[rr])
+                with np.errstate(all="ignore"):
+                    c = np.linalg.solve(JtJ, rhs[..., None])[..., 0]
+                v[rr] = np.einsum("nik,nk->ni", J, np.nan_to_num(c))
     if not s.vcon:
         return vecs
     cids = sorted(s.vcon)

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import UnsupportedError
-from ..surface import project_tangent, project_to_constraints
+from ..surface import displace, project_tangent, project_to_constraints, restore_state, state
 from . import gradient as GR
 
 
@@ -113,12 +113,7 @@ class Iterator:
 
     def _mobile(self):
         s = self.surface
-        mobile = ~s.vattr["fixed"]
-        bnd = s.vattr.get("boundary")
-        if bnd is not None and np.any((bnd != 0) & mobile):
-            raise UnsupportedError("motion of vertices on parametric boundaries that are not "
-                                   "FIXED", "comes later in the evolve issue")
-        return mobile
+        return ~s.vattr["fixed"]
 
     def _project_tangent(self, vecs):
         """Project vectors (list of (nv,3)) onto the constraint tangent spaces."""
@@ -140,10 +135,12 @@ class Iterator:
         return gs, us, A
 
     # -- one move ------------------------------------------------------------------
-    def _move(self, X0, vel, scale, cons, us, A, mobile, targets, report):
-        """Trial move M(scale) from X0: step, project, restore constraint values."""
+    def _move(self, base, vel, scale, cons, us, A, mobile, targets, report):
+        """Trial move M(scale) from the snapshot ``base`` (:func:`surface.state`):
+        step, project, restore constraint values.  With ``us`` None the
+        restoring directions are taken at the moved positions."""
         s = self.surface
-        s.X = X0 + scale * vel
+        displace(s, base, scale * vel)
         moved = np.nonzero(mobile)[0]
         project_to_constraints(s, moved)
         if not len(cons):
@@ -161,9 +158,9 @@ class Iterator:
                 delta = np.linalg.solve(cur_A, d)
             except np.linalg.LinAlgError:
                 delta = np.linalg.lstsq(cur_A, d, rcond=None)[0]
-            Xprev = s.X.copy()
+            prev = state(s)
             shift = sum(dl * u for dl, u in zip(delta, cur_us))
-            s.X = s.X + shift
+            displace(s, prev, shift)
             project_to_constraints(s, moved)
             t_new = s.evaluate()
             d_new = targets - cons.values(t_new)
@@ -173,12 +170,12 @@ class Iterator:
                     report.append(f"Total constraint difference would increase by factor of "
                                   f"{err_new / err:f}.")
                     report.append("Aborting constraint adjustment.")
-                s.X = Xprev
+                restore_state(s, prev)
                 t = s.evaluate()
                 return t
             if err_new > 1.01 * err and it > 0:
                 # undo and take half the correction
-                s.X = Xprev + 0.5 * shift
+                displace(s, prev, 0.5 * shift)
                 project_to_constraints(s, moved)
                 t_new = s.evaluate()
                 d_new = targets - cons.values(t_new)
@@ -242,7 +239,7 @@ class Iterator:
             self.cg_S_old = S
             self.cg_f_old = f_raw      # the Evolver keeps the unprojected force
             vel = h
-        X0 = s.X.copy()
+        X0 = state(s)
         warnings = []
 
         def E(scale, report=None):
@@ -263,7 +260,7 @@ class Iterator:
                        targets, report)
         e = t.energy
         if not math.isfinite(e):
-            s.X = X0
+            restore_state(s, X0)
             sess.recalc()
             warnings.append("WARNING 1864: energy is not finite; coordinates restored.")
             return StepResult(t0.energy, t0.total_area, scale, lam, {}, False,
@@ -271,7 +268,7 @@ class Iterator:
         if E0 is None:
             E0 = t0.energy
         if sess.toggles.get("check_increase", 0) and e > E0:
-            s.X = X0
+            restore_state(s, X0)
             sess.recalc()
             warnings.append("WARNING 1865: Motion would have increased energy. Restoring "
                             "coordinates.")
