@@ -10,8 +10,10 @@ where ``H`` is the Hessian of the Lagrangian ``E − Σ λ_i g_i − Σ μ_v φ(
 level-set constraints φ), ``C`` holds the gradients of the ``g_i`` and
 ``T`` maps the free coordinates ``dy`` of each mobile vertex (its tangent
 space to its level-set constraints) to ``dx = T dy``.  Everything is a
-sparse matrix; the system is solved with a sparse LU factorization
-(``scipy.sparse.linalg.splu``).  After the move, vertices are projected
+sparse matrix; the system is solved by CHOLMOD's sparse LDLᵀ of the
+Hessian block and a Schur complement for the border when scikit-sparse is
+installed (extra ``pyevolver[cholmod]``), by a sparse LU factorization of
+the bordered matrix (``scipy.sparse.linalg.splu``) otherwise.  After the move, vertices are projected
 back onto their constraints and the fixed values restored as in ``g``.
 
 Hessians: facet area (tension), edge length, facet volume (z-flux and
@@ -24,6 +26,7 @@ coordinate gives all columns (Curtis–Powell–Reid 1974; Coleman–Moré 1983)
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import scipy.sparse as sp
@@ -81,22 +84,28 @@ def _assemble(nv, verts, blocks, basis=None):
     m, k = verts.shape
     if basis is not None:
         Bv = basis.B[verts]                                        # (m, k, 3, d)
-        d = Bv.shape[3]
         blocks = np.einsum("maip,mabij,mbjq->mabpq", Bv, blocks, Bv, optimize=True)
-        idx = basis.start[verts][:, :, None] + np.arange(d)        # (m, k, d)
-        ok = np.arange(d)[None, None, :] < basis.ndof[verts][:, :, None]
-        idx = np.where(ok, idx, -1)
-        rows = np.broadcast_to(idx[:, :, None, :, None], (m, k, k, d, d)).ravel()
-        cols = np.broadcast_to(idx[:, None, :, None, :], (m, k, k, d, d)).ravel()
-        vals = blocks.ravel()
-        keep = (rows >= 0) & (cols >= 0)
-        return sp.csr_matrix((vals[keep], (rows[keep], cols[keep])),
-                             shape=(basis.n, basis.n))
+        return _assemble_projected(verts, blocks, basis)
     rows = (3 * verts[:, :, None, None, None] + np.arange(3)[None, None, None, :, None])
     cols = (3 * verts[:, None, :, None, None] + np.arange(3)[None, None, None, None, :])
     rows = np.broadcast_to(rows, (m, k, k, 3, 3)).ravel()
     cols = np.broadcast_to(cols, (m, k, k, 3, 3)).ravel()
     return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(3 * nv, 3 * nv))
+
+
+def _assemble_projected(verts, blocks, basis):
+    """Sparse (ndof, ndof) matrix from projected element blocks (m, k, k, d, d)."""
+    m, k = verts.shape
+    d = blocks.shape[3]
+    idx = basis.start[verts][:, :, None] + np.arange(d)        # (m, k, d)
+    ok = np.arange(d)[None, None, :] < basis.ndof[verts][:, :, None]
+    idx = np.where(ok, idx, -1)
+    rows = np.broadcast_to(idx[:, :, None, :, None], (m, k, k, d, d)).ravel()
+    cols = np.broadcast_to(idx[:, None, :, None, :], (m, k, k, d, d)).ravel()
+    vals = blocks.ravel()
+    keep = (rows >= 0) & (cols >= 0)
+    return sp.csr_matrix((vals[keep], (rows[keep], cols[keep])),
+                         shape=(basis.n, basis.n))
 
 
 def facet_area_hessian(t, weights, basis=None):
@@ -117,6 +126,26 @@ def facet_area_hessian(t, weights, basis=None):
     P, N2, L, w = P[ok], N2[ok], L[ok], weights[ok]
     n = N2 / L[:, None]
     e = np.stack([P[:, 2] - P[:, 1], P[:, 0] - P[:, 2], P[:, 1] - P[:, 0]], 1)
+    if basis is not None and basis.B.shape[2] == 1:
+        # one free direction u_v per vertex: contract in closed form,
+        # u_aᵀ H_ab u_b = ½ ε_ab u_a·(n × u_b) + (w_a·w_b − (n·w_a)(n·w_b)) / (2|N|)
+        # with w_a = e_a × u_a
+        F = s.F[ok]
+        U = basis.B[F][:, :, :, 0]                                   # (m, 3, 3)
+        W = np.cross(e, U)
+        nw = np.einsum("mi,mai->ma", n, W)
+        K = np.einsum("mai,mbi->mab", W, W) - nw[:, :, None] * nw[:, None, :]
+        K /= (2 * L)[:, None, None]
+        nxU = np.cross(n[:, None, :], U)
+        T3 = np.einsum("mai,mbi->mab", U, nxU)                     # u_a·(n × u_b)
+        K[:, 0, 2] += 0.5 * T3[:, 0, 2]
+        K[:, 1, 0] += 0.5 * T3[:, 1, 0]
+        K[:, 2, 1] += 0.5 * T3[:, 2, 1]
+        K[:, 0, 1] -= 0.5 * T3[:, 0, 1]
+        K[:, 1, 2] -= 0.5 * T3[:, 1, 2]
+        K[:, 2, 0] -= 0.5 * T3[:, 2, 0]
+        K *= w[:, None, None]
+        return _assemble_projected(F, K[:, :, :, None, None], basis)
     # [e_a]x^T (I - n n^T) [e_b]x = (e_a.e_b) I - e_b e_a^T - c_a c_b^T, c_a = n x e_a
     c = np.cross(n[:, None, :], e)                                   # (m, 3, 3)
     dots = np.einsum("mai,mbi->mab", e, e)
@@ -152,6 +181,32 @@ def facet_volume_hessian(t, weights, symmetric, basis=None):
     s = t.surface
     P = GR._facet_points(t)
     m = len(P)
+    if basis is not None and basis.B.shape[2] == 1:
+        # one free direction u_v per vertex: second directional derivatives
+        U = basis.B[s.F][:, :, :, 0]                                 # (m, 3, 3)
+        K = np.zeros((m, 3, 3))
+        if symmetric:
+            # v = det[x0, x1, x2]/6: u_a in slot a, u_b in slot b, x_c in slot c
+            for a in range(3):
+                for b in range(3):
+                    if a != b:
+                        c = 3 - a - b
+                        slots = [None, None, None]
+                        slots[a], slots[b], slots[c] = U[:, a], U[:, b], P[:, c]
+                        K[:, a, b] = np.einsum("mi,mi->m", slots[0],
+                                               np.cross(slots[1], slots[2])) / 6.0
+        else:
+            # v = Z cz / 6: Z = Σ z, cz bilinear in (x, y)
+            C = np.array([[0, 1, -1], [-1, 0, 1], [1, -1, 0]], float)
+            Z = P[:, :, 2].sum(axis=1)
+            dcz = GR._cz_grad(P)                                     # (m, 3, 3)
+            du = dcz[:, :, 0] * U[:, :, 0] + dcz[:, :, 1] * U[:, :, 1]   # dcz_a · u_a
+            uz = U[:, :, 2]
+            xy = U[:, :, 0][:, :, None] * U[:, :, 1][:, None, :]     # u_ax u_by
+            K = (Z[:, None, None] * (C[None] * xy + C.T[None] * xy.transpose(0, 2, 1))
+                 + uz[:, :, None] * du[:, None, :] + du[:, :, None] * uz[:, None, :]) / 6.0
+        K *= np.asarray(weights)[:, None, None]
+        return _assemble_projected(s.F, K[:, :, :, None, None], basis)
     B = np.zeros((m, 3, 3, 3, 3))
     if symmetric:
         # v = det[x0, x1, x2]/6: d²v/dx_a^i dx_b^j = ±ε_ijk x_c^k / 6
@@ -471,6 +526,59 @@ def constraint_curvature(s, grads, force_grad):
                          shape=(3 * s.nv, 3 * s.nv))
 
 
+def _cholmod():
+    """scikit-sparse's CHOLMOD module, or None when it is not installed."""
+    try:
+        from sksparse import cholmod
+    except ImportError:
+        return None
+    return cholmod
+
+
+def solve_bordered(K, B, r, d, method=None):
+    """Solve ``[[K, B], [Bᵀ, 0]] [y; μ] = [r; d]``.
+
+    K : sparse symmetric (n, n); B : (n, k) dense or None; r : (n,); d : (k,).
+    Returns the stacked solution (n + k,).  ``method`` "cholmod" factors K
+    with CHOLMOD's LDLᵀ (scikit-sparse; symmetric, indefinite allowed) and
+    eliminates the k multipliers by the Schur complement ``Bᵀ K⁻¹ B``;
+    "splu" factors the whole bordered matrix with SuperLU.  By default
+    CHOLMOD when installed, SuperLU otherwise or when CHOLMOD meets a zero
+    pivot.
+    """
+    chol = _cholmod() if method in (None, "cholmod") else None
+    if method == "cholmod" and chol is None:
+        raise UnsupportedError("hessian solver cholmod", "scikit-sparse is not installed")
+    if chol is not None:
+        try:
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                f = chol.cholesky(K.tocsc(), mode="simplicial")
+                if B is None:
+                    y = f(r)
+                    sol = y
+                else:
+                    Z = f(np.column_stack([r, B]))
+                    S = B.T @ Z[:, 1:]
+                    mu = np.linalg.solve(S, B.T @ Z[:, 0] - d)
+                    y = Z[:, 0] - Z[:, 1:] @ mu
+                    sol = np.concatenate([y, mu])
+            if np.all(np.isfinite(sol)):
+                return sol
+        except (chol.CholmodError, np.linalg.LinAlgError):
+            pass
+    if B is None:
+        M, rhs = K.tocsc(), r
+    else:
+        M = sp.bmat([[K, sp.csc_matrix(B)], [sp.csc_matrix(B.T), None]], format="csc")
+        rhs = np.concatenate([r, d])
+    try:
+        return spla.splu(M).solve(rhs)
+    except RuntimeError as exc:
+        raise UnsupportedError("hessian on a singular Hessian",
+                               f"the bordered Hessian could not be factored ({exc})") from None
+
+
 def newton_direction(it):
     """The Newton motion (nv, 3) and new multipliers for the iterator's surface.
 
@@ -511,21 +619,13 @@ def newton_direction(it):
         K = K - T.T @ Hc @ T
     K = K.tocsc()
     rhs = -(T.T @ gE.ravel())
-    ncons = len(cons)
-    if ncons:
+    B = d = None
+    if len(cons):
         Cm = np.stack([g.ravel() for g in gs], axis=1)          # (3nv, k)
-        B = sp.csc_matrix(T.T @ Cm)
-        M = sp.bmat([[K, B], [B.T, None]], format="csc")
+        B = np.asarray(T.T @ Cm)
         d = cons.targets(s) - cons.values(t)
-        rhs = np.concatenate([rhs, d])
-    else:
-        M = K
-    try:
-        sol = spla.splu(M).solve(rhs)
-    except RuntimeError as exc:
-        raise UnsupportedError("hessian on a singular Hessian",
-                               f"the bordered Hessian could not be factored ({exc})") from None
+    sol = solve_bordered(K, B, rhs, d)
     dy = sol[:K.shape[0]]
-    lam_new = -sol[K.shape[0]:] if ncons else lam
+    lam_new = -sol[K.shape[0]:] if len(cons) else lam
     dx = (T @ dy).reshape(-1, 3)
     return dx, lam_new, cons, mobile
