@@ -71,6 +71,12 @@ class Session:
         self.filename = filename
         self.surface = surface
         self._iterator = None                  # no CG history, pressures not yet valid
+        # REF's gravity flag (reported by G): on when the datafile declares a
+        # nonzero gravity_constant or a body has a density (mound.fe: on with
+        # gravity_constant 0; cube.fe: off with the default constant 1)
+        b = surface.bodies
+        self.toggles["gravity"] = int(scene.values.get("gravity_constant", 0) != 0 or
+                                      bool(b.n and np.any(b.density)))
         self.variables = surface.params        # parameters and variables share one namespace
         for k in ("scale_limit", "constraint_tolerance"):
             if k in scene.values:
@@ -174,6 +180,7 @@ class Session:
         if s is None:
             return
         s.gravity_constant = self.variables.get("gravity_constant", s.gravity_constant)
+        s.gravity_on = bool(self.toggles.get("gravity", 1))
         t = s.evaluate()
         s.bodies.volume = t.volumes
         self.totals = t

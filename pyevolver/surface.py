@@ -70,6 +70,7 @@ class Surface:
         self.torus_filled = False
         self.params = {}
         self.gravity_constant = 1.0
+        self.gravity_on = True       # the `gravity` toggle (G v sets it to v != 0)
         self.gap_constant = 1.0
 
     # -- topology helpers ---------------------------------------------------
@@ -336,7 +337,7 @@ class Totals:
         s = self.surface
         b = s.bodies
         G_ = s.gravity_constant
-        if G_ == 0 or not np.any(b.density):
+        if G_ == 0 or not s.gravity_on or not np.any(b.density):
             return 0.0
         per_facet = G.facet_gravity(self.facet_x0, self.facet_S)
         return float(G_ * (b.density @ (b.facet_matrix @ per_facet)))

@@ -828,11 +828,16 @@ class Interpreter:
             s.write(f"Conjugate gradient now {'OFF' if old else 'ON'}. (was {'on' if old else 'off'})\n")
             return
         if raw == "G":
-            old_on = s.surface.gravity_constant != 0
+            old_on = s.toggles.get("gravity", 0)
             if arg is not None:
                 s.surface.gravity_constant = float(self.value(arg))
-            s.write("Gravity is now ON with gravitational constant %g. (was %s)\n"
-                    % (s.surface.gravity_constant, "on" if old_on else "off"))
+            g = s.surface.gravity_constant
+            s.toggles["gravity"] = int(g != 0)
+            was = "on" if old_on else "off"
+            if g != 0:
+                s.write(f"Gravity is now ON with gravitational constant {g:g}. (was {was})\n")
+            else:
+                s.write(f"Gravity is now OFF. (was {was})\n")
             s.recalc()
             return
         if len(raw) == 1 and raw in LETTER_LATER:
@@ -864,6 +869,9 @@ class Interpreter:
         elif name == "ribiere":
             s.write(f"Polak-Ribiere conjugate gradient {'ON' if new else 'OFF'}. "
                     f"(was {'on' if old else 'off'})\n")
+        elif name == "gravity":
+            s.write(f"Gravity {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
+            s.recalc()
         else:
             s.write(f"{name} {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
 

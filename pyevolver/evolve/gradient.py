@@ -185,7 +185,7 @@ def energy_gradient(t):
         g += gap_energy_grad(t)
     b = s.bodies
     if b.n:
-        if s.gravity_constant != 0 and np.any(b.density):
+        if s.gravity_constant != 0 and s.gravity_on and np.any(b.density):
             w = s.gravity_constant * (b.facet_matrix.T @ b.density)
             g += corner_scatter(t, facet_gravity_grad(t), w)
         pmask = ~np.isnan(b.pressure)
