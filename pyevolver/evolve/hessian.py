@@ -335,23 +335,24 @@ def fd_hessian(fun, s, h=None):
     return 0.5 * (H + H.T)
 
 
-def _analytic_parts(s, t, cons, lam, basis=None, hessian=True):
+def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
     """Analytic Hessian and gradient of the parts that have closed forms,
     and whether they cover the whole Lagrangian.
 
     The Hessian is (3nv, 3nv), or projected on ``basis`` (see
     :func:`_assemble`); with ``hessian=False`` only the gradient is formed
-    (``H`` is None).
+    (``H`` is None), with ``gradient=False`` only the Hessian (``g`` is None).
     """
     parts = []                       # (hessian function, args) of each analytic term
     parts.append((facet_area_hessian, (t, s.facet_tension)))
-    g = GR.corner_scatter(t, GR.facet_area_grad(t), s.facet_tension)
+    g = GR.corner_scatter(t, GR.facet_area_grad(t), s.facet_tension) if gradient else None
     complete = set(t.terms) <= {"facet_tension", "edge_tension", "gravity"}
     et = s.eattr.get("tension")
     if et is not None and np.any(et):
         nz = np.nonzero(et)[0]
         parts.append((edge_length_hessian, (t, nz, et[nz])))
-        g = g + GR.edge_length_grad(t, nz, et[nz])
+        if gradient:
+            g = g + GR.edge_length_grad(t, nz, et[nz])
     if getattr(t, "con_energy", 0.0):
         complete = False
     b = s.bodies
@@ -359,7 +360,8 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True):
         if s.periods is None:
             w = s.gravity_constant * (b.facet_matrix.T @ b.density)
             parts.append((facet_gravity_hessian, (t, w)))
-            g = g + GR.corner_scatter(t, GR.facet_gravity_grad(t), w)
+            if gradient:
+                g = g + GR.corner_scatter(t, GR.facet_gravity_grad(t), w)
         else:
             complete = False
     plain_volume = s.periods is None and not GR.content_edge_terms(t)
@@ -372,7 +374,8 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True):
                 w[i] = -lam[k]
             fw = b.facet_matrix.T @ w
             parts.append((facet_volume_hessian, (t, fw, s.symmetric_content)))
-            g = g + GR.corner_scatter(t, GR.facet_volume_grad(t, s.symmetric_content), fw)
+            if gradient:
+                g = g + GR.corner_scatter(t, GR.facet_volume_grad(t, s.symmetric_content), fw)
         else:
             complete = False
     H = None
@@ -387,7 +390,7 @@ def lagrangian_hessian(s, cons, lam, grad_fn, basis=None):
     """Sparse Hessian of E − Σ λ_i g_i (level-set terms excluded): (3nv, 3nv),
     or ``Tᵀ H T`` on a :class:`Basis`."""
     t = s.evaluate()
-    H, _, complete = _analytic_parts(s, t, cons, lam, basis)
+    H, _, complete = _analytic_parts(s, t, cons, lam, basis, gradient=False)
     if complete:
         return H
 
