@@ -55,6 +55,7 @@ class Session:
         self.start_time = time.time()
         self.interp = I.Interpreter(self)
         self._iterator = None
+        self.counts = {}                       # equi_count, refine_count, ... (spec §9.7)
         self.iteration_counter = 0
         self.total_time = 0.0
 
@@ -207,6 +208,9 @@ class Session:
         """
         from .evolve.iterate import progress_line
         results = []
+        if self.surface.nv == 0:                # e.g. after `t` removed everything (REF)
+            self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")
+            return results
         for k in range(n, 0, -1):
             r = self.iterator.step()
             results.append(r)
@@ -326,6 +330,7 @@ class Session:
         from .mesh.equiangulate import equiangulate
         new, n = equiangulate(self.surface)
         self._replace_surface(new)
+        self.counts["equi"] = n                 # REF: the last sweep's flips
         if echo:
             self.write(f"Edges switched in equiangulation: {n}\n")
         return n
@@ -334,6 +339,7 @@ class Session:
         from .mesh.edge_divide import edge_divide
         new, n = edge_divide(self.surface, edges)
         self._replace_surface(new)
+        self._count("refine", n)                # REF: l and K accumulate, r does not
         if echo:
             self.write(f"New edges: {n}\n")
         return n
@@ -357,8 +363,33 @@ class Session:
             raise UnsupportedError("notch in the string model")
         new, n = notch(self.surface, angle)
         self._replace_surface(new)
+        self._count("notch", n)
         if echo:
             self.write(f"Number of edges notched: {n}\n")
+        return n
+
+    def _count(self, key, n):
+        self.counts[key] = self.counts.get(key, 0) + n
+
+    def delete_short_edges(self, length, echo=True):
+        """``t L`` / ``edgeweed L``: delete edges shorter than ``L`` (spec §8.4)."""
+        from .mesh.delete_edges import delete_short_edges
+        new, n = delete_short_edges(self.surface, length)
+        self._replace_surface(new)
+        self._count("edge_delete", n)
+        if echo:
+            self.write(f"Deleted edges: {n}\n")
+        return n
+
+    def weed(self, area, echo=True):
+        """``w A`` / ``areaweed A``: remove facets of area below ``A`` by
+        deleting one of their edges, shortest first (spec §8.4)."""
+        from .mesh.delete_edges import weed_small_facets
+        new, n = weed_small_facets(self.surface, area)
+        self._replace_surface(new)
+        self._count("edge_delete", n)
+        if echo:
+            self.write(f"Skinny triangles weeded: {n}\n")
         return n
 
     def vertex_average(self, mode="V", echo=True):
@@ -425,9 +456,12 @@ class Session:
             "g": lambda: s.gravity_constant,
             "iteration_counter": lambda: self.iteration_counter,
             "total_time": lambda: self.total_time,
-            "equi_count": lambda: 0, "edge_delete_count": lambda: 0,
-            "vertex_pop_count": lambda: 0, "edge_pop_count": lambda: 0,
-            "notch_count": lambda: 0, "refine_count": lambda: 0, "where_count": lambda: 0,
+            "equi_count": lambda: self.counts.get("equi", 0),
+            "edge_delete_count": lambda: self.counts.get("edge_delete", 0),
+            "vertex_pop_count": lambda: self.counts.get("vertex_pop", 0),
+            "edge_pop_count": lambda: self.counts.get("edge_pop", 0),
+            "notch_count": lambda: self.counts.get("notch", 0),
+            "refine_count": lambda: self.counts.get("refine", 0), "where_count": lambda: 0,
             "random": lambda: random.random(),
             "quantity_count": lambda: len(s.quantities),
         }
@@ -447,9 +481,17 @@ class Session:
             raise ExpressionError(f"{kind} index must be a number")
         k = int(index)
         n = self.count(kind)
+        sign = -1 if k < 0 else 1
+        attrs = {"vertex": "vattr", "edge": "eattr", "facet": "fattr"}.get(kind)
+        ids = getattr(self.surface, attrs).get("id") if attrs else None
+        if ids is not None:                     # ids with gaps after deletions
+            hit = np.nonzero(ids == abs(k))[0]
+            if k == 0 or not len(hit):
+                raise ExpressionError(f"{kind}[{k}] does not exist")
+            return I.ElemRef(kind, int(hit[0]), sign)
         if k == 0 or abs(k) > n:
             raise ExpressionError(f"{kind}[{k}] does not exist ({kind} ids are 1..{n})")
-        return I.ElemRef(kind, abs(k) - 1, -1 if k < 0 else 1)
+        return I.ElemRef(kind, abs(k) - 1, sign)
 
     def generate(self, gen, env):
         """Elements of a generator, with its ``where`` filter applied."""
@@ -537,15 +579,16 @@ class Session:
         s = self.surface
         t = self.totals
         k, i = base.kind, base.i
+        eid = float(s.ids(k)[i]) if k in ("vertex", "edge", "facet") else float(i + 1)
         if name in ("id",):
-            return float(i + 1)
+            return eid
         if name == "oid":
-            return float((i + 1) * base.sign)
+            return eid * base.sign
         if name == "original":
             arr = {"vertex": s.vattr, "edge": s.eattr, "facet": s.fattr}.get(k, {}).get("original")
             if k == "body":
                 return float(s.bodies.original[i])
-            return float(arr[i]) if arr is not None and arr[i] else float(i + 1)
+            return float(arr[i]) if arr is not None and arr[i] else eid
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
             if arr.ndim == 1:
@@ -715,11 +758,12 @@ class Session:
         kind = gen.kind
         t = self.totals
         w = self.write
+        vid, eid, fid = s.ids("vertex"), s.ids("edge"), s.ids("facet")
         if kind == "vertex":
             w("// Id               X                Y               Z\n")
             for el in els:
                 x = s.X[el.i]
-                line = f"{el.i + 1:3d}  {x[0]:17.15g} {x[1]:17.15g} {x[2]:17.15g}"
+                line = f"{vid[el.i]:3d}  {x[0]:17.15g} {x[1]:17.15g} {x[2]:17.15g}"
                 cons = [c for c in sorted(s.vcon) if s.vcon[c][el.i]]
                 if cons:
                     line += "  constraints " + " ".join(map(str, cons)) + " "
@@ -729,8 +773,8 @@ class Session:
         elif kind == "edge":
             w("// Id    endpoints\n")
             for el in els:
-                a, b = s.E[el.i] + 1
-                line = f"{el.i + 1:3d}   {a:5d} {b:4d}     /*length {t.edge_length[el.i]:g}*/"
+                a, b = vid[s.E[el.i]]
+                line = f"{eid[el.i]:3d}   {a:5d} {b:4d}     /*length {t.edge_length[el.i]:g}*/"
                 if s.eattr["fixed"][el.i]:
                     line += " fixed"
                 w(line + "\n")
@@ -739,10 +783,10 @@ class Session:
             w("// Id    edges\n")
             for el in els:
                 idx, sgn = edge_index(s.FE[el.i])
-                es = " ".join(str(int((e + 1) * g)) for e, g in zip(idx, sgn))
+                es = " ".join(str(int(eid[e] * g)) for e, g in zip(idx, sgn))
                 orig = s.fattr["original"][el.i]
-                line = f"{el.i + 1:3d}   {es} /*area {t.facet_area[el.i]:g}*/"
-                if orig and orig != el.i + 1:
+                line = f"{fid[el.i]:3d}   {es} /*area {t.facet_area[el.i]:g}*/"
+                if orig and orig != fid[el.i]:
                     line += f" original {orig}"
                 w(line + "\n")
         elif kind == "body":

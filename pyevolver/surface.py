@@ -116,6 +116,15 @@ class Surface:
         self._corners = (topo, Fc)
         return Fc
 
+    def ids(self, kind):
+        """(n,) element ids of ``kind`` ("vertex", "edge", "facet"): 1..n
+        after loading; deletions (``t``, ``w``, ...) leave gaps, as in the
+        Evolver, and new elements take ids above the largest."""
+        attrs = {"vertex": self.vattr, "edge": self.eattr, "facet": self.fattr}[kind]
+        n = {"vertex": self.nv, "edge": self.ne, "facet": self.nf}[kind]
+        a = attrs.get("id")
+        return a if a is not None else np.arange(1, n + 1)
+
     @property
     def facet_tension(self):
         return self.fattr["tension"]
@@ -695,11 +704,13 @@ class _Builder:
             ne += n
             kids = []
             for j in range(n):
-                row = (~spokes[j], loop[j], spokes[(j + 1) % n])
+                # the face keeps its id for the triangle on its last edge,
+                # (in-spoke, edge, out-spoke); the others start with their
+                # edge (the Evolver's `list facets` after loading cube.fe)
                 if j == n - 1:
-                    FE[k] = row
+                    FE[k] = (~spokes[j], loop[j], spokes[(j + 1) % n])
                 else:
-                    new_F.append((row, k))
+                    new_F.append(((loop[j], spokes[(j + 1) % n], ~spokes[j]), k))
                     kids.append(nf)
                     nf += 1
             self.split_children[k] = [k] + kids

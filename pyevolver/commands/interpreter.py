@@ -544,8 +544,6 @@ LETTER_LATER = {
     "g": "g (iteration) comes with the evolve issue",
     "U": "U (conjugate gradient) comes with the evolve issue",
     "m": "m (fixed scale) comes with the evolve issue",
-    "t": "t (edge weeding) comes with the mesh-upkeep issue",
-    "w": "w (area weeding) comes with the mesh-upkeep issue",
     "j": "j (jiggle) comes with the mesh-upkeep issue",
     "o": "o (vertex popping)", "O": "O (edge popping)",
     "G": "G (gravity) comes with the evolve issue",
@@ -557,7 +555,7 @@ LETTER_LATER = {
 WORD_LATER = {
     "saddle", "ritz", "eigenprobe", "lanczos", "hessian_menu",
     "vertex_average", "raw_vertex_average", "rawest_vertex_average",
-    "edgeweed", "areaweed", "pop", "edgeswap",
+    "pop", "edgeswap",
     "t1_edgeswap", "delete", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
     "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
     "conj_grad_later", "fix", "unfix", "burchard", "zoom",
@@ -797,6 +795,15 @@ class Interpreter:
         if raw == "r":
             for _ in range(1 if arg is None else self._count(arg)):
                 s.refine()
+            return
+        if raw in ("t", "w") or name in ("edgeweed", "areaweed"):
+            if arg is None:
+                raise CommandError(f"{raw} needs a value (for example: {raw} 0.01)")
+            v = float(self.value(arg))
+            if raw == "t" or name == "edgeweed":
+                s.delete_short_edges(v)
+            else:
+                s.weed(v)
             return
         if raw in ("l", "K", "n") or name in ("edge_divide", "notch"):
             if arg is None:

@@ -22,6 +22,12 @@ def _append_rows(arr, rows):
     return np.concatenate([arr, rows]) if len(rows) else arr.copy()
 
 
+def _new_ids(ids, n):
+    """Ids for ``n`` new elements after the existing ``ids``."""
+    top = int(ids.max()) if len(ids) else 0
+    return np.arange(top + 1, top + 1 + n)
+
+
 def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
          f_from_facet=()):
     """A copy of ``s`` with new vertices, edges and facets appended.
@@ -78,6 +84,8 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
         elif key == "boundary":
             rows[:len(ve)] = s.eattr["boundary"][ve] if "boundary" in s.eattr else 0
             rows[len(ve):] = s.fattr["boundary"][vf] if "boundary" in s.fattr else 0
+        elif key == "id":
+            rows[:] = _new_ids(arr, nv_new)
         va[key] = _append_rows(arr, rows)
     t.vattr = va
     t.vcon = {}
@@ -110,6 +118,8 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
             rows[len(ee):] = s.fattr["boundary"][ef]
         elif key == "original":
             rows[:] = 0
+        elif key == "id":
+            rows[:] = _new_ids(arr, ne_new)
         ea[key] = _append_rows(arr, rows)
     t.eattr = ea
     t.econ = {}
@@ -132,6 +142,8 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
         rows = arr[ff].copy()
         if key == "original":
             rows[:] = 0
+        elif key == "id":
+            rows[:] = _new_ids(arr, nf_new)
         fa[key] = _append_rows(arr, rows)
     t.fattr = fa
     t.fcon = {cid: _append_rows(on, on[ff]) for cid, on in s.fcon.items()}

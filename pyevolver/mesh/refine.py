@@ -154,20 +154,24 @@ def split_edges(s, ref):
     FE = t.FE
     new_edges = []       # (index array, from-vertex, to-vertex, facets, kind)
 
-    # case 3: a0: M2->M0, a1: M0->M1, a2: M1->M2
+    # case 3, numbered as the Evolver does: interior edges b0: M0->M2,
+    # b1: M1->M0, b2: M2->M1; the facet keeps its id for the middle triangle
+    # (~b2, ~b0, ~b1) and its three new ids go to the corner triangles at
+    # corners 0, 1, 2 (checked with `list facet` / `list edge` after r on
+    # cube.fe)
     if len(f3):
-        a0, a1, a2 = base3, base3 + 1, base3 + 2
+        b0, b1, b2 = base3, base3 + 1, base3 + 2
         m0, m1, m2 = Mv[f3, 0], Mv[f3, 1], Mv[f3, 2]
-        E[a0] = np.stack([m2, m0], 1)
-        E[a1] = np.stack([m0, m1], 1)
-        E[a2] = np.stack([m1, m2], 1)
+        E[b0] = np.stack([m0, m2], 1)
+        E[b1] = np.stack([m1, m0], 1)
+        E[b2] = np.stack([m2, m1], 1)
         fi, se = first[f3], second[f3]
-        FE[f3] = np.stack([fi[:, 0], ~a0, se[:, 2]], 1)
-        FE[fb3] = np.stack([fi[:, 1], ~a1, se[:, 0]], 1)
-        FE[fb3 + 1] = np.stack([fi[:, 2], ~a2, se[:, 1]], 1)
-        FE[fb3 + 2] = np.stack([a1, a2, a0], 1)
-        new_edges += [(a0, f3, ("m", 2), ("m", 0)), (a1, f3, ("m", 0), ("m", 1)),
-                      (a2, f3, ("m", 1), ("m", 2))]
+        FE[f3] = np.stack([~b2, ~b0, ~b1], 1)
+        FE[fb3] = np.stack([fi[:, 0], b0, se[:, 2]], 1)
+        FE[fb3 + 1] = np.stack([se[:, 0], fi[:, 1], b1], 1)
+        FE[fb3 + 2] = np.stack([b2, se[:, 1], fi[:, 2]], 1)
+        new_edges += [(b0, f3, ("m", 0), ("m", 2)), (b1, f3, ("m", 1), ("m", 0)),
+                      (b2, f3, ("m", 2), ("m", 1))]
     # case 2 (sides 0, 1 refined): a: M0->M1 cuts corner 1, d: M0->c2
     if len(f2):
         a, d = base2, base2 + 1

@@ -1,0 +1,230 @@
+"""Edge deletion: ``t`` (tiny edges), ``w`` (weed small triangles), ``delete``.
+
+Spec §8.4 and the manual's ``t`` / ``w`` / ``delete`` entries.  Deleting an
+edge ``e = (a, b)`` merges one endpoint into the other.  The head is
+eliminated if it may be, else the tail: a vertex may be eliminated when it
+is not FIXED and lies on exactly the edge's constraints and boundary (so the
+kept vertex carries at least as many).  When the kept vertex could have been
+eliminated too, it moves to the edge's midpoint (projected back onto the
+edge's constraints), as the Evolver shrinks the edge to zero length;
+otherwise it stays where it is.  The
+facets on ``e`` disappear, and in each of them the side at the eliminated
+vertex merges into the side at the kept one.  A deletion is refused (the
+edge is skipped) when the edge is FIXED, neither endpoint may be
+eliminated, or two sides to be merged carry different constraints,
+boundaries or fixedness.  A common neighbour of the endpoints outside the
+facets on ``e`` makes two more edges merge; facets left sharing all three
+edges with another ("pillows") are removed in pairs with their then bare
+edges and isolated vertices, as the Evolver does (checked on mound.fe with
+two short edges: same counts, ids and coordinates).
+
+Edges are visited one at a time in the given order (edge id order for
+``t``), so that each deletion sees the surface the previous ones left; the
+per-deletion work is vectorized over the arrays.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..surface import project_to_constraints
+from .shrink import subset
+
+
+def _dec(x):
+    return x if x >= 0 else ~x
+
+
+class _Deleter:
+    def __init__(self, s):
+        if s.periods is not None:
+            from ..errors import UnsupportedError
+            raise UnsupportedError("deleting edges in the torus model")
+        self.s = s
+        self.X = s.X.copy()
+        self.moved = []
+        self.E = s.E.copy()
+        self.FE = s.FE.copy()
+        self.FEabs = np.where(self.FE >= 0, self.FE, ~self.FE)
+        self.valive = np.ones(s.nv, bool)
+        self.ealive = np.ones(s.ne, bool)
+        self.falive = np.ones(s.nf, bool)
+        self.vfixed = s.vattr["fixed"]
+        self.efixed = s.eattr["fixed"]
+        cids = sorted(set(s.vcon) | set(s.econ))
+        self.vsig = np.zeros((s.nv, len(cids) + 1), np.int64)
+        self.esig = np.zeros((s.ne, len(cids) + 1), np.int64)
+        for k, c in enumerate(cids):
+            if c in s.vcon:
+                self.vsig[:, k] = s.vcon[c]
+            if c in s.econ:
+                self.esig[:, k] = s.econ[c] != 0
+        if "boundary" in s.vattr:
+            self.vsig[:, -1] = s.vattr["boundary"]
+        if "boundary" in s.eattr:
+            self.esig[:, -1] = s.eattr["boundary"]
+        self.count = 0
+
+    def length(self, e):
+        a, b = self.E[e]
+        return float(np.linalg.norm(self.X[b] - self.X[a]))
+
+    def facets_of(self, e):
+        return np.nonzero(self.falive & (self.FEabs == e).any(axis=1))[0]
+
+    def neighbours(self, v):
+        E = self.E
+        on = self.ealive & ((E[:, 0] == v) | (E[:, 1] == v))
+        ends = E[on]
+        return set(np.where(ends[:, 0] == v, ends[:, 1], ends[:, 0]).tolist())
+
+    def _eliminable(self, v, e):
+        return (not self.vfixed[v]) and np.array_equal(self.vsig[v], self.esig[e])
+
+    def delete(self, e, reverse=False):
+        """Try to delete edge ``e``; True when it was deleted.  ``reverse``
+        takes the edge against its orientation (``w`` deletes the edge as
+        its facet runs along it)."""
+        if not self.ealive[e] or self.efixed[e]:
+            return False
+        a, b = (int(x) for x in self.E[e])
+        if reverse:
+            a, b = b, a
+        if a == b:
+            return False
+        if self._eliminable(b, e):
+            keep, elim = a, b
+        elif self._eliminable(a, e):
+            keep, elim = b, a
+        else:
+            return False
+        merges = []          # (facet, side at elim, side at keep, third vertex)
+        for f in self.facets_of(e):
+            sides = [int(x) for x in self.FEabs[f] if x != e]
+            if len(sides) != 2:
+                return False
+            ends = [tuple(self.E[x]) for x in sides]
+            if elim in ends[0]:
+                eb, ea = sides
+            else:
+                ea, eb = sides
+            c = [v for v in self.E[eb] if v != elim][0]
+            if (not np.array_equal(self.esig[eb], self.esig[ea])
+                    or self.efixed[eb] != self.efixed[ea]):
+                return False
+            merges.append((f, eb, ea, int(c)))
+        # a common neighbour outside those facets: its two edges become one
+        for c in sorted(self.neighbours(keep) & self.neighbours(elim) - {m[3] for m in merges}):
+            eb, ea = self._edge_between(elim, c), self._edge_between(keep, c)
+            if (not np.array_equal(self.esig[eb], self.esig[ea])
+                    or self.efixed[eb] != self.efixed[ea]):
+                return False
+            merges.append((None, eb, ea, c))
+        E, FE = self.E, self.FE
+        for f, eb, ea, c in merges:
+            # after the merge eb runs between the same vertices as ea
+            eb_ends = tuple(keep if v == elim else int(v) for v in E[eb])
+            same = eb_ends == tuple(int(v) for v in E[ea])
+            fwd, bwd = FE == eb, FE == ~eb
+            FE[fwd] = ea if same else ~ea
+            FE[bwd] = ~ea if same else ea
+            self.FEabs[fwd | bwd] = ea
+            self.ealive[eb] = False
+            if f is not None:
+                self.falive[f] = False
+        E[E == elim] = keep
+        if self._eliminable(keep, e):
+            # both ends as free as the edge: the edge shrinks to its midpoint
+            self.X[keep] = 0.5 * (self.X[keep] + self.X[elim])
+            self.moved.append(keep)
+        self.valive[elim] = False
+        self.ealive[e] = False
+        self._drop_pillows(keep)
+        self.count += 1
+        return True
+
+    def _edge_between(self, u, v):
+        E = self.E
+        hit = np.nonzero(self.ealive & (((E[:, 0] == u) & (E[:, 1] == v)) |
+                                        ((E[:, 0] == v) & (E[:, 1] == u))))[0]
+        return int(hit[0])
+
+    def _drop_pillows(self, v):
+        """Facets at ``v`` that now share all three edges come in pairs (a
+        flat "pillow"): both go, then their edges left without facets and
+        vertices left without edges (the Evolver's cleanup after a merge)."""
+        ev = np.nonzero(self.ealive & (self.E == v).any(axis=1))[0]
+        at = np.nonzero(self.falive & np.isin(self.FEabs, ev).any(axis=1))[0]
+        if len(at) < 2:
+            return
+        keys = np.sort(self.FEabs[at], axis=1)
+        _, inv, cnt = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+        dead = at[cnt[inv.ravel()] >= 2]
+        if not len(dead):
+            return
+        self.falive[dead] = False
+        edges = np.unique(self.FEabs[dead])
+        still = np.isin(edges, self.FEabs[self.falive])
+        gone = edges[~still]
+        self.ealive[gone] = False
+        verts = np.unique(self.E[gone])
+        used = np.isin(verts, self.E[self.ealive])
+        self.valive[verts[~used]] = False
+
+    def result(self):
+        if not self.count:
+            return self.s
+        t = subset(self.s, self.E, self.FE, self.valive, self.ealive, self.falive)
+        t.X = self.X[self.valive].copy()
+        if self.moved:
+            new = np.cumsum(self.valive) - 1
+            project_to_constraints(t, new[np.array(self.moved)])
+        return t
+
+
+def delete_short_edges(s, length):
+    """``t length``: delete the edges shorter than ``length`` (id order).
+
+    Returns ``(new surface, number deleted)``.
+    """
+    d = _Deleter(s)
+    L = np.linalg.norm(s.X[s.E[:, 1]] - s.X[s.E[:, 0]], axis=1)
+    for e in np.nonzero(L < length)[0]:
+        e = int(e)
+        if d.ealive[e] and d.length(e) < length:
+            d.delete(e)
+    return d.result(), d.count
+
+
+def weed_small_facets(s, area):
+    """``w area``: for each facet of area below ``area`` (id order), delete
+    its shortest deletable edge (edges tried shortest first).
+
+    Returns ``(new surface, number of facets weeded)``.
+    """
+    d = _Deleter(s)
+    F = s.F
+    A = 0.5 * np.linalg.norm(np.cross(s.X[F[:, 1]] - s.X[F[:, 0]], s.X[F[:, 2]] - s.X[F[:, 0]]),
+                             axis=1)
+    weeded = 0
+    for f in np.nonzero(A < area)[0]:
+        f = int(f)
+        if not d.falive[f]:
+            continue
+        P = d.X[[d.E[_dec(x)][0] if x >= 0 else d.E[_dec(x)][1] for x in d.FE[f]]]
+        if 0.5 * np.linalg.norm(np.cross(P[1] - P[0], P[2] - P[0])) >= area:
+            continue
+        sides = sorted((int(x) for x in d.FE[f]), key=lambda x: d.length(_dec(x)))
+        for x in sides:
+            if d.delete(_dec(x), reverse=x < 0):
+                weeded += 1
+                break
+    return d.result(), weeded
+
+
+def delete_edges(s, edges):
+    """``delete edges``: try each listed edge in order; returns
+    ``(new surface, number deleted)``."""
+    d = _Deleter(s)
+    for e in edges:
+        d.delete(int(e))
+    return d.result(), d.count
