@@ -335,6 +335,18 @@ class Session:
             self.write(f"Edges switched in equiangulation: {n}\n")
         return n
 
+    def edgeswap(self, edges, echo=True):
+        """``edgeswap gen``: flip the listed edges that are diagonals of
+        quadrilaterals, whatever the angles (manual: EDGESWAP)."""
+        from .mesh.equiangulate import equiangulate
+        only = np.zeros(self.surface.ne, bool)
+        only[np.asarray(edges, np.int64)] = True
+        new, n = equiangulate(self.surface, threshold=np.inf, only=only)
+        self._replace_surface(new)
+        if echo:
+            self.write(f"Edges swapped: {n}\n")
+        return n
+
     def _bisect(self, edges, echo):
         from .mesh.edge_divide import edge_divide
         new, n = edge_divide(self.surface, edges)
@@ -379,6 +391,16 @@ class Session:
         self._count("edge_delete", n)
         if echo:
             self.write(f"Deleted edges: {n}\n")
+        return n
+
+    def delete_elements(self, kind, items, echo=True):
+        """``delete edges ...`` / ``delete facets ...``: delete the edges (or,
+        per facet, its shortest deletable side) as ``t`` / ``w`` do."""
+        from .mesh.delete_edges import delete_edges, delete_facets
+        fn = delete_edges if kind == "edge" else delete_facets
+        new, n = fn(self.surface, items)
+        self._replace_surface(new)
+        self._count("edge_delete", n)
         return n
 
     def weed(self, area, echo=True):

@@ -102,7 +102,12 @@ CASES = [
     ("cube_short.fe", "t 0.05\ng 3"), ("cube_short.fe", "w 0.01\ng 3"),
     ("mound_short.fe", "t 0.05\ng 3"), ("cube.fe", "r\ng 5\nt 0.3\ng 2"),
     ("cube_irr.fe", "r\ng 3\nw 0.07\ng 2"),
-    ("cube.fe", "r\ng 5\nw 0.055\ng 2"),
+    ("cube.fe", "r\ng 5\nw 0.055\ng 2"), ("cube_irr.fe", "r\ng 3\nt 0.3\ng 2"),
+    ("cube_irr.fe", "r\ng 3\nt 0.4\ng 2"), ("cube_irr.fe", "r\ng 3\nw 0.05\ng 2"),
+    ("cube_irr.fe", "r\ng 3\nw 0.1\ng 2"), ("cube.fe", "r\ng 5\nt 0.45\ng 2"),
+    ("cube_irr.fe", "r\ng 3\ndelete edges where length < 0.3\ng 2"),
+    ("cube_irr.fe", "r\ng 3\ndelete facets where area < 0.05\ng 2"),
+    ("cube_irr.fe", "r\ng 3\nedgeswap edges where id < 20\ng 2"),
 ]
 
 
@@ -121,7 +126,7 @@ def test_mesh_ops_match_reference(evolver, name, cmds, tmp_path):
         assert abs(a - b) <= 1e-12 * max(abs(b), 1.0), (ours, ref)
     # report lines ("Edges refined: 4", "Edges switched in equiangulation: 24", "Vertices: ...")
     heads = ("Edges", "Vertices:", "Vertex averaging", "Number of edges notched", "New edges",
-             "Deleted edges", "Skinny triangles weeded")
+             "Deleted edges", "Skinny triangles weeded", "Facets deleted")
     rep = [l.strip() for l in lines if l.startswith(heads)]
     mine = [l.strip() for l in out.getvalue().splitlines() if l.startswith(heads)]
     assert rep == mine

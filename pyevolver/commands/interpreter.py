@@ -388,6 +388,12 @@ class _CmdTransformer(ExprTransformer):
     def refine(self, _r, gen):
         return ("refine", gen)
 
+    def edgeswap(self, _r, gen):
+        return ("edgeswap", gen)
+
+    def delete(self, _r, gen):
+        return ("delete", gen)
+
     def break_(self, _b, n=None):
         return ("break", n)
 
@@ -555,8 +561,8 @@ LETTER_LATER = {
 WORD_LATER = {
     "saddle", "ritz", "eigenprobe", "lanczos", "hessian_menu",
     "vertex_average", "raw_vertex_average", "rawest_vertex_average",
-    "pop", "edgeswap",
-    "t1_edgeswap", "delete", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
+    "pop",
+    "t1_edgeswap", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
     "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
     "conj_grad_later", "fix", "unfix", "burchard", "zoom",
 }
@@ -734,6 +740,37 @@ class Interpreter:
             raise UnsupportedError("refine of " + ", ".join(sorted(kinds - {"edge"})) + "s",
                                    "only 'refine edges' is supported")
         s.refine_edges([el.i for el in els])
+
+    def _x_edgeswap(self, node):
+        s = self.session
+        els = s.generate(node[1], self.env)
+        if {el.kind for el in els} - {"edge"}:
+            raise CommandError("edgeswap needs edges (for example: edgeswap edge[3])")
+        s.edgeswap([el.i for el in els])
+
+    def _x_delete(self, node):
+        s = self.session
+        gen = node[1]
+        if gen.kind not in ("edge", "facet"):
+            raise CommandError("delete needs edges or facets (for example: "
+                               "delete edges where length < 0.01)")
+        n = 0
+        if gen.where is None or gen.base[0] != "all":
+            n = s.delete_elements(gen.kind, [el.i for el in s.generate(gen, self.env)])
+        else:
+            # `delete edges where cond`: like the Evolver, visit the elements
+            # in id order and test cond when each is reached, on the surface
+            # the earlier deletions left (a merge can make a later edge short)
+            for eid in s.surface.ids(gen.kind).tolist():
+                hit = np.nonzero(s.surface.ids(gen.kind) == eid)[0]
+                if not len(hit):
+                    continue
+                el = ElemRef(gen.kind, int(hit[0]))
+                with self.env.element(el, gen.var):
+                    v = gen.where.ev(self.env)
+                if not isinstance(v, str) and v:
+                    n += s.delete_elements(gen.kind, [el.i])
+        s.write(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted: {n}\n")
 
     def _x_break(self, node):
         raise _Break(1 if node[1] is None else int(self.value(node[1])))

@@ -24,6 +24,8 @@ per-deletion work is vectorized over the arrays.
 """
 from __future__ import annotations
 
+import heapq
+
 import numpy as np
 
 from ..surface import project_to_constraints
@@ -120,18 +122,18 @@ class _Deleter:
                 return False
             merges.append((None, eb, ea, c))
         E, FE = self.E, self.FE
+        E[E == elim] = keep
         for f, eb, ea, c in merges:
-            # after the merge eb runs between the same vertices as ea
-            eb_ends = tuple(keep if v == elim else int(v) for v in E[eb])
-            same = eb_ends == tuple(int(v) for v in E[ea])
-            fwd, bwd = FE == eb, FE == ~eb
-            FE[fwd] = ea if same else ~ea
-            FE[bwd] = ~ea if same else ea
-            self.FEabs[fwd | bwd] = ea
-            self.ealive[eb] = False
+            # the two sides now join the same vertices; the Evolver keeps the
+            # one that came from the eliminated vertex (eb) and drops ea
+            same = tuple(E[ea]) == tuple(E[eb])
+            fwd, bwd = FE == ea, FE == ~ea
+            FE[fwd] = eb if same else ~eb
+            FE[bwd] = ~eb if same else eb
+            self.FEabs[fwd | bwd] = eb
+            self.ealive[ea] = False
             if f is not None:
                 self.falive[f] = False
-        E[E == elim] = keep
         if self._eliminable(keep, e):
             # both ends as free as the edge: the edge shrinks to its midpoint
             self.X[keep] = 0.5 * (self.X[keep] + self.X[elim])
@@ -182,16 +184,30 @@ class _Deleter:
 
 
 def delete_short_edges(s, length):
-    """``t length``: delete the edges shorter than ``length`` (id order).
+    """``t length``: visit the edges in id order and delete each that is
+    shorter than ``length`` when it is visited (as the Evolver's ``delete
+    edges where length < L``: an edge shortened by an earlier merge counts).
 
     Returns ``(new surface, number deleted)``.
     """
     d = _Deleter(s)
     L = np.linalg.norm(s.X[s.E[:, 1]] - s.X[s.E[:, 0]], axis=1)
-    for e in np.nonzero(L < length)[0]:
-        e = int(e)
-        if d.ealive[e] and d.length(e) < length:
-            d.delete(e)
+    heap = np.nonzero(L < length)[0].tolist()          # ascending: already a heap
+    seen = set()
+    while heap:
+        e = heapq.heappop(heap)
+        if e in seen or not d.ealive[e]:
+            continue
+        seen.add(e)
+        if d.length(e) >= length:
+            continue
+        if d.delete(e) and d.moved:
+            # edges at the moved vertex, not yet visited, may now be short
+            v = d.moved[-1]
+            for x in np.nonzero(d.ealive & (d.E == v).any(axis=1))[0]:
+                x = int(x)
+                if x > e and x not in seen and d.length(x) < length:
+                    heapq.heappush(heap, x)
     return d.result(), d.count
 
 
@@ -201,24 +217,50 @@ def weed_small_facets(s, area):
 
     Returns ``(new surface, number of facets weeded)``.
     """
-    d = _Deleter(s)
     F = s.F
     A = 0.5 * np.linalg.norm(np.cross(s.X[F[:, 1]] - s.X[F[:, 0]], s.X[F[:, 2]] - s.X[F[:, 0]]),
                              axis=1)
+    return _weed(s, np.nonzero(A < area)[0], area)
+
+
+def _facet_area(d, f):
+    P = d.X[[d.E[_dec(x)][0] if x >= 0 else d.E[_dec(x)][1] for x in d.FE[f]]]
+    return 0.5 * float(np.linalg.norm(np.cross(P[1] - P[0], P[2] - P[0])))
+
+
+def _weed(s, facets, area):
+    """Visit ``facets`` in id order (with ``area``: also facets that a merge
+    made smaller than ``area``, and only while they still are)."""
+    d = _Deleter(s)
     weeded = 0
-    for f in np.nonzero(A < area)[0]:
-        f = int(f)
-        if not d.falive[f]:
+    heap = sorted(int(f) for f in facets)
+    seen = set()
+    while heap:
+        f = heapq.heappop(heap)
+        if f in seen or not d.falive[f]:
             continue
-        P = d.X[[d.E[_dec(x)][0] if x >= 0 else d.E[_dec(x)][1] for x in d.FE[f]]]
-        if 0.5 * np.linalg.norm(np.cross(P[1] - P[0], P[2] - P[0])) >= area:
+        seen.add(f)
+        if area is not None and _facet_area(d, f) >= area:
             continue
         sides = sorted((int(x) for x in d.FE[f]), key=lambda x: d.length(_dec(x)))
         for x in sides:
             if d.delete(_dec(x), reverse=x < 0):
                 weeded += 1
+                if area is not None and d.moved:
+                    v = d.moved[-1]
+                    ev = np.nonzero(d.ealive & (d.E == v).any(axis=1))[0]
+                    for g in np.nonzero(d.falive & np.isin(d.FEabs, ev).any(axis=1))[0]:
+                        g = int(g)
+                        if g > f and g not in seen and _facet_area(d, g) < area:
+                            heapq.heappush(heap, g)
                 break
     return d.result(), weeded
+
+
+def delete_facets(s, facets):
+    """``delete facets``: for each listed facet, its shortest deletable side
+    goes (as in ``w``); returns ``(new surface, number of facets)``."""
+    return _weed(s, facets, None)
 
 
 def delete_edges(s, edges):

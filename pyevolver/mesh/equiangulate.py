@@ -60,8 +60,13 @@ def _signature(s):
     return ek, fk
 
 
-def equiangulate(s, threshold=-0.001):
-    """One equiangulation pass; returns ``(new surface, number of flips)``."""
+def equiangulate(s, threshold=-0.001, only=None):
+    """One equiangulation pass; returns ``(new surface, number of flips)``.
+
+    With ``only`` (a (ne,) bool mask) just those edges are candidates, and
+    with ``threshold=inf`` they are flipped whatever the angles
+    (``edgeswap``); the topological conditions are the same.
+    """
     import copy
     if s.nf == 0:
         return s, 0
@@ -91,6 +96,8 @@ def equiangulate(s, threshold=-0.001):
 
     # vectorized first test: which edges pass the criterion now
     eligible = (val == 2) & ~t.eattr["fixed"]
+    if only is not None:
+        eligible &= only
     f0, f1 = ef[:, 0], ef[:, 1]
     ok = eligible & (f0 >= 0)
     ok[ok] &= np.abs(tension[f0[ok]] - tension[f1[ok]]) <= 1e-10
@@ -106,7 +113,8 @@ def equiangulate(s, threshold=-0.001):
         d, e = sides(f1[cand], ekk[cand, 1])
         with np.errstate(all="ignore"):
             crit = (b * b + c * c - a * a) / (b * c) + (d * d + e * e - a * a) / (d * e)
-        cand = cand[crit < threshold]
+        if np.isfinite(threshold):
+            cand = cand[crit < threshold]
     if not len(cand):
         return s, 0
 
@@ -142,7 +150,7 @@ def equiangulate(s, threshold=-0.001):
         lb, lc = lengths[b1 if b1 >= 0 else ~b1], lengths[c1 if c1 >= 0 else ~c1]
         ld, le = lengths[b2 if b2 >= 0 else ~b2], lengths[c2 if c2 >= 0 else ~c2]
         crit = (lb * lb + lc * lc - A * A) / (lb * lc) + (ld * ld + le * le - A * A) / (ld * le)
-        if not crit < threshold:
+        if np.isfinite(threshold) and not crit < threshold:
             continue
         # flip: a was p->q in fa = (a, b1: q->r, c1: r->p), fb = (~a, b2: p->s, c2: s->q)
         p, q = int(E[ed, 0]), int(E[ed, 1])
