@@ -56,6 +56,7 @@ class Session:
         self.interp = I.Interpreter(self)
         self._iterator = None
         self.counts = {}                       # equi_count, refine_count, ... (spec §9.7)
+        self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
         self.iteration_counter = 0
         self.total_time = 0.0
 
@@ -403,6 +404,29 @@ class Session:
         self._count("edge_delete", n)
         return n
 
+    def jiggle(self, temperature=None, echo=True):
+        """``j [T]``: move every vertex that is not FIXED or on a parametric
+        boundary by a Gaussian displacement of deviation T × mean edge length
+        (T defaults to ``jiggle_temperature``); vertices on constraints are
+        projected back.  Seeded by ``random_seed`` (pyevolver's generator,
+        so the numbers differ from the Evolver's)."""
+        s = self.surface
+        T = self.settings["jiggle_temperature"] if temperature is None else float(temperature)
+        t = self.totals
+        sigma = T * (float(np.mean(t.edge_length)) if s.ne else 0.0)
+        move = ~s.vattr["fixed"]
+        if "boundary" in s.vattr:
+            move &= s.vattr["boundary"] == 0
+        new = copy.copy(s)
+        new.__dict__.pop("_lift_cache", None)
+        new.X = s.X.copy()
+        idx = np.nonzero(move)[0]
+        new.X[idx] += sigma * self.rng.standard_normal((len(idx), 3))
+        project_to_constraints(new, idx)
+        self._replace_surface(new)
+        if echo:
+            self.write("One jiggle done.\n")
+
     def weed(self, area, echo=True):
         """``w A`` / ``areaweed A``: remove facets of area below ``A`` by
         deleting one of their edges, shortest first (spec §8.4)."""
@@ -443,6 +467,8 @@ class Session:
             del self.commands[name]
         if name in self.settings:
             self.settings[name] = value
+            if name == "random_seed":
+                self.rng = np.random.default_rng(int(value))
             return
         if name == "gravity_constant":
             self.surface.gravity_constant = float(value)
@@ -484,7 +510,7 @@ class Session:
             "edge_pop_count": lambda: self.counts.get("edge_pop", 0),
             "notch_count": lambda: self.counts.get("notch", 0),
             "refine_count": lambda: self.counts.get("refine", 0), "where_count": lambda: 0,
-            "random": lambda: random.random(),
+            "random": lambda: float(self.rng.random()),
             "quantity_count": lambda: len(s.quantities),
         }
         fn = simple.get(name)

@@ -241,3 +241,27 @@ def test_edge_deletion_keeps_a_valid_surface(cmds):
     s.run("g 1")
     if s.surface.nv == 0:
         assert "WARNING 1051" in out.getvalue()
+
+
+def test_jiggle_is_seeded_and_scaled():
+    """``j T``: Gaussian moves of deviation T × mean edge length (manual),
+    FIXED vertices stay, the same ``random_seed`` gives the same surface."""
+    import io
+    runs = []
+    for _ in range(2):
+        s = Session.load(example("mound.fe"), out=io.StringIO())
+        s.run("re\ng 3\nrandom_seed := 7")
+        X0 = s.surface.X.copy()
+        L = s.totals.edge_length.mean()
+        s.run("j 0.01")
+        consistent(s.surface)
+        D = s.surface.X - X0
+        fixed = s.surface.vattr["fixed"]
+        assert np.all(D[fixed] == 0)
+        on = s.surface.vcon[1]
+        assert np.abs(s.surface.X[on, 2]).max() <= 1e-12          # back on z = 0
+        free = ~fixed & ~on
+        sd = D[free].std()
+        assert 0.5 * 0.01 * L < sd < 2 * 0.01 * L
+        runs.append(s.surface.X)
+    assert np.array_equal(runs[0], runs[1])

@@ -550,7 +550,6 @@ LETTER_LATER = {
     "g": "g (iteration) comes with the evolve issue",
     "U": "U (conjugate gradient) comes with the evolve issue",
     "m": "m (fixed scale) comes with the evolve issue",
-    "j": "j (jiggle) comes with the mesh-upkeep issue",
     "o": "o (vertex popping)", "O": "O (edge popping)",
     "G": "G (gravity) comes with the evolve issue",
     "e": "e (extrapolation)", "i": "i (information)", "Q": "Q (quantities)",
@@ -832,6 +831,9 @@ class Interpreter:
         if raw == "r":
             for _ in range(1 if arg is None else self._count(arg)):
                 s.refine()
+            return
+        if raw == "j":
+            s.jiggle(None if arg is None else float(self.value(arg)))
             return
         if raw in ("t", "w") or name in ("edgeweed", "areaweed"):
             if arg is None:
