@@ -141,9 +141,22 @@ def main(argv=None):
                     help="subdivision level (default 6 = 81,920 facets)")
     ap.add_argument("--out", default=None,
                     help="output path (default benchmarks/data/icosphere_<nf>.fe)")
+    ap.add_argument("--jitter", type=float, default=0.0,
+                    help="move each vertex by this fraction of the mean edge length in a "
+                         "random tangent direction (seed 0; gives u something to flip)")
     args = ap.parse_args(argv)
-    out = args.out or os.path.join(HERE, "data", f"icosphere_{20 * 4 ** args.level}.fe")
+    tag = f"_jitter{args.jitter:g}" if args.jitter else ""
+    out = args.out or os.path.join(HERE, "data", f"icosphere_{20 * 4 ** args.level}{tag}.fe")
     X, F = icosphere(args.level)
+    if args.jitter:
+        E, _ = unique_edges(F)
+        h = np.linalg.norm(X[E[:, 0]] - X[E[:, 1]], axis=1).mean()
+        rng = np.random.default_rng(0)
+        d = rng.standard_normal(X.shape)
+        d -= np.einsum("ij,ij->i", d, X)[:, None] * X          # tangent to the unit sphere
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        X = X + args.jitter * h * d
+        X /= np.linalg.norm(X, axis=1)[:, None]
     nv, ne, nf, vol = write_datafile(out, X, F)
     size = os.path.getsize(out)
     print(f"wrote {out}: {nv} vertices, {ne} edges, {nf} facets, "

@@ -14,6 +14,7 @@ in id order, so the result is that of the Evolver's sequential pass.
 from __future__ import annotations
 
 import heapq
+import math
 
 import numpy as np
 
@@ -21,22 +22,72 @@ from .. import geometry as G
 
 
 def edge_facets(s):
-    """(ne, 2) the two facets of each edge and their sides, valence (ne,)."""
+    """(ne, 2) the two facets of each edge and their sides, valence (ne,).
+
+    Rows are filled for edges with exactly two facets (first and last
+    occurrence in facet order), ``-1`` elsewhere.
+    """
     idx, sgn, _ = s.topology()
     flat_e = idx.ravel()
     flat_f = np.repeat(np.arange(s.nf), 3)
     flat_k = np.tile(np.arange(3), s.nf)
     val = np.bincount(flat_e, minlength=s.ne)
-    order = np.argsort(flat_e, kind="stable")
-    start = np.concatenate([[0], np.cumsum(val)[:-1]])
-    ef = np.full((s.ne, 2), -1, np.int64)
-    ek = np.full((s.ne, 2), -1, np.int64)
-    two = np.nonzero(val == 2)[0]
-    ef[two, 0] = flat_f[order[start[two]]]
-    ef[two, 1] = flat_f[order[start[two] + 1]]
-    ek[two, 0] = flat_k[order[start[two]]]
-    ek[two, 1] = flat_k[order[start[two] + 1]]
+    first_f = np.full(s.ne, -1, np.int64)
+    first_k = np.full(s.ne, -1, np.int64)
+    first_f[flat_e[::-1]] = flat_f[::-1]          # later writes win: the first occurrence
+    first_k[flat_e[::-1]] = flat_k[::-1]
+    last_f = np.full(s.ne, -1, np.int64)
+    last_k = np.full(s.ne, -1, np.int64)
+    last_f[flat_e] = flat_f
+    last_k[flat_e] = flat_k
+    two = val == 2
+    ef = np.where(two[:, None], np.stack([first_f, last_f], 1), -1)
+    ek = np.where(two[:, None], np.stack([first_k, last_k], 1), -1)
     return ef, ek, val
+
+
+def _quads(E, FE, ef, edges):
+    """For each edge of ``edges`` (two facets of opposite orientations): its
+    facets ``fa`` (running along the edge) and ``fb``, the other sides
+    ``b1, c1`` of fa and ``b2, c2`` of fb (signed, in facet order after the
+    edge) and the opposite vertices ``r`` (of fa) and ``sv`` (of fb).
+    Edges whose facets do not run opposite ways are dropped (None if none)."""
+    fa, fb = ef[edges, 0], ef[edges, 1]
+    A = np.where(FE[fa] >= 0, FE[fa], ~FE[fa])
+    ka = np.argmax(A == edges[:, None], axis=1)
+    B = np.where(FE[fb] >= 0, FE[fb], ~FE[fb])
+    kb = np.argmax(B == edges[:, None], axis=1)
+    sa = FE[fa, ka]
+    swap = sa < 0
+    fa, fb = np.where(swap, fb, fa), np.where(swap, fa, fb)
+    ka, kb = np.where(swap, kb, ka), np.where(swap, ka, kb)
+    if not (np.all(FE[fa, ka] >= 0) and np.all(FE[fb, kb] < 0)):
+        return None
+    b1, c1 = FE[fa, (ka + 1) % 3], FE[fa, (ka + 2) % 3]
+    b2, c2 = FE[fb, (kb + 1) % 3], FE[fb, (kb + 2) % 3]
+
+    def head(x):
+        return np.where(x >= 0, E[np.where(x >= 0, x, 0), 1], E[np.where(x < 0, ~x, 0), 0])
+    return fa, fb, b1, c1, b2, c2, head(b1), head(b2)
+
+
+def _passes(FE, ef, edges, lengths, threshold):
+    """The flip criterion of each edge of ``edges`` (bool), from the current
+    facets and edge lengths; always true for ``threshold = inf``."""
+    if not np.isfinite(threshold):
+        return np.ones(len(edges), bool)
+    out = []
+    a = lengths[edges]
+    tot = np.zeros(len(edges))
+    for j in (0, 1):
+        f = ef[edges, j]
+        A = np.where(FE[f] >= 0, FE[f], ~FE[f])
+        k = np.argmax(A == edges[:, None], axis=1)
+        b = lengths[A[np.arange(len(edges)), (k + 1) % 3]]
+        c = lengths[A[np.arange(len(edges)), (k + 2) % 3]]
+        with np.errstate(all="ignore"):
+            tot += (b * b + c * c - a * a) / (b * c)
+    return tot < threshold
 
 
 def _signature(s):
@@ -85,15 +136,6 @@ def equiangulate(s, threshold=-0.001, only=None):
     tension = t.fattr["tension"]
     esig, fsig = _signature(t)
 
-    def opposite(e, f, k):
-        """Lengths of the other two sides of facet f (e at side k), the
-        encoded sides and the vertex opposite e."""
-        s1 = FE[f, (k + 1) % 3]
-        s2 = FE[f, (k + 2) % 3]
-        i1 = s1 if s1 >= 0 else ~s1
-        v = E[i1, 1] if s1 >= 0 else E[i1, 0]
-        return s1, s2, v
-
     # vectorized first test: which edges pass the criterion now
     eligible = (val == 2) & ~t.eattr["fixed"]
     if only is not None:
@@ -103,7 +145,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     ok[ok] &= np.abs(tension[f0[ok]] - tension[f1[ok]]) <= 1e-10
     ok[ok] &= (fsig[f0[ok]] == esig[ok]) & (fsig[f1[ok]] == esig[ok])
     cand = np.nonzero(ok)[0]
-    if len(cand):
+    if len(cand) and np.isfinite(threshold):
         idx = t.topology()[0]
 
         def sides(fs, ks):
@@ -113,72 +155,147 @@ def equiangulate(s, threshold=-0.001, only=None):
         d, e = sides(f1[cand], ekk[cand, 1])
         with np.errstate(all="ignore"):
             crit = (b * b + c * c - a * a) / (b * c) + (d * d + e * e - a * a) / (d * e)
-        if np.isfinite(threshold):
-            cand = cand[crit < threshold]
+        cand = cand[crit < threshold]
     if not len(cand):
         return s, 0
 
-    # adjacency for the "already joined" test
+    # Candidates whose quadrilaterals share no vertex with another
+    # candidate's cannot interact with any other visit of the pass (their
+    # flips change only facets and edges among their own four vertices), so
+    # they are flipped at once; the rest go through the sequential pass.
     nv = t.nv
+    heap = cand
+    flips_at_once = 0
+    if wrap is None:
+        quad = _quads(E, FE, ef, cand)
+        if quad is not None:
+            fa, fb, b1, c1, b2, c2, r, sv = quad
+            use = np.bincount(np.concatenate([E[cand, 0], E[cand, 1], r, sv]), minlength=nv)
+            iso = ((use[E[cand, 0]] == 1) & (use[E[cand, 1]] == 1) & (use[r] == 1)
+                   & (use[sv] == 1) & (r != sv))
+            keys = np.sort(np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1]))
+            k = np.minimum(r, sv) * nv + np.maximum(r, sv)
+            pos = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
+            iso &= keys[pos] != k                     # r and sv not joined yet
+            if iso.any():
+                I = cand[iso]
+                fa, fb, b1, c1, b2, c2, r, sv = (x[iso] for x in quad)
+                E[I, 0], E[I, 1] = sv, r
+                FE[fa] = np.stack([c1, b2, I], 1)
+                FE[fb] = np.stack([~I, c2, b1], 1)
+                for side, old, new in ((b1, fa, fb), (b2, fb, fa)):
+                    i = np.where(side >= 0, side, ~side)
+                    two = val[i] == 2
+                    i, old, new = i[two], old[two], new[two]
+                    ef[i, 0] = np.where(ef[i, 0] == old, new, ef[i, 0])
+                    ef[i, 1] = np.where(ef[i, 1] == old, new, ef[i, 1])
+                lengths[I] = np.linalg.norm(t.X[r] - t.X[sv], axis=1)
+                flips_at_once = len(I)
+                # their outer sides, visited after them, are visited again
+                # if they pass now (if not, only a later flip next to them
+                # can make them pass, and that flip puts them back)
+                outer = np.stack([c1, b2, c2, b1], 1)
+                outer = np.where(outer >= 0, outer, ~outer)
+                later = outer > I[:, None]
+                again = np.unique(outer[later])
+                okd = np.zeros(len(again), bool)
+                sel = ok[again]
+                okd[sel] = _passes(FE, ef, again[sel], lengths, threshold)
+                heap = np.union1d(cand[~iso], again[okd])
+
+    # adjacency for the "already joined" test
     pairs = set((np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])).tolist())
-    heap = cand.tolist()
+    heap = np.asarray(heap).tolist()
     heapq.heapify(heap)
-    seen = set()
     flips = 0
+    finite = bool(np.isfinite(threshold))
+    okl = ok.tolist()
+    vall = val.tolist()
+    lengths = lengths.tolist()
+    Xl = t.X                     # read with .item(): scalar access without array temporaries
+    # flat Python lists for the sequential part (list indexing is several
+    # times faster than numpy scalar access); written back at the end
+    El = E.ravel().tolist()
+    FEl = FE.ravel().tolist()
+    efl = ef.ravel().tolist()
+
+    def dec(x):
+        return x if x >= 0 else ~x
+
+    last = -1
     while heap:
         ed = heapq.heappop(heap)
-        if ed in seen:
+        if ed == last:              # pops come in increasing order: a repeat is adjacent
             continue
-        seen.add(ed)
-        if not ok[ed]:
+        last = ed
+        if not okl[ed]:
             continue
-        fa, fb = int(ef[ed, 0]), int(ef[ed, 1])
-        ka = int(np.nonzero((FE[fa] == ed) | (FE[fa] == ~ed))[0][0])
-        kb = int(np.nonzero((FE[fb] == ed) | (FE[fb] == ~ed))[0][0])
-        if FE[fa, ka] < 0:
-            fa, fb, ka, kb = fb, fa, kb, ka
-        if FE[fa, ka] < 0 or FE[fb, kb] >= 0:
+        fa, fb = efl[2 * ed], efl[2 * ed + 1]
+        row_a = FEl[3 * fa:3 * fa + 3]
+        row_b = FEl[3 * fb:3 * fb + 3]
+        ned = ~ed
+        x = row_a[0]
+        ka = 0 if (x == ed or x == ned) else (1 if (row_a[1] == ed or row_a[1] == ned) else 2)
+        x = row_b[0]
+        kb = 0 if (x == ed or x == ned) else (1 if (row_b[1] == ed or row_b[1] == ned) else 2)
+        if row_a[ka] < 0:
+            fa, fb, ka, kb, row_a, row_b = fb, fa, kb, ka, row_b, row_a
+        if row_a[ka] < 0 or row_b[kb] >= 0:
             continue            # the two facets do not have opposite orientations
-        b1, c1, r = opposite(ed, fa, ka)
-        b2, c2, sv = opposite(ed, fb, kb)
+        b1, c1 = row_a[(ka + 1) % 3], row_a[(ka + 2) % 3]
+        b2, c2 = row_b[(kb + 1) % 3], row_b[(kb + 2) % 3]
+        r = El[2 * b1 + 1] if b1 >= 0 else El[2 * ~b1]          # head of b1
+        sv = El[2 * b2 + 1] if b2 >= 0 else El[2 * ~b2]         # head of b2
         if r == sv:
             continue
-        key = min(r, sv) * nv + max(r, sv)
+        key = r * nv + sv if r < sv else sv * nv + r
         if key in pairs:
             continue
         A = lengths[ed]
-        lb, lc = lengths[b1 if b1 >= 0 else ~b1], lengths[c1 if c1 >= 0 else ~c1]
-        ld, le = lengths[b2 if b2 >= 0 else ~b2], lengths[c2 if c2 >= 0 else ~c2]
+        lb = lengths[b1 if b1 >= 0 else ~b1]
+        lc = lengths[c1 if c1 >= 0 else ~c1]
+        ld = lengths[b2 if b2 >= 0 else ~b2]
+        le = lengths[c2 if c2 >= 0 else ~c2]
         crit = (lb * lb + lc * lc - A * A) / (lb * lc) + (ld * ld + le * le - A * A) / (ld * le)
-        if np.isfinite(threshold) and not crit < threshold:
+        if finite and not crit < threshold:
             continue
         # flip: a was p->q in fa = (a, b1: q->r, c1: r->p), fb = (~a, b2: p->s, c2: s->q)
-        p, q = int(E[ed, 0]), int(E[ed, 1])
+        p, q = El[2 * ed], El[2 * ed + 1]
         pairs.discard(min(p, q) * nv + max(p, q))
         pairs.add(key)
         if wrap is not None:
             def w(x):
                 return wrap[x] if x >= 0 else -wrap[~x]
             wrap[ed] = -w(c1) - w(b2)          # s -> r through p
-        E[ed] = (sv, r)
-        FE[fa] = (c1, b2, ed)
-        FE[fb] = (~ed, c2, b1)
+        El[2 * ed], El[2 * ed + 1] = sv, r
+        FEl[3 * fa:3 * fa + 3] = (c1, b2, ed)
+        FEl[3 * fb:3 * fb + 3] = (~ed, c2, b1)
         # b1 moved from fa to fb, b2 from fb to fa
         for side, old, new in ((b1, fa, fb), (b2, fb, fa)):
-            i = side if side >= 0 else ~side
-            if val[i] == 2:
-                ef[i] = np.where(ef[i] == old, new, ef[i])
-        new_len = np.linalg.norm(G.edge_vectors(t.X, E[ed:ed + 1],
-                                                None if wv is None else
-                                                (wrap[ed:ed + 1] @ t.periods)), axis=1)[0]
-        lengths[ed] = new_len
+            i = dec(side)
+            if vall[i] == 2:
+                if efl[2 * i] == old:
+                    efl[2 * i] = new
+                if efl[2 * i + 1] == old:
+                    efl[2 * i + 1] = new
+        if wv is None:
+            dx = Xl.item(r, 0) - Xl.item(sv, 0)
+            dy = Xl.item(r, 1) - Xl.item(sv, 1)
+            dz = Xl.item(r, 2) - Xl.item(sv, 2)
+            lengths[ed] = math.sqrt(dx * dx + dy * dy + dz * dz)
+        else:
+            E[ed] = (sv, r)
+            lengths[ed] = float(np.linalg.norm(G.edge_vectors(
+                t.X, E[ed:ed + 1], wrap[ed:ed + 1] @ t.periods), axis=1)[0])
         flips += 1
         # edges of the changed facets come up again if not yet visited
-        for f in (fa, fb):
-            for x in FE[f]:
-                i = int(x if x >= 0 else ~x)
-                if i > ed and i not in seen:
-                    heapq.heappush(heap, i)
-    t.__dict__.pop("_topo", None)          # E and FE were changed in place
+        for x in (c1, b2, c2, b1):
+            i = x if x >= 0 else ~x
+            if i > ed:                # not yet visited (visits go in id order)
+                heapq.heappush(heap, i)
+    if flips:
+        t.E = np.array(El, dtype=np.int64).reshape(-1, 2)
+        t.FE = np.array(FEl, dtype=np.int64).reshape(-1, 3)
+    t.__dict__.pop("_topo", None)          # E and FE were changed
     t.topology_version = getattr(s, "topology_version", 0) + 1
-    return t, flips
+    return t, flips + flips_at_once
