@@ -326,6 +326,15 @@ class Session:
         if echo:
             self.write(f"Edges refined: {n}\n")
 
+    def refine_facets(self, facets, echo=True):
+        """``refine facets where ...``: split each facet into three at its
+        centroid (REF's report "Facets refined: N")."""
+        from .mesh.notch import split_facets_at_centre
+        f = np.unique(np.asarray(facets, np.int64))
+        self._replace_surface(split_facets_at_centre(self.surface, f))
+        if echo:
+            self.write(f"Facets refined: {len(f)}\n")
+
     def equiangulate(self, echo=True):
         """``u``: one equiangulation sweep (spec §8.2)."""
         from .mesh.equiangulate import equiangulate
@@ -636,7 +645,7 @@ class Session:
             arr = {"vertex": s.vattr, "edge": s.eattr, "facet": s.fattr}.get(k, {}).get("original")
             if k == "body":
                 return float(s.bodies.original[i])
-            return float(arr[i]) if arr is not None and arr[i] else eid
+            return float(arr[i]) if arr is not None else 0.0     # 0: no original (REF)
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
             if arr.ndim == 1:
@@ -823,6 +832,9 @@ class Session:
             for el in els:
                 a, b = vid[s.E[el.i]]
                 line = f"{eid[el.i]:3d}   {a:5d} {b:4d}     /*length {t.edge_length[el.i]:g}*/"
+                eorig = s.eattr.get("original")
+                if eorig is not None and eorig[el.i] and eorig[el.i] != eid[el.i]:
+                    line += f"  original {eorig[el.i]}"
                 if s.eattr["fixed"][el.i]:
                     line += " fixed"
                 w(line + "\n")

@@ -294,3 +294,31 @@ def test_equiangulation_on_a_jittered_icosphere_matches_reference(evolver, tmp_p
             if l.startswith(("Edges switched", "Vertex averaging"))]
     assert mine == rep and rep[0] == "Edges switched in equiangulation: 473"
     assert abs(s.total_area - ref) <= 1e-12 * ref
+
+
+def test_refine_facets_matches_reference(evolver, tmp_path):
+    """``refine facet[1]`` / ``refine facets where ...``: each facet split at
+    its centroid into three, numbered as REF (``list`` output compared token
+    for token), then ``g 3``."""
+    import io
+    cmds = ("refine facet[1]\nlist facet where id == 1 or id > 24\nlist edges where id > 36\n"
+            "refine facets where id < 5\ng 3\n")
+    text = cmds + 'printf "RESULT %d %d %d %.17g\\n", vertex_count, edge_count, facet_count, ' \
+                  'total_energy\n'
+    ref = [l.split() for l in run_reference(evolver, example("cube.fe"), text, cwd=str(tmp_path))
+           if l.strip() and not l.lstrip().startswith("//")]
+    out = io.StringIO()
+    s = Session.load(example("cube.fe"), out=out)
+    s.run(text)
+    consistent(s.surface)
+    mine = [l.split() for l in out.getvalue().splitlines()
+            if l.strip() and not l.lstrip().startswith("//")]
+    assert len(mine) == len(ref)
+    for a, b in zip(mine, ref):
+        if a[0] == "RESULT":
+            assert a[1:4] == b[1:4]
+            assert abs(float(a[4]) - float(b[4])) <= 1e-12 * float(b[4])
+        elif "area:" in a:
+            assert abs(float(a[4]) - float(b[4])) <= 1e-9 * float(b[4])
+        else:
+            assert a == b, (a, b)

@@ -26,7 +26,7 @@ def test_failing_command_leaves_state():
 
 @pytest.mark.parametrize("cmd,word", [("o", "o"), ("O", "O"),
                                       ("lagrange 2", "lagrange"), ("quadratic", "quadratic"),
-                                      ("refine facets where id == 1", "refine")])
+                                      ("refine vertex[1]", "refine")])
 def test_later_features_refused_by_name(cmd, word):
     s = session()
     with pytest.raises(CommandError, match=f"not supported.*{word}"):

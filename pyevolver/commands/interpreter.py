@@ -735,10 +735,13 @@ class Interpreter:
         s = self.session
         els = s.generate(node[1], self.env)
         kinds = {el.kind for el in els}
-        if kinds - {"edge"}:
-            raise UnsupportedError("refine of " + ", ".join(sorted(kinds - {"edge"})) + "s",
-                                   "only 'refine edges' is supported")
-        s.refine_edges([el.i for el in els])
+        if kinds - {"edge", "facet"}:
+            raise UnsupportedError("refine of " + ", ".join(sorted(kinds - {"edge", "facet"}))
+                                   + "s", "'refine edges' and 'refine facets' are supported")
+        if node[1].kind == "facet":
+            s.refine_facets([el.i for el in els])
+        else:
+            s.refine_edges([el.i for el in els])
 
     def _x_edgeswap(self, node):
         s = self.session

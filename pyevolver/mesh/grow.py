@@ -117,7 +117,7 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
         elif key == "boundary" and "boundary" in s.fattr:
             rows[len(ee):] = s.fattr["boundary"][ef]
         elif key == "original":
-            rows[:] = 0
+            rows[len(ee):] = 0          # edge halves keep their parent's, as REF's `list`
         elif key == "id":
             rows[:] = _new_ids(arr, ne_new)
         ea[key] = _append_rows(arr, rows)
@@ -139,10 +139,8 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     # -- facets
     fa = {}
     for key, arr in s.fattr.items():
-        rows = arr[ff].copy()
-        if key == "original":
-            rows[:] = 0
-        elif key == "id":
+        rows = arr[ff].copy()           # "original" too: REF lists `original 1` for them
+        if key == "id":
             rows[:] = _new_ids(arr, nf_new)
         fa[key] = _append_rows(arr, rows)
     t.fattr = fa

@@ -57,9 +57,11 @@ def split_facets_at_centre(s, facets):
     FEn = new.FE
     g1 = nf + 2 * np.arange(k)
     g2 = g1 + 1
-    FEn[f] = np.stack([FE[:, 0], bm, ~am], axis=1)        # a->b, b->m, m->a
-    FEn[g1] = np.stack([FE[:, 1], cm, ~bm], axis=1)       # b->c, c->m, m->b
-    FEn[g2] = np.stack([FE[:, 2], am, ~cm], axis=1)       # c->a, a->m, m->c
+    # numbered as the Evolver's `refine facet`: the facet keeps its id for
+    # the triangle on its third side, the new ids go to the first and second
+    FEn[f] = np.stack([~cm, FE[:, 2], am], axis=1)        # m->c, c->a, a->m
+    FEn[g1] = np.stack([FE[:, 0], bm, ~am], axis=1)       # a->b, b->m, m->a
+    FEn[g2] = np.stack([FE[:, 1], cm, ~bm], axis=1)       # b->c, c->m, m->b
     new.__dict__.pop("_topo", None)
     if new.vcon:
         project_to_constraints(new, m)
