@@ -11,14 +11,12 @@ from __future__ import annotations
 
 import copy
 import math
-import random
 import sys
 import time
 
 import numpy as np
 
 from .commands import interpreter as I
-from .commands.cformat import print_value
 from .datafile.reader import read_datafile
 from .errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
 from .expr import nodes as N
@@ -564,7 +562,6 @@ class Session:
         return out
 
     def _gen_base(self, base, env):
-        s = self.surface
         tag = base[0]
         if tag == "var":
             el = env.lookup(base[1])

@@ -13,7 +13,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import geometry as G
-from .errors import DatafileError, UnsupportedError, ExpressionError
+from .errors import DatafileError, UnsupportedError
 from .expr import nodes as N
 from .methods import method_info
 
@@ -633,7 +633,6 @@ class _Builder:
                     raise self.error(f"face {blk.ids[pos]}: '{kw}' is not a facet attribute",
                                      blk.lines[pos])
         # validate edge loops
-        tri_rows = []
         E = s.E
         table = isinstance(blk.data, np.ndarray)
         if table:
@@ -1211,7 +1210,6 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
     tol = tol if tol is not None else s.params.get("constraint_tolerance", 1e-12)
     cids = sorted(s.vcon)
     onmat = np.stack([s.vcon[c][idx] for c in cids], axis=1)
-    fixed = s.vattr["fixed"][idx]
     anyon = np.nonzero(onmat.any(axis=1))[0]
     if not len(anyon):
         return

@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from conftest import example, SHARED
+from conftest import example
 from reference import run_reference
 
 # reference check 18 (copied from shared/reference-checks/scripts)

@@ -10,8 +10,6 @@ Conjugate gradient (Polak-Ribiere by default, Fletcher-Reeves with
 carries any difference forward.
 """
 import re
-import subprocess
-import sys
 
 import pytest
 

@@ -16,7 +16,7 @@ from lark.exceptions import UnexpectedInput, VisitError
 
 from ..errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
 from ..expr import nodes as N
-from ..expr.transform import ExprTransformer, expr_grammar, unescape
+from ..expr.transform import ExprTransformer, expr_grammar
 from .cformat import c_format, print_value
 
 _HERE = os.path.dirname(__file__)

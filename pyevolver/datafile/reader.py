@@ -14,11 +14,10 @@ import numpy as np
 from lark import Lark, Token, v_args
 from lark.exceptions import UnexpectedInput, UnexpectedCharacters, UnexpectedToken, VisitError
 
-from ..errors import DatafileError, UnsupportedError, ExpressionError, PyEvolverError
+from ..errors import DatafileError, ExpressionError, PyEvolverError
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
-from ..scene import (Scene, ConstraintDecl, BoundaryDecl, QuantityDecl, MethodDecl,
-                     ElementBlock)
+from ..scene import (Scene, ConstraintDecl, BoundaryDecl, QuantityDecl, MethodDecl)
 from .preprocess import preprocess, read_source
 
 _HERE = os.path.dirname(__file__)

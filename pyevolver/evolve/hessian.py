@@ -25,7 +25,6 @@ coordinate gives all columns (Curtis–Powell–Reid 1974; Coleman–Moré 1983)
 """
 from __future__ import annotations
 
-import math
 import warnings
 
 import numpy as np
@@ -34,7 +33,7 @@ import scipy.sparse.linalg as spla
 
 from .. import geometry as G
 from ..errors import UnsupportedError
-from ..surface import boundary_eval, boundary_groups, project_to_constraints
+from ..surface import boundary_eval, boundary_groups
 from . import gradient as GR
 
 

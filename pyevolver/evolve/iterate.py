@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import UnsupportedError
 from ..surface import displace, project_tangent, project_to_constraints, restore_state, state
 from . import gradient as GR
 
@@ -85,7 +84,6 @@ class _Constraints:
         return np.where(out > 0, out, default)
 
     def gradients(self, t):
-        s = t.surface
         gs = []
         if self.bodies:
             vg = GR.body_volume_gradients(t)

@@ -76,7 +76,6 @@ def _passes(FE, ef, edges, lengths, threshold):
     facets and edge lengths; always true for ``threshold = inf``."""
     if not np.isfinite(threshold):
         return np.ones(len(edges), bool)
-    out = []
     a = lengths[edges]
     tot = np.zeros(len(edges))
     for j in (0, 1):
