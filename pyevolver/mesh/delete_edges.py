@@ -134,8 +134,9 @@ class _Deleter:
             self.ealive[ea] = False
             if f is not None:
                 self.falive[f] = False
-        if self._eliminable(keep, e):
+        if self._eliminable(keep, e) and self.vsig[keep, -1] == 0:
             # both ends as free as the edge: the edge shrinks to its midpoint
+            # (not on a parametric boundary, where the kept vertex stays put)
             self.X[keep] = 0.5 * (self.X[keep] + self.X[elim])
             self.moved.append(keep)
         self.valive[elim] = False
@@ -177,9 +178,11 @@ class _Deleter:
             return self.s
         t = subset(self.s, self.E, self.FE, self.valive, self.ealive, self.falive)
         t.X = self.X[self.valive].copy()
-        if self.moved:
+        moved = np.unique(np.array(self.moved, np.int64))
+        moved = moved[self.valive[moved]] if len(moved) else moved
+        if len(moved):
             new = np.cumsum(self.valive) - 1
-            project_to_constraints(t, new[np.array(self.moved)])
+            project_to_constraints(t, new[moved])
         return t
 
 
