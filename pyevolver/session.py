@@ -181,6 +181,8 @@ class Session:
             return
         s.gravity_constant = self.variables.get("gravity_constant", s.gravity_constant)
         s.gravity_on = bool(self.toggles.get("gravity", 1))
+        s.curvature_mode = ("norm" if self.toggles.get("normal_curvature") else
+                            "eff" if self.toggles.get("effective_area") else "plain")
         t = s.evaluate()
         s.bodies.volume = t.volumes
         self.totals = t
@@ -479,6 +481,9 @@ class Session:
             return
         if name == "gravity_constant":
             self.surface.gravity_constant = float(value)
+        if name == "sq_curvature_modulus" and self.surface is not None:
+            self.surface.sq_curvature_modulus = float(value)
+            return
         if self.surface is not None and name in self.surface.quantities:
             raise CommandError(f"'{name}' is a quantity; assign to {name}.target or "
                                f"{name}.modulus")
@@ -508,6 +513,7 @@ class Session:
             "torus": lambda: 1 if s.periods is not None else 0,
             "datafilename": lambda: self.filename,
             "gravity_constant": lambda: s.gravity_constant,
+            "sq_curvature_modulus": lambda: s.sq_curvature_modulus,
             "g": lambda: s.gravity_constant,
             "iteration_counter": lambda: self.iteration_counter,
             "total_time": lambda: self.total_time,

@@ -72,6 +72,8 @@ class Surface:
         self.gravity_constant = 1.0
         self.gravity_on = True       # the `gravity` toggle (G v sets it to v != 0)
         self.gap_constant = 1.0
+        self.sq_curvature_modulus = 0.0     # legacy SQUARED_CURVATURE c
+        self.curvature_mode = "plain"       # toggles: effective_area -> eff, normal_curvature -> norm
 
     # -- topology helpers ---------------------------------------------------
     @property
@@ -192,6 +194,13 @@ class Totals:
         if gap:
             self.terms["gap"] = gap
             energy += gap
+        if s.sq_curvature_modulus:
+            # legacy top-of-file SQUARED_CURVATURE (spec 5.3): the vertex
+            # method picked by the effective_area / normal_curvature toggles
+            from .methods.curvature import legacy_energy
+            e = s.sq_curvature_modulus * legacy_energy(self)
+            self.terms["sq_curvature"] = e
+            energy += e
         self.volumes = self._volumes()
         b = s.bodies
         if b.n:
@@ -404,6 +413,7 @@ class _Builder:
         s.torus_filled = "torus_filled" in sc.flags
         s.gravity_constant = sc.values.get("gravity_constant", 1.0)
         s.gap_constant = sc.values.get("gap_constant", 1.0)
+        s.sq_curvature_modulus = float(sc.values.get("squared_curvature", 0.0))
         if sc.torus:
             vals = sc.values.get("_periods")
             P = np.eye(3) if vals is None else np.array(vals).reshape(3, 3)

@@ -183,6 +183,9 @@ def energy_gradient(t):
         g += edge_vector_integral_grad(t, comps, idx, sign)
     if "gap" in t.terms:
         g += gap_energy_grad(t)
+    if "sq_curvature" in t.terms:
+        from ..methods.curvature import legacy_gradient
+        g += s.sq_curvature_modulus * legacy_gradient(t)
     b = s.bodies
     if b.n:
         if s.gravity_constant != 0 and s.gravity_on and np.any(b.density):
@@ -297,8 +300,12 @@ def quantity_gradient(t, q):
         elif name == "facet_vector_integral":
             g += _facet_vector_integral_grad(t, m.vector or [], idx, w)
         else:
-            from ..errors import UnsupportedError
-            raise UnsupportedError(f"the gradient of method {name}")
+            from ..methods import GRADIENTS
+            fn = GRADIENTS.get(name)
+            if fn is None:
+                from ..errors import UnsupportedError
+                raise UnsupportedError(f"the gradient of method {name}")
+            g += fn(t, m, np.asarray(idx, np.int64), w)
     return g
 
 

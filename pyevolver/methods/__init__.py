@@ -20,6 +20,7 @@ from ..errors import UnsupportedError
 from .. import geometry as G
 
 METHODS = {}
+GRADIENTS = {}     # name -> fn(totals, method, idx, weights) -> (nv, 3)
 
 # Evolver methods pyevolver knows by name but does not implement (yet).
 CURVATURE_METHODS = {
@@ -32,9 +33,12 @@ CURVATURE_METHODS = {
 }
 
 
-def register_method(name, etype, fn):
-    """Register ``fn`` as the value function of method ``name`` on ``etype``."""
+def register_method(name, etype, fn, gradient=None):
+    """Register ``fn`` as the value function of method ``name`` on ``etype``
+    (and ``gradient(totals, method, idx, weights)`` -> (nv, 3) for ``g``)."""
     METHODS[name.lower()] = (etype, fn)
+    if gradient is not None:
+        GRADIENTS[name.lower()] = gradient
 
 
 def method_info(name):
@@ -121,3 +125,20 @@ for _name, _et, _fn in [
     ("edge_vector_integral", "edge", _edge_vector_integral),
 ]:
     register_method(_name, _et, _fn)
+
+
+def _register_curvature():
+    from . import curvature as C
+    for name in C.VERTEX_METHODS:
+        register_method(name, "vertex", C.vertex_values, C.vertex_gradient)
+    for name in ("mean_curvature_integral", "mean_curvature_integral_a"):
+        register_method(name, "edge", C.mci_values, C.mci_gradient)
+        CURVATURE_METHODS.discard(name)
+    register_method("star_gauss_curvature", "vertex", C.star_gauss_values,
+                    C.star_gauss_gradient)
+    register_method("sq_gauss_curvature", "vertex", C.sq_gauss_values, C.sq_gauss_gradient)
+    CURVATURE_METHODS.difference_update(C.VERTEX_METHODS)
+    CURVATURE_METHODS.difference_update({"star_gauss_curvature", "sq_gauss_curvature"})
+
+
+_register_curvature()

@@ -1,0 +1,355 @@
+"""Squared mean curvature energies and ∫H dA as quantity methods (spec §5).
+
+Every vertex method is built from three sums over the star of facets of a
+vertex v (Surface Evolver manual, "Named methods"; spec §5 checked against
+evolver-nox-d 2.70):
+
+* ``A_v = Σ_f A_f`` — the whole star area;
+* ``F_v = ∇_v A`` — the area gradient at v, ``Σ_f ½ n_f × e_f`` (e_f the side
+  of f opposite v);
+* ``N_v = Σ_f ½ N_f`` — the facets' area vectors.
+
+with the mean curvature estimates ``h_plain = 3|F|/(2A)``,
+``h_eff = 3|F|/(2|N|)``, ``h_norm = 3 F·F/(2 F·N)``, ``h_perp = 3 F·N/(2 N·N)``
+and ``E_v = (h − h0)² A/3``.  The gradient of ``Σ_v E_v`` with respect to
+all vertices follows by the chain rule: ``∂E/∂F`` is carried to the
+vertices by the facet-area Hessian (applied facet by facet as a
+Hessian-vector product, never assembled), ``∂E/∂N`` through
+``∂(D·N_f)/∂x`` and ``∂E/∂A`` through the area gradient.
+
+``mean_curvature_integral`` is the edge method ``Σ_e ½ L_e θ_e`` with θ_e
+the signed exterior dihedral angle (positive where the surface is convex
+towards its normals), ∫H dA with H = (k1 + k2)/2.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import UnsupportedError
+
+# method -> (estimate, honours h_zero, old-style (zero at FIXED / boundary vertices))
+VERTEX_METHODS = {
+    "sq_mean_curvature": ("plain", "switch", True),
+    "eff_area_sq_mean_curvature": ("eff", "switch", True),
+    "normal_sq_mean_curvature": ("norm", "yes", True),
+    "star_sq_mean_curvature": ("plain", "no", False),
+    "star_eff_area_sq_mean_curvature": ("eff", "no", False),
+    "star_normal_sq_mean_curvature": ("norm", "yes", False),
+    "star_perp_sq_mean_curvature": ("perp", "yes", False),
+}
+
+
+def _scatter(nv, idx, vals):
+    """Sum rows ``vals`` (k, 3) or values (k,) into the vertices ``idx``."""
+    if vals.ndim == 1:
+        return np.bincount(idx, weights=vals, minlength=nv)
+    return np.stack([np.bincount(idx, weights=vals[:, k], minlength=nv) for k in range(3)], 1)
+
+
+def star_sums(t):
+    """Per-vertex ``A`` (nv,), ``F`` (nv, 3), ``N`` (nv, 3) and per-facet
+    pieces: corners ``P`` (nf, 3, 3), unit normals ``n``, ``|N2|``."""
+    from ..evolve import gradient as GR
+    s = t.surface
+    F = s.F
+    P = GR._facet_points(t)
+    N2 = t.facet_N2
+    L = np.linalg.norm(N2, axis=1)
+    with np.errstate(all="ignore"):
+        n = np.nan_to_num(N2 / L[:, None])
+    Ag = GR.facet_area_grad(t)                                  # (nf, 3, 3)
+    Af = 0.5 * L
+    flat = F.ravel()
+    A = np.bincount(flat, weights=np.repeat(Af, 3), minlength=s.nv)
+    Fv = _scatter(s.nv, flat, Ag.reshape(-1, 3))
+    Nv = _scatter(s.nv, flat, np.repeat(0.5 * N2, 3, axis=0))
+    return A, Fv, Nv, (P, n, L, Ag)
+
+
+def _h_zero(s, method):
+    """Per-vertex h0 (nv,) or None when h_zero is not defined."""
+    ex = s.extra.get(("vertex", "h_zero"))
+    if ex is not None:
+        return np.asarray(ex, float).reshape(s.nv)
+    if "h_zero" in s.params:
+        return np.full(s.nv, float(s.params["h_zero"]))
+    return None
+
+
+def _check_supported(s):
+    if s.periods is not None:
+        raise UnsupportedError("curvature methods in the torus model")
+    if s.vcon and any(np.any(m) for m in s.vcon.values()):
+        raise UnsupportedError("curvature methods at vertices on level-set constraints",
+                               "REF projects F and N onto the constraints there")
+    idx, _, _ = s.topology()
+    val = np.bincount(idx.ravel(), minlength=s.ne)
+    if np.any(val == 1):
+        raise UnsupportedError("curvature methods on surfaces with a free boundary",
+                               "the partial stars of boundary vertices")
+
+
+def _vertex_energy(s, A, F, N, name):
+    """``E`` (nv,) and its partial derivatives ``dF``, ``dN`` (nv, 3), ``dA``."""
+    kind, hz, old = VERTEX_METHODS[name]
+    h0 = _h_zero(s, name) if hz != "no" else None
+    if h0 is not None and hz == "switch":
+        kind = "perp"                      # REF: defining h_zero switches to h_perp
+    nv = s.nv
+    FF = np.einsum("ij,ij->i", F, F)
+    FN = np.einsum("ij,ij->i", F, N)
+    NN = np.einsum("ij,ij->i", N, N)
+    dF = np.zeros((nv, 3))
+    dN = np.zeros((nv, 3))
+    with np.errstate(all="ignore"):
+        if kind == "plain":
+            E = 0.75 * FF / A
+            dF = 1.5 * F / A[:, None]
+            dA = -0.75 * FF / A ** 2
+        elif kind == "eff":
+            E = 0.75 * A * FF / NN
+            dF = 1.5 * (A / NN)[:, None] * F
+            dN = -1.5 * (A * FF / NN ** 2)[:, None] * N
+            dA = 0.75 * FF / NN
+        else:
+            if kind == "norm":
+                ok = FN != 0
+                h = np.where(ok, 1.5 * FF / FN, 0.0)
+                dhF = np.where(ok[:, None], 1.5 * (2 * F * FN[:, None] - FF[:, None] * N)
+                               / (FN ** 2)[:, None], 0.0)
+                dhN = np.where(ok[:, None], -1.5 * (FF / FN ** 2)[:, None] * F, 0.0)
+            else:                               # perp
+                ok = NN > 0
+                h = np.where(ok, 1.5 * FN / NN, 0.0)
+                dhF = np.where(ok[:, None], 1.5 * N / NN[:, None], 0.0)
+                dhN = np.where(ok[:, None], 1.5 * (F * NN[:, None] - 2 * FN[:, None] * N)
+                               / (NN ** 2)[:, None], 0.0)
+            d = h - (h0 if h0 is not None else 0.0)
+            E = d * d * A / 3.0
+            dF = (2 * d * A / 3.0)[:, None] * dhF
+            dN = (2 * d * A / 3.0)[:, None] * dhN
+            dA = d * d / 3.0
+    E, dA = np.nan_to_num(E), np.nan_to_num(dA)
+    dF, dN = np.nan_to_num(dF), np.nan_to_num(dN)
+    if old:
+        skip = s.vattr["fixed"].copy()
+        if "boundary" in s.vattr:
+            skip |= s.vattr["boundary"] != 0
+        E[skip] = 0.0
+        dF[skip] = 0.0
+        dN[skip] = 0.0
+        dA[skip] = 0.0
+    return E, dF, dN, dA
+
+
+def vertex_values(ctx, m, idx):
+    """Per-vertex energies of a squared mean curvature method."""
+    s = ctx.surface
+    _check_supported(s)
+    A, F, N, _ = star_sums(ctx)
+    E, _, _, _ = _vertex_energy(s, A, F, N, m.method)
+    return E[idx]
+
+
+def _area_hvp(P, n, L, U):
+    """Facet-area Hessian times per-corner vectors ``U`` (nf, 3, 3), facet
+    by facet: the directional derivative of ``∂A/∂x_a = ½ n × e_a``."""
+    e = np.stack([P[:, 2] - P[:, 1], P[:, 0] - P[:, 2], P[:, 1] - P[:, 0]], 1)
+    de = np.stack([U[:, 2] - U[:, 1], U[:, 0] - U[:, 2], U[:, 1] - U[:, 0]], 1)
+    dN2 = (np.cross(U[:, 1] - U[:, 0], P[:, 2] - P[:, 0])
+           + np.cross(P[:, 1] - P[:, 0], U[:, 2] - U[:, 0]))
+    with np.errstate(all="ignore"):
+        dn = np.nan_to_num((dN2 - n * np.einsum("ij,ij->i", n, dN2)[:, None]) / L[:, None])
+    return 0.5 * (np.cross(dn[:, None, :], e) + np.cross(n[:, None, :], de))
+
+
+def vertex_gradient(t, m, idx, w):
+    """Gradient (nv, 3) of ``Σ_v w_v E_v`` over the vertices ``idx``."""
+    from ..evolve import gradient as GR
+    s = t.surface
+    _check_supported(s)
+    A, F, N, (P, n, L, Ag) = star_sums(t)
+    _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method)
+    wv = np.zeros(s.nv)
+    np.add.at(wv, idx, w)
+    dF, dN, dA = dF * wv[:, None], dN * wv[:, None], dA * wv
+    Fc = s.F
+    g = _area_hvp(P, n, L, dF[Fc])                                # via F_v
+    g += 0.5 * GR._n2_grad_dot(P, dN[Fc].sum(axis=1))              # via N_v
+    g += Ag * dA[Fc].sum(axis=1)[:, None, None]                    # via A_v
+    return GR.corner_scatter(t, g)
+
+
+# -- mean_curvature_integral ----------------------------------------------------------------
+
+def _dihedral(t, idx):
+    """For edges ``idx`` with two facets: the facet running along the edge
+    (f1) and against it (f2), their corner arrays, θ (signed exterior
+    angle), and the pieces of its gradient."""
+    from ..mesh.equiangulate import edge_facets
+    s = t.surface
+    ef, ek, val = edge_facets(s)
+    ok = val[idx] == 2
+    e = idx[ok]
+    fa, fb = ef[e, 0], ef[e, 1]
+    ka, kb = ek[e, 0], ek[e, 1]
+    fwd_a = s.FE[fa, ka] >= 0
+    f1 = np.where(fwd_a, fa, fb)
+    f2 = np.where(fwd_a, fb, fa)
+    return ok, e, f1, f2
+
+
+def mci_values(ctx, m, idx):
+    s = ctx.surface
+    if s.periods is not None:
+        raise UnsupportedError("mean_curvature_integral in the torus model")
+    idx = np.asarray(idx, np.int64)
+    out = np.zeros(len(idx))
+    ok, e, f1, f2 = _dihedral(ctx, idx)
+    N1, N2 = ctx.facet_N2[f1], ctx.facet_N2[f2]
+    d = ctx.edge_vec[e]
+    Le = np.linalg.norm(d, axis=1)
+    S = np.einsum("ij,ij->i", np.cross(N1, N2), d) / Le
+    C = np.einsum("ij,ij->i", N1, N2)
+    out[ok] = 0.5 * Le * np.arctan2(S, C)
+    return out
+
+
+def mci_gradient(t, m, idx, w):
+    from ..evolve import gradient as GR
+    s = t.surface
+    idx = np.asarray(idx, np.int64)
+    ok, e, f1, f2 = _dihedral(t, idx)
+    w = np.asarray(w, float)[ok]
+    P = GR._facet_points(t)
+    P1, P2 = P[f1], P[f2]
+    N1, N2 = t.facet_N2[f1], t.facet_N2[f2]
+    d = t.edge_vec[e]
+    Le = np.linalg.norm(d, axis=1)
+    u = d / Le[:, None]
+    X = np.cross(N1, N2)
+    S = np.einsum("ij,ij->i", X, u)
+    C = np.einsum("ij,ij->i", N1, N2)
+    theta = np.arctan2(S, C)
+    R = S * S + C * C
+    # dθ = (C dS − S dC)/R with S = u·(N1 × N2), C = N1·N2
+    a = (C / R)[:, None]
+    b = (S / R)[:, None]
+    # through N1 (facet f1 corners) and N2 (facet f2 corners)
+    g1 = GR._n2_grad_dot(P1, a * np.cross(N2, u) - b * N2)
+    g2 = GR._n2_grad_dot(P2, a * np.cross(u, N1) - b * N1)
+    # through u = d/|d| (edge endpoints)
+    du = a * X
+    du = (du - u * np.einsum("ij,ij->i", u, du)[:, None]) / Le[:, None]
+    coef = (0.5 * Le * w)[:, None, None]
+    g = np.zeros((s.nv, 3))
+    g += GR.scatter(s.nv, s.F[f1].ravel(), (g1 * coef).reshape(-1, 3))
+    g += GR.scatter(s.nv, s.F[f2].ravel(), (g2 * coef).reshape(-1, 3))
+    tail, head = s.E[e, 0], s.E[e, 1]
+    gu = du * (0.5 * Le * w)[:, None] + (0.5 * theta * w)[:, None] * u   # + ½ θ dL
+    g += GR.scatter(s.nv, head, gu)
+    g -= GR.scatter(s.nv, tail, gu)
+    return g
+
+
+# -- Gaussian curvature ---------------------------------------------------------------------
+
+def _angles(P):
+    """Corner angles (nf, 3) of the facets and their gradients
+    (nf, 3 corners, 3 points, 3): d(angle at a)/d x_b."""
+    out = np.zeros(P.shape[:2])
+    grad = np.zeros(P.shape[:2] + (3, 3))
+    for a in range(3):
+        b, c = (a + 1) % 3, (a + 2) % 3
+        u = P[:, b] - P[:, a]
+        v = P[:, c] - P[:, a]
+        X = np.cross(u, v)
+        S = np.linalg.norm(X, axis=1)
+        C = np.einsum("ij,ij->i", u, v)
+        R = S * S + C * C
+        with np.errstate(all="ignore"):
+            nh = np.nan_to_num(X / S[:, None])
+            du = (C[:, None] * np.cross(v, nh) - S[:, None] * v) / R[:, None]
+            dv = (C[:, None] * np.cross(nh, u) - S[:, None] * u) / R[:, None]
+        out[:, a] = np.arctan2(S, C)
+        grad[:, a, b] = du
+        grad[:, a, c] = dv
+        grad[:, a, a] = -(du + dv)
+    return out, grad
+
+
+def _gauss(t):
+    """Angle defect K (nv,), star area A (nv,) and the per-facet pieces."""
+    s = t.surface
+    from ..evolve import gradient as GR
+    P = GR._facet_points(t)
+    ang, dang = _angles(P)
+    K = 2 * np.pi - np.bincount(s.F.ravel(), weights=ang.ravel(), minlength=s.nv)
+    A = np.bincount(s.F.ravel(), weights=np.repeat(t.facet_area, 3), minlength=s.nv)
+    return K, A, P, dang
+
+
+def star_gauss_values(ctx, m, idx):
+    """``star_gauss_curvature``: the angle defect 2π − Σ angles at a vertex."""
+    _check_supported(ctx.surface)
+    K, _, _, _ = _gauss(ctx)
+    return K[idx]
+
+
+def sq_gauss_values(ctx, m, idx):
+    """``sq_gauss_curvature``: K²/(A/3) at a vertex (closed surfaces)."""
+    _check_supported(ctx.surface)
+    K, A, _, _ = _gauss(ctx)
+    return (K * K / (A / 3.0))[idx]
+
+
+def _gauss_grad(t, idx, w, square):
+    from ..evolve import gradient as GR
+    s = t.surface
+    _check_supported(s)
+    K, A, P, dang = _gauss(t)
+    wv = np.zeros(s.nv)
+    np.add.at(wv, idx, w)
+    if square:
+        dK = 2 * K / (A / 3.0) * wv
+        dA = -3.0 * K * K / (A * A) * wv
+    else:
+        dK, dA = wv, np.zeros(s.nv)
+    Fc = s.F
+    # K_v = 2π − Σ angles at v: d/dx of Σ_v dK_v K_v
+    g = -np.einsum("fa,fabk->fbk", dK[Fc], dang)
+    g += GR.facet_area_grad(t) * dA[Fc].sum(axis=1)[:, None, None]
+    return GR.corner_scatter(t, g)
+
+
+def star_gauss_gradient(t, m, idx, w):
+    return _gauss_grad(t, np.asarray(idx, np.int64), np.asarray(w, float), False)
+
+
+def sq_gauss_gradient(t, m, idx, w):
+    return _gauss_grad(t, np.asarray(idx, np.int64), np.asarray(w, float), True)
+
+
+# -- legacy SQUARED_CURVATURE ---------------------------------------------------------------
+
+class _Legacy:
+    def __init__(self, method):
+        self.method = method
+
+
+_LEGACY = {"plain": "sq_mean_curvature", "eff": "eff_area_sq_mean_curvature",
+           "norm": "normal_sq_mean_curvature"}
+
+
+def legacy_energy(t):
+    """Σ_v E_v of the old vertex method the toggles select (spec §5.3):
+    ``normal_curvature`` supersedes ``effective_area``."""
+    s = t.surface
+    m = _Legacy(_LEGACY[s.curvature_mode])
+    return float(vertex_values(t, m, np.arange(s.nv)).sum())
+
+
+def legacy_gradient(t):
+    s = t.surface
+    m = _Legacy(_LEGACY[s.curvature_mode])
+    return vertex_gradient(t, m, np.arange(s.nv), np.ones(s.nv))
