@@ -151,11 +151,15 @@ class Iterator:
             # restore along the constraint gradients at the moved positions
             _, us, A = self._constrained_dirs(t, cons, mobile)
         cur_us, cur_A = us, A
+        half_next = False
         for it in range(10):
             try:
                 delta = np.linalg.solve(cur_A, d)
             except np.linalg.LinAlgError:
                 delta = np.linalg.lstsq(cur_A, d, rcond=None)[0]
+            if half_next:
+                delta = 0.5 * delta
+                half_next = False
             prev = state(s)
             shift = sum(dl * u for dl, u in zip(delta, cur_us))
             displace(s, prev, shift)
@@ -163,27 +167,32 @@ class Iterator:
             t_new = s.evaluate()
             d_new = targets - cons.values(t_new)
             err_new = float(np.sum(np.abs(d_new) / cons.tolerances(t_new, tol)))
-            if err_new > 100 * err and err > 0 and it > 0:
-                if report:
+            if err_new > 100 * err and err > 0:
+                if report is not None:
                     report.append(f"Total constraint difference would increase by factor of "
                                   f"{err_new / err:f}.")
                     report.append("Aborting constraint adjustment.")
                 restore_state(s, prev)
+                return s.evaluate()
+            if err_new > 1.01 * err:
+                # REF (itdebug): "Diff increased. Restoring coords."; the next
+                # projection takes half the correction along gradients taken
+                # where it starts, and is judged against the increased value
+                # (REF's Old_diff).  Checked step for step on check 14.
+                restore_state(s, prev)
                 t = s.evaluate()
-                return t
-            if err_new > 1.01 * err and it > 0:
-                # undo and take half the correction
-                displace(s, prev, 0.5 * shift)
-                project_to_constraints(s, moved)
-                t_new = s.evaluate()
-                d_new = targets - cons.values(t_new)
-                err_new = float(np.sum(np.abs(d_new) / cons.tolerances(t_new, tol)))
+                _, cur_us, cur_A = self._constrained_dirs(t, cons, mobile)
+                self._carry = (cur_us, cur_A)
+                err = err_new
+                half_next = True
+                continue
             improved = err_new < 0.5 * err
             t, d, err = t_new, d_new, err_new
             if err <= 1.0:
                 return t
             if not improved:
-                gs, cur_us, cur_A = self._constrained_dirs(t, cons, mobile)
+                _, cur_us, cur_A = self._constrained_dirs(t, cons, mobile)
+            self._carry = (cur_us, cur_A)
         if report is not None:
             report.append("WARNING 1055: Volume or quantity constraints don't converge in "
                           "10 projections.")
@@ -239,9 +248,15 @@ class Iterator:
             vel = h
         X0 = state(s)
         warnings = []
+        trial_msgs = []
+        # Trial moves start from the directions at X0 (REF resets them after
+        # each trial); the repeated move after a rejected one starts from the
+        # directions the rejected move last recomputed (REF keeps those),
+        # checked restoring step by restoring step on check 14.
+        self._carry = (us, A)
 
-        def E(scale, report=None):
-            t = self._move(X0, vel, scale, cons, us, A, mobile, targets, report)
+        def E(scale):
+            t = self._move(X0, vel, scale, cons, us, A, mobile, targets, trial_msgs)
             e = t.energy
             return e if math.isfinite(e) else math.inf
 
@@ -252,10 +267,11 @@ class Iterator:
             E0 = None
         else:
             scale, E0, s1 = self._line_search(E, settings["scale"], smax)
-        # actual move
-        report = []
-        t = self._move(X0, vel, settings.get("scale_scale", 1.0) * scale, cons, us, A, mobile,
-                       targets, report)
+        # actual move (REF prints what the trial moves reported first)
+        report = trial_msgs
+        self._carry = (us, A)
+        t = self._move(X0, vel, settings.get("scale_scale", 1.0) * scale, cons, us, A,
+                       mobile, targets, report)
         e = t.energy
         if not math.isfinite(e):
             restore_state(s, X0)
@@ -274,8 +290,7 @@ class Iterator:
                               message="increase", warnings=report + warnings)
         if not fixed_scale and e > E0 and scale > 0:
             scale = s1
-            report = []
-            t = self._move(X0, vel, scale, cons, us, A, mobile, targets, report)
+            t = self._move(X0, vel, scale, cons, *self._carry, mobile, targets, report)
             self.cg_history = None
         if not fixed_scale:
             settings["scale"] = scale
