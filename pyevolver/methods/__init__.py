@@ -142,3 +142,11 @@ def _register_curvature():
 
 
 _register_curvature()
+
+
+def _register_harmonic():
+    from . import harmonic as H
+    register_method("harmonic_energy", "edge", H.values, H.gradient)
+
+
+_register_harmonic()
