@@ -66,6 +66,41 @@ def star_sums(t):
     return A, Fv, Nv, (P, n, L, Ag)
 
 
+def star_sums_fast(t):
+    """``A`` (nv,), ``F`` (nv, 3), ``N`` (nv, 3) as :func:`star_sums`, from
+    axis-major arrays (one gather of the corners, cross products by
+    components, bincount scatters): the value path of ``g``'s trial moves."""
+    s = t.surface
+    nv = s.nv
+    Fc = s.facet_corners()                                   # (3 corners, nf)
+    Pc = getattr(t, "_corner_xyz", None)                     # gathered by Totals
+    if Pc is not None:
+        P = Pc                                               # P[axis][corner] (nf,)
+        N2 = t.facet_N2.T
+    else:
+        P = np.ascontiguousarray(s.X.T)[:, Fc]               # (3 axes, 3 corners, nf)
+        a = P[:, 1] - P[:, 0]
+        b = P[:, 2] - P[:, 0]
+        N2 = np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                       a[0] * b[1] - a[1] * b[0]])           # (3, nf)
+    L = 2.0 * t.facet_area
+    with np.errstate(all="ignore"):
+        n = np.nan_to_num(N2 / L)
+    flat = Fc.ravel()
+    A = 0.5 * np.bincount(flat, weights=np.tile(L, 3), minlength=nv)
+    N = np.empty((nv, 3))
+    F = np.zeros((nv, 3))
+    for k in range(3):
+        N[:, k] = 0.5 * np.bincount(flat, weights=np.tile(N2[k], 3), minlength=nv)
+    for c in range(3):
+        e = [P[k][(c + 2) % 3] - P[k][(c + 1) % 3] for k in range(3)]   # side opposite c
+        idx = Fc[c]
+        F[:, 0] += np.bincount(idx, weights=0.5 * (n[1] * e[2] - n[2] * e[1]), minlength=nv)
+        F[:, 1] += np.bincount(idx, weights=0.5 * (n[2] * e[0] - n[0] * e[2]), minlength=nv)
+        F[:, 2] += np.bincount(idx, weights=0.5 * (n[0] * e[1] - n[1] * e[0]), minlength=nv)
+    return A, F, N
+
+
 def _h_zero(s, method):
     """Per-vertex h0 (nv,) or None when h_zero is not defined."""
     ex = s.extra.get(("vertex", "h_zero"))
@@ -82,9 +117,12 @@ def _check_supported(s):
     if s.vcon and any(np.any(m) for m in s.vcon.values()):
         raise UnsupportedError("curvature methods at vertices on level-set constraints",
                                "REF projects F and N onto the constraints there")
-    idx, _, _ = s.topology()
-    val = np.bincount(idx.ravel(), minlength=s.ne)
-    if np.any(val == 1):
+    topo = s.topology()
+    c = s.__dict__.get("_free_boundary")
+    if c is None or c[0] is not topo:
+        c = (topo, bool(np.any(np.bincount(topo[0].ravel(), minlength=s.ne) == 1)))
+        s._free_boundary = c
+    if c[1]:
         raise UnsupportedError("curvature methods on surfaces with a free boundary",
                                "the partial stars of boundary vertices")
 
@@ -146,7 +184,7 @@ def vertex_values(ctx, m, idx):
     """Per-vertex energies of a squared mean curvature method."""
     s = ctx.surface
     _check_supported(s)
-    A, F, N, _ = star_sums(ctx)
+    A, F, N = star_sums_fast(ctx)
     E, _, _, _ = _vertex_energy(s, A, F, N, m.method)
     return E[idx]
 
