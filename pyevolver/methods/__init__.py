@@ -137,6 +137,7 @@ def _register_curvature():
     register_method("star_gauss_curvature", "vertex", C.star_gauss_values,
                     C.star_gauss_gradient)
     register_method("sq_gauss_curvature", "vertex", C.sq_gauss_values, C.sq_gauss_gradient)
+    register_method("cotan_sq_mean_curvature", "vertex", C.cotan_values, C.cotan_gradient)
     CURVATURE_METHODS.difference_update(C.VERTEX_METHODS)
     CURVATURE_METHODS.difference_update({"star_gauss_curvature", "sq_gauss_curvature"})
 
