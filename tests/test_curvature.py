@@ -87,7 +87,8 @@ def _fd_check(S, value, grad, rng, h=1e-6, n=12):
 
 
 @pytest.mark.parametrize("name", WILLMORE + ["mean_curvature_integral", "sq_gauss_curvature",
-                                             "star_gauss_curvature"])
+                                             "star_gauss_curvature", "circle_willmore",
+                                             "harmonic_energy"])
 @pytest.mark.parametrize("h_zero", [None, 0.7])
 def test_gradient_matches_finite_differences(blob, name, h_zero):
     S = blob.surface
@@ -219,4 +220,28 @@ def test_cotan_gradient_with_obtuse_triangles(tmp_path):
     def value():
         return float(METHODS[name][1](S.evaluate(), _M(name), np.arange(n)) @ w)
     assert _fd_check(S, value, grad, np.random.default_rng(4), n=30) <= 1e-6
+
+
+def test_circle_willmore_matches_reference_and_vanishes_on_inscribed_spheres(
+        evolver, icospheres, tmp_path):
+    """Bobenko's energy (Möbius invariant): 0 on the icospheres (all
+    vertices on one sphere); REF's value on blob0.fe and on the refined
+    icosahedron (2π) within 1e-12."""
+    from reference import run_reference
+    for S in icospheres:
+        assert abs(_value(S.evaluate(), "circle_willmore")) <= 1e-9
+    with open(os.path.join(CHECKS, "blob0.fe")) as fh:
+        body = "".join(l for l in fh if not l.startswith("quantity"))
+    path = tmp_path / "cw.fe"
+    path.write_text("quantity cw info_only method circle_willmore global\n" + body)
+    text = 'printf "RESULT %.17g\\n", cw.value\nr\nprintf "RESULT %.17g\\n", cw.value\n'
+    ref = [float(l.split()[1]) for l in run_reference(evolver, str(path), text,
+                                                      cwd=str(tmp_path))
+           if l.startswith("RESULT")]
+    s = Session.load(str(path), out=io.StringIO())
+    mine = [_value(s.surface.evaluate(), "circle_willmore")]
+    s.run("r")
+    mine.append(_value(s.surface.evaluate(), "circle_willmore"))
+    for a, b in zip(mine, ref):
+        assert abs(a - b) <= 1e-12 * max(abs(b), 1.0)
 

@@ -138,6 +138,8 @@ def _register_curvature():
                     C.star_gauss_gradient)
     register_method("sq_gauss_curvature", "vertex", C.sq_gauss_values, C.sq_gauss_gradient)
     register_method("cotan_sq_mean_curvature", "vertex", C.cotan_values, C.cotan_gradient)
+    register_method("circle_willmore", "vertex", C.circle_willmore_values,
+                    C.circle_willmore_gradient)
     CURVATURE_METHODS.difference_update(C.VERTEX_METHODS)
     CURVATURE_METHODS.difference_update({"star_gauss_curvature", "sq_gauss_curvature"})
 

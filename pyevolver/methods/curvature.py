@@ -498,3 +498,83 @@ def cotan_gradient(t, m, idx, w):
         g[:, b] -= cot[:, k, None] * dU
     g += np.einsum("fc,fcpk->fpk", uA[Fc], Amg)
     return GR.corner_scatter(t, g)
+
+
+# -- circle_willmore (Bobenko's conformal energy) ---------------------------------------------
+
+def _edge_quads(s):
+    """For every edge with two facets: its ends ``i, j`` and the third
+    vertices ``k, l`` of its two facets (edges (nq,), vertices 4 × (nq,))."""
+    from ..mesh.equiangulate import edge_facets
+    ef, ek, val = edge_facets(s)
+    e = np.nonzero(val == 2)[0]
+    F = s.F
+    f1, f2 = ef[e, 0], ef[e, 1]
+    k1, k2 = ek[e, 0], ek[e, 1]
+    # the side k of a facet runs from corner k to corner k+1: its opposite corner is k+2
+    k = F[f1, (k1 + 2) % 3]
+    l_ = F[f2, (k2 + 2) % 3]
+    return e, s.E[e, 0], s.E[e, 1], k, l_
+
+
+def _bobenko_beta(X, i, j, k, l_, grad=False):
+    """β of each edge: the angle between the circumcircles of its two
+    facets, computed after inversion about x_i (β is Möbius invariant), where
+    the circles become the lines j'k' and j'l': β = π − ∠(k' − j', l' − j')."""
+    def inv(p):
+        r2 = np.einsum("ij,ij->i", p, p)
+        return p / r2[:, None], r2
+
+    a, ra = inv(X[j] - X[i])
+    b, rb = inv(X[k] - X[i])
+    c, rc = inv(X[l_] - X[i])
+    u, v = b - a, c - a
+    w = np.cross(u, v)
+    S = np.linalg.norm(w, axis=1)
+    C = np.einsum("ij,ij->i", u, v)
+    beta = np.pi - np.arctan2(S, C)
+    if not grad:
+        return beta
+    R = S * S + C * C
+    with np.errstate(all="ignore"):
+        nh = np.nan_to_num(w / S[:, None])
+        dth_du = (C[:, None] * np.cross(v, nh) - S[:, None] * v) / R[:, None]
+        dth_dv = (C[:, None] * np.cross(nh, u) - S[:, None] * u) / R[:, None]
+    dbu, dbv = -dth_du, -dth_dv                   # β = π − θ
+
+    def inv_t(p_inv, r2, g):
+        # d(p/|p|²) = (I − 2 p̂ p̂ᵀ)/|p|² dp, symmetric: transpose = itself
+        ph = p_inv * np.sqrt(r2)[:, None]         # unit vector of p
+        return (g - 2 * ph * np.einsum("ij,ij->i", ph, g)[:, None]) / r2[:, None]
+    gj = inv_t(a, ra, -(dbu + dbv))
+    gk = inv_t(b, rb, dbu)
+    gl = inv_t(c, rc, dbv)
+    gi = -(gj + gk + gl)
+    return beta, (gi, gj, gk, gl)
+
+
+def circle_willmore_values(ctx, m, idx):
+    """``circle_willmore``: Bobenko's W = Σ_e β_e − π V, as per-vertex values
+    ½ Σ_{e∋v} β_e − π (REF: 0 on polyhedra inscribed in a sphere, 1.1430603354544
+    on blob0.fe).  Not differentiable where some β = 0 or π."""
+    s = ctx.surface
+    _check_supported(s)
+    e, i, j, k, l_ = _edge_quads(s)
+    beta = _bobenko_beta(s.X, i, j, k, l_)
+    per_v = 0.5 * (np.bincount(i, weights=beta, minlength=s.nv)
+                   + np.bincount(j, weights=beta, minlength=s.nv)) - np.pi
+    return per_v[idx]
+
+
+def circle_willmore_gradient(t, m, idx, w):
+    s = t.surface
+    _check_supported(s)
+    wv = np.zeros(s.nv)
+    np.add.at(wv, np.asarray(idx, np.int64), w)
+    e, i, j, k, l_ = _edge_quads(s)
+    _, (gi, gj, gk, gl) = _bobenko_beta(s.X, i, j, k, l_, grad=True)
+    coef = 0.5 * (wv[i] + wv[j])[:, None]
+    g = np.zeros((s.nv, 3))
+    for v, gv in ((i, gi), (j, gj), (k, gk), (l_, gl)):
+        g += _scatter(s.nv, v, gv * coef)
+    return g
