@@ -1,0 +1,1 @@
+"""Study scripts that reproduce the figures of shared/papers/pl-methods-biomembranes."""
