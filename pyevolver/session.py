@@ -215,6 +215,18 @@ class Session:
         for k in range(n, 0, -1):
             r = self.iterator.step()
             results.append(r)
+            L = self.settings.get("autochop_length", 0.0)
+            if self.toggles.get("autochop") and L > 0:
+                # autochop (spec §9.5): edges longer than autochop_length after
+                # the move are bisected ("Autochopped N edges." before the line).
+                # REF's choice of edges differs where it predicts lengths from
+                # the unrestored motion (mound.fe); equal on cube.fe
+                from .mesh.edge_divide import edge_divide, long_edges
+                chop = long_edges(self.surface, L)
+                if len(chop):
+                    new, nch = edge_divide(self.surface, chop)
+                    self._replace_surface(new)
+                    r.warnings.append(f"Autochopped {nch} edges.")
             if echo:
                 for w in r.warnings:
                     self.write(w + "\n")

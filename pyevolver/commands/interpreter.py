@@ -909,6 +909,8 @@ class Interpreter:
             v = self.value(arg)
             new = 1 if v else 0
         old = s.toggles.get(name, TOGGLE_DEFAULTS.get(name, 0))
+        if name == "autopop" and new:
+            raise UnsupportedError("autopop", "vertex and edge popping (o, O) is not implemented")
         s.toggles[name] = new
         if name == "check_increase":
             s.write(f"Increase check {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
@@ -918,6 +920,13 @@ class Interpreter:
         elif name == "ribiere":
             s.write(f"Polak-Ribiere conjugate gradient {'ON' if new else 'OFF'}. "
                     f"(was {'on' if old else 'off'})\n")
+        elif name == "autochop":
+            if new:
+                s.write(f"Autochopping ON. Chop length {s.settings.get('autochop_length', 0.0):g}"
+                        f"  (was {'on' if old else 'off'})\n"
+                        "Set autochop length with  AUTOCHOP_LENGTH := value\n")
+            else:
+                s.write(f"Autochopping OFF. (was {'on' if old else 'off'})\n")
         elif name == "gravity":
             s.write(f"Gravity {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
             s.recalc()
