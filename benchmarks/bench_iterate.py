@@ -24,10 +24,8 @@ import argparse
 import os
 import subprocess
 import sys
-import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(HERE)
+from _common import REPO, icosphere_file, wall
 
 CHILD = r"""
 import io, sys, time
@@ -46,30 +44,6 @@ print((t1 - t0) / k, t3 - t2, repr(e))
 """
 
 
-def datafile(level, vesicle=False):
-    tag = "_vesicle" if vesicle else ""
-    path = os.path.join(HERE, "data", f"icosphere_{20 * 4 ** level}{tag}.fe")
-    if not os.path.exists(path):
-        subprocess.run([sys.executable, os.path.join(HERE, "make_icosphere.py"),
-                        "--level", str(level), "--out", path]
-                       + (["--vesicle"] if vesicle else []), check=True)
-    return path
-
-
-def wall(cmd, stdin, repeat):
-    best = None
-    out = ""
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        p = subprocess.run(cmd, input=stdin, capture_output=True, text=True, timeout=3600)
-        dt = time.perf_counter() - t0
-        if p.returncode != 0:
-            raise SystemExit(f"{cmd[0]} failed: {p.stderr[-500:]}")
-        best = dt if best is None else min(best, dt)
-        out = p.stdout
-    return best, out
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--levels", type=int, nargs="+", default=[4, 5, 6])
@@ -84,7 +58,7 @@ def main():
     env["PYTHONPATH"] = REPO + os.pathsep + env.get("PYTHONPATH", "")
     rows = []
     for lev in a.levels:
-        f = datafile(lev, a.vesicle)
+        f = icosphere_file(lev, vesicle=a.vesicle)
         nf = 20 * 4 ** lev
         base, _ = wall([a.evolver, "-p1", f], "q\nq\n", a.repeat)
         gk, out = wall([a.evolver, "-p1", f], f"g 1\ng {a.steps}\nq\nq\n", a.repeat)

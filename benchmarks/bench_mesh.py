@@ -24,10 +24,8 @@ import argparse
 import os
 import subprocess
 import sys
-import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(HERE)
+from _common import REPO, icosphere_file, wall
 
 CHILD = r"""
 import io, sys, time
@@ -50,31 +48,6 @@ print(out.getvalue().strip().splitlines()[-1])
 """
 
 
-def datafile(level, jitter=0.0):
-    tag = f"_jitter{jitter:g}" if jitter else ""
-    path = os.path.join(HERE, "data", f"icosphere_{20 * 4 ** level}{tag}.fe")
-    if not os.path.exists(path):
-        args = [sys.executable, os.path.join(HERE, "make_icosphere.py"), "--level", str(level),
-                "--out", path]
-        if jitter:
-            args += ["--jitter", str(jitter)]
-        subprocess.run(args, check=True)
-    return path
-
-
-def wall(cmd, stdin, repeat):
-    best, out = None, ""
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        p = subprocess.run(cmd, input=stdin, capture_output=True, text=True, timeout=3600)
-        dt = time.perf_counter() - t0
-        if p.returncode != 0:
-            raise SystemExit(f"{cmd[0]} failed: {p.stderr[-500:]}")
-        best = dt if best is None else min(best, dt)
-        out = p.stdout
-    return best, out
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--level", type=int, default=6)
@@ -85,7 +58,7 @@ def main():
     env["PYTHONPATH"] = REPO + os.pathsep + env.get("PYTHONPATH", "")
     rows, bad = [], False
     for cmd, jitter in (("r", 0.0), ("u", 0.3)):
-        f = datafile(a.level, jitter)
+        f = icosphere_file(a.level, jitter)
         base, _ = wall([a.evolver, "-p1", f], "q\nq\n", a.repeat)
         tot, out = wall([a.evolver, "-p1", f],
                         f'{cmd}\nprintf "AREA %.17g\\n", total_area\nq\nq\n', a.repeat)

@@ -73,10 +73,16 @@ class _Deleter:
     def facets_of(self, e):
         return np.nonzero(self.falive & (self.FEabs == e).any(axis=1))[0]
 
+    def edges_at(self, v):
+        """Indices of the live edges with an end at vertex ``v``."""
+        return np.nonzero(self.ealive & (self.E == v).any(axis=1))[0]
+
+    def facets_at(self, v):
+        """Indices of the live facets with a corner at vertex ``v``."""
+        return np.nonzero(self.falive & np.isin(self.FEabs, self.edges_at(v)).any(axis=1))[0]
+
     def neighbours(self, v):
-        E = self.E
-        on = self.ealive & ((E[:, 0] == v) | (E[:, 1] == v))
-        ends = E[on]
+        ends = self.E[self.edges_at(v)]
         return set(np.where(ends[:, 0] == v, ends[:, 1], ends[:, 0]).tolist())
 
     def _eliminable(self, v, e):
@@ -155,8 +161,7 @@ class _Deleter:
         """Facets at ``v`` that now share all three edges come in pairs (a
         flat "pillow"): both go, then their edges left without facets and
         vertices left without edges (the Evolver's cleanup after a merge)."""
-        ev = np.nonzero(self.ealive & (self.E == v).any(axis=1))[0]
-        at = np.nonzero(self.falive & np.isin(self.FEabs, ev).any(axis=1))[0]
+        at = self.facets_at(v)
         if len(at) < 2:
             return
         keys = np.sort(self.FEabs[at], axis=1)
@@ -186,6 +191,22 @@ class _Deleter:
         return t
 
 
+def _in_id_order(first, visit):
+    """Visit ids in increasing order, starting from ``first``; ``visit(i)``
+    returns ids to visit as well (those not above ``i`` were passed already,
+    as in the Evolver's single pass over its element list)."""
+    heap = sorted({int(i) for i in first})
+    last = -1
+    while heap:
+        i = heapq.heappop(heap)
+        if i == last:
+            continue
+        last = i
+        for j in visit(i):
+            if j > i:
+                heapq.heappush(heap, int(j))
+
+
 def delete_short_edges(s, length):
     """``t length``: visit the edges in id order and delete each that is
     shorter than ``length`` when it is visited (as the Evolver's ``delete
@@ -195,22 +216,13 @@ def delete_short_edges(s, length):
     """
     d = _Deleter(s)
     L = np.linalg.norm(s.X[s.E[:, 1]] - s.X[s.E[:, 0]], axis=1)
-    heap = np.nonzero(L < length)[0].tolist()          # ascending: already a heap
-    seen = set()
-    while heap:
-        e = heapq.heappop(heap)
-        if e in seen or not d.ealive[e]:
-            continue
-        seen.add(e)
-        if d.length(e) >= length:
-            continue
-        if d.delete(e) and d.moved:
-            # edges at the moved vertex, not yet visited, may now be short
-            v = d.moved[-1]
-            for x in np.nonzero(d.ealive & (d.E == v).any(axis=1))[0]:
-                x = int(x)
-                if x > e and x not in seen and d.length(x) < length:
-                    heapq.heappush(heap, x)
+
+    def visit(e):
+        if not d.ealive[e] or d.length(e) >= length or not d.delete(e) or not d.moved:
+            return ()
+        # edges at the moved vertex may now be short
+        return [x for x in d.edges_at(d.moved[-1]).tolist() if d.length(x) < length]
+    _in_id_order(np.nonzero(L < length)[0], visit)
     return d.result(), d.count
 
 
@@ -235,29 +247,21 @@ def _weed(s, facets, area):
     """Visit ``facets`` in id order (with ``area``: also facets that a merge
     made smaller than ``area``, and only while they still are)."""
     d = _Deleter(s)
-    weeded = 0
-    heap = sorted(int(f) for f in facets)
-    seen = set()
-    while heap:
-        f = heapq.heappop(heap)
-        if f in seen or not d.falive[f]:
-            continue
-        seen.add(f)
-        if area is not None and _facet_area(d, f) >= area:
-            continue
-        sides = sorted((int(x) for x in d.FE[f]), key=lambda x: d.length(_dec(x)))
-        for x in sides:
+    weeded = [0]
+
+    def visit(f):
+        if not d.falive[f] or (area is not None and _facet_area(d, f) >= area):
+            return ()
+        for x in sorted((int(x) for x in d.FE[f]), key=lambda x: d.length(_dec(x))):
             if d.delete(_dec(x), reverse=x < 0):
-                weeded += 1
-                if area is not None and d.moved:
-                    v = d.moved[-1]
-                    ev = np.nonzero(d.ealive & (d.E == v).any(axis=1))[0]
-                    for g in np.nonzero(d.falive & np.isin(d.FEabs, ev).any(axis=1))[0]:
-                        g = int(g)
-                        if g > f and g not in seen and _facet_area(d, g) < area:
-                            heapq.heappush(heap, g)
-                break
-    return d.result(), weeded
+                weeded[0] += 1
+                if area is None or not d.moved:
+                    return ()
+                return [g for g in d.facets_at(d.moved[-1]).tolist()
+                        if _facet_area(d, g) < area]
+        return ()
+    _in_id_order(facets, visit)
+    return d.result(), weeded[0]
 
 
 def delete_facets(s, facets):

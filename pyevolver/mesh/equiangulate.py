@@ -71,19 +71,22 @@ def _quads(E, FE, ef, edges):
     return fa, fb, b1, c1, b2, c2, head(b1), head(b2)
 
 
-def _passes(FE, ef, edges, lengths, threshold):
-    """The flip criterion of each edge of ``edges`` (bool), from the current
-    facets and edge lengths; always true for ``threshold = inf``."""
+def _passes(FEabs, ef, edges, lengths, threshold, ek=None):
+    """The flip criterion of each edge of ``edges`` (bool), from the facets'
+    unsigned edges ``FEabs`` and the edge lengths; always true for
+    ``threshold = inf``.  ``ek``
+    (the edges' sides in their facets, from :func:`edge_facets`) saves the
+    search when the facets are those ``edge_facets`` saw."""
     if not np.isfinite(threshold):
         return np.ones(len(edges), bool)
     a = lengths[edges]
     tot = np.zeros(len(edges))
+    rows = np.arange(len(edges))
     for j in (0, 1):
-        f = ef[edges, j]
-        A = np.where(FE[f] >= 0, FE[f], ~FE[f])
-        k = np.argmax(A == edges[:, None], axis=1)
-        b = lengths[A[np.arange(len(edges)), (k + 1) % 3]]
-        c = lengths[A[np.arange(len(edges)), (k + 2) % 3]]
+        A = FEabs[ef[edges, j]]
+        k = ek[edges, j] if ek is not None else np.argmax(A == edges[:, None], axis=1)
+        b = lengths[A[rows, (k + 1) % 3]]
+        c = lengths[A[rows, (k + 2) % 3]]
         with np.errstate(all="ignore"):
             tot += (b * b + c * c - a * a) / (b * c)
     return tot < threshold
@@ -144,17 +147,8 @@ def equiangulate(s, threshold=-0.001, only=None):
     ok[ok] &= np.abs(tension[f0[ok]] - tension[f1[ok]]) <= 1e-10
     ok[ok] &= (fsig[f0[ok]] == esig[ok]) & (fsig[f1[ok]] == esig[ok])
     cand = np.nonzero(ok)[0]
-    if len(cand) and np.isfinite(threshold):
-        idx = t.topology()[0]
-
-        def sides(fs, ks):
-            return (lengths[idx[fs, (ks + 1) % 3]], lengths[idx[fs, (ks + 2) % 3]])
-        a = lengths[cand]
-        b, c = sides(f0[cand], ekk[cand, 0])
-        d, e = sides(f1[cand], ekk[cand, 1])
-        with np.errstate(all="ignore"):
-            crit = (b * b + c * c - a * a) / (b * c) + (d * d + e * e - a * a) / (d * e)
-        cand = cand[crit < threshold]
+    if len(cand):
+        cand = cand[_passes(t.topology()[0], ef, cand, lengths, threshold, ekk)]
     if not len(cand):
         return s, 0
 
@@ -199,7 +193,8 @@ def equiangulate(s, threshold=-0.001, only=None):
                 again = np.unique(outer[later])
                 okd = np.zeros(len(again), bool)
                 sel = ok[again]
-                okd[sel] = _passes(FE, ef, again[sel], lengths, threshold)
+                okd[sel] = _passes(np.where(FE >= 0, FE, ~FE), ef, again[sel], lengths,
+                                    threshold)
                 heap = np.union1d(cand[~iso], again[okd])
 
     # adjacency for the "already joined" test

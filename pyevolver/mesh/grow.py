@@ -22,6 +22,24 @@ def _append_rows(arr, rows):
     return np.concatenate([arr, rows]) if len(rows) else arr.copy()
 
 
+def remap_quantities(s, t, remap):
+    """Quantities of ``s`` carried over to the new surface ``t``: global
+    methods cover all of t's elements, the others' member lists go through
+    ``remap(etype, idx, sgn) -> (idx, sgn)``."""
+    sizes = {"vertex": t.nv, "edge": t.ne, "facet": t.nf}
+    out = {}
+    for name, q in s.quantities.items():
+        q2 = copy.copy(q)
+        q2.methods = []
+        for (m, etype, idx, sgn) in q.methods:
+            if sgn is None:
+                q2.methods.append((m, etype, np.arange(sizes[etype]), None))
+            else:
+                q2.methods.append((m, etype) + tuple(remap(etype, idx, sgn)))
+        out[name] = q2
+    return out
+
+
 def _new_ids(ids, n):
     """Ids for ``n`` new elements after the existing ``ids``."""
     top = int(ids.max()) if len(ids) else 0
@@ -184,25 +202,18 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     t.bodies = b
 
     # -- quantities
-    t.quantities = {}
-    sizes = {"vertex": t.nv, "edge": t.ne, "facet": t.nf}
     parents = {"edge": (ee, s.ne), "facet": (ff, s.nf)}
-    for name, q in s.quantities.items():
-        q2 = copy.copy(q)
-        q2.methods = []
-        for (m, etype, idx, sgn) in q.methods:
-            if sgn is None:
-                q2.methods.append((m, etype, np.arange(sizes[etype]), None))
-                continue
-            if etype in parents and len(parents[etype][0]):
-                par, base = parents[etype]
-                where = np.full(base, -1, np.int64)
-                where[idx] = np.arange(len(idx))
-                hit = where[par]
-                kids = np.nonzero(hit >= 0)[0]
-                idx = np.concatenate([idx, base + kids])
-                sgn = np.concatenate([sgn, sgn[hit[kids]]])
-            q2.methods.append((m, etype, idx, sgn))
-        t.quantities[name] = q2
+
+    def add_children(etype, idx, sgn):
+        # every member element's children become members with its sign
+        if etype not in parents or not len(parents[etype][0]):
+            return idx, sgn
+        par, base = parents[etype]
+        where = np.full(base, -1, np.int64)
+        where[idx] = np.arange(len(idx))
+        hit = where[par]
+        kids = np.nonzero(hit >= 0)[0]
+        return np.concatenate([idx, base + kids]), np.concatenate([sgn, sgn[hit[kids]]])
+    t.quantities = remap_quantities(s, t, add_children)
     t.topology_version = getattr(s, "topology_version", 0) + 1
     return t

@@ -13,6 +13,8 @@ import copy
 
 import numpy as np
 
+from .grow import remap_quantities
+
 
 def _renumber(keep):
     new = np.full(len(keep), -1, np.int64)
@@ -67,19 +69,10 @@ def subset(s, E, FE, vkeep, ekeep, fkeep):
         b.volume = None
     t.bodies = b
     newidx = {"vertex": nv_, "edge": ne_, "facet": nf_}
-    sizes = {"vertex": t.nv, "edge": t.ne, "facet": t.nf}
-    t.quantities = {}
-    for name, q in s.quantities.items():
-        q2 = copy.copy(q)
-        q2.methods = []
-        for (m, etype, idx, sgn) in q.methods:
-            if sgn is None:
-                q2.methods.append((m, etype, np.arange(sizes[etype]), None))
-                continue
-            if etype in keep:
-                ok = keep[etype][idx]
-                idx, sgn = newidx[etype][idx[ok]], sgn[ok]
-            q2.methods.append((m, etype, idx, sgn))
-        t.quantities[name] = q2
+
+    def drop(etype, idx, sgn):
+        ok = keep[etype][idx]
+        return newidx[etype][idx[ok]], sgn[ok]
+    t.quantities = remap_quantities(s, t, drop)
     t.topology_version = getattr(s, "topology_version", 0) + 1
     return t

@@ -47,29 +47,10 @@ def _scatter(nv, idx, vals):
 
 
 def star_sums(t):
-    """Per-vertex ``A`` (nv,), ``F`` (nv, 3), ``N`` (nv, 3) and per-facet
-    pieces: corners ``P`` (nf, 3, 3), unit normals ``n``, ``|N2|``."""
-    from ..evolve import gradient as GR
-    s = t.surface
-    F = s.F
-    P = GR._facet_points(t)
-    N2 = t.facet_N2
-    L = np.linalg.norm(N2, axis=1)
-    with np.errstate(all="ignore"):
-        n = np.nan_to_num(N2 / L[:, None])
-    Ag = GR.facet_area_grad(t)                                  # (nf, 3, 3)
-    Af = 0.5 * L
-    flat = F.ravel()
-    A = np.bincount(flat, weights=np.repeat(Af, 3), minlength=s.nv)
-    Fv = _scatter(s.nv, flat, Ag.reshape(-1, 3))
-    Nv = _scatter(s.nv, flat, np.repeat(0.5 * N2, 3, axis=0))
-    return A, Fv, Nv, (P, n, L, Ag)
-
-
-def star_sums_fast(t):
-    """``A`` (nv,), ``F`` (nv, 3), ``N`` (nv, 3) as :func:`star_sums`, from
-    axis-major arrays (one gather of the corners, cross products by
-    components, bincount scatters): the value path of ``g``'s trial moves."""
+    """Per-vertex star area ``A`` (nv,), area gradient ``F`` (nv, 3) and sum
+    of area vectors ``N`` (nv, 3), from the corners the :class:`Totals`
+    gathered axis-major (cross products by components, bincount scatters:
+    this runs in every trial move of ``g``)."""
     s = t.surface
     nv = s.nv
     Fc = s.facet_corners()                                   # (3 corners, nf)
@@ -184,7 +165,7 @@ def vertex_values(ctx, m, idx):
     """Per-vertex energies of a squared mean curvature method."""
     s = ctx.surface
     _check_supported(s)
-    A, F, N = star_sums_fast(ctx)
+    A, F, N = star_sums(ctx)
     E, _, _, _ = _vertex_energy(s, A, F, N, m.method)
     return E[idx]
 
@@ -206,8 +187,13 @@ def vertex_gradient(t, m, idx, w):
     from ..evolve import gradient as GR
     s = t.surface
     _check_supported(s)
-    A, F, N, (P, n, L, Ag) = star_sums(t)
+    A, F, N = star_sums(t)
     _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method)
+    P = GR._facet_points(t)
+    L = 2.0 * t.facet_area
+    with np.errstate(all="ignore"):
+        n = np.nan_to_num(t.facet_N2 / L[:, None])
+    Ag = GR.facet_area_grad(t)
     wv = np.zeros(s.nv)
     np.add.at(wv, idx, w)
     dF, dN, dA = dF * wv[:, None], dN * wv[:, None], dA * wv
@@ -221,16 +207,15 @@ def vertex_gradient(t, m, idx, w):
 # -- mean_curvature_integral ----------------------------------------------------------------
 
 def _dihedral(t, idx):
-    """For edges ``idx`` with two facets: the facet running along the edge
-    (f1) and against it (f2), their corner arrays, θ (signed exterior
-    angle), and the pieces of its gradient."""
+    """For the edges ``idx``: which have two facets (``ok``), those edges
+    ``e``, and their facets running along (``f1``) and against (``f2``) them."""
     from ..mesh.equiangulate import edge_facets
     s = t.surface
     ef, ek, val = edge_facets(s)
     ok = val[idx] == 2
     e = idx[ok]
     fa, fb = ef[e, 0], ef[e, 1]
-    ka, kb = ek[e, 0], ek[e, 1]
+    ka = ek[e, 0]
     fwd_a = s.FE[fa, ka] >= 0
     f1 = np.where(fwd_a, fa, fb)
     f2 = np.where(fwd_a, fb, fa)
@@ -397,26 +382,12 @@ def legacy_gradient(t):
 
 def _cot_and_grad(P):
     """Cotangents (nf, 3) of the corner angles and their gradients
-    (nf, 3 corners, 3 points, 3)."""
-    cot = np.zeros(P.shape[:2])
-    grad = np.zeros(P.shape[:2] + (3, 3))
-    for k in range(3):
-        a, b = (k + 1) % 3, (k + 2) % 3
-        u = P[:, a] - P[:, k]
-        v = P[:, b] - P[:, k]
-        X = np.cross(u, v)
-        S = np.linalg.norm(X, axis=1)
-        C = np.einsum("ij,ij->i", u, v)
-        with np.errstate(all="ignore"):
-            nh = np.nan_to_num(X / S[:, None])
-            S2 = (S * S)[:, None]
-            du = (v * S[:, None] - C[:, None] * np.cross(v, nh)) / S2
-            dv = (u * S[:, None] - C[:, None] * np.cross(nh, u)) / S2
-            cot[:, k] = C / S
-        grad[:, k, a] = du
-        grad[:, k, b] = dv
-        grad[:, k, k] = -(du + dv)
-    return cot, grad
+    (nf, 3 corners, 3 points, 3), from :func:`_angles`:
+    d cot θ = −dθ / sin² θ."""
+    ang, dang = _angles(P)
+    s = np.sin(ang)
+    with np.errstate(all="ignore"):
+        return np.cos(ang) / s, -dang / (s * s)[:, :, None, None]
 
 
 def _mixed_areas(P, cot, cot_grad, Af, Ag):
