@@ -245,3 +245,120 @@ def test_circle_willmore_matches_reference_and_vanishes_on_inscribed_spheres(
     for a, b in zip(mine, ref):
         assert abs(a - b) <= 1e-12 * max(abs(b), 1.0)
 
+
+
+# -- Hessians ---------------------------------------------------------------------------------
+
+HESSIAN_METHODS = WILLMORE + ["mean_curvature_integral", "sq_gauss_curvature",
+                              "star_gauss_curvature", "harmonic_energy"]
+
+
+@pytest.fixture(scope="module")
+def rough_icosphere(tmp_path_factory):
+    """The 162-vertex icosphere with every vertex moved by up to 15% of an edge."""
+    path = str(tmp_path_factory.mktemp("rough") / "ico.fe")
+    subprocess.run([sys.executable, os.path.join(HERE, "..", "benchmarks", "make_icosphere.py"),
+                    "--level", "2", "--jitter", "0.15", "--out", path], check=True,
+                   capture_output=True)
+    return Session.load(path, out=io.StringIO()).surface
+
+
+@pytest.mark.parametrize("name", HESSIAN_METHODS)
+@pytest.mark.parametrize("h_zero", [None, 0.7])
+def test_hessian_vector_products_match_finite_differences(rough_icosphere, name, h_zero):
+    """H v against central differences of the analytic gradient along v,
+    ``(∇E(x + εv) − ∇E(x − εv)) / 2ε``, for random v: relative error ≤ 1e-6
+    (measured 3e-11 to 2e-10); H is symmetric."""
+    from pyevolver.methods import HESSIANS
+    S = rough_icosphere
+    S.params.pop("h_zero", None)
+    if h_zero is not None:
+        S.params["h_zero"] = h_zero
+    X0 = S.X.copy()
+    try:
+        etype, _ = METHODS[name]
+        n = S.nv if etype == "vertex" else S.ne
+        idx, w = np.arange(n), np.linspace(0.5, 1.5, n)
+        Hm = HESSIANS[name](S.evaluate(), _M(name), idx, w)
+        assert abs(Hm - Hm.T).max() <= 1e-12 * abs(Hm).max()
+        rng = np.random.default_rng(7)
+        eps = 1e-6
+        for _ in range(3):
+            v = rng.standard_normal(X0.shape)
+            S.X = X0 + eps * v
+            gp = C_GRADS[name](S.evaluate(), _M(name), idx, w)
+            S.X = X0 - eps * v
+            gm = C_GRADS[name](S.evaluate(), _M(name), idx, w)
+            S.X = X0
+            fd = ((gp - gm) / (2 * eps)).ravel()
+            assert np.linalg.norm(Hm @ v.ravel() - fd) <= 1e-6 * np.linalg.norm(fd)
+    finally:
+        S.X = X0
+        S.params.pop("h_zero", None)
+
+
+def test_projected_curvature_hessians_equal_TtHT(rough_icosphere):
+    """The star sums' Jacobian and the element blocks contracted with per-vertex
+    bases before assembly give Tᵀ H T of the full matrix."""
+    from pyevolver.evolve import hessian as EH
+    from pyevolver.methods import HESSIANS
+    S = rough_icosphere
+    rng = np.random.default_rng(12)
+    basis = EH.Basis(rng.standard_normal((S.nv, 3, 3)), rng.integers(0, 4, S.nv))
+    T = basis.matrix()
+    t = S.evaluate()
+    for name in ("star_perp_sq_mean_curvature", "sq_gauss_curvature",
+                 "cotan_sq_mean_curvature", "mean_curvature_integral"):
+        etype, _ = METHODS[name]
+        n = S.nv if etype == "vertex" else S.ne
+        args = (t, _M(name), np.arange(n), np.ones(n))
+        full = HESSIANS[name](*args)
+        proj = HESSIANS[name](*args, basis=basis).toarray()
+        ref = (T.T @ full @ T).toarray()
+        assert np.abs(proj - ref).max() <= 1e-12 * np.abs(ref).max(), name
+
+
+def _vesicle(tmp_path, method):
+    """Reference check 13's vesicle with another bending method, unit surface
+    tension instead of the fixed-area quantity, refined once and squashed."""
+    with open(os.path.join(CHECKS, "vesicle.fe")) as fh:
+        text = fh.read()
+    text = "\n".join(l for l in text.splitlines() if not l.startswith("quantity surf"))
+    text = text.replace("method star_perp_sq_mean_curvature", f"method {method}")
+    text = text.replace("tension 0", "tension 1")
+    path = tmp_path / f"ves_{method}.fe"
+    path.write_text(text)
+    s = Session.load(str(path), out=io.StringIO())
+    s.run("r\nforeach vertex vv do { rr := sqrt(vv.x^2+vv.y^2+vv.z^2); vv.x := vv.x/rr; "
+          "vv.y := 1.1*vv.y/rr; vv.z := 0.9*vv.z/rr }\nrecalc\ng 3")
+    return s
+
+
+@pytest.mark.parametrize("method", ["star_perp_sq_mean_curvature", "sq_mean_curvature",
+                                    "mean_curvature_integral"])
+def test_hessian_steps_with_bending_energy_converge(tmp_path, method):
+    """Newton steps (hessian_normal) with a bending energy under a fixed
+    volume: the normal component of the Lagrangian gradient falls at least
+    100× per step after the first (measured about 1000×: 3e-2, 7e-5, 6e-8, 7e-11, 7e-14
+    with star_perp) to round-off, and the volume stays on target.  (The
+    step is not exactly Newton's for the moving normals, hence linear
+    convergence with a small rate.  REF 2.70's Hessians of these methods
+    are not exact: its ``hessian`` reduces the energy 0.77× per step on this
+    surface, and it refuses the non-star methods, "has no Hessian
+    available".)"""
+    from pyevolver.evolve import hessian as EH
+    s = _vesicle(tmp_path, method)
+    S = s.surface
+    res = []
+    for _ in range(6):
+        s.hessian(echo=False)
+        t = S.evaluate()
+        n = EH.vertex_normals(S, t)
+        gE = np.einsum("ij,ij->i", GR.energy_gradient(t), n)
+        gV = np.einsum("ij,ij->i", GR.body_volume_gradients(t)[0], n)
+        lam = (gE @ gV) / (gV @ gV)
+        res.append(np.abs(gE - lam * gV).max() / np.abs(gE).max())
+    for a, b in zip(res[1:], res[2:]):
+        assert b <= max(1e-2 * a, 1e-12), res
+    assert res[-1] <= 1e-12
+    assert abs(t.volumes[0] - S.bodies.target[0]) <= 1e-12 * S.bodies.target[0]

@@ -345,7 +345,7 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
     parts = []                       # (hessian function, args) of each analytic term
     parts.append((facet_area_hessian, (t, s.facet_tension)))
     g = GR.corner_scatter(t, GR.facet_area_grad(t), s.facet_tension) if gradient else None
-    complete = set(t.terms) <= {"facet_tension", "edge_tension", "gravity"}
+    complete = set(t.terms) <= {"facet_tension", "edge_tension", "gravity", "sq_curvature"}
     et = s.eattr.get("tension")
     if et is not None and np.any(et):
         nz = np.nonzero(et)[0]
@@ -364,8 +364,26 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
         else:
             complete = False
     plain_volume = s.periods is None and not GR.content_edge_terms(t)
-    if cons.quantities or (b.n and not np.all(np.isnan(b.pressure))):
+    if b.n and not np.all(np.isnan(b.pressure)):
         complete = False
+    if "sq_curvature" in t.terms:
+        from ..methods.curvature_hessian import legacy_hessian
+        from ..methods.curvature import legacy_gradient
+        k = s.sq_curvature_modulus
+        parts.append((lambda basis=None: k * legacy_hessian(t, basis), ()))
+        if gradient:
+            g = g + k * legacy_gradient(t)
+    # named quantities: energies with weight 1, fixed ones with −λ
+    weighted = [(q, 1.0) for q in s.quantities.values() if q.kind == "energy"]
+    weighted += [(q, -lam[len(cons.bodies) + k]) for k, q in enumerate(cons.quantities)]
+    for q, wq in weighted:
+        hq = _quantity_hessian(t, q, wq)
+        if hq is None:
+            complete = False
+            continue
+        parts.extend(hq)
+        if gradient:
+            g = g + wq * GR.quantity_gradient(t, q)
     if cons.bodies:
         if plain_volume:
             w = np.zeros(b.n)
@@ -383,6 +401,34 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
             h = fn(*args, basis=basis)
             H = h if H is None else H + h
     return H, g, complete
+
+
+def _quantity_hessian(t, q, weight):
+    """Hessian terms ``[(function, args)]`` of ``weight × q``, or None when
+    one of its methods has no analytic Hessian."""
+    from ..methods import HESSIANS
+    s = t.surface
+    out = []
+    for m, etype, idx, sign in q.methods:
+        w = np.ones(len(idx)) if sign is None else np.asarray(sign, float)
+        w = w * (m.modulus * q.modulus * weight)
+        name = m.method
+        if name in ("facet_area", "facet_volume"):
+            full = np.zeros(s.nf)
+            np.add.at(full, idx, w)
+            if name == "facet_area":
+                out.append((facet_area_hessian, (t, full)))
+            elif s.periods is None:
+                out.append((facet_volume_hessian, (t, full, s.symmetric_content)))
+            else:
+                return None
+        elif name == "edge_length":
+            out.append((edge_length_hessian, (t, np.asarray(idx, np.int64), w)))
+        elif name in HESSIANS:
+            out.append((HESSIANS[name], (t, m, np.asarray(idx, np.int64), w)))
+        else:
+            return None
+    return out
 
 
 def lagrangian_hessian(s, cons, lam, grad_fn, basis=None):

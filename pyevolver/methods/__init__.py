@@ -21,6 +21,7 @@ from .. import geometry as G
 
 METHODS = {}
 GRADIENTS = {}     # name -> fn(totals, method, idx, weights) -> (nv, 3)
+HESSIANS = {}      # name -> fn(totals, method, idx, weights, basis=None) -> sparse
 
 # Evolver methods pyevolver knows by name but does not implement (yet).
 CURVATURE_METHODS = {
@@ -33,12 +34,16 @@ CURVATURE_METHODS = {
 }
 
 
-def register_method(name, etype, fn, gradient=None):
+def register_method(name, etype, fn, gradient=None, hessian=None):
     """Register ``fn`` as the value function of method ``name`` on ``etype``
-    (and ``gradient(totals, method, idx, weights)`` -> (nv, 3) for ``g``)."""
+    (and ``gradient(totals, method, idx, weights)`` -> (nv, 3) for ``g``,
+    ``hessian(totals, method, idx, weights, basis=None)`` -> sparse
+    (3nv, 3nv) for ``hessian``)."""
     METHODS[name.lower()] = (etype, fn)
     if gradient is not None:
         GRADIENTS[name.lower()] = gradient
+    if hessian is not None:
+        HESSIANS[name.lower()] = hessian
 
 
 def method_info(name):
@@ -129,15 +134,18 @@ for _name, _et, _fn in [
 
 def _register_curvature():
     from . import curvature as C
+    from . import curvature_hessian as CH
     for name in C.VERTEX_METHODS:
-        register_method(name, "vertex", C.vertex_values, C.vertex_gradient)
+        register_method(name, "vertex", C.vertex_values, C.vertex_gradient, CH.vertex_hessian)
     for name in ("mean_curvature_integral", "mean_curvature_integral_a"):
-        register_method(name, "edge", C.mci_values, C.mci_gradient)
+        register_method(name, "edge", C.mci_values, C.mci_gradient, CH.mci_hessian)
         CURVATURE_METHODS.discard(name)
     register_method("star_gauss_curvature", "vertex", C.star_gauss_values,
-                    C.star_gauss_gradient)
-    register_method("sq_gauss_curvature", "vertex", C.sq_gauss_values, C.sq_gauss_gradient)
-    register_method("cotan_sq_mean_curvature", "vertex", C.cotan_values, C.cotan_gradient)
+                    C.star_gauss_gradient, CH.star_gauss_hessian)
+    register_method("sq_gauss_curvature", "vertex", C.sq_gauss_values, C.sq_gauss_gradient,
+                    CH.sq_gauss_hessian)
+    register_method("cotan_sq_mean_curvature", "vertex", C.cotan_values, C.cotan_gradient,
+                    CH.cotan_hessian)
     register_method("circle_willmore", "vertex", C.circle_willmore_values,
                     C.circle_willmore_gradient)
     CURVATURE_METHODS.difference_update(C.VERTEX_METHODS)
@@ -149,7 +157,7 @@ _register_curvature()
 
 def _register_harmonic():
     from . import harmonic as H
-    register_method("harmonic_energy", "edge", H.values, H.gradient)
+    register_method("harmonic_energy", "edge", H.values, H.gradient, H.hessian)
 
 
 _register_harmonic()

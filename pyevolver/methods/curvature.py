@@ -108,12 +108,27 @@ def _check_supported(s):
                                "the partial stars of boundary vertices")
 
 
-def _vertex_energy(s, A, F, N, name):
-    """``E`` (nv,) and its partial derivatives ``dF``, ``dN`` (nv, 3), ``dA``."""
+def _kind(s, name):
+    """The estimate a method uses on this surface, its h0 (nv,) or None,
+    and whether it is old-style."""
     kind, hz, old = VERTEX_METHODS[name]
     h0 = _h_zero(s, name) if hz != "no" else None
     if h0 is not None and hz == "switch":
         kind = "perp"                      # REF: defining h_zero switches to h_perp
+    return kind, h0, old
+
+
+def _skipped(s):
+    """(nv,) bool: vertices where the old-style methods are zero."""
+    skip = s.vattr["fixed"].copy()
+    if "boundary" in s.vattr:
+        skip |= s.vattr["boundary"] != 0
+    return skip
+
+
+def _vertex_energy(s, A, F, N, name):
+    """``E`` (nv,) and its partial derivatives ``dF``, ``dN`` (nv, 3), ``dA``."""
+    kind, h0, old = _kind(s, name)
     nv = s.nv
     FF = np.einsum("ij,ij->i", F, F)
     FN = np.einsum("ij,ij->i", F, N)
@@ -151,9 +166,7 @@ def _vertex_energy(s, A, F, N, name):
     E, dA = np.nan_to_num(E), np.nan_to_num(dA)
     dF, dN = np.nan_to_num(dF), np.nan_to_num(dN)
     if old:
-        skip = s.vattr["fixed"].copy()
-        if "boundary" in s.vattr:
-            skip |= s.vattr["boundary"] != 0
+        skip = _skipped(s)
         E[skip] = 0.0
         dF[skip] = 0.0
         dN[skip] = 0.0

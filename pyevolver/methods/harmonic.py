@@ -27,3 +27,13 @@ def gradient(t, m, idx, w):
     idx = np.asarray(idx, np.int64)
     g = (2.0 * C * np.asarray(w, float))[:, None] * t.edge_vec[idx]
     return scatter(s.nv, s.E[idx, 1], g) - scatter(s.nv, s.E[idx, 0], g)
+
+
+def hessian(t, m, idx, w, basis=None):
+    """Constant per-edge blocks ``(2/√3) w [[I, −I], [−I, I]]``."""
+    from ..evolve.hessian import _assemble
+    s = t.surface
+    idx = np.asarray(idx, np.int64)
+    K = (2.0 * C * np.asarray(w, float))[:, None, None] * np.eye(3)[None]
+    B = np.stack([np.stack([K, -K], 1), np.stack([-K, K], 1)], 1)
+    return _assemble(s.nv, s.E[idx], B, basis)

@@ -1,0 +1,339 @@
+"""Hessians of the curvature energies, for ``hessian`` and Hessian-vector products.
+
+Every vertex energy is ``Σ_v w_v φ(y_v)`` where ``y_v`` is a short vector of
+star sums over the facets around v (``(A, F, N)`` for the squared mean
+curvature methods of :mod:`.curvature`, ``(K, A)`` for ``sq_gauss_curvature``,
+``(S, A)`` for ``cotan_sq_mean_curvature``).  With ``J`` the Jacobian of all
+the ``y_v`` (a sparse (r·nv, 3nv) matrix assembled from per-facet blocks) the
+Hessian is the Gauss–Newton part plus the curvature of the star sums::
+
+    H = Jᵀ diag(∇²φ_v) J + Σ_f ∇²( Σ_{v ∈ f} ∇φ_v · y_{v,f} )
+
+The first term couples vertices two edges apart (a common star), the second
+is a 9×9 block per facet.  The per-facet pieces and their exact second
+derivatives come from :mod:`.jets`; the area-gradient term ``λ · ∇_c A``
+is written as ``N · w / (4A)`` with ``w = Σ_c e_c × λ_c`` (``∇_c A = N × e_c
+/ (4A)``, ``e_c`` the side opposite corner c).  ``mean_curvature_integral`` is
+a 12×12 block per edge (its two facets), the angle sums of the Gaussian
+curvatures 9×9 blocks per facet.
+
+All functions take ``(t, method, idx, w, basis=None)`` as the gradients do
+and return a sparse matrix: (3nv, 3nv), or ``Tᵀ H T`` on a
+:class:`pyevolver.evolve.hessian.Basis`.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import curvature as C
+from . import jets as J
+
+
+# -- assembly ---------------------------------------------------------------------------------
+
+def _elements(nv, verts, H, basis):
+    """Sparse matrix from per-element Hessians H (m, 3k, 3k) on ``verts`` (m, k)."""
+    from ..evolve.hessian import _assemble
+    m, k = verts.shape
+    H = np.nan_to_num(H)
+    return _assemble(nv, verts, H.reshape(m, k, 3, k, 3).transpose(0, 1, 3, 2, 4), basis)
+
+
+def _rows(nrows, ridx, verts, blocks, nv, basis):
+    """Sparse (nrows, 3nv or basis.n) matrix from per-element row blocks:
+    ``ridx`` (m, r) row numbers, ``verts`` (m, k), ``blocks`` (m, r, k, 3)."""
+    m, r = ridx.shape
+    k = verts.shape[1]
+    blocks = np.nan_to_num(blocks)
+    if basis is None:
+        cols = 3 * verts[:, :, None] + np.arange(3)
+        rows = np.broadcast_to(ridx[:, :, None, None], (m, r, k, 3))
+        cols = np.broadcast_to(cols[:, None], (m, r, k, 3))
+        return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())),
+                             shape=(nrows, 3 * nv))
+    Bv = basis.B[verts]                                         # (m, k, 3, d)
+    d = Bv.shape[3]
+    vals = np.einsum("mrki,mkid->mrkd", blocks, Bv)
+    idx = basis.start[verts][:, :, None] + np.arange(d)
+    ok = np.arange(d)[None, None, :] < basis.ndof[verts][:, :, None]
+    rows = np.broadcast_to(ridx[:, :, None, None], (m, r, k, d))
+    cols = np.broadcast_to(idx[:, None], (m, r, k, d))
+    keep = np.broadcast_to(ok[:, None], (m, r, k, d))
+    return sp.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(nrows, basis.n))
+
+
+def _gauss_newton(Jm, M):
+    """``Jmᵀ diag(M) Jm`` for per-vertex blocks M (nv, r, r)."""
+    nv, r, _ = M.shape
+    Md = sp.bsr_matrix((np.nan_to_num(M), np.arange(nv), np.arange(nv + 1)),
+                       shape=(nv * r, nv * r)).tocsr()
+    return (Jm.T @ (Md @ Jm)).tocsr()
+
+
+def _vertex_weights(nv, idx, w):
+    wv = np.zeros(nv)
+    np.add.at(wv, np.asarray(idx, np.int64), np.asarray(w, float))
+    return wv
+
+
+def _facet_jets(P):
+    """Corner jets, ``N = (x1−x0)×(x2−x0)``, ``|N|`` and the area of facets P (nf, 3, 3)."""
+    x = J.points(P)
+    N2 = J.cross(x[1] - x[0], x[2] - x[0])
+    L = J.norm(N2)
+    return x, N2, L, L * 0.5
+
+
+def _inverse(s):
+    with np.errstate(all="ignore"):
+        return s.apply(1.0 / s.v, -1.0 / s.v ** 2, 2.0 / s.v ** 3)
+
+
+# -- squared mean curvature (the star sums A, F, N) ---------------------------------------------
+
+def _ratio(P, gP, HP, Q, gQ, HQ):
+    """Gradient and Hessian of P/Q over z (6,) from those of P and Q."""
+    with np.errstate(all="ignore"):
+        g = gP / Q[:, None] - (P / Q ** 2)[:, None] * gQ
+        o = gP[:, :, None] * gQ[:, None, :]
+        H = (HP / Q[:, None, None] - (o + np.swapaxes(o, 1, 2)) / (Q ** 2)[:, None, None]
+             - (P / Q ** 2)[:, None, None] * HQ
+             + (2 * P / Q ** 3)[:, None, None] * gQ[:, :, None] * gQ[:, None, :])
+    return g, H
+
+
+def vertex_energy_hessian(s, A, F, N, name):
+    """Hessian (nv, 7, 7) of the vertex energies ``E_v`` of method ``name`` in
+    the variables ``(A, F, N)`` (see :func:`curvature._vertex_energy`)."""
+    kind, h0, old = C._kind(s, name)
+    nv = s.nv
+    M = np.zeros((nv, 7, 7))
+    I3 = np.eye(3)
+    FF = np.einsum("ij,ij->i", F, F)
+    FN = np.einsum("ij,ij->i", F, N)
+    NN = np.einsum("ij,ij->i", N, N)
+    with np.errstate(all="ignore"):
+        if kind == "plain":                        # 0.75 F·F / A
+            M[:, 1:4, 1:4] = (1.5 / A)[:, None, None] * I3
+            M[:, 0, 1:4] = M[:, 1:4, 0] = -1.5 * F / (A ** 2)[:, None]
+            M[:, 0, 0] = 1.5 * FF / A ** 3
+        elif kind == "eff":                        # 0.75 A q, q = F·F / N·N
+            qF = 2 * F / NN[:, None]
+            qN = -2 * (FF / NN ** 2)[:, None] * N
+            qFF = (2 / NN)[:, None, None] * I3
+            qFN = -4 * F[:, :, None] * N[:, None, :] / (NN ** 2)[:, None, None]
+            qNN = (-2 * FF / NN ** 2)[:, None, None] * I3 \
+                + (8 * FF / NN ** 3)[:, None, None] * N[:, :, None] * N[:, None, :]
+            a = (0.75 * A)[:, None, None]
+            M[:, 1:4, 1:4] = a * qFF
+            M[:, 1:4, 4:7] = a * qFN
+            M[:, 4:7, 1:4] = a * np.swapaxes(qFN, 1, 2)
+            M[:, 4:7, 4:7] = a * qNN
+            M[:, 0, 1:4] = M[:, 1:4, 0] = 0.75 * qF
+            M[:, 0, 4:7] = M[:, 4:7, 0] = 0.75 * qN
+        else:                                      # (h − h0)² A / 3, h = 1.5 P/Q
+            Z = np.zeros((nv, 3))
+            Zm = np.zeros((nv, 6, 6))
+            swap = Zm.copy()
+            swap[:, :3, 3:] = swap[:, 3:, :3] = I3
+            if kind == "norm":                     # P = F·F, Q = F·N
+                ok = FN != 0
+                P, gP = FF, np.hstack([2 * F, Z])
+                HP = Zm.copy()
+                HP[:, :3, :3] = 2 * I3
+                Q, gQ, HQ = FN, np.hstack([N, F]), swap
+            else:                                  # P = F·N, Q = N·N
+                ok = NN > 0
+                P, gP, HP = FN, np.hstack([N, F]), swap
+                Q, gQ = NN, np.hstack([Z, 2 * N])
+                HQ = Zm.copy()
+                HQ[:, 3:, 3:] = 2 * I3
+            gr, Hr = _ratio(P, gP, HP, Q, gQ, HQ)
+            h = 1.5 * P / Q
+            gh, Hh = 1.5 * gr, 1.5 * Hr
+            d = h - (h0 if h0 is not None else 0.0)
+            M[:, 1:, 1:] = (2 * A / 3)[:, None, None] * (gh[:, :, None] * gh[:, None, :]
+                                                         + d[:, None, None] * Hh)
+            M[:, 0, 1:] = M[:, 1:, 0] = (2 * d / 3)[:, None] * gh
+            M[~ok] = 0.0
+    M = np.nan_to_num(M)
+    if old:
+        M[C._skipped(s)] = 0.0
+    return M
+
+
+def star_hessian(t, M, dA, dF, dN, basis=None):
+    """Hessian of ``Σ_v φ_v(A_v, F_v, N_v)`` given the per-vertex Hessians
+    M (nv, 7, 7) and first derivatives ``dA`` (nv,), ``dF``, ``dN`` (nv, 3)."""
+    from ..evolve import gradient as GR
+    s = t.surface
+    nv, Fc = s.nv, s.F
+    P = GR._facet_points(t)
+    nf = len(P)
+    x, N2, L, Aj = _facet_jets(P)
+    # curvature of the star sums: α A_f + Σ_c λ_c · ∇_c A_f + ½ Λ · N_f
+    lam = dF[Fc]                                                  # (nf, 3, 3)
+    e = [x[2] - x[1], x[0] - x[2], x[1] - x[0]]
+    w = J.cross_const(e[0], lam[:, 0]) + J.cross_const(e[1], lam[:, 1]) \
+        + J.cross_const(e[2], lam[:, 2])
+    psi = J.dot(N2, w) * _inverse(L * 2.0)
+    H = (Aj.H * dA[Fc].sum(axis=1)[:, None, None] + psi.H
+         + 0.5 * N2.hc(dN[Fc].sum(axis=1)))
+    H2 = _elements(nv, Fc, H, basis)
+    # Gauss–Newton part through the Jacobian of (A_v, F_v, N_v)
+    blocks = np.empty((nf, 3, 7, 9))
+    blocks[:, :, 0, :] = Aj.g[:, None, :]
+    for c in range(3):
+        blocks[:, c, 1:4, :] = Aj.H[:, 3 * c:3 * c + 3, :]      # ∂F_c/∂x = ∂²A/∂x_c∂x
+    blocks[:, :, 4:7, :] = 0.5 * N2.J[:, None]
+    ridx = (7 * Fc[:, :, None] + np.arange(7)).reshape(nf, 21)
+    Jm = _rows(7 * nv, ridx, Fc, blocks.reshape(nf, 21, 3, 3), nv, basis)
+    return _gauss_newton(Jm, M) + H2
+
+
+def vertex_hessian(t, m, idx, w, basis=None):
+    """Hessian of ``Σ_v w_v E_v`` for the squared mean curvature methods."""
+    s = t.surface
+    C._check_supported(s)
+    A, F, N = C.star_sums(t)
+    _, dF, dN, dA = C._vertex_energy(s, A, F, N, m.method)
+    wv = _vertex_weights(s.nv, idx, w)
+    M = vertex_energy_hessian(s, A, F, N, m.method) * wv[:, None, None]
+    return star_hessian(t, M, dA * wv, dF * wv[:, None], dN * wv[:, None], basis)
+
+
+def legacy_hessian(t, basis=None):
+    """Hessian of the legacy SQUARED_CURVATURE vertex method (unit weights)."""
+    s = t.surface
+    m = C._Legacy(C._LEGACY[s.curvature_mode])
+    return vertex_hessian(t, m, np.arange(s.nv), np.ones(s.nv), basis)
+
+
+# -- mean_curvature_integral ----------------------------------------------------------------------
+
+def mci_hessian(t, m, idx, w, basis=None):
+    """Hessian of ``Σ_e w_e ½ L_e θ_e``: a 12×12 block per edge over its
+    ends and the third vertices of its two facets."""
+    s = t.surface
+    idx = np.asarray(idx, np.int64)
+    ok, e, f1, f2 = C._dihedral(t, idx)
+    w = np.asarray(w, float)[ok]
+    tail, head = s.E[e, 0], s.E[e, 1]
+    k = s.F[f1].sum(axis=1) - tail - head
+    l_ = s.F[f2].sum(axis=1) - tail - head
+    verts = np.stack([tail, head, k, l_], axis=1)
+    x = J.points(s.X[verts])
+    d = x[1] - x[0]
+    N1 = J.cross(d, x[2] - x[0])                 # f1 runs tail → head → k
+    N2 = J.cross(x[0] - x[1], x[3] - x[1])       # f2 runs head → tail → l
+    L = J.norm(d)
+    u = d * _inverse(L)
+    theta = J.atan2(J.dot(u, J.cross(N1, N2)), J.dot(N1, N2))
+    E = (L * theta) * (0.5 * w)
+    return _elements(s.nv, verts, E.H, basis)
+
+
+# -- Gaussian curvature -------------------------------------------------------------------------
+
+def _angle_jets(x):
+    out = []
+    for a in range(3):
+        u = x[(a + 1) % 3] - x[a]
+        v = x[(a + 2) % 3] - x[a]
+        out.append(J.atan2(J.norm(J.cross(u, v)), J.dot(u, v)))
+    return out
+
+
+def _gauss_hessian(t, idx, w, square, basis):
+    s = t.surface
+    C._check_supported(s)
+    K, A, P, _ = C._gauss(t)
+    nv, Fc = s.nv, s.F
+    nf = len(P)
+    wv = _vertex_weights(nv, idx, w)
+    x, _, _, Aj = _facet_jets(P)
+    ang = _angle_jets(x)
+    with np.errstate(all="ignore"):
+        if square:
+            dK = 6 * K / A * wv
+            dA = -3 * K * K / (A * A) * wv
+        else:
+            dK, dA = wv, np.zeros(nv)
+    H = Aj.H * dA[Fc].sum(axis=1)[:, None, None]
+    for c in range(3):
+        H = H - dK[Fc[:, c]][:, None, None] * ang[c].H          # K_v = 2π − Σ angles
+    H2 = _elements(nv, Fc, H, basis)
+    if not square:
+        return H2
+    blocks = np.empty((nf, 3, 2, 9))
+    for c in range(3):
+        blocks[:, c, 0, :] = -ang[c].g
+    blocks[:, :, 1, :] = Aj.g[:, None, :]
+    ridx = (2 * Fc[:, :, None] + np.arange(2)).reshape(nf, 6)
+    Jm = _rows(2 * nv, ridx, Fc, blocks.reshape(nf, 6, 3, 3), nv, basis)
+    M = np.empty((nv, 2, 2))
+    with np.errstate(all="ignore"):
+        M[:, 0, 0] = 6 / A
+        M[:, 0, 1] = M[:, 1, 0] = -6 * K / A ** 2
+        M[:, 1, 1] = 6 * K * K / A ** 3
+    return _gauss_newton(Jm, M * wv[:, None, None]) + H2
+
+
+def star_gauss_hessian(t, m, idx, w, basis=None):
+    return _gauss_hessian(t, idx, w, False, basis)
+
+
+def sq_gauss_hessian(t, m, idx, w, basis=None):
+    return _gauss_hessian(t, idx, w, True, basis)
+
+
+# -- cotan_sq_mean_curvature ---------------------------------------------------------------------
+
+def cotan_hessian(t, m, idx, w, basis=None):
+    """Hessian of ``Σ_v w_v |S_v|² / (16 A_v)`` (MDSB; see :func:`curvature.cotan_values`)."""
+    s = t.surface
+    C._check_supported(s)
+    P, cot, _, _, _, Sv, Av = C._cotan_parts(t)
+    nv, Fc = s.nv, s.F
+    nf = len(P)
+    wv = _vertex_weights(nv, idx, w)
+    x, _, _, Aj = _facet_jets(P)
+    cj = []
+    for a in range(3):
+        u = x[(a + 1) % 3] - x[a]
+        v = x[(a + 2) % 3] - x[a]
+        cj.append(J.dot(u, v) * _inverse(J.norm(J.cross(u, v))))
+    Sc, Am = [], []
+    obtuse = cot < 0
+    any_obt = obtuse.any(axis=1)
+    for c in range(3):
+        c1, c2 = (c + 1) % 3, (c + 2) % 3
+        Sc.append((x[c] - x[c1]) * cj[c2] + (x[c] - x[c2]) * cj[c1])
+        eij, eik = x[c1] - x[c], x[c2] - x[c]
+        vor = (J.dot(eij, eij) * cj[c2] + J.dot(eik, eik) * cj[c1]) * 0.125
+        frac = np.where(obtuse[:, c], 0.5, 0.25)
+        Am.append(J.S(np.where(any_obt, frac * Aj.v, vor.v),
+                      np.where(any_obt[:, None], frac[:, None] * Aj.g, vor.g),
+                      np.where(any_obt[:, None, None], frac[:, None, None] * Aj.H, vor.H)))
+    with np.errstate(all="ignore"):
+        SS = np.einsum("ij,ij->i", Sv, Sv)
+        dS = Sv / (8 * Av)[:, None] * wv[:, None]
+        dA = -SS / (16 * Av * Av) * wv
+    dS, dA = np.nan_to_num(dS), np.nan_to_num(dA)
+    H = np.zeros((nf, 9, 9))
+    for c in range(3):
+        H += Sc[c].hc(dS[Fc[:, c]]) + dA[Fc[:, c]][:, None, None] * Am[c].H
+    H2 = _elements(nv, Fc, H, basis)
+    blocks = np.empty((nf, 3, 4, 9))
+    for c in range(3):
+        blocks[:, c, :3, :] = Sc[c].J
+        blocks[:, c, 3, :] = Am[c].g
+    ridx = (4 * Fc[:, :, None] + np.arange(4)).reshape(nf, 12)
+    Jm = _rows(4 * nv, ridx, Fc, blocks.reshape(nf, 12, 3, 3), nv, basis)
+    M = np.zeros((nv, 4, 4))
+    with np.errstate(all="ignore"):
+        M[:, :3, :3] = (1 / (8 * Av))[:, None, None] * np.eye(3)
+        M[:, :3, 3] = M[:, 3, :3] = -Sv / (8 * Av ** 2)[:, None]
+        M[:, 3, 3] = SS / (8 * Av ** 3)
+    return _gauss_newton(Jm, M * wv[:, None, None]) + H2
