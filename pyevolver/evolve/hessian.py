@@ -367,8 +367,8 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
     if b.n and not np.all(np.isnan(b.pressure)):
         complete = False
     if "sq_curvature" in t.terms:
-        from ..methods.curvature_hessian import legacy_hessian
         from ..methods.curvature import legacy_gradient
+        from ..methods.curvature_hessian import legacy_hessian
         k = s.sq_curvature_modulus
         parts.append((lambda basis=None: k * legacy_hessian(t, basis), ()))
         if gradient:

@@ -29,14 +29,13 @@ import scipy.sparse as sp
 from . import curvature as C
 from . import jets as J
 
-
 # -- assembly ---------------------------------------------------------------------------------
 
 def _elements(nv, verts, H, basis):
     """Sparse matrix from per-element Hessians H (m, 3k, 3k) on ``verts`` (m, k)."""
     from ..evolve.hessian import _assemble
     m, k = verts.shape
-    H = np.nan_to_num(H)
+    H = _finite(H)
     return _assemble(nv, verts, H.reshape(m, k, 3, k, 3).transpose(0, 1, 3, 2, 4), basis)
 
 
@@ -45,7 +44,7 @@ def _rows(nrows, ridx, verts, blocks, nv, basis):
     ``ridx`` (m, r) row numbers, ``verts`` (m, k), ``blocks`` (m, r, k, 3)."""
     m, r = ridx.shape
     k = verts.shape[1]
-    blocks = np.nan_to_num(blocks)
+    blocks = _finite(blocks)
     if basis is None:
         cols = 3 * verts[:, :, None] + np.arange(3)
         rows = np.broadcast_to(ridx[:, :, None, None], (m, r, k, 3))
@@ -54,19 +53,31 @@ def _rows(nrows, ridx, verts, blocks, nv, basis):
                              shape=(nrows, 3 * nv))
     Bv = basis.B[verts]                                         # (m, k, 3, d)
     d = Bv.shape[3]
-    vals = np.einsum("mrki,mkid->mrkd", blocks, Bv)
+    # contract each vertex's 3 columns with its basis: (m, r, k, 3) @ (m, 1, k, 3, d)
+    vals = np.matmul(blocks[:, :, :, None, :], Bv[:, None])[:, :, :, 0, :]
     idx = basis.start[verts][:, :, None] + np.arange(d)
-    ok = np.arange(d)[None, None, :] < basis.ndof[verts][:, :, None]
     rows = np.broadcast_to(ridx[:, :, None, None], (m, r, k, d))
     cols = np.broadcast_to(idx[:, None], (m, r, k, d))
+    if (basis.ndof >= d).all():
+        return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())),
+                             shape=(nrows, basis.n))
+    ok = np.arange(d)[None, None, :] < basis.ndof[verts][:, :, None]
     keep = np.broadcast_to(ok[:, None], (m, r, k, d))
     return sp.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(nrows, basis.n))
+
+
+def _finite(a):
+    """``a`` with non-finite entries (degenerate elements) set to 0."""
+    bad = ~np.isfinite(a)
+    if bad.any():
+        a = np.where(bad, 0.0, a)
+    return a
 
 
 def _gauss_newton(Jm, M):
     """``Jmᵀ diag(M) Jm`` for per-vertex blocks M (nv, r, r)."""
     nv, r, _ = M.shape
-    Md = sp.bsr_matrix((np.nan_to_num(M), np.arange(nv), np.arange(nv + 1)),
+    Md = sp.bsr_matrix((_finite(M), np.arange(nv), np.arange(nv + 1)),
                        shape=(nv * r, nv * r)).tocsr()
     return (Jm.T @ (Md @ Jm)).tocsr()
 

@@ -98,10 +98,12 @@ class V:
     ``hc(w)`` the Hessian (m, n, n) of ``w · V`` at fixed ``w`` (m, 3)
     (None when V is linear)."""
 
-    __slots__ = ("v", "J", "_hc")
+    __slots__ = ("J", "_hc", "coef", "v")
 
-    def __init__(self, v, J, hc=None):
-        self.v, self.J, self._hc = v, J, hc
+    def __init__(self, v, J, hc=None, coef=None):
+        # coef (k,): V = Σ_i coef_i x_i, the same combination of the points
+        # for every element (then J = coef ⊗ I and products have closed forms)
+        self.v, self.J, self._hc, self.coef = v, J, hc, coef
 
     def hc(self, w):
         if self._hc is None:
@@ -110,10 +112,10 @@ class V:
         return self._hc(w)
 
     def __add__(self, o):
-        return V(self.v + o.v, self.J + o.J, _sum_hc(self, o, 1.0))
+        return V(self.v + o.v, self.J + o.J, _sum_hc(self, o, 1.0), _combine(self, o, 1.0))
 
     def __sub__(self, o):
-        return V(self.v - o.v, self.J - o.J, _sum_hc(self, o, -1.0))
+        return V(self.v - o.v, self.J - o.J, _sum_hc(self, o, -1.0), _combine(self, o, -1.0))
 
     def __mul__(self, s):
         """``s V`` for a scalar jet (or array) ``s``."""
@@ -121,11 +123,12 @@ class V:
             s = np.asarray(s, float)
             sv = s if s.ndim else np.full(len(self.v), float(s))
             hc = None if self._hc is None else (lambda w: self.hc(w * sv[:, None]))
-            return V(self.v * sv[:, None], self.J * sv[:, None, None], hc)
+            coef = self.coef * float(s) if (self.coef is not None and not s.ndim) else None
+            return V(self.v * sv[:, None], self.J * sv[:, None, None], hc, coef)
         a = self
 
         def hc(w):
-            Jw = np.einsum("mkn,mk->mn", a.J, w)
+            Jw = _vJ(w, a.J)
             wa = np.einsum("mk,mk->m", w, a.v)
             out = wa[:, None, None] * s.H + s.g[:, :, None] * Jw[:, None, :] \
                 + Jw[:, :, None] * s.g[:, None, :]
@@ -135,6 +138,19 @@ class V:
         return V(a.v * s.v[:, None], a.J * s.v[:, None, None] + a.v[:, :, None] * s.g[:, None, :], hc)
 
     __rmul__ = __mul__
+
+
+def _combine(a, b, sign):
+    if a.coef is None or b.coef is None:
+        return None
+    return a.coef + sign * b.coef
+
+
+def _kron3(C, Q):
+    """(m, 3k, 3k) matrices with 3×3 blocks ``C_ij Q`` for C (k, k), Q (m, 3, 3)."""
+    k = len(C)
+    out = C[None, :, None, :, None] * Q[:, None, :, None, :]
+    return out.reshape(len(Q), 3 * k, 3 * k)
 
 
 def _sum_hc(a, b, sign):
@@ -150,15 +166,35 @@ def points(P):
     for i in range(k):
         J = np.zeros((m, 3, 3 * k))
         J[:, :, 3 * i:3 * i + 3] = np.eye(3)
-        out.append(V(P[:, i].copy(), J))
+        coef = np.zeros(k)
+        coef[i] = 1.0
+        out.append(V(P[:, i].copy(), J, coef=coef))
+    return out
+
+
+def _vJ(v, Jm):
+    """``vᵀ J`` (m, n) for vectors v (m, 3) and Jacobians J (m, 3, n)."""
+    return v[:, 0, None] * Jm[:, 0] + v[:, 1, None] * Jm[:, 1] + v[:, 2, None] * Jm[:, 2]
+
+
+def _JtJ(A, B):
+    """``Aᵀ B`` (m, n, n) for Jacobians A, B (m, 3, n): three outer products
+    (faster than a batched matmul of 3-row matrices)."""
+    out = A[:, 0, :, None] * B[:, 0, None, :]
+    out += A[:, 1, :, None] * B[:, 1, None, :]
+    out += A[:, 2, :, None] * B[:, 2, None, :]
     return out
 
 
 def dot(a, b):
     """Scalar jet of ``a · b``."""
-    g = np.einsum("mkn,mk->mn", a.J, b.v) + np.einsum("mkn,mk->mn", b.J, a.v)
-    JJ = np.einsum("mkp,mkq->mpq", a.J, b.J)
-    H = JJ + np.swapaxes(JJ, 1, 2)
+    g = _vJ(b.v, a.J) + _vJ(a.v, b.J)
+    if a.coef is not None and b.coef is not None:
+        C = np.outer(a.coef, b.coef)
+        H = _kron3(C + C.T, np.broadcast_to(np.eye(3), (len(g), 3, 3)))
+    else:
+        JJ = _JtJ(a.J, b.J)
+        H = JJ + np.swapaxes(JJ, 1, 2)
     if a._hc is not None:
         H += a.hc(b.v)
     if b._hc is not None:
@@ -169,13 +205,17 @@ def dot(a, b):
 def cross(a, b):
     """Vector jet of ``a × b``."""
     v = np.cross(a.v, b.v)
-    J = -np.einsum("mij,mjn->min", skew(b.v), a.J) + np.einsum("mij,mjn->min", skew(a.v), b.J)
+    J = np.cross(a.v[:, :, None], b.J, axis=1) - np.cross(b.v[:, :, None], a.J, axis=1)
 
     def hc(w):
         # w·(a×b): a·(b×w) and b·(w×a) through the Hessians of a and b,
         # and 2 w·(da × db) = −2 daᵀ [w]× db
-        K = np.einsum("mkp,mkl,mlq->mpq", a.J, skew(w), b.J, optimize=True)
-        out = -(K + np.swapaxes(K, 1, 2))
+        if a.coef is not None and b.coef is not None:
+            C = np.outer(a.coef, b.coef)
+            out = _kron3(C.T - C, skew(w))            # [w]×ᵀ = −[w]×
+        else:
+            K = _JtJ(a.J, np.cross(w[:, :, None], b.J, axis=1))
+            out = -(K + np.swapaxes(K, 1, 2))
         if a._hc is not None:
             out += a.hc(np.cross(b.v, w))
         if b._hc is not None:
@@ -186,7 +226,7 @@ def cross(a, b):
 
 def cross_const(a, c):
     """Vector jet of ``a × c`` for a constant vector ``c`` (m, 3)."""
-    J = -np.einsum("mij,mjn->min", skew(c), a.J)
+    J = -np.cross(c[:, :, None], a.J, axis=1)
     hc = None if a._hc is None else (lambda w: a.hc(np.cross(c, w)))
     return V(np.cross(a.v, c), J, hc)
 
