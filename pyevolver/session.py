@@ -27,7 +27,8 @@ READ_ONLY = {
     "facet_count", "body_count", "facetedge_count", "space_dimension",
     "surface_dimension", "torus", "datafilename", "equi_count", "edge_delete_count",
     "vertex_pop_count", "edge_pop_count", "notch_count", "refine_count", "where_count",
-    "iteration_counter", "total_time", "random", "quantity_count",
+    "iteration_counter", "total_time", "random", "quantity_count", "symmetry_group",
+    "simplex_representation", "lagrange_order", "date_and_time",
 }
 DEFAULTS = {
     "scale": 0.1, "scale_limit": 1.0, "scale_scale": 1.0, "target_tolerance": 1e-4,
@@ -46,7 +47,11 @@ class Session:
         self.surface = None
         self.totals = None
         self.variables = {}
-        self.commands = {}
+        self.commands = {}                     # name -> interpreter.Proc
+        self.letters = {}                      # single letters redefined with :::=
+        self.arrays = {}                       # array variables (define name real[n])
+        self.array_types = {}
+        self.attr_types = {}                   # (kind, name) -> 'integer' / 'real' / ...
         self.toggles = {}
         self.settings = dict(DEFAULTS)
         self.filename = ""
@@ -84,6 +89,8 @@ class Session:
         if "scale" in scene.values:
             self.settings["scale"] = scene.values["scale"]
         self.commands = {}
+        self.letters = {}
+        self.arrays = {}
         self.recalc()
         if run_read and scene.read_text:
             self.run(scene.read_text, where=filename, line=scene.read_line + 1,
@@ -118,6 +125,9 @@ class Session:
     def run_one(self, text, where="<command>", line=1):
         ast = I.parse_command(text, where, line)
         snap = self._snapshot()
+        scopes = self.interp.env.scopes
+        depth = len(scopes)
+        scopes.append({})
         try:
             self.interp.execute(ast)
         except I.Quit:
@@ -136,12 +146,15 @@ class Session:
         except RecursionError:
             self._restore(snap)
             raise CommandError(f"{where}:{line}: recursion too deep") from None
+        finally:
+            del scopes[depth:]
         self.refresh()
 
     def _snapshot(self):
         s = self.surface
         b = s.bodies if s is not None else None
-        return (dict(self.variables), dict(self.commands), dict(self.toggles),
+        return (dict(self.variables), dict(self.commands), dict(self.letters),
+                {k: v.copy() for k, v in self.arrays.items()}, dict(self.toggles),
                 dict(self.settings),
                 None if s is None else s.X.copy(),
                 None if b is None or not b.n else (b.target.copy(), b.pressure.copy(),
@@ -150,14 +163,20 @@ class Session:
                                         for k, q in s.quantities.items()},
                 None if s is None else {k: v.copy() for k, v in s.extra.items()},
                 None if s is None else {k: v.copy() for k, v in s.vattr.items()},
+                None if s is None else {k: v.copy() for k, v in s.eattr.items()},
+                None if s is None else {k: v.copy() for k, v in s.fattr.items()},
+                None if s is None else {k: m.copy() for k, m in s.vcon.items()},
                 s)
 
     def _restore(self, snap):
-        vars_, cmds, toggles, settings, X, bod, qs, extra, vattr, surface = snap
+        (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
+         fattr, vcon, surface) = snap
         self.surface = surface
         self.variables.clear()
         self.variables.update(vars_)
         self.commands = cmds
+        self.letters = letters
+        self.arrays = arrays
         self.toggles = toggles
         self.settings = settings
         s = self.surface
@@ -171,6 +190,9 @@ class Session:
                 q.target, q.modulus, q.kind = t, m, kind
             s.extra = extra
             s.vattr = vattr
+            s.eattr = eattr
+            s.fattr = fattr
+            s.vcon = vcon
 
     # -- evaluation ------------------------------------------------------------------
     def recalc(self, keep_cg=False):
@@ -537,6 +559,9 @@ class Session:
             "refine_count": lambda: self.counts.get("refine", 0), "where_count": lambda: 0,
             "random": lambda: float(self.rng.random()),
             "quantity_count": lambda: len(s.quantities),
+            "symmetry_group": lambda: 0, "simplex_representation": lambda: 0,
+            "lagrange_order": lambda: 1,
+            "date_and_time": lambda: time.strftime("%a %b %d %H:%M:%S %Y"),
         }
         fn = simple.get(name)
         if fn is None:
@@ -581,6 +606,8 @@ class Session:
 
     def _gen_base(self, base, env):
         tag = base[0]
+        if "facetedge" in base[1:3]:
+            raise UnsupportedError("facetedge elements")
         if tag == "var":
             el = env.lookup(base[1])
             if not isinstance(el, I.ElemRef):
@@ -663,10 +690,19 @@ class Session:
             return float(arr[i]) if arr is not None else 0.0     # 0: no original (REF)
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
+            conv = int if self.attr_types.get((k, name)) == "integer" else float
             if arr.ndim == 1:
-                return float(arr[i])
+                return conv(arr[i])
             j = int(idx) if idx is not None else 1
-            return float(arr[i, j - 1])
+            if j < 1 or j > arr.shape[1]:
+                raise ExpressionError(f"{k} attribute {name}[{j}]: index outside 1..{arr.shape[1]}")
+            return conv(arr[i, j - 1])
+        if name == "show":          # the default show criteria (graphics are not drawn)
+            if k == "facet":
+                return 1.0
+            if k == "edge":
+                return float(bool(s.eattr["fixed"][i]) or
+                             len(self.sub_elements(base, "facet")) != 2)
         if k == "vertex":
             coords = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}
             if name in coords:
@@ -711,7 +747,13 @@ class Session:
             if name == "area":
                 return float(t.facet_area[i])
             if name in ("x", "y", "z"):
-                return float(0.5 * t.facet_N2[i, "xyz".index(name)] * base.sign)
+                j = "xyz".index(name)
+                if s.periods is None and s.sdim == 3:
+                    # the Evolver's order of operations: (side 1) x (side 2), so
+                    # signed zeros come out as in its exporters' output
+                    a, b, c = s.X[s.F[i]]
+                    return float(0.5 * np.cross(b - a, c - b)[j] * base.sign)
+                return float(0.5 * t.facet_N2[i, j] * base.sign)
             if name in ("tension", "density"):
                 return float(s.facet_tension[i])
             if name == "fixed":
@@ -720,8 +762,11 @@ class Session:
                 m = s.fcon.get(int(idx))
                 return float(m[i]) if m is not None else 0.0
             if name in ("color", "colour", "frontcolor", "backcolor"):
-                c = s.fattr.get(name.replace("colour", "color"))
-                return float(c[i]) if c is not None else 0.0
+                key = name.replace("colour", "color")
+                c = s.fattr.get("backcolor" if key == "backcolor" else "frontcolor")
+                if c is None:
+                    c = s.fattr.get("color")
+                return float(c[i]) if c is not None else 15.0     # white (REF default)
             if name == "valence":
                 return 3.0
         elif k == "body":
@@ -740,6 +785,16 @@ class Session:
                 return float(b.density[i])
             if name == "fixed":
                 return float(not math.isnan(b.target[i]))
+        if name in I._KIND and idx is not None:       # ff.edge[2], ee.vertex[1]
+            kind = I._KIND[name]
+            if kind == "facetedge":
+                raise UnsupportedError("facetedge elements")
+            subs = self.sub_elements(base, kind)
+            j = int(idx)
+            if j < 1 or j > len(subs):
+                raise ExpressionError(f"{base}.{kind}[{j}] does not exist ({k} {int(eid)} has "
+                                      f"{len(subs)} {kind}{'s' if len(subs) != 1 else ''})")
+            return subs[j - 1]
         if name in s.quantities:
             raise UnsupportedError(f"per-element quantity values ({k}.{name})")
         raise ExpressionError(f"{k} has no attribute '{name}'")
@@ -774,10 +829,16 @@ class Session:
         k, i = base.kind, base.i
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
+            if self.attr_types.get((k, name)) == "integer":
+                value = float(int(value))            # C conversion truncates
             if arr.ndim == 1:
                 arr[i] = value
             else:
-                arr[i, (int(idx) if idx is not None else 1) - 1] = value
+                j = int(idx) if idx is not None else 1
+                if j < 1 or j > arr.shape[1]:
+                    raise CommandError(f"{k} attribute {name}[{j}]: index outside "
+                                       f"1..{arr.shape[1]}")
+                arr[i, j - 1] = value
             return
         if k == "vertex" and name in ("x", "y", "z", "x1", "x2", "x3"):
             j = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}[name]
@@ -802,26 +863,170 @@ class Session:
         if k == "facet" and name in ("tension", "density"):
             s.fattr["tension"][i] = value
             return
+        if k in ("edge", "facet") and name in ("color", "colour", "frontcolor", "backcolor"):
+            attrs, n = (s.eattr, s.ne) if k == "edge" else (s.fattr, s.nf)
+            name = name.replace("colour", "color")
+            default = 0 if k == "edge" else 15
+            if "color" not in attrs:
+                attrs["color"] = np.full(n, default, np.int64)
+            if name == "color":
+                for key in ("color", "frontcolor", "backcolor"):
+                    if key in attrs:
+                        attrs[key][i] = int(value)
+            elif name == "frontcolor":
+                for key in ("color", "frontcolor"):
+                    if key in attrs:
+                        attrs[key][i] = int(value)
+            else:
+                if name not in attrs:
+                    attrs[name] = attrs["color"].copy()
+                attrs[name][i] = int(value)
+            return
+        if k in ("vertex", "edge", "facet") and name in ("fixed", "no_refine"):
+            attrs = {"vertex": s.vattr, "edge": s.eattr, "facet": s.fattr}[k]
+            if name not in attrs:
+                attrs[name] = np.zeros(self.count(k), bool)
+            attrs[name][i] = bool(value)
+            return
         if k == "edge" and name in ("tension", "density"):
             s.eattr.setdefault("tension", np.zeros(s.ne))[i] = value
             return
         raise CommandError(f"cannot assign to {k} attribute '{name}'")
 
-    def set_elements(self, gen, attr, expr, env, unset):
+    def set_elements(self, gen, attr, expr, env, unset, idx=None):
         els = self.generate(gen, env)
+        if attr in ("fixed", "no_refine") and (expr is None or unset):
+            if gen.kind == "body":
+                raise CommandError(f"bodies cannot be {'un' if unset else ''}set {attr}; "
+                                   f"use 'set body target expr' / 'unset body target'")
+            for el in els:
+                self.set_attr(el, attr, None, 0.0 if unset else 1.0)
+            return
         if unset:
-            raise UnsupportedError(f"unset {attr}", "comes with the evolve issue")
+            if attr in ("constraint",) and expr is not None:
+                self.unset_constraint(els, int(self.interp.value(expr)))
+                return
+            if attr == "target" and gen.kind == "body":
+                b = self.surface.bodies
+                for el in els:
+                    b.target[el.i] = np.nan
+                return
+            if attr == "pressure" and gen.kind == "body":
+                b = self.surface.bodies
+                for el in els:
+                    b.pressure[el.i] = np.nan
+                return
+            if (gen.kind, attr) in self.surface.extra:
+                for el in els:
+                    self.set_attr(el, attr, None, 0.0)
+                return
+            raise UnsupportedError(f"unset {gen.kind} {attr}")
         if expr is None:
             raise UnsupportedError(f"set {gen.kind} {attr} (without a value)")
         # compute every value first, then assign (like the Evolver's set)
         vals = []
+        ix = None if idx is None else self.interp.value(idx)
         for el in els:
             with env.element(el, gen.var):
                 vals.append(self.interp.value(expr))
         for el, v in zip(els, vals):
-            self.set_attr(el, attr, None, v)
+            self.set_attr(el, attr, ix, v)
         if gen.kind == "vertex" and attr in ("x", "y", "z"):
             project_to_constraints(self.surface, np.array([e.i for e in els], np.int64))
+
+    def unset_constraint(self, els, cid):
+        s = self.surface
+        if cid not in s.vcon and cid not in s.econ and cid not in s.fcon:
+            return
+        for el in els:
+            table = {"vertex": s.vcon, "edge": s.econ, "facet": s.fcon}.get(el.kind)
+            if table is None:
+                raise CommandError("constraints belong to vertices, edges and facets")
+            m = table.get(cid)
+            if m is not None:
+                m[el.i] = 0
+
+    def fix_elements(self, els, on):
+        """``fix``/``unfix`` elements; returns how many changed."""
+        n = 0
+        for el in els:
+            if el.kind == "body":
+                raise CommandError("cannot fix or unfix bodies; to fix a volume use "
+                                   "'set body target expr', to free it 'unset body target'")
+            old = self.get_attr(el, "fixed", None)
+            if bool(old) != bool(on):
+                self.set_attr(el, "fixed", None, 1.0 if on else 0.0)
+                n += 1
+        return n
+
+    def fix_name(self, name, on):
+        """``fix quantity`` / ``unfix quantity``."""
+        s = self.surface
+        if name in s.quantities:
+            q = s.quantities[name]
+            if on:
+                q.target = float(self.totals.quantity_values[name])
+                q.kind = "fixed"
+            else:
+                q.kind = "info_only" if q.kind == "fixed" else q.kind
+            return
+        if name in self.variables:
+            raise UnsupportedError(f"{'fix' if on else 'unfix'} {name} (optimizing parameters)")
+        raise CommandError(f"{'fix' if on else 'unfix'}: '{name}' is not a quantity "
+                           f"(expected: fix element_generator or fix quantity_name)")
+
+    def define_attribute(self, kind, name, typ, shape):
+        """``define vertex attribute name real[3]`` at run time."""
+        s = self.surface
+        if typ not in ("real", "integer"):
+            raise UnsupportedError(f"{typ} element attributes", "real and integer are supported")
+        if len(shape) > 1:
+            raise UnsupportedError("element attributes with more than one dimension")
+        if kind == "facetedge":           # declared; facetedges themselves are refused when used
+            self.attr_types[(kind, name)] = typ
+            return
+        n = self.count(kind)
+        key = (kind, name)
+        new = np.zeros((n,) + tuple(shape)) if shape else np.zeros(n)
+        old = s.extra.get(key)
+        if old is not None:
+            if old.shape == new.shape:
+                self.attr_types[key] = typ
+                return
+            if old.ndim == new.ndim == 2:          # resizing keeps the values
+                m = min(old.shape[1], new.shape[1])
+                new[:, :m] = old[:, :m]
+        s.extra[key] = new
+        self.attr_types[key] = typ
+
+    def read_file(self, name):
+        """``read "file"``: run a command file (the current directory first,
+        then the directories of EVOLVERPATH).  An error stops the file."""
+        import os
+        cands = [name]
+        if not os.path.isabs(name):
+            for d in os.environ.get("EVOLVERPATH", "").split(os.pathsep):
+                if d:
+                    cands.append(os.path.join(d, name))
+        path = next((c for c in cands if os.path.isfile(c)), None)
+        if path is None:
+            raise CommandError(f"read: cannot find file '{name}' (looked in the current "
+                               f"directory and EVOLVERPATH)")
+        if len(self.interp.env.scopes) > 200:
+            raise CommandError(f"read \"{name}\": files read each other too deeply")
+        try:
+            with open(path, encoding="latin-1") as fh:
+                text = fh.read()
+        except OSError as exc:
+            raise CommandError(f"read: cannot read '{name}': {exc.strerror}") from None
+        try:
+            self.run(text, where=path, line=1, stop_on_error=True)
+        except I.Quit:
+            raise
+        except PyEvolverError as exc:
+            # like the Evolver, an error abandons the rest of the file; what
+            # ran before it stays done
+            self.write_err(f"{exc}\n")
 
     # -- listing ---------------------------------------------------------------------------------
     def list_elements(self, gen, env):

@@ -71,4 +71,6 @@ def print_value(v):
     """``print expr``: numbers with ``%20.15g``, strings as they are."""
     if isinstance(v, str):
         return v
+    if isinstance(v, int):              # integer-typed attributes print as integers (REF)
+        return "%d" % v
     return "%20.15g" % float(v)

@@ -160,7 +160,7 @@ class QRef:
 
 _KIND = {"vertex": "vertex", "vertices": "vertex", "edge": "edge", "edges": "edge",
          "facet": "facet", "facets": "facet", "face": "facet", "faces": "facet",
-         "body": "body", "bodies": "body"}
+         "body": "body", "bodies": "body", "facetedge": "facetedge", "facetedges": "facetedge"}
 
 
 class ElemIndex(N.Node):
@@ -232,6 +232,71 @@ class OnTest(N.Node):
         if el is None:
             raise ExpressionError(f"{self.what} needs an element (use it in a where clause)")
         return env.session.get_attr(el, self.what, self.arg.ev(env))
+
+
+class UserCall(N.Node):
+    """``name(args)`` in an expression: a user function or a string builtin."""
+
+    __slots__ = ("name", "args")
+
+    def __init__(self, name, args):
+        self.name = name.lower()
+        self.args = args
+
+    def ev(self, env):
+        return env.session.interp.call_in_expr(self.name, self.args)
+
+    def children(self):
+        return tuple(self.args)
+
+
+class ArrayRef(N.Node):
+    """``arr[i][j]`` of an array variable (1-based, as in the Evolver)."""
+
+    __slots__ = ("name", "index")
+
+    def __init__(self, name, index):
+        self.name = name.lower()
+        self.index = index
+
+    def ev(self, env):
+        interp = env.session.interp
+        arr, pos = interp.array_slot(self.name, [interp.value(i) for i in self.index])
+        v = arr[pos]
+        return v if isinstance(v, str) else float(v)
+
+    def children(self):
+        return tuple(self.index)
+
+
+class Sprintf(N.Node):
+    __slots__ = ("args",)
+
+    def __init__(self, args):
+        self.args = args
+
+    def ev(self, env):
+        interp = env.session.interp
+        vals = [interp.value(a) for a in self.args]
+        if not vals or not isinstance(vals[0], str):
+            raise ExpressionError("sprintf needs a format string first")
+        return c_format(vals[0], vals[1:])
+
+    def children(self):
+        return tuple(self.args)
+
+
+class Proc:
+    """A user command: ``name := {...}`` (no parameters), ``procedure``
+    or ``function``."""
+
+    __slots__ = ("name", "params", "body", "function", "text")
+
+    def __init__(self, name, params, body, function=False):
+        self.name = name
+        self.params = params          # [(type, name)]
+        self.body = body              # statement tuple, None for a prototype
+        self.function = function
 
 
 class Generator:
@@ -307,6 +372,103 @@ class _CmdTransformer(ExprTransformer):
     def foreach(self, _f, gen, _d, body):
         return ("foreach", gen, body)
 
+    def redirect(self, body, op, target):
+        return ("redirect", body, str(op), target)
+
+    def pipe(self, body, _p, target):
+        return ("pipe",)
+
+    def params(self, *ps):
+        return list(ps)
+
+    def param(self, typ, name):
+        return (str(typ).lower(), str(name).lower())
+
+    def procedure(self, _p, name, *rest):
+        params = rest[0] if len(rest) == 2 else []
+        return ("procdef", Proc(str(name).lower(), params, rest[-1]))
+
+    def prototype(self, _p, name, params=None):
+        return ("procdef", Proc(str(name).lower(), params or [], None))
+
+    def function(self, _f, typ, name, *rest):
+        params = rest[0] if len(rest) == 2 else []
+        return ("procdef", Proc(str(name).lower(), params, rest[-1], function=True))
+
+    def fprototype(self, _f, typ, name, params=None):
+        return ("procdef", Proc(str(name).lower(), params or [], None, function=True))
+
+    def redefine(self, name, _r, body):
+        return ("redefine", str(name), body)
+
+    def redefine_restore(self, name, _r):
+        return ("redefine", str(name), None)
+
+    def builtin_letter(self, tok):
+        return ("bare", str(tok)[1], None, True)
+
+    def local_(self, _l, *names):
+        return ("local", [str(n).lower() for n in names])
+
+    def dims(self, *exprs):
+        return list(exprs)
+
+    def define_attr(self, _d, kind, _a, name, typ, dims=None):
+        return ("define_attr", _KIND[str(kind).lower()], str(name).lower(), str(typ).lower(),
+                dims or [])
+
+    def define_fe_attr(self, _d, *rest):
+        return ("unsupported", "facetedge attributes")
+
+    def define_array(self, _d, name, typ, dims=None):
+        return ("define_array", str(name).lower(), str(typ).lower(), dims or [])
+
+    def read(self, _r, expr=None):
+        return ("read", expr)
+
+    def abort(self, _a):
+        return ("abort",)
+
+    def fix(self, _f, gen):
+        return ("fix", gen, True)
+
+    def unfix(self, _f, gen):
+        return ("fix", gen, False)
+
+    def fix_name(self, _f, name):
+        return ("fix_name", str(name).lower(), True)
+
+    def unfix_name(self, _f, name):
+        return ("fix_name", str(name).lower(), False)
+
+    def histogram(self, tok, gen, expr):
+        return ("histogram", gen, expr, str(tok).lower() == "loghistogram")
+
+    def call_stmt(self, name, *args):
+        return ("call", str(name).lower(), [a for a in args if a is not None])
+
+    def user_call(self, name, *args):
+        return UserCall(str(name), [a for a in args if a is not None])
+
+    def array_ref(self, name, *idx):
+        return ArrayRef(str(name), list(idx))
+
+    def sprintf_expr(self, _s, *args):
+        return Sprintf(list(args))
+
+    def lv_array(self, name, *idx):
+        return ("array", str(name).lower(), list(idx))
+
+    def set_idx(self, _s, base, attr, idx, expr, *rest):
+        _, where = self._split_where(rest)
+        return ("set", Generator(base, None, where), str(attr).lower(), expr, idx)
+
+    def set_dot(self, _s, var, attr, *rest):
+        rest, where = self._split_where(rest)
+        idx = rest[0] if len(rest) == 2 else None
+        return ("set", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
+                rest[-1], idx)
+
     def define(self, lv, _a, body):
         if lv[0] != "name":
             raise CommandError("only a name can be defined as a command")
@@ -381,9 +543,6 @@ class _CmdTransformer(ExprTransformer):
         rest, where = self._split_where(rest)
         return ("unset", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
                 rest[0] if rest else None)
-
-    def sprintf_assign(self, lv, _a, _s, *args):
-        return ("sprintf", lv, list(args))
 
     def refine(self, _r, gen):
         return ("refine", gen)
@@ -497,7 +656,8 @@ class _Continue(Exception):
 
 
 class _Return(Exception):
-    pass
+    def __init__(self, value=None):
+        self.value = value
 
 
 class Quit(Exception):
@@ -511,6 +671,7 @@ class Env:
     def __init__(self, session):
         self.session = session
         self.frames = []        # [(var name or None, ElemRef)]
+        self.scopes = []        # local variables of the running commands: [dict]
 
     def current(self):
         return self.frames[-1][1] if self.frames else None
@@ -531,8 +692,12 @@ class Env:
             if var == name:
                 return el
         s = self.session
+        if self.scopes and name in self.scopes[-1]:
+            return self.scopes[-1][name]
         if name in s.variables:
             return s.variables[name]
+        if name in s.arrays:
+            raise ExpressionError(f"'{name}' is an array; index it as {name}[i]")
         if self.frames:
             el = self.frames[-1][1]
             try:
@@ -544,6 +709,40 @@ class Env:
 
 # ---------------------------------------------------------------------------
 # the interpreter
+
+
+def histogram_text(vals, log=False):
+    """The ``histogram``/``loghistogram`` report: the Evolver's bins (21 equal
+    bins from the least to the greatest value; 20 logarithmic bins over the
+    positive values, with a ``<= 0.0`` line counting the others)."""
+    if not vals:
+        return "No qualifying values.\n"
+    out = []
+    if log:
+        nonpos = sum(1 for v in vals if v <= 0)
+        vals = [v for v in vals if v > 0]
+        if nonpos:
+            out.append("          <= 0.0           %d" % nonpos)
+        if not vals:
+            return "\n".join(out) + "\n"
+    lo, hi = min(vals), max(vals)
+    if hi <= lo:
+        out.append("%10.5g - %10.5g     %d" % (lo, hi, len(vals)))
+        return "\n".join(out) + "\n"
+    nbins = 20 if log else 21
+    if log:
+        a, b = np.log(lo), np.log(hi)
+        keys = [(np.log(v) - a) / (b - a) * nbins for v in vals]
+        edges = [float(np.exp(a + (b - a) * k / nbins)) for k in range(nbins + 1)]
+    else:
+        keys = [(v - lo) / (hi - lo) * nbins for v in vals]
+        edges = [lo + (hi - lo) * k / nbins for k in range(nbins + 1)]
+    counts = [0] * nbins
+    for k in keys:
+        counts[min(nbins - 1, max(0, int(k)))] += 1
+    for k in range(nbins):
+        out.append("%10.5g - %10.5g     %d" % (edges[k], edges[k + 1], counts[k]))
+    return "\n".join(out) + "\n"
 
 
 LETTER_LATER = {
@@ -652,20 +851,196 @@ class Interpreter:
                 self.execute(step)
 
     def _x_foreach(self, node):
+        # the elements are listed first (ones created by the body are not
+        # visited) but, as in the Evolver, `where` is tested when each element
+        # is reached, on the surface the earlier passes left
         gen, body = node[1], node[2]
-        for el in list(self.session.generate(gen, self.env)):
+        for el in list(self.session._gen_base(gen.base, self.env)):
             with self.env.element(el, gen.var):
+                if gen.where is not None:
+                    v = gen.where.ev(self.env)
+                    if isinstance(v, str) or not v:
+                        continue
                 if not self._loop(body):
                     break
 
     def _x_define(self, node):
         name = node[1].lower()
         if len(node[1]) < 2:
-            raise UnsupportedError(f"redefining the single-letter command '{node[1]}'",
-                                   "use :::= (Tier 2)")
+            raise CommandError(f"'{node[1]}' is a single-letter command; redefine it with "
+                               f"{node[1]} :::= {{ ... }}")
+        self._check_free(name, "command")
         if name in self.session.variables:
             del self.session.variables[name]
-        self.session.commands[name] = node[2]
+        self.session.commands[name] = Proc(name, [], node[2])
+
+    def _check_free(self, name, what):
+        s = self.session
+        from ..session import READ_ONLY
+        if name in READ_ONLY or name in s.settings or name in TOGGLES or \
+                (s.surface is not None and name in s.surface.quantities):
+            raise CommandError(f"'{name}' is a built-in name; it cannot be a {what}")
+
+    def _x_procdef(self, node):
+        proc = node[1]
+        if len(proc.name) < 2:
+            raise CommandError(f"'{proc.name}' is a single-letter command, not a "
+                               f"{'function' if proc.function else 'procedure'} name")
+        self._check_free(proc.name, "function" if proc.function else "procedure")
+        old = self.session.commands.get(proc.name)
+        if proc.body is None and old is not None and old.body is not None:
+            return                      # a prototype after the definition
+        self.session.variables.pop(proc.name, None)
+        self.session.commands[proc.name] = proc
+
+    def _x_redefine(self, node):
+        raw, body = node[1], node[2]
+        if len(raw) != 1:
+            raise CommandError(f":::= redefines single-letter commands; '{raw}' is not one "
+                               f"(use {raw} := {{ ... }})")
+        if body is None:
+            self.session.letters.pop(raw, None)
+        else:
+            self.session.letters[raw] = Proc(raw, [], body)
+
+    def _x_local(self, node):
+        if not self.env.scopes:
+            raise CommandError("'local' is only allowed inside a command body")
+        scope = self.env.scopes[-1]
+        for name in node[1]:
+            if len(name) < 2:
+                raise CommandError(f"'{name}' is a single-letter command, not a variable")
+            scope.setdefault(name, 0.0)
+
+    # -- procedures -------------------------------------------------------------
+    def run_proc(self, proc, args):
+        """Run a user command with argument values; returns the value of
+        ``return expr`` (functions) or None."""
+        if proc.body is None:
+            raise CommandError(f"'{proc.name}' is declared but not defined yet")
+        if len(args) != len(proc.params):
+            raise CommandError(f"{'function' if proc.function else 'procedure'} "
+                               f"'{proc.name}' needs {len(proc.params)} argument"
+                               f"{'s' if len(proc.params) != 1 else ''}, the call has "
+                               f"{len(args)}")
+        if len(self.env.scopes) > 900:
+            raise CommandError(f"'{proc.name}': calls nested too deeply")
+        scope = {name: v for (_, name), v in zip(proc.params, args)}
+        self.env.scopes.append(scope)
+        try:
+            self.execute(proc.body)
+        except _Return as r:
+            return r.value
+        except (_Break, _Continue):
+            return None
+        finally:
+            self.env.scopes.pop()
+        return None
+
+    def call_in_expr(self, name, arg_nodes):
+        s = self.session
+        if name == "sizeof":
+            if len(arg_nodes) != 1:
+                raise ExpressionError("sizeof() takes one argument")
+            a = arg_nodes[0]
+            if isinstance(a, N.Var) and a.name in s.arrays:
+                return float(s.arrays[a.name].size)
+            v = self.value(a)
+            if not isinstance(v, str):
+                raise ExpressionError("sizeof() needs a string or an array")
+            return float(len(v))
+        if name == "is_defined":
+            if len(arg_nodes) != 1:
+                raise ExpressionError("is_defined() takes one argument")
+            v = self.value(arg_nodes[0])
+            if not isinstance(v, str):
+                raise ExpressionError("is_defined() needs a name in a string")
+            return float(self.is_defined(v.lower()))
+        proc = s.commands.get(name)
+        if proc is None:
+            raise ExpressionError(f"unknown function '{name}'")
+        args = [self.value(a) for a in arg_nodes]
+        v = self.run_proc(proc, args)
+        if not proc.function:
+            raise ExpressionError(f"'{name}' is a procedure; it has no value")
+        if v is None:
+            raise ExpressionError(f"function '{name}' ended without 'return value'")
+        return v
+
+    def is_defined(self, name):
+        s = self.session
+        if name in s.commands or name in s.variables or name in s.arrays or \
+                (self.env.scopes and name in self.env.scopes[-1]):
+            return True
+        try:
+            s.internal(name)
+            return True
+        except PyEvolverError:
+            return False
+
+    def _x_call(self, node):
+        name, args = node[1], node[2]
+        proc = self.session.commands.get(name)
+        if proc is None:
+            if len(args) == 1 and name in ("g", "r", "u"):
+                return self._x_bare(("bare", name, args[0]))
+            raise CommandError(f"unknown procedure '{name}'")
+        self.run_proc(proc, [self.value(a) for a in args])
+
+    # -- arrays ----------------------------------------------------------------
+    def _x_define_array(self, node):
+        _, name, typ, dims = node
+        s = self.session
+        if len(name) < 2:
+            raise CommandError(f"'{name}' is a single-letter command, not a variable")
+        shape = []
+        for d in dims:
+            v = self.value(d)
+            if isinstance(v, str) or int(v) < 0:
+                raise CommandError(f"define {name}: array sizes must be numbers >= 0")
+            shape.append(int(v))
+        if not shape:                       # `define name real`: a plain variable
+            if name not in s.variables:
+                s.set_variable(name, "" if typ == "string" else 0.0)
+            return
+        old = s.arrays.get(name)
+        new = np.zeros(shape, dtype=object if typ == "string" else float)
+        if typ == "string":
+            new[...] = ""
+        if old is not None and old.ndim == new.ndim:     # redefining keeps the values
+            sl = tuple(slice(0, min(a, b)) for a, b in zip(old.shape, new.shape))
+            new[sl] = old[sl]
+        s.arrays[name] = new
+        s.array_types[name] = typ
+
+    def array_slot(self, name, idx):
+        s = self.session
+        arr = s.arrays.get(name)
+        if arr is None:
+            raise ExpressionError(f"'{name}' is not an array (define it first: "
+                                  f"define {name} real[n])")
+        if len(idx) != arr.ndim:
+            raise ExpressionError(f"array '{name}' has {arr.ndim} dimension"
+                                  f"{'s' if arr.ndim != 1 else ''}, got {len(idx)} indices")
+        pos = []
+        for k, n in zip(idx, arr.shape):
+            if isinstance(k, str):
+                raise ExpressionError(f"array '{name}': an index must be a number")
+            k = int(k)
+            if k < 1 or k > n:
+                raise ExpressionError(f"array '{name}': index {k} is outside 1..{n}")
+            pos.append(k - 1)
+        return arr, tuple(pos)
+
+    def _x_define_attr(self, node):
+        _, kind, name, typ, dims = node
+        shape = []
+        for d in dims:
+            v = self.value(d)
+            if isinstance(v, str) or int(v) < 0:
+                raise CommandError(f"define {kind} attribute {name}: sizes must be numbers >= 0")
+            shape.append(int(v))
+        self.session.define_attribute(kind, name, typ, shape)
 
     def _x_assign(self, node):
         self._store(node[1], self.value(node[2]))
@@ -682,6 +1057,9 @@ class Interpreter:
     def _load(self, lv):
         if lv[0] == "name":
             return self.env.lookup(lv[1].lower())
+        if lv[0] == "array":
+            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
+            return arr[pos]
         base = lv[1].ev(self.env)
         idx = None if lv[3] is None else self.value(lv[3])
         return self.session.get_attr(base, lv[2], idx)
@@ -696,17 +1074,27 @@ class Interpreter:
             for var, el in self.env.frames:
                 if var == name:
                     raise CommandError(f"cannot assign to loop variable '{name}'")
+            if self.env.scopes and name in self.env.scopes[-1]:
+                self.env.scopes[-1][name] = value
+                return
+            if name in s.commands:
+                del s.commands[name]
+            if name in s.arrays:
+                raise CommandError(f"'{name}' is an array; assign to {name}[i]")
             s.set_variable(name, value)
+            return
+        if lv[0] == "array":
+            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
+            if arr.dtype == object:
+                arr[pos] = value if isinstance(value, str) else print_value(value).strip()
+            elif isinstance(value, str):
+                raise CommandError(f"array '{lv[1]}' holds numbers, not strings")
+            else:
+                arr[pos] = value
             return
         base = lv[1].ev(self.env)
         idx = None if lv[3] is None else self.value(lv[3])
         s.set_attr(base, lv[2], idx, value)
-
-    def _x_sprintf(self, node):
-        args = [self.value(a) for a in node[2]]
-        if not args or not isinstance(args[0], str):
-            raise CommandError("sprintf needs a format string first")
-        self._store(node[1], c_format(args[0], args[1:]))
 
     def _x_print(self, node):
         v = self.value(node[1])
@@ -726,7 +1114,64 @@ class Interpreter:
         self.session.list_elements(node[1], self.env)
 
     def _x_set(self, node):
-        self.session.set_elements(node[1], node[2], node[3], self.env, unset=False)
+        idx = node[4] if len(node) > 4 else None
+        self.session.set_elements(node[1], node[2], node[3], self.env, unset=False, idx=idx)
+
+    def _x_fix(self, node):
+        gen, on = node[1], node[2]
+        s = self.session
+        els = s.generate(gen, self.env)
+        n = s.fix_elements(els, on)
+        s.write(f"{'Fixed' if on else 'Unfixed'}: {n}\n")
+
+    def _x_fix_name(self, node):
+        self.session.fix_name(node[1], node[2])
+
+    def _x_histogram(self, node):
+        gen, expr, log = node[1], node[2], node[3]
+        vals = []
+        for el in self.session.generate(gen, self.env):
+            with self.env.element(el, gen.var):
+                v = self.value(expr)
+            if isinstance(v, str):
+                raise CommandError("histogram needs numbers")
+            vals.append(float(v))
+        self.session.write(histogram_text(vals, log))
+
+    # -- files --------------------------------------------------------------------
+    def _x_redirect(self, node):
+        _, body, op, target = node
+        name = self.value(target)
+        if not isinstance(name, str) or not name:
+            raise CommandError(f"'{op}' needs a file name in quotes (for example: "
+                               f"do_off {op} \"out.off\")")
+        s = self.session
+        try:
+            fh = open(name, "w" if op == ">>>" else "a", encoding="latin-1", newline="")
+        except OSError as exc:
+            raise CommandError(f"cannot open '{name}' for output: {exc.strerror}") from None
+        old = s.out
+        s.out = fh
+        try:
+            self.execute(body)
+        finally:
+            s.out = old
+            fh.close()
+
+    def _x_pipe(self, node):
+        raise UnsupportedError("piping output to a command ('|')",
+                               "scripts never reach a shell; use >> or >>> to write a file")
+
+    def _x_read(self, node):
+        if node[1] is None:
+            raise UnsupportedError("read without a file name", "use read \"file\"")
+        name = self.value(node[1])
+        if not isinstance(name, str):
+            raise CommandError("read needs a file name in quotes (for example: read \"off.cmd\")")
+        self.session.read_file(name)
+
+    def _x_abort(self, node):
+        raise CommandError("Command aborted (abort).")
 
     def _x_unset(self, node):
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=True)
@@ -781,7 +1226,7 @@ class Interpreter:
         raise _Continue(1 if node[1] is None else int(self.value(node[1])))
 
     def _x_return(self, node):
-        raise _Return()
+        raise _Return(None if node[1] is None else self.value(node[1]))
 
     def _x_unsupported(self, node):
         raise UnsupportedError(node[1])
@@ -790,13 +1235,24 @@ class Interpreter:
         raw, arg = node[1], node[2]
         name = raw.lower()
         s = self.session
+        builtin = len(node) > 3
         if name in s.commands and len(raw) > 1:
+            proc = s.commands[name]
+            if proc.params:
+                if arg is None:
+                    raise CommandError(f"'{raw}' needs {len(proc.params)} argument"
+                                       f"{'s' if len(proc.params) != 1 else ''}: "
+                                       f"{raw}(...)")
+                self.run_proc(proc, [self.value(arg)])
+                return
             n = 1 if arg is None else self._count(arg)
             for _ in range(n):
-                try:
-                    self.execute(s.commands[name])
-                except _Return:
-                    pass
+                self.run_proc(proc, [])
+            return
+        if not builtin and raw in s.letters:
+            n = 1 if arg is None else self._count(arg)
+            for _ in range(n):
+                self.run_proc(s.letters[raw], [])
             return
         if raw in ("q",) or name in ("quit", "bye", "exit"):
             raise Quit(0 if arg is None else int(self.value(arg)))
