@@ -693,10 +693,7 @@ class Session:
             conv = int if self.attr_types.get((k, name)) == "integer" else float
             if arr.ndim == 1:
                 return conv(arr[i])
-            j = int(idx) if idx is not None else 1
-            if j < 1 or j > arr.shape[1]:
-                raise ExpressionError(f"{k} attribute {name}[{j}]: index outside 1..{arr.shape[1]}")
-            return conv(arr[i, j - 1])
+            return conv(arr[(i,) + self._attr_pos(k, name, arr, idx)])
         if name == "show":          # the default show criteria (graphics are not drawn)
             if k == "facet":
                 return 1.0
@@ -799,6 +796,23 @@ class Session:
             raise UnsupportedError(f"per-element quantity values ({k}.{name})")
         raise ExpressionError(f"{k} has no attribute '{name}'")
 
+    @staticmethod
+    def _attr_pos(k, name, arr, idx):
+        """0-based position inside an array attribute from 1-based indices."""
+        if idx is None:
+            raise ExpressionError(f"{k} attribute '{name}' is an array; index it as "
+                                  f"{name}[i]")
+        idx = idx if isinstance(idx, tuple) else (idx,)
+        if len(idx) != arr.ndim - 1:
+            raise ExpressionError(f"{k} attribute '{name}' needs {arr.ndim - 1} "
+                                  f"ind{'ices' if arr.ndim > 2 else 'ex'}, got {len(idx)}")
+        pos = []
+        for j, n in zip(idx, arr.shape[1:]):
+            if isinstance(j, str) or int(j) < 1 or int(j) > n:
+                raise ExpressionError(f"{k} attribute {name}[{j}]: index outside 1..{n}")
+            pos.append(int(j) - 1)
+        return tuple(pos)
+
     def _quantity_attr(self, qname, name):
         q = self.surface.quantities[qname]
         if name == "value":
@@ -834,11 +848,7 @@ class Session:
             if arr.ndim == 1:
                 arr[i] = value
             else:
-                j = int(idx) if idx is not None else 1
-                if j < 1 or j > arr.shape[1]:
-                    raise CommandError(f"{k} attribute {name}[{j}]: index outside "
-                                       f"1..{arr.shape[1]}")
-                arr[i, j - 1] = value
+                arr[(i,) + self._attr_pos(k, name, arr, idx)] = value
             return
         if k == "vertex" and name in ("x", "y", "z", "x1", "x2", "x3"):
             j = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}[name]
@@ -980,8 +990,6 @@ class Session:
         s = self.surface
         if typ not in ("real", "integer"):
             raise UnsupportedError(f"{typ} element attributes", "real and integer are supported")
-        if len(shape) > 1:
-            raise UnsupportedError("element attributes with more than one dimension")
         if kind == "facetedge":           # declared; facetedges themselves are refused when used
             self.attr_types[(kind, name)] = typ
             return
@@ -993,9 +1001,9 @@ class Session:
             if old.shape == new.shape:
                 self.attr_types[key] = typ
                 return
-            if old.ndim == new.ndim == 2:          # resizing keeps the values
-                m = min(old.shape[1], new.shape[1])
-                new[:, :m] = old[:, :m]
+            if old.ndim == new.ndim:               # resizing keeps the values
+                sl = tuple(slice(0, min(a, b)) for a, b in zip(old.shape, new.shape))
+                new[sl] = old[sl]
         s.extra[key] = new
         self.attr_types[key] = typ
 
@@ -1032,7 +1040,7 @@ class Session:
     def list_elements(self, gen, env):
         s = self.surface
         els = self.generate(gen, env)
-        kind = gen.kind
+        kind = gen.kind or (els[0].kind if els else None)
         t = self.totals
         w = self.write
         vid, eid, fid = s.ids("vertex"), s.ids("edge"), s.ids("facet")

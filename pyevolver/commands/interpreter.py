@@ -61,21 +61,26 @@ def _scan(text):
     in_str = False
     in_comment = False
     start = None
+    opened = False          # the buffered command has had a '{'
     for lineno, line in enumerate(text.split("\n"), 1):
         i = 0
         n = len(line)
-        code_end = n
+        code = []               # the line without its comments
         while i < n:
             c = line[i]
             if in_comment:
                 if line.startswith("*/", i):
                     in_comment = False
+                    code.append("  ")
                     i += 2
                     continue
+                code.append(" ")
                 i += 1
                 continue
             if in_str:
+                code.append(c)
                 if c == "\\":
+                    code.append(line[i + 1:i + 2])
                     i += 2
                     continue
                 if c == '"':
@@ -85,35 +90,46 @@ def _scan(text):
             if c == '"':
                 in_str = True
             elif line.startswith("//", i):
-                code_end = i
                 break
             elif line.startswith("/*", i):
                 in_comment = True
+                code.append("  ")
                 i += 2
                 continue
             elif c in "{(":
                 depth += 1
+                if c == "{":
+                    opened = True
             elif c in "})":
                 depth -= 1
+            code.append(c)
             i += 1
-        if not line[:code_end].strip() and not in_comment and not in_str and depth == 0:
-            continue            # blank lines neither start nor end a command
+        # commands are kept without their comments (blanked, so columns stay)
+        code = "".join(code)
+        if not code.strip() and not in_str:
+            if buf:
+                buf.append(code)    # inside an unfinished command
+            continue                # blank and comment lines neither start nor end one
         if start is None:
             start = lineno
-        buf.append(line)
-        tail = line[:code_end].rstrip()
+        buf.append(code)
+        tail = code.rstrip()
         if depth > 0 or in_str or in_comment or tail.endswith(_CONT_END) or \
                 _ends_with_keyword(tail):
             continue
+        if not opened and not tail.endswith(";") and _PROC_START.match("\n".join(buf)):
+            continue        # a procedure/function header waits for its body (or ';')
         out.append(("\n".join(buf), start))
         buf = []
         start = None
         depth = 0
+        opened = False
     pending = ("\n".join(buf), start) if buf else None
     # an 'else' at the start of a command belongs to the previous 'if'
     merged = []
     for chunk, ln in out:
-        if merged and _starts_with_else(chunk):
+        if merged and (_starts_with_else(chunk) or
+                       (_WHILE_START.match(chunk) and _DO_OPEN.match(merged[-1][0]))):
             prev, pln = merged[-1]
             merged[-1] = (prev + "\n" + chunk, pln)
         else:
@@ -123,6 +139,9 @@ def _scan(text):
 
 _KW_END = re.compile(r"(?:^|[^A-Za-z0-9_])(then|else|do)$", re.I)
 _ELSE_START = re.compile(r"\s*else\b", re.I)
+_WHILE_START = re.compile(r"\s*while\b", re.I)
+_DO_OPEN = re.compile(r"\s*do\s*\{.*\}\s*$", re.I | re.S)      # `do { ... }` waiting for `while`
+_PROC_START = re.compile(r"(?:\s|/\*.*?\*/|//[^\n]*)*(procedure|function)\b", re.I | re.S)
 
 
 def _ends_with_keyword(tail):
@@ -187,10 +206,17 @@ class Attr(N.Node):
 
     def ev(self, env):
         base = self.base.ev(env)
-        idx = None if self.index is None else self.index.ev(env)
+        if self.index is None:
+            idx = None
+        elif isinstance(self.index, list):
+            idx = tuple(i.ev(env) for i in self.index)
+        else:
+            idx = self.index.ev(env)
         return env.session.get_attr(base, self.name, idx)
 
     def children(self):
+        if isinstance(self.index, list):
+            return (self.base,) + tuple(self.index)
         return (self.base,) + ((self.index,) if self.index is not None else ())
 
 
@@ -456,6 +482,15 @@ class _CmdTransformer(ExprTransformer):
     def sprintf_expr(self, _s, *args):
         return Sprintf(list(args))
 
+    def array_lit(self, *items):
+        return list(items)
+
+    def assign_array(self, lv, _a, items):
+        return ("assign_array", lv, items)
+
+    def define_other(self, _d, what, name):
+        return ("unsupported", f"define {str(what).lower()}")
+
     def lv_array(self, name, *idx):
         return ("array", str(name).lower(), list(idx))
 
@@ -489,8 +524,8 @@ class _CmdTransformer(ExprTransformer):
     def lv_attr(self, base, name):
         return ("attr", base, name, None)
 
-    def lv_attr_index(self, base, name, idx):
-        return ("attr", base, name, idx)
+    def lv_attr_index(self, base, name, *idx):
+        return ("attr", base, name, idx[0] if len(idx) == 1 else list(idx))
 
     def attr_name(self, tok):
         return str(tok).lower()
@@ -530,19 +565,9 @@ class _CmdTransformer(ExprTransformer):
         return ("set", Generator(base, str(var).lower(), where), str(attr).lower(),
                 rest[0] if rest else None)
 
-    def set_elemvar(self, _s, var, attr, *rest):
-        rest, where = self._split_where(rest)
-        return ("set", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
-                rest[0] if rest else None)
-
     def unset(self, _s, base, attr, *rest):
         rest, where = self._split_where(rest)
         return ("unset", Generator(base, None, where), str(attr).lower(), rest[0] if rest else None)
-
-    def unset_elemvar(self, _s, var, attr, *rest):
-        rest, where = self._split_where(rest)
-        return ("unset", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
-                rest[0] if rest else None)
 
     def refine(self, _r, gen):
         return ("refine", gen)
@@ -577,7 +602,10 @@ class _CmdTransformer(ExprTransformer):
         return ("define", lv[1], ("seq", []))
 
     def unsupported(self, tok, body=None):
-        word = str(tok).split()[0].lower()
+        words = str(tok).split()
+        word = words[0].lower()
+        if word == "define" and len(words) > 1:
+            word = "define " + words[1].lower() + " (at run time)"
         return ("unsupported", word)
 
     def generator(self, base, *rest):
@@ -599,14 +627,17 @@ class _CmdTransformer(ExprTransformer):
     def gen_sub(self, base, kind, idx=None):
         return ("sub", base, _KIND[str(kind).lower()], idx)
 
+    def gen_var(self, name):
+        return ("var", str(name).lower())
+
     def gen_var_sub(self, name, kind, idx=None):
         return ("varsub", str(name).lower(), _KIND[str(kind).lower()], idx)
 
     def attr(self, base, name):
         return Attr(base, name)
 
-    def attr_index(self, base, name, idx):
-        return Attr(base, name, idx)
+    def attr_index(self, base, name, *idx):
+        return Attr(base, name, idx[0] if len(idx) == 1 else list(idx))
 
     def elem_ref(self, kind, idx):
         return ElemIndex(str(kind), idx)
@@ -1061,8 +1092,7 @@ class Interpreter:
             arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
             return arr[pos]
         base = lv[1].ev(self.env)
-        idx = None if lv[3] is None else self.value(lv[3])
-        return self.session.get_attr(base, lv[2], idx)
+        return self.session.get_attr(base, lv[2], self._index(lv[3]))
 
     def _store(self, lv, value):
         s = self.session
@@ -1093,8 +1123,47 @@ class Interpreter:
                 arr[pos] = value
             return
         base = lv[1].ev(self.env)
-        idx = None if lv[3] is None else self.value(lv[3])
-        s.set_attr(base, lv[2], idx, value)
+        s.set_attr(base, lv[2], self._index(lv[3]), value)
+
+    def _index(self, idx):
+        if idx is None:
+            return None
+        if isinstance(idx, list):
+            return tuple(self.value(i) for i in idx)
+        return self.value(idx)
+
+    def _x_assign_array(self, node):
+        lv, items = node[1], node[2]
+        if lv[0] != "name":
+            raise CommandError("a {...} list can only be assigned to an array name")
+        name = lv[1].lower()
+
+        def shape(x):
+            return [len(x)] + shape(x[0]) if isinstance(x, list) else []
+
+        def flat(x):
+            if isinstance(x, list):
+                return [v for it in x for v in flat(it)]
+            v = self.value(x)
+            if isinstance(v, str):
+                raise CommandError(f"{name}: array values must be numbers")
+            return [float(v)]
+        vals = flat(items)
+        s = self.session
+        arr = s.arrays.get(name)
+        if arr is None:
+            if name in s.commands or len(name) < 2:
+                raise CommandError(f"'{name}' is a command, not an array")
+            s.arrays[name] = np.array(vals, float).reshape(shape(items))
+            s.array_types[name] = "real"
+            return
+        if arr.dtype == object:
+            raise CommandError(f"array '{name}' holds strings")
+        flat_arr = arr.reshape(-1)
+        if len(vals) > flat_arr.size:
+            raise CommandError(f"array '{name}' has {flat_arr.size} entries; the list has "
+                               f"{len(vals)}")
+        flat_arr[:len(vals)] = vals
 
     def _x_print(self, node):
         v = self.value(node[1])
@@ -1110,7 +1179,21 @@ class Interpreter:
         else:
             self.session.write(text)
 
+    def _var_elem(self, name):
+        for var, el in reversed(self.env.frames):
+            if var == name:
+                return el
+        return None
+
     def _x_list(self, node):
+        gen = node[1]
+        if gen.base[0] == "var" and self._var_elem(gen.base[1]) is None:
+            what = gen.base[1]
+            if what in ("topinfo", "bottominfo", "procedures", "attributes", "quantities",
+                        "method_instances", "constraints", "boundaries"):
+                raise UnsupportedError(f"list {what}")
+            raise CommandError(f"list: '{what}' is not an element (expected for example "
+                               f"list vertex[3] or list facets where area > 0.1)")
         self.session.list_elements(node[1], self.env)
 
     def _x_set(self, node):
@@ -1120,6 +1203,10 @@ class Interpreter:
     def _x_fix(self, node):
         gen, on = node[1], node[2]
         s = self.session
+        if gen.base[0] == "var" and gen.where is None and \
+                not isinstance(self._var_elem(gen.base[1]), ElemRef):
+            s.fix_name(gen.base[1], on)
+            return
         els = s.generate(gen, self.env)
         n = s.fix_elements(els, on)
         s.write(f"{'Fixed' if on else 'Unfixed'}: {n}\n")
@@ -1183,7 +1270,7 @@ class Interpreter:
         if kinds - {"edge", "facet"}:
             raise UnsupportedError("refine of " + ", ".join(sorted(kinds - {"edge", "facet"}))
                                    + "s", "'refine edges' and 'refine facets' are supported")
-        if node[1].kind == "facet":
+        if kinds == {"facet"}:
             s.refine_facets([el.i for el in els])
         else:
             s.refine_edges([el.i for el in els])
