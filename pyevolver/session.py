@@ -28,7 +28,7 @@ READ_ONLY = {
     "surface_dimension", "torus", "datafilename", "equi_count", "edge_delete_count",
     "vertex_pop_count", "edge_pop_count", "notch_count", "refine_count", "where_count",
     "iteration_counter", "total_time", "random", "quantity_count", "symmetry_group",
-    "simplex_representation", "lagrange_order", "date_and_time",
+    "simplex_representation", "lagrange_order", "date_and_time", "linear", "quadratic",
 }
 DEFAULTS = {
     "scale": 0.1, "scale_limit": 1.0, "scale_scale": 1.0, "target_tolerance": 1e-4,
@@ -91,11 +91,29 @@ class Session:
         self.commands = {}
         self.letters = {}
         self.arrays = {}
+        self._init_view_matrix()
         self.recalc()
         if run_read and scene.read_text:
             self.run(scene.read_text, where=filename, line=scene.read_line + 1,
                      stop_on_error=False)
         return self
+
+    def _init_view_matrix(self):
+        """The graphics view matrix (exporters read it): the Evolver's initial
+        view fits the bounding box into [-1, 1]^3."""
+        s = self.surface
+        d = s.sdim
+        M = np.eye(d + 1)
+        if s.nv:
+            lo, hi = s.X.min(axis=0), s.X.max(axis=0)
+            size = float(np.max(hi - lo))
+            if size > 0:
+                sc = 2.0 / size
+                for k in range(d):
+                    M[k, k] = sc
+                    M[k, d] = -sc * (lo[k] + hi[k]) / 2
+        self.arrays["view_matrix"] = M
+        self.array_types["view_matrix"] = "real"
 
     # -- output -----------------------------------------------------------------
     def write(self, text):
@@ -560,7 +578,7 @@ class Session:
             "random": lambda: float(self.rng.random()),
             "quantity_count": lambda: len(s.quantities),
             "symmetry_group": lambda: 0, "simplex_representation": lambda: 0,
-            "lagrange_order": lambda: 1,
+            "lagrange_order": lambda: 1, "linear": lambda: 1, "quadratic": lambda: 0,
             "date_and_time": lambda: time.strftime("%a %b %d %H:%M:%S %Y"),
         }
         fn = simple.get(name)
@@ -641,7 +659,14 @@ class Session:
         i = el.i
         if el.kind == "vertex":
             if kind == "edge":
-                return [I.ElemRef("edge", int(e)) for e in np.nonzero((s.E == i).any(axis=1))[0]]
+                # oriented away from the vertex (oid < 0 where it is the head);
+                # the Evolver's order on a freshly loaded surface: the first
+                # edge, then the others newest first
+                es = np.nonzero((s.E == i).any(axis=1))[0]
+                ids = s.ids("edge")[es]
+                es = es[np.argsort(ids, kind="stable")]
+                es = list(es[:1]) + list(es[1:][::-1])
+                return [I.ElemRef("edge", int(e), 1 if s.E[e, 0] == i else -1) for e in es]
             if kind == "facet":
                 return [I.ElemRef("facet", int(f)) for f in np.nonzero((s.F == i).any(axis=1))[0]]
         if el.kind == "edge":
@@ -651,9 +676,16 @@ class Session:
                     a, b = b, a
                 return [I.ElemRef("vertex", int(a)), I.ElemRef("vertex", int(b))]
             if kind == "facet":
+                # oriented like the edge: oid < 0 where the facet runs against it
                 from .geometry import edge_index
-                idx, _ = edge_index(s.FE)
-                return [I.ElemRef("facet", int(f)) for f in np.nonzero((idx == i).any(axis=1))[0]]
+                idx, sgn = edge_index(s.FE)
+                out = []
+                for f in np.nonzero((idx == i).any(axis=1))[0]:
+                    g = int(sgn[f][np.nonzero(idx[f] == i)[0][0]]) * el.sign
+                    out.append(I.ElemRef("facet", int(f), g))
+                # the facet running along the edge first (REF, two-facet edges)
+                out.sort(key=lambda r: -r.sign * el.sign)
+                return out
         if el.kind == "facet":
             from .geometry import edge_index
             if kind == "vertex":
@@ -702,6 +734,11 @@ class Session:
                              len(self.sub_elements(base, "facet")) != 2)
         if k == "vertex":
             coords = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}
+            if name == "x" and idx is not None:          # x[2] is y
+                j = int(idx) if not isinstance(idx, tuple) else -1
+                if j < 1 or j > s.sdim:
+                    raise ExpressionError(f"vertex x[{j}]: index outside 1..{s.sdim}")
+                return float(s.X[i, j - 1])
             if name in coords:
                 return float(s.X[i, coords[name]])
             if name == "__x" and idx is not None:
@@ -716,6 +753,16 @@ class Session:
                 return float(b is not None and b[i] == int(idx))
             if name == "valence":
                 return float(np.count_nonzero((s.E == i).any(axis=1)))
+            if name in ("vertexnormal", "vertex_normal"):
+                if idx is None or isinstance(idx, tuple):
+                    raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
+                j = int(idx)
+                if j < 1 or j > s.sdim:
+                    raise ExpressionError(f"{name}[{j}]: index outside 1..{s.sdim}")
+                from .geometry import vertex_normals
+                if s.nf == 0:
+                    raise UnsupportedError("vertex_normal in the string model")
+                return float(vertex_normals(s.F, t.facet_N2, s.nv)[i, j - 1])
             if name in ("p1", "p2") and "params" in s.vattr:
                 return float(s.vattr["params"][i, int(name[1]) - 1])
         elif k == "edge":
@@ -852,6 +899,10 @@ class Session:
             return
         if k == "vertex" and name in ("x", "y", "z", "x1", "x2", "x3"):
             j = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}[name]
+            if name == "x" and idx is not None:
+                j = int(idx) - 1 if not isinstance(idx, tuple) else -1
+                if j < 0 or j >= s.sdim:
+                    raise CommandError(f"vertex x[{j + 1}]: index outside 1..{s.sdim}")
             s.X[i, j] = value
             return
         if k == "body":

@@ -17,7 +17,7 @@ from lark.exceptions import UnexpectedInput, VisitError
 from ..errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
-from .cformat import c_format, print_value
+from .cformat import c_format, print_array, print_value
 
 _HERE = os.path.dirname(__file__)
 
@@ -312,6 +312,28 @@ class Sprintf(N.Node):
         return tuple(self.args)
 
 
+class _Signed(N.Node):
+    """Unary + or - in the command grammar (kept so that `set` can tell
+    `set vertex vv x -1` from `set vertex[1] count n-1`)."""
+
+    __slots__ = ("op", "a")
+
+    def __init__(self, op, a):
+        self.op = op
+        self.a = a
+
+    def ev(self, env):
+        v = self.a.ev(env)
+        if self.op == "+":
+            return v
+        if isinstance(v, str):
+            raise ExpressionError("cannot negate a string")
+        return -v
+
+    def children(self):
+        return (self.a,)
+
+
 class Proc:
     """A user command: ``name := {...}`` (no parameters), ``procedure``
     or ``function``."""
@@ -560,10 +582,24 @@ class _CmdTransformer(ExprTransformer):
         rest, where = self._split_where(rest)
         return ("set", Generator(base, None, where), str(attr).lower(), rest[0] if rest else None)
 
+    def pos(self, _op, a):
+        return _Signed("+", a)
+
+    def neg(self, _op, a):
+        return _Signed("-", a)
+
     def set_var(self, _s, base, var, attr, *rest):
         rest, where = self._split_where(rest)
-        return ("set", Generator(base, str(var).lower(), where), str(attr).lower(),
-                rest[0] if rest else None)
+        var, attr = str(var).lower(), str(attr).lower()
+        expr = rest[0] if rest else None
+        node = ("set", Generator(base, var, where), attr, expr)
+        if isinstance(expr, _Signed):
+            # `set vertex[3] number count+1` reads like `set GEN NAME NAME -expr`;
+            # which one is meant is decided when it runs (is `number` an attribute?)
+            alt = ("set", Generator(base, None, where), var,
+                   N.Bin(expr.op, N.Var(attr), expr.a), None)
+            return ("set_either", node, alt, var)
+        return node
 
     def unset(self, _s, base, attr, *rest):
         rest, where = self._split_where(rest)
@@ -799,7 +835,7 @@ TOGGLES = {
     "conj_grad", "check_increase", "autopop", "autochop", "quiet", "quietgo",
     "hessian_normal", "normal_motion", "area_normalization", "effective_area",
     "normal_curvature", "assume_oriented", "autorecalc", "estimate", "volgrads_every",
-    "verbose", "ribiere", "approximate_curvature", "runge_kutta", "kraynikpopvertex",
+    "verbose", "ribiere", "approximate_curvature", "rgb_colors", "runge_kutta", "kraynikpopvertex",
     "kraynikpopedge", "hessian_diff", "linear_metric", "post_project", "gravity",
     "keep_macros", "brief", "itdebug", "memdebug", "visibility_test", "clipped",
     "connected", "thicken", "smooth_graph", "pscolorflag", "gridflag", "crossingflag",
@@ -810,6 +846,9 @@ TOGGLES = {
 }
 GRAPHICS = {"s", "P", "show", "show_expr", "transforms", "transform_expr", "geomview",
             "postscript", "showq", "view_transforms", "ps", "oogl", "gv", "screen"}
+SETTABLE_ATTRS = {"x", "y", "z", "x1", "x2", "x3", "color", "colour", "frontcolor", "backcolor",
+                  "tension", "density", "fixed", "no_refine", "target", "pressure", "volconst",
+                  "constraint", "boundary", "opacity"}
 TOGGLE_DEFAULTS = {"hessian_normal": 1, "autorecalc": 1, "ribiere": 1}
 
 
@@ -1166,7 +1205,12 @@ class Interpreter:
         flat_arr[:len(vals)] = vals
 
     def _x_print(self, node):
-        v = self.value(node[1])
+        e = node[1]
+        if isinstance(e, N.Var) and e.name in self.session.arrays and \
+                not (self.env.scopes and e.name in self.env.scopes[-1]):
+            self.session.write(print_array(self.session.arrays[e.name]) + "\n")
+            return
+        v = self.value(e)
         self.session.write(print_value(v) + "\n")
 
     def _x_printf(self, node):
@@ -1199,6 +1243,14 @@ class Interpreter:
     def _x_set(self, node):
         idx = node[4] if len(node) > 4 else None
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=False, idx=idx)
+
+    def _x_set_either(self, node):
+        primary, alt, name = node[1], node[2], node[3]
+        gen = primary[1]
+        kind = gen.kind
+        s = self.session
+        is_attr = (kind, name) in s.surface.extra or name in SETTABLE_ATTRS
+        self.execute(alt if is_attr else primary)
 
     def _x_fix(self, node):
         gen, on = node[1], node[2]
