@@ -287,7 +287,12 @@ class ArrayRef(N.Node):
 
     def ev(self, env):
         interp = env.session.interp
-        arr, pos = interp.array_slot(self.name, [interp.value(i) for i in self.index])
+        idx = [interp.value(i) for i in self.index]
+        if self.name not in env.session.arrays and env.current() is not None:
+            # a bare indexed attribute inside a generator: form_factors[2]
+            return env.session.get_attr(env.current(), self.name,
+                                        idx[0] if len(idx) == 1 else tuple(idx))
+        arr, pos = interp.array_slot(self.name, idx)
         v = arr[pos]
         return v if isinstance(v, str) else float(v)
 
@@ -310,28 +315,6 @@ class Sprintf(N.Node):
 
     def children(self):
         return tuple(self.args)
-
-
-class _Signed(N.Node):
-    """Unary + or - in the command grammar (kept so that `set` can tell
-    `set vertex vv x -1` from `set vertex[1] count n-1`)."""
-
-    __slots__ = ("op", "a")
-
-    def __init__(self, op, a):
-        self.op = op
-        self.a = a
-
-    def ev(self, env):
-        v = self.a.ev(env)
-        if self.op == "+":
-            return v
-        if isinstance(v, str):
-            raise ExpressionError("cannot negate a string")
-        return -v
-
-    def children(self):
-        return (self.a,)
 
 
 class Proc:
@@ -582,24 +565,10 @@ class _CmdTransformer(ExprTransformer):
         rest, where = self._split_where(rest)
         return ("set", Generator(base, None, where), str(attr).lower(), rest[0] if rest else None)
 
-    def pos(self, _op, a):
-        return _Signed("+", a)
-
-    def neg(self, _op, a):
-        return _Signed("-", a)
-
     def set_var(self, _s, base, var, attr, *rest):
         rest, where = self._split_where(rest)
-        var, attr = str(var).lower(), str(attr).lower()
-        expr = rest[0] if rest else None
-        node = ("set", Generator(base, var, where), attr, expr)
-        if isinstance(expr, _Signed):
-            # `set vertex[3] number count+1` reads like `set GEN NAME NAME -expr`;
-            # which one is meant is decided when it runs (is `number` an attribute?)
-            alt = ("set", Generator(base, None, where), var,
-                   N.Bin(expr.op, N.Var(attr), expr.a), None)
-            return ("set_either", node, alt, var)
-        return node
+        return ("set", Generator(base, str(var).lower(), where), str(attr).lower(),
+                rest[0] if rest else None)
 
     def unset(self, _s, base, attr, *rest):
         rest, where = self._split_where(rest)
@@ -688,8 +657,27 @@ class _CmdTransformer(ExprTransformer):
 _TRANSFORMER = _CmdTransformer()
 
 
+# `set vertex y y+dy` could read as "set, with loop name y, attribute y to +dy"
+# (the grammar's choice); the Evolver means "attribute y to y+dy".  Unless the
+# second name is an attribute and the first is not, the value is made to start
+# with a number (`0+y+dy`, the same value) so that only that reading parses.
+_SET_AMBIG = re.compile(r"\bset(\s+)(vertices|vertex|edges|edge|facets|facet|faces|face|bodies|body)"
+                        r"(\s*\[[^\[\]]*\])?(\s+)([a-z_]\w*)(\s+)([a-z_]\w*)(?=\s*[-+])", re.I)
+
+
+def _disambiguate_set(text):
+    def fix(m):
+        first, second = m.group(5).lower(), m.group(7).lower()
+        if second in SETTABLE_ATTRS and first not in SETTABLE_ATTRS:
+            return m.group(0)
+        return (m.group(0)[:m.start(7) - m.start(0)] + "0+" + m.group(7))
+    return _SET_AMBIG.sub(fix, text)
+
+
 def parse_command(text, where="<command>", line=1):
     """Parse one complete command; raises :class:`CommandError` with location."""
+    if "set" in text.lower():
+        text = _disambiguate_set(text)
     try:
         tree = command_parser().parse(text)
         return _TRANSFORMER.transform(tree)
@@ -1191,11 +1179,9 @@ class Interpreter:
         s = self.session
         arr = s.arrays.get(name)
         if arr is None:
-            if name in s.commands or len(name) < 2:
-                raise CommandError(f"'{name}' is a command, not an array")
-            s.arrays[name] = np.array(vals, float).reshape(shape(items))
-            s.array_types[name] = "real"
-            return
+            dims = "".join(f"[{n}]" for n in shape(items))
+            raise CommandError(f"'{name}' is not an array; define it first "
+                               f"(define {name} real{dims})")
         if arr.dtype == object:
             raise CommandError(f"array '{name}' holds strings")
         flat_arr = arr.reshape(-1)
@@ -1243,14 +1229,6 @@ class Interpreter:
     def _x_set(self, node):
         idx = node[4] if len(node) > 4 else None
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=False, idx=idx)
-
-    def _x_set_either(self, node):
-        primary, alt, name = node[1], node[2], node[3]
-        gen = primary[1]
-        kind = gen.kind
-        s = self.session
-        is_attr = (kind, name) in s.surface.extra or name in SETTABLE_ATTRS
-        self.execute(alt if is_attr else primary)
 
     def _x_fix(self, node):
         gen, on = node[1], node[2]
