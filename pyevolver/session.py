@@ -133,7 +133,7 @@ class Session:
         for chunk, ln in I.split_commands(text):
             try:
                 self.run_one(chunk, where, line + ln - 1)
-            except I.Quit:
+            except (I.Quit, I.Interrupted):
                 raise
             except PyEvolverError as exc:
                 if stop_on_error:
@@ -148,9 +148,14 @@ class Session:
         scopes.append({})
         try:
             self.interp.execute(ast)
-        except I.Quit:
+        except (I.Quit, I.Interrupted):
             self.refresh()
             raise
+        except KeyboardInterrupt:
+            self._restore(snap)
+            self.refresh()
+            raise I.Interrupted("Interrupted: the surface is as it was before the command.") \
+                from None
         except (I._Break, I._Continue, I._Return):
             pass
         except PyEvolverError as exc:
@@ -302,7 +307,9 @@ class Session:
             if installed:
                 signal.signal(signal.SIGINT, old)
         if flag["hit"]:
-            self.write("Interrupted: stopped after a complete iteration.\n")
+            # the rest of the command (an enclosing loop too) is abandoned; the
+            # surface is the one after the last complete iteration
+            raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
     def hessian(self, seek=False, max_scale=None, echo=True):
         """``hessian``: one Newton step on the constrained problem;

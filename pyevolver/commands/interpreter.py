@@ -715,6 +715,10 @@ class _Return(Exception):
         self.value = value
 
 
+class Interrupted(Exception):
+    """Ctrl-C: the running command stops and the prompt returns."""
+
+
 class Quit(Exception):
     def __init__(self, code=0):
         self.code = code
