@@ -79,8 +79,24 @@ def _main(argv=None):
         return q.code
 
 
+def history_file():
+    return os.environ.get("PYEVOLVER_HISTORY") or \
+        os.path.join(os.path.expanduser("~"), ".pyevolver_history")
+
+
 def repl(session, stdin=None):
-    """Read commands until ``q`` or end of input; returns the exit code."""
+    """Read commands until ``q`` or end of input; returns the exit code.
+
+    At a terminal the line editor is prompt_toolkit (history kept across
+    runs in ~/.pyevolver_history or $PYEVOLVER_HISTORY, Tab completion,
+    ``more> `` for unfinished commands); piped input is read plainly so that
+    batch output stays byte-compatible with the Evolver's.
+    """
+    if stdin is None and sys.stdin.isatty() and sys.stdout.isatty():
+        try:
+            return _repl_terminal(session)
+        except ImportError:           # prompt_toolkit not installed: plain prompts
+            pass
     stdin = stdin or sys.stdin
     interactive = stdin.isatty()
     buf = ""
@@ -112,9 +128,80 @@ def _run(session, text, lineno):
     try:
         session.run(text, where="<stdin>", line=max(1, lineno - text.count("\n") + 1),
                     stop_on_error=False)
+    except I.Interrupted as exc:
+        sys.stdout.write(f"\n{exc}\n")
     except KeyboardInterrupt:
         sys.stdout.write("\nInterrupted.\n")
     sys.stdout.flush()
+
+
+def _repl_terminal(session):
+    from prompt_toolkit import PromptSession
+    from prompt_toolkit.history import FileHistory
+
+    try:
+        history = FileHistory(history_file())
+    except OSError:
+        history = None
+    ps = PromptSession(history=history, completer=_completer(session),
+                       complete_while_typing=False)
+    buf = ""
+    lineno = 0
+    while True:
+        try:
+            line = ps.prompt(MORE if buf else PROMPT)
+        except KeyboardInterrupt:            # Ctrl-C at the prompt drops the line
+            buf = ""
+            continue
+        except EOFError:
+            return 0
+        lineno += 1
+        buf += line + "\n"
+        if I.needs_more(buf):
+            continue
+        text, buf = buf, ""
+        _run(session, text, lineno)
+
+
+# words the completer offers besides the session's own names
+KEYWORDS = sorted({
+    "if", "then", "else", "while", "do", "for", "foreach", "where", "procedure",
+    "function", "local", "define", "attribute", "return", "break", "continue", "print",
+    "printf", "errprintf", "sprintf", "list", "set", "unset", "fix", "unfix", "refine",
+    "delete", "edgeswap", "histogram", "loghistogram", "read", "abort", "quit", "recalc",
+    "vertex", "vertices", "edge", "edges", "facet", "facets", "body", "bodies",
+    "sum", "avg", "max", "min", "count", "hessian", "hessian_seek", "equiangulate",
+    "show_vol", "optimize", "integer", "real", "string", "on", "off",
+})
+ATTRIBUTES = ["id", "oid", "original", "x", "y", "z", "length", "area", "volume", "target",
+              "pressure", "volconst", "density", "tension", "color", "frontcolor",
+              "backcolor", "fixed", "valence", "on_constraint", "on_boundary",
+              "vertex_normal", "no_refine", "value", "modulus"]
+
+
+def _completer(session):
+    from prompt_toolkit.completion import Completer, Completion
+
+    class EvolverCompleter(Completer):
+        def get_completions(self, document, complete_event):
+            word = document.get_word_before_cursor(WORD=False)
+            if not word or not (word[0].isalpha() or word[0] == "_"):
+                return
+            w = word.lower()
+            names = set(KEYWORDS) | set(ATTRIBUTES) | set(I.TOGGLES)
+            names |= set(session.commands) | set(session.arrays)
+            names |= {k for k, v in session.variables.items()}
+            names |= set(session.settings)
+            from .session import READ_ONLY
+            names |= READ_ONLY
+            s = session.surface
+            if s is not None:
+                names |= set(s.quantities)
+                names |= {name for (_, name) in s.extra}
+            for name in sorted(n for n in names if n.startswith(w) and n != w):
+                yield Completion(name, start_position=-len(word))
+
+    return EvolverCompleter()
 
 
 if __name__ == "__main__":   # pragma: no cover

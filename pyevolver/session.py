@@ -27,7 +27,8 @@ READ_ONLY = {
     "facet_count", "body_count", "facetedge_count", "space_dimension",
     "surface_dimension", "torus", "datafilename", "equi_count", "edge_delete_count",
     "vertex_pop_count", "edge_pop_count", "notch_count", "refine_count", "where_count",
-    "iteration_counter", "total_time", "random", "quantity_count",
+    "iteration_counter", "total_time", "random", "quantity_count", "symmetry_group",
+    "simplex_representation", "lagrange_order", "date_and_time", "linear", "quadratic",
 }
 DEFAULTS = {
     "scale": 0.1, "scale_limit": 1.0, "scale_scale": 1.0, "target_tolerance": 1e-4,
@@ -46,7 +47,11 @@ class Session:
         self.surface = None
         self.totals = None
         self.variables = {}
-        self.commands = {}
+        self.commands = {}                     # name -> interpreter.Proc
+        self.letters = {}                      # single letters redefined with :::=
+        self.arrays = {}                       # array variables (define name real[n])
+        self.array_types = {}
+        self.attr_types = {}                   # (kind, name) -> 'integer' / 'real' / ...
         self.toggles = {}
         self.settings = dict(DEFAULTS)
         self.filename = ""
@@ -84,11 +89,31 @@ class Session:
         if "scale" in scene.values:
             self.settings["scale"] = scene.values["scale"]
         self.commands = {}
+        self.letters = {}
+        self.arrays = {}
+        self._init_view_matrix()
         self.recalc()
         if run_read and scene.read_text:
             self.run(scene.read_text, where=filename, line=scene.read_line + 1,
                      stop_on_error=False)
         return self
+
+    def _init_view_matrix(self):
+        """The graphics view matrix (exporters read it): the Evolver's initial
+        view fits the bounding box into [-1, 1]^3."""
+        s = self.surface
+        d = s.sdim
+        M = np.eye(d + 1)
+        if s.nv:
+            lo, hi = s.X.min(axis=0), s.X.max(axis=0)
+            size = float(np.max(hi - lo))
+            if size > 0:
+                sc = 2.0 / size
+                for k in range(d):
+                    M[k, k] = sc
+                    M[k, d] = -sc * (lo[k] + hi[k]) / 2
+        self.arrays["view_matrix"] = M
+        self.array_types["view_matrix"] = "real"
 
     # -- output -----------------------------------------------------------------
     def write(self, text):
@@ -108,7 +133,7 @@ class Session:
         for chunk, ln in I.split_commands(text):
             try:
                 self.run_one(chunk, where, line + ln - 1)
-            except I.Quit:
+            except (I.Quit, I.Interrupted):
                 raise
             except PyEvolverError as exc:
                 if stop_on_error:
@@ -118,11 +143,19 @@ class Session:
     def run_one(self, text, where="<command>", line=1):
         ast = I.parse_command(text, where, line)
         snap = self._snapshot()
+        scopes = self.interp.env.scopes
+        depth = len(scopes)
+        scopes.append({})
         try:
             self.interp.execute(ast)
-        except I.Quit:
+        except (I.Quit, I.Interrupted):
             self.refresh()
             raise
+        except KeyboardInterrupt:
+            self._restore(snap)
+            self.refresh()
+            raise I.Interrupted("Interrupted: the surface is as it was before the command.") \
+                from None
         except (I._Break, I._Continue, I._Return):
             pass
         except PyEvolverError as exc:
@@ -136,12 +169,15 @@ class Session:
         except RecursionError:
             self._restore(snap)
             raise CommandError(f"{where}:{line}: recursion too deep") from None
+        finally:
+            del scopes[depth:]
         self.refresh()
 
     def _snapshot(self):
         s = self.surface
         b = s.bodies if s is not None else None
-        return (dict(self.variables), dict(self.commands), dict(self.toggles),
+        return (dict(self.variables), dict(self.commands), dict(self.letters),
+                {k: v.copy() for k, v in self.arrays.items()}, dict(self.toggles),
                 dict(self.settings),
                 None if s is None else s.X.copy(),
                 None if b is None or not b.n else (b.target.copy(), b.pressure.copy(),
@@ -150,14 +186,20 @@ class Session:
                                         for k, q in s.quantities.items()},
                 None if s is None else {k: v.copy() for k, v in s.extra.items()},
                 None if s is None else {k: v.copy() for k, v in s.vattr.items()},
+                None if s is None else {k: v.copy() for k, v in s.eattr.items()},
+                None if s is None else {k: v.copy() for k, v in s.fattr.items()},
+                None if s is None else {k: m.copy() for k, m in s.vcon.items()},
                 s)
 
     def _restore(self, snap):
-        vars_, cmds, toggles, settings, X, bod, qs, extra, vattr, surface = snap
+        (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
+         fattr, vcon, surface) = snap
         self.surface = surface
         self.variables.clear()
         self.variables.update(vars_)
         self.commands = cmds
+        self.letters = letters
+        self.arrays = arrays
         self.toggles = toggles
         self.settings = settings
         s = self.surface
@@ -171,6 +213,9 @@ class Session:
                 q.target, q.modulus, q.kind = t, m, kind
             s.extra = extra
             s.vattr = vattr
+            s.eattr = eattr
+            s.fattr = fattr
+            s.vcon = vcon
 
     # -- evaluation ------------------------------------------------------------------
     def recalc(self, keep_cg=False):
@@ -262,7 +307,9 @@ class Session:
             if installed:
                 signal.signal(signal.SIGINT, old)
         if flag["hit"]:
-            self.write("Interrupted: stopped after a complete iteration.\n")
+            # the rest of the command (an enclosing loop too) is abandoned; the
+            # surface is the one after the last complete iteration
+            raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
     def hessian(self, seek=False, max_scale=None, echo=True):
         """``hessian``: one Newton step on the constrained problem;
@@ -537,6 +584,9 @@ class Session:
             "refine_count": lambda: self.counts.get("refine", 0), "where_count": lambda: 0,
             "random": lambda: float(self.rng.random()),
             "quantity_count": lambda: len(s.quantities),
+            "symmetry_group": lambda: 0, "simplex_representation": lambda: 0,
+            "lagrange_order": lambda: 1, "linear": lambda: 1, "quadratic": lambda: 0,
+            "date_and_time": lambda: time.strftime("%a %b %d %H:%M:%S %Y"),
         }
         fn = simple.get(name)
         if fn is None:
@@ -581,6 +631,8 @@ class Session:
 
     def _gen_base(self, base, env):
         tag = base[0]
+        if "facetedge" in base[1:3]:
+            raise UnsupportedError("facetedge elements")
         if tag == "var":
             el = env.lookup(base[1])
             if not isinstance(el, I.ElemRef):
@@ -614,7 +666,14 @@ class Session:
         i = el.i
         if el.kind == "vertex":
             if kind == "edge":
-                return [I.ElemRef("edge", int(e)) for e in np.nonzero((s.E == i).any(axis=1))[0]]
+                # oriented away from the vertex (oid < 0 where it is the head);
+                # the Evolver's order on a freshly loaded surface: the first
+                # edge, then the others newest first
+                es = np.nonzero((s.E == i).any(axis=1))[0]
+                ids = s.ids("edge")[es]
+                es = es[np.argsort(ids, kind="stable")]
+                es = list(es[:1]) + list(es[1:][::-1])
+                return [I.ElemRef("edge", int(e), 1 if s.E[e, 0] == i else -1) for e in es]
             if kind == "facet":
                 return [I.ElemRef("facet", int(f)) for f in np.nonzero((s.F == i).any(axis=1))[0]]
         if el.kind == "edge":
@@ -624,9 +683,16 @@ class Session:
                     a, b = b, a
                 return [I.ElemRef("vertex", int(a)), I.ElemRef("vertex", int(b))]
             if kind == "facet":
+                # oriented like the edge: oid < 0 where the facet runs against it
                 from .geometry import edge_index
-                idx, _ = edge_index(s.FE)
-                return [I.ElemRef("facet", int(f)) for f in np.nonzero((idx == i).any(axis=1))[0]]
+                idx, sgn = edge_index(s.FE)
+                out = []
+                for f in np.nonzero((idx == i).any(axis=1))[0]:
+                    g = int(sgn[f][np.nonzero(idx[f] == i)[0][0]]) * el.sign
+                    out.append(I.ElemRef("facet", int(f), g))
+                # the facet running along the edge first (REF, two-facet edges)
+                out.sort(key=lambda r: -r.sign * el.sign)
+                return out
         if el.kind == "facet":
             from .geometry import edge_index
             if kind == "vertex":
@@ -663,12 +729,23 @@ class Session:
             return float(arr[i]) if arr is not None else 0.0     # 0: no original (REF)
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
+            conv = int if self.attr_types.get((k, name)) == "integer" else float
             if arr.ndim == 1:
-                return float(arr[i])
-            j = int(idx) if idx is not None else 1
-            return float(arr[i, j - 1])
+                return conv(arr[i])
+            return conv(arr[(i,) + self._attr_pos(k, name, arr, idx)])
+        if name == "show":          # the default show criteria (graphics are not drawn)
+            if k == "facet":
+                return 1.0
+            if k == "edge":
+                return float(bool(s.eattr["fixed"][i]) or
+                             len(self.sub_elements(base, "facet")) != 2)
         if k == "vertex":
             coords = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}
+            if name == "x" and idx is not None:          # x[2] is y
+                j = int(idx) if not isinstance(idx, tuple) else -1
+                if j < 1 or j > s.sdim:
+                    raise ExpressionError(f"vertex x[{j}]: index outside 1..{s.sdim}")
+                return float(s.X[i, j - 1])
             if name in coords:
                 return float(s.X[i, coords[name]])
             if name == "__x" and idx is not None:
@@ -683,6 +760,16 @@ class Session:
                 return float(b is not None and b[i] == int(idx))
             if name == "valence":
                 return float(np.count_nonzero((s.E == i).any(axis=1)))
+            if name in ("vertexnormal", "vertex_normal"):
+                if idx is None or isinstance(idx, tuple):
+                    raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
+                j = int(idx)
+                if j < 1 or j > s.sdim:
+                    raise ExpressionError(f"{name}[{j}]: index outside 1..{s.sdim}")
+                from .geometry import vertex_normals
+                if s.nf == 0:
+                    raise UnsupportedError("vertex_normal in the string model")
+                return float(vertex_normals(s.F, t.facet_N2, s.nv)[i, j - 1])
             if name in ("p1", "p2") and "params" in s.vattr:
                 return float(s.vattr["params"][i, int(name[1]) - 1])
         elif k == "edge":
@@ -711,7 +798,13 @@ class Session:
             if name == "area":
                 return float(t.facet_area[i])
             if name in ("x", "y", "z"):
-                return float(0.5 * t.facet_N2[i, "xyz".index(name)] * base.sign)
+                j = "xyz".index(name)
+                if s.periods is None and s.sdim == 3:
+                    # the Evolver's order of operations: (side 1) x (side 2), so
+                    # signed zeros come out as in its exporters' output
+                    a, b, c = s.X[s.F[i]]
+                    return float(0.5 * np.cross(b - a, c - b)[j] * base.sign)
+                return float(0.5 * t.facet_N2[i, j] * base.sign)
             if name in ("tension", "density"):
                 return float(s.facet_tension[i])
             if name == "fixed":
@@ -720,8 +813,11 @@ class Session:
                 m = s.fcon.get(int(idx))
                 return float(m[i]) if m is not None else 0.0
             if name in ("color", "colour", "frontcolor", "backcolor"):
-                c = s.fattr.get(name.replace("colour", "color"))
-                return float(c[i]) if c is not None else 0.0
+                key = name.replace("colour", "color")
+                c = s.fattr.get("backcolor" if key == "backcolor" else "frontcolor")
+                if c is None:
+                    c = s.fattr.get("color")
+                return float(c[i]) if c is not None else 15.0     # white (REF default)
             if name == "valence":
                 return 3.0
         elif k == "body":
@@ -740,9 +836,36 @@ class Session:
                 return float(b.density[i])
             if name == "fixed":
                 return float(not math.isnan(b.target[i]))
+        if name in I._KIND and idx is not None:       # ff.edge[2], ee.vertex[1]
+            kind = I._KIND[name]
+            if kind == "facetedge":
+                raise UnsupportedError("facetedge elements")
+            subs = self.sub_elements(base, kind)
+            j = int(idx)
+            if j < 1 or j > len(subs):
+                raise ExpressionError(f"{base}.{kind}[{j}] does not exist ({k} {int(eid)} has "
+                                      f"{len(subs)} {kind}{'s' if len(subs) != 1 else ''})")
+            return subs[j - 1]
         if name in s.quantities:
             raise UnsupportedError(f"per-element quantity values ({k}.{name})")
         raise ExpressionError(f"{k} has no attribute '{name}'")
+
+    @staticmethod
+    def _attr_pos(k, name, arr, idx):
+        """0-based position inside an array attribute from 1-based indices."""
+        if idx is None:
+            raise ExpressionError(f"{k} attribute '{name}' is an array; index it as "
+                                  f"{name}[i]")
+        idx = idx if isinstance(idx, tuple) else (idx,)
+        if len(idx) != arr.ndim - 1:
+            raise ExpressionError(f"{k} attribute '{name}' needs {arr.ndim - 1} "
+                                  f"ind{'ices' if arr.ndim > 2 else 'ex'}, got {len(idx)}")
+        pos = []
+        for j, n in zip(idx, arr.shape[1:]):
+            if isinstance(j, str) or int(j) < 1 or int(j) > n:
+                raise ExpressionError(f"{k} attribute {name}[{j}]: index outside 1..{n}")
+            pos.append(int(j) - 1)
+        return tuple(pos)
 
     def _quantity_attr(self, qname, name):
         q = self.surface.quantities[qname]
@@ -774,13 +897,19 @@ class Session:
         k, i = base.kind, base.i
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
+            if self.attr_types.get((k, name)) == "integer":
+                value = float(int(value))            # C conversion truncates
             if arr.ndim == 1:
                 arr[i] = value
             else:
-                arr[i, (int(idx) if idx is not None else 1) - 1] = value
+                arr[(i,) + self._attr_pos(k, name, arr, idx)] = value
             return
         if k == "vertex" and name in ("x", "y", "z", "x1", "x2", "x3"):
             j = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}[name]
+            if name == "x" and idx is not None:
+                j = int(idx) - 1 if not isinstance(idx, tuple) else -1
+                if j < 0 or j >= s.sdim:
+                    raise CommandError(f"vertex x[{j + 1}]: index outside 1..{s.sdim}")
             s.X[i, j] = value
             return
         if k == "body":
@@ -802,32 +931,174 @@ class Session:
         if k == "facet" and name in ("tension", "density"):
             s.fattr["tension"][i] = value
             return
+        if k in ("edge", "facet") and name in ("color", "colour", "frontcolor", "backcolor"):
+            attrs, n = (s.eattr, s.ne) if k == "edge" else (s.fattr, s.nf)
+            name = name.replace("colour", "color")
+            default = 0 if k == "edge" else 15
+            if "color" not in attrs:
+                attrs["color"] = np.full(n, default, np.int64)
+            if name == "color":
+                for key in ("color", "frontcolor", "backcolor"):
+                    if key in attrs:
+                        attrs[key][i] = int(value)
+            elif name == "frontcolor":
+                for key in ("color", "frontcolor"):
+                    if key in attrs:
+                        attrs[key][i] = int(value)
+            else:
+                if name not in attrs:
+                    attrs[name] = attrs["color"].copy()
+                attrs[name][i] = int(value)
+            return
+        if k in ("vertex", "edge", "facet") and name in ("fixed", "no_refine"):
+            attrs = {"vertex": s.vattr, "edge": s.eattr, "facet": s.fattr}[k]
+            if name not in attrs:
+                attrs[name] = np.zeros(self.count(k), bool)
+            attrs[name][i] = bool(value)
+            return
         if k == "edge" and name in ("tension", "density"):
             s.eattr.setdefault("tension", np.zeros(s.ne))[i] = value
             return
         raise CommandError(f"cannot assign to {k} attribute '{name}'")
 
-    def set_elements(self, gen, attr, expr, env, unset):
+    def set_elements(self, gen, attr, expr, env, unset, idx=None):
         els = self.generate(gen, env)
+        if attr in ("fixed", "no_refine") and (expr is None or unset):
+            if gen.kind == "body":
+                raise CommandError(f"bodies cannot be {'un' if unset else ''}set {attr}; "
+                                   f"use 'set body target expr' / 'unset body target'")
+            for el in els:
+                self.set_attr(el, attr, None, 0.0 if unset else 1.0)
+            return
         if unset:
-            raise UnsupportedError(f"unset {attr}", "comes with the evolve issue")
+            if attr in ("constraint",) and expr is not None:
+                self.unset_constraint(els, int(self.interp.value(expr)))
+                return
+            if attr == "target" and gen.kind == "body":
+                b = self.surface.bodies
+                for el in els:
+                    b.target[el.i] = np.nan
+                return
+            if attr == "pressure" and gen.kind == "body":
+                b = self.surface.bodies
+                for el in els:
+                    b.pressure[el.i] = np.nan
+                return
+            if (gen.kind, attr) in self.surface.extra:
+                for el in els:
+                    self.set_attr(el, attr, None, 0.0)
+                return
+            raise UnsupportedError(f"unset {gen.kind} {attr}")
         if expr is None:
             raise UnsupportedError(f"set {gen.kind} {attr} (without a value)")
         # compute every value first, then assign (like the Evolver's set)
         vals = []
+        ix = None if idx is None else self.interp.value(idx)
         for el in els:
             with env.element(el, gen.var):
                 vals.append(self.interp.value(expr))
         for el, v in zip(els, vals):
-            self.set_attr(el, attr, None, v)
+            self.set_attr(el, attr, ix, v)
         if gen.kind == "vertex" and attr in ("x", "y", "z"):
             project_to_constraints(self.surface, np.array([e.i for e in els], np.int64))
+
+    def unset_constraint(self, els, cid):
+        s = self.surface
+        if cid not in s.vcon and cid not in s.econ and cid not in s.fcon:
+            return
+        for el in els:
+            table = {"vertex": s.vcon, "edge": s.econ, "facet": s.fcon}.get(el.kind)
+            if table is None:
+                raise CommandError("constraints belong to vertices, edges and facets")
+            m = table.get(cid)
+            if m is not None:
+                m[el.i] = 0
+
+    def fix_elements(self, els, on):
+        """``fix``/``unfix`` elements; returns how many changed."""
+        n = 0
+        for el in els:
+            if el.kind == "body":
+                raise CommandError("cannot fix or unfix bodies; to fix a volume use "
+                                   "'set body target expr', to free it 'unset body target'")
+            old = self.get_attr(el, "fixed", None)
+            if bool(old) != bool(on):
+                self.set_attr(el, "fixed", None, 1.0 if on else 0.0)
+                n += 1
+        return n
+
+    def fix_name(self, name, on):
+        """``fix quantity`` / ``unfix quantity``."""
+        s = self.surface
+        if name in s.quantities:
+            q = s.quantities[name]
+            if on:
+                q.target = float(self.totals.quantity_values[name])
+                q.kind = "fixed"
+            else:
+                q.kind = "info_only" if q.kind == "fixed" else q.kind
+            return
+        if name in self.variables:
+            raise UnsupportedError(f"{'fix' if on else 'unfix'} {name} (optimizing parameters)")
+        raise CommandError(f"{'fix' if on else 'unfix'}: '{name}' is not a quantity "
+                           f"(expected: fix element_generator or fix quantity_name)")
+
+    def define_attribute(self, kind, name, typ, shape):
+        """``define vertex attribute name real[3]`` at run time."""
+        s = self.surface
+        if typ not in ("real", "integer"):
+            raise UnsupportedError(f"{typ} element attributes", "real and integer are supported")
+        if kind == "facetedge":           # declared; facetedges themselves are refused when used
+            self.attr_types[(kind, name)] = typ
+            return
+        n = self.count(kind)
+        key = (kind, name)
+        new = np.zeros((n,) + tuple(shape)) if shape else np.zeros(n)
+        old = s.extra.get(key)
+        if old is not None:
+            if old.shape == new.shape:
+                self.attr_types[key] = typ
+                return
+            if old.ndim == new.ndim:               # resizing keeps the values
+                sl = tuple(slice(0, min(a, b)) for a, b in zip(old.shape, new.shape))
+                new[sl] = old[sl]
+        s.extra[key] = new
+        self.attr_types[key] = typ
+
+    def read_file(self, name):
+        """``read "file"``: run a command file (the current directory first,
+        then the directories of EVOLVERPATH).  An error stops the file."""
+        import os
+        cands = [name]
+        if not os.path.isabs(name):
+            for d in os.environ.get("EVOLVERPATH", "").split(os.pathsep):
+                if d:
+                    cands.append(os.path.join(d, name))
+        path = next((c for c in cands if os.path.isfile(c)), None)
+        if path is None:
+            raise CommandError(f"read: cannot find file '{name}' (looked in the current "
+                               f"directory and EVOLVERPATH)")
+        if len(self.interp.env.scopes) > 200:
+            raise CommandError(f"read \"{name}\": files read each other too deeply")
+        try:
+            with open(path, encoding="latin-1") as fh:
+                text = fh.read()
+        except OSError as exc:
+            raise CommandError(f"read: cannot read '{name}': {exc.strerror}") from None
+        try:
+            self.run(text, where=path, line=1, stop_on_error=True)
+        except I.Quit:
+            raise
+        except PyEvolverError as exc:
+            # like the Evolver, an error abandons the rest of the file; what
+            # ran before it stays done
+            self.write_err(f"{exc}\n")
 
     # -- listing ---------------------------------------------------------------------------------
     def list_elements(self, gen, env):
         s = self.surface
         els = self.generate(gen, env)
-        kind = gen.kind
+        kind = gen.kind or (els[0].kind if els else None)
         t = self.totals
         w = self.write
         vid, eid, fid = s.ids("vertex"), s.ids("edge"), s.ids("facet")

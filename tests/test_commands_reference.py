@@ -83,7 +83,7 @@ def test_quantities_v_report(evolver, tmp_path):
 
 
 READ_SECTION_FILES = ["100grain", "addload_example", "cat", "catbody", "catman", "column",
-                      "crystal", "cube", "knotty", "metric", "mound", "octa", "phelanc",
+                      "crystal", "cube", "knotty", "metric", "mound", "mylarcube", "octa", "phelanc",
                       "popstr", "qmound", "quad", "quadm", "relaxed", "simplex3", "slidestr",
                       "sphere", "symtest", "tankex", "twointor"]
 
@@ -91,7 +91,7 @@ READ_SECTION_FILES = ["100grain", "addload_example", "cat", "catbody", "catman",
 @pytest.mark.parametrize("name", READ_SECTION_FILES)
 def test_read_sections_of_examples_parse(evolver, name):
     """Every command in the read sections of the shipped examples parses
-    (mylarcube.fe uses array attributes, Tier 2, and is left out)."""
+    (mylarcube.fe's array attributes and `r :::=` included)."""
     from pyevolver.commands.interpreter import split_commands, parse_command
     from pyevolver.datafile.preprocess import preprocess, read_source
     path = example(name + ".fe")

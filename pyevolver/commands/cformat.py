@@ -67,8 +67,19 @@ def c_format(fmt, args):
     return "".join(out)
 
 
+def print_array(a):
+    """``print array``: nested braces, numbers ``%2.15g`` (REF layout)."""
+    def row(x, depth):
+        if x.ndim == 1:
+            return "{" + ",".join(v if isinstance(v, str) else "%2.15g" % v for v in x) + "}"
+        return "{" + (",\n" + " " * (depth + 1)).join(row(y, depth + 1) for y in x) + "}"
+    return row(a, 0)
+
+
 def print_value(v):
     """``print expr``: numbers with ``%20.15g``, strings as they are."""
     if isinstance(v, str):
         return v
+    if isinstance(v, int):              # integer-typed attributes print as integers (REF)
+        return "%d" % v
     return "%20.15g" % float(v)

@@ -17,7 +17,7 @@ from lark.exceptions import UnexpectedInput, VisitError
 from ..errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
-from .cformat import c_format, print_value
+from .cformat import c_format, print_array, print_value
 
 _HERE = os.path.dirname(__file__)
 
@@ -61,21 +61,26 @@ def _scan(text):
     in_str = False
     in_comment = False
     start = None
+    opened = False          # the buffered command has had a '{'
     for lineno, line in enumerate(text.split("\n"), 1):
         i = 0
         n = len(line)
-        code_end = n
+        code = []               # the line without its comments
         while i < n:
             c = line[i]
             if in_comment:
                 if line.startswith("*/", i):
                     in_comment = False
+                    code.append("  ")
                     i += 2
                     continue
+                code.append(" ")
                 i += 1
                 continue
             if in_str:
+                code.append(c)
                 if c == "\\":
+                    code.append(line[i + 1:i + 2])
                     i += 2
                     continue
                 if c == '"':
@@ -85,35 +90,46 @@ def _scan(text):
             if c == '"':
                 in_str = True
             elif line.startswith("//", i):
-                code_end = i
                 break
             elif line.startswith("/*", i):
                 in_comment = True
+                code.append("  ")
                 i += 2
                 continue
             elif c in "{(":
                 depth += 1
+                if c == "{":
+                    opened = True
             elif c in "})":
                 depth -= 1
+            code.append(c)
             i += 1
-        if not line[:code_end].strip() and not in_comment and not in_str and depth == 0:
-            continue            # blank lines neither start nor end a command
+        # commands are kept without their comments (blanked, so columns stay)
+        code = "".join(code)
+        if not code.strip() and not in_str:
+            if buf:
+                buf.append(code)    # inside an unfinished command
+            continue                # blank and comment lines neither start nor end one
         if start is None:
             start = lineno
-        buf.append(line)
-        tail = line[:code_end].rstrip()
+        buf.append(code)
+        tail = code.rstrip()
         if depth > 0 or in_str or in_comment or tail.endswith(_CONT_END) or \
                 _ends_with_keyword(tail):
             continue
+        if not opened and not tail.endswith(";") and _PROC_START.match("\n".join(buf)):
+            continue        # a procedure/function header waits for its body (or ';')
         out.append(("\n".join(buf), start))
         buf = []
         start = None
         depth = 0
+        opened = False
     pending = ("\n".join(buf), start) if buf else None
     # an 'else' at the start of a command belongs to the previous 'if'
     merged = []
     for chunk, ln in out:
-        if merged and _starts_with_else(chunk):
+        if merged and (_starts_with_else(chunk) or
+                       (_WHILE_START.match(chunk) and _DO_OPEN.match(merged[-1][0]))):
             prev, pln = merged[-1]
             merged[-1] = (prev + "\n" + chunk, pln)
         else:
@@ -123,6 +139,9 @@ def _scan(text):
 
 _KW_END = re.compile(r"(?:^|[^A-Za-z0-9_])(then|else|do)$", re.I)
 _ELSE_START = re.compile(r"\s*else\b", re.I)
+_WHILE_START = re.compile(r"\s*while\b", re.I)
+_DO_OPEN = re.compile(r"\s*do\s*\{.*\}\s*$", re.I | re.S)      # `do { ... }` waiting for `while`
+_PROC_START = re.compile(r"(?:\s|/\*.*?\*/|//[^\n]*)*(procedure|function)\b", re.I | re.S)
 
 
 def _ends_with_keyword(tail):
@@ -160,7 +179,7 @@ class QRef:
 
 _KIND = {"vertex": "vertex", "vertices": "vertex", "edge": "edge", "edges": "edge",
          "facet": "facet", "facets": "facet", "face": "facet", "faces": "facet",
-         "body": "body", "bodies": "body"}
+         "body": "body", "bodies": "body", "facetedge": "facetedge", "facetedges": "facetedge"}
 
 
 class ElemIndex(N.Node):
@@ -187,10 +206,17 @@ class Attr(N.Node):
 
     def ev(self, env):
         base = self.base.ev(env)
-        idx = None if self.index is None else self.index.ev(env)
+        if self.index is None:
+            idx = None
+        elif isinstance(self.index, list):
+            idx = tuple(i.ev(env) for i in self.index)
+        else:
+            idx = self.index.ev(env)
         return env.session.get_attr(base, self.name, idx)
 
     def children(self):
+        if isinstance(self.index, list):
+            return (self.base,) + tuple(self.index)
         return (self.base,) + ((self.index,) if self.index is not None else ())
 
 
@@ -232,6 +258,76 @@ class OnTest(N.Node):
         if el is None:
             raise ExpressionError(f"{self.what} needs an element (use it in a where clause)")
         return env.session.get_attr(el, self.what, self.arg.ev(env))
+
+
+class UserCall(N.Node):
+    """``name(args)`` in an expression: a user function or a string builtin."""
+
+    __slots__ = ("name", "args")
+
+    def __init__(self, name, args):
+        self.name = name.lower()
+        self.args = args
+
+    def ev(self, env):
+        return env.session.interp.call_in_expr(self.name, self.args)
+
+    def children(self):
+        return tuple(self.args)
+
+
+class ArrayRef(N.Node):
+    """``arr[i][j]`` of an array variable (1-based, as in the Evolver)."""
+
+    __slots__ = ("name", "index")
+
+    def __init__(self, name, index):
+        self.name = name.lower()
+        self.index = index
+
+    def ev(self, env):
+        interp = env.session.interp
+        idx = [interp.value(i) for i in self.index]
+        if self.name not in env.session.arrays and env.current() is not None:
+            # a bare indexed attribute inside a generator: form_factors[2]
+            return env.session.get_attr(env.current(), self.name,
+                                        idx[0] if len(idx) == 1 else tuple(idx))
+        arr, pos = interp.array_slot(self.name, idx)
+        v = arr[pos]
+        return v if isinstance(v, str) else float(v)
+
+    def children(self):
+        return tuple(self.index)
+
+
+class Sprintf(N.Node):
+    __slots__ = ("args",)
+
+    def __init__(self, args):
+        self.args = args
+
+    def ev(self, env):
+        interp = env.session.interp
+        vals = [interp.value(a) for a in self.args]
+        if not vals or not isinstance(vals[0], str):
+            raise ExpressionError("sprintf needs a format string first")
+        return c_format(vals[0], vals[1:])
+
+    def children(self):
+        return tuple(self.args)
+
+
+class Proc:
+    """A user command: ``name := {...}`` (no parameters), ``procedure``
+    or ``function``."""
+
+    __slots__ = ("name", "params", "body", "function", "text")
+
+    def __init__(self, name, params, body, function=False):
+        self.name = name
+        self.params = params          # [(type, name)]
+        self.body = body              # statement tuple, None for a prototype
+        self.function = function
 
 
 class Generator:
@@ -307,6 +403,112 @@ class _CmdTransformer(ExprTransformer):
     def foreach(self, _f, gen, _d, body):
         return ("foreach", gen, body)
 
+    def redirect(self, body, op, target):
+        return ("redirect", body, str(op), target)
+
+    def pipe(self, body, _p, target):
+        return ("pipe",)
+
+    def params(self, *ps):
+        return list(ps)
+
+    def param(self, typ, name):
+        return (str(typ).lower(), str(name).lower())
+
+    def procedure(self, _p, name, *rest):
+        params = rest[0] if len(rest) == 2 else []
+        return ("procdef", Proc(str(name).lower(), params, rest[-1]))
+
+    def prototype(self, _p, name, params=None):
+        return ("procdef", Proc(str(name).lower(), params or [], None))
+
+    def function(self, _f, typ, name, *rest):
+        params = rest[0] if len(rest) == 2 else []
+        return ("procdef", Proc(str(name).lower(), params, rest[-1], function=True))
+
+    def fprototype(self, _f, typ, name, params=None):
+        return ("procdef", Proc(str(name).lower(), params or [], None, function=True))
+
+    def redefine(self, name, _r, body):
+        return ("redefine", str(name), body)
+
+    def redefine_restore(self, name, _r):
+        return ("redefine", str(name), None)
+
+    def builtin_letter(self, tok):
+        return ("bare", str(tok)[1], None, True)
+
+    def local_(self, _l, *names):
+        return ("local", [str(n).lower() for n in names])
+
+    def dims(self, *exprs):
+        return list(exprs)
+
+    def define_attr(self, _d, kind, _a, name, typ, dims=None):
+        return ("define_attr", _KIND[str(kind).lower()], str(name).lower(), str(typ).lower(),
+                dims or [])
+
+    def define_fe_attr(self, _d, *rest):
+        return ("unsupported", "facetedge attributes")
+
+    def define_array(self, _d, name, typ, dims=None):
+        return ("define_array", str(name).lower(), str(typ).lower(), dims or [])
+
+    def read(self, _r, expr=None):
+        return ("read", expr)
+
+    def abort(self, _a):
+        return ("abort",)
+
+    def fix(self, _f, gen):
+        return ("fix", gen, True)
+
+    def unfix(self, _f, gen):
+        return ("fix", gen, False)
+
+    def fix_name(self, _f, name):
+        return ("fix_name", str(name).lower(), True)
+
+    def unfix_name(self, _f, name):
+        return ("fix_name", str(name).lower(), False)
+
+    def histogram(self, tok, gen, expr):
+        return ("histogram", gen, expr, str(tok).lower() == "loghistogram")
+
+    def call_stmt(self, name, *args):
+        return ("call", str(name).lower(), [a for a in args if a is not None])
+
+    def user_call(self, name, *args):
+        return UserCall(str(name), [a for a in args if a is not None])
+
+    def array_ref(self, name, *idx):
+        return ArrayRef(str(name), list(idx))
+
+    def sprintf_expr(self, _s, *args):
+        return Sprintf(list(args))
+
+    def array_lit(self, *items):
+        return list(items)
+
+    def assign_array(self, lv, _a, items):
+        return ("assign_array", lv, items)
+
+    def define_other(self, _d, what, name):
+        return ("unsupported", f"define {str(what).lower()}")
+
+    def lv_array(self, name, *idx):
+        return ("array", str(name).lower(), list(idx))
+
+    def set_idx(self, _s, base, attr, idx, expr, *rest):
+        _, where = self._split_where(rest)
+        return ("set", Generator(base, None, where), str(attr).lower(), expr, idx)
+
+    def set_dot(self, _s, var, attr, *rest):
+        rest, where = self._split_where(rest)
+        idx = rest[0] if len(rest) == 2 else None
+        return ("set", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
+                rest[-1], idx)
+
     def define(self, lv, _a, body):
         if lv[0] != "name":
             raise CommandError("only a name can be defined as a command")
@@ -327,8 +529,8 @@ class _CmdTransformer(ExprTransformer):
     def lv_attr(self, base, name):
         return ("attr", base, name, None)
 
-    def lv_attr_index(self, base, name, idx):
-        return ("attr", base, name, idx)
+    def lv_attr_index(self, base, name, *idx):
+        return ("attr", base, name, idx[0] if len(idx) == 1 else list(idx))
 
     def attr_name(self, tok):
         return str(tok).lower()
@@ -368,22 +570,9 @@ class _CmdTransformer(ExprTransformer):
         return ("set", Generator(base, str(var).lower(), where), str(attr).lower(),
                 rest[0] if rest else None)
 
-    def set_elemvar(self, _s, var, attr, *rest):
-        rest, where = self._split_where(rest)
-        return ("set", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
-                rest[0] if rest else None)
-
     def unset(self, _s, base, attr, *rest):
         rest, where = self._split_where(rest)
         return ("unset", Generator(base, None, where), str(attr).lower(), rest[0] if rest else None)
-
-    def unset_elemvar(self, _s, var, attr, *rest):
-        rest, where = self._split_where(rest)
-        return ("unset", Generator(("var", str(var).lower()), None, where), str(attr).lower(),
-                rest[0] if rest else None)
-
-    def sprintf_assign(self, lv, _a, _s, *args):
-        return ("sprintf", lv, list(args))
 
     def refine(self, _r, gen):
         return ("refine", gen)
@@ -418,7 +607,10 @@ class _CmdTransformer(ExprTransformer):
         return ("define", lv[1], ("seq", []))
 
     def unsupported(self, tok, body=None):
-        word = str(tok).split()[0].lower()
+        words = str(tok).split()
+        word = words[0].lower()
+        if word == "define" and len(words) > 1:
+            word = "define " + words[1].lower() + " (at run time)"
         return ("unsupported", word)
 
     def generator(self, base, *rest):
@@ -440,14 +632,17 @@ class _CmdTransformer(ExprTransformer):
     def gen_sub(self, base, kind, idx=None):
         return ("sub", base, _KIND[str(kind).lower()], idx)
 
+    def gen_var(self, name):
+        return ("var", str(name).lower())
+
     def gen_var_sub(self, name, kind, idx=None):
         return ("varsub", str(name).lower(), _KIND[str(kind).lower()], idx)
 
     def attr(self, base, name):
         return Attr(base, name)
 
-    def attr_index(self, base, name, idx):
-        return Attr(base, name, idx)
+    def attr_index(self, base, name, *idx):
+        return Attr(base, name, idx[0] if len(idx) == 1 else list(idx))
 
     def elem_ref(self, kind, idx):
         return ElemIndex(str(kind), idx)
@@ -462,8 +657,27 @@ class _CmdTransformer(ExprTransformer):
 _TRANSFORMER = _CmdTransformer()
 
 
+# `set vertex y y+dy` could read as "set, with loop name y, attribute y to +dy"
+# (the grammar's choice); the Evolver means "attribute y to y+dy".  Unless the
+# second name is an attribute and the first is not, the value is made to start
+# with a number (`0+y+dy`, the same value) so that only that reading parses.
+_SET_AMBIG = re.compile(r"\bset(\s+)(vertices|vertex|edges|edge|facets|facet|faces|face|bodies|body)"
+                        r"(\s*\[[^\[\]]*\])?(\s+)([a-z_]\w*)(\s+)([a-z_]\w*)(?=\s*[-+])", re.I)
+
+
+def _disambiguate_set(text):
+    def fix(m):
+        first, second = m.group(5).lower(), m.group(7).lower()
+        if second in SETTABLE_ATTRS and first not in SETTABLE_ATTRS:
+            return m.group(0)
+        return (m.group(0)[:m.start(7) - m.start(0)] + "0+" + m.group(7))
+    return _SET_AMBIG.sub(fix, text)
+
+
 def parse_command(text, where="<command>", line=1):
     """Parse one complete command; raises :class:`CommandError` with location."""
+    if "set" in text.lower():
+        text = _disambiguate_set(text)
     try:
         tree = command_parser().parse(text)
         return _TRANSFORMER.transform(tree)
@@ -497,7 +711,12 @@ class _Continue(Exception):
 
 
 class _Return(Exception):
-    pass
+    def __init__(self, value=None):
+        self.value = value
+
+
+class Interrupted(Exception):
+    """Ctrl-C: the running command stops and the prompt returns."""
 
 
 class Quit(Exception):
@@ -511,6 +730,7 @@ class Env:
     def __init__(self, session):
         self.session = session
         self.frames = []        # [(var name or None, ElemRef)]
+        self.scopes = []        # local variables of the running commands: [dict]
 
     def current(self):
         return self.frames[-1][1] if self.frames else None
@@ -531,8 +751,12 @@ class Env:
             if var == name:
                 return el
         s = self.session
+        if self.scopes and name in self.scopes[-1]:
+            return self.scopes[-1][name]
         if name in s.variables:
             return s.variables[name]
+        if name in s.arrays:
+            raise ExpressionError(f"'{name}' is an array; index it as {name}[i]")
         if self.frames:
             el = self.frames[-1][1]
             try:
@@ -544,6 +768,40 @@ class Env:
 
 # ---------------------------------------------------------------------------
 # the interpreter
+
+
+def histogram_text(vals, log=False):
+    """The ``histogram``/``loghistogram`` report: the Evolver's bins (21 equal
+    bins from the least to the greatest value; 20 logarithmic bins over the
+    positive values, with a ``<= 0.0`` line counting the others)."""
+    if not vals:
+        return "No qualifying values.\n"
+    out = []
+    if log:
+        nonpos = sum(1 for v in vals if v <= 0)
+        vals = [v for v in vals if v > 0]
+        if nonpos:
+            out.append("          <= 0.0           %d" % nonpos)
+        if not vals:
+            return "\n".join(out) + "\n"
+    lo, hi = min(vals), max(vals)
+    if hi <= lo:
+        out.append("%10.5g - %10.5g     %d" % (lo, hi, len(vals)))
+        return "\n".join(out) + "\n"
+    nbins = 20 if log else 21
+    if log:
+        a, b = np.log(lo), np.log(hi)
+        keys = [(np.log(v) - a) / (b - a) * nbins for v in vals]
+        edges = [float(np.exp(a + (b - a) * k / nbins)) for k in range(nbins + 1)]
+    else:
+        keys = [(v - lo) / (hi - lo) * nbins for v in vals]
+        edges = [lo + (hi - lo) * k / nbins for k in range(nbins + 1)]
+    counts = [0] * nbins
+    for k in keys:
+        counts[min(nbins - 1, max(0, int(k)))] += 1
+    for k in range(nbins):
+        out.append("%10.5g - %10.5g     %d" % (edges[k], edges[k + 1], counts[k]))
+    return "\n".join(out) + "\n"
 
 
 LETTER_LATER = {
@@ -569,7 +827,7 @@ TOGGLES = {
     "conj_grad", "check_increase", "autopop", "autochop", "quiet", "quietgo",
     "hessian_normal", "normal_motion", "area_normalization", "effective_area",
     "normal_curvature", "assume_oriented", "autorecalc", "estimate", "volgrads_every",
-    "verbose", "ribiere", "approximate_curvature", "runge_kutta", "kraynikpopvertex",
+    "verbose", "ribiere", "approximate_curvature", "rgb_colors", "runge_kutta", "kraynikpopvertex",
     "kraynikpopedge", "hessian_diff", "linear_metric", "post_project", "gravity",
     "keep_macros", "brief", "itdebug", "memdebug", "visibility_test", "clipped",
     "connected", "thicken", "smooth_graph", "pscolorflag", "gridflag", "crossingflag",
@@ -580,6 +838,9 @@ TOGGLES = {
 }
 GRAPHICS = {"s", "P", "show", "show_expr", "transforms", "transform_expr", "geomview",
             "postscript", "showq", "view_transforms", "ps", "oogl", "gv", "screen"}
+SETTABLE_ATTRS = {"x", "y", "z", "x1", "x2", "x3", "color", "colour", "frontcolor", "backcolor",
+                  "tension", "density", "fixed", "no_refine", "target", "pressure", "volconst",
+                  "constraint", "boundary", "opacity"}
 TOGGLE_DEFAULTS = {"hessian_normal": 1, "autorecalc": 1, "ribiere": 1}
 
 
@@ -652,20 +913,196 @@ class Interpreter:
                 self.execute(step)
 
     def _x_foreach(self, node):
+        # the elements are listed first (ones created by the body are not
+        # visited) but, as in the Evolver, `where` is tested when each element
+        # is reached, on the surface the earlier passes left
         gen, body = node[1], node[2]
-        for el in list(self.session.generate(gen, self.env)):
+        for el in list(self.session._gen_base(gen.base, self.env)):
             with self.env.element(el, gen.var):
+                if gen.where is not None:
+                    v = gen.where.ev(self.env)
+                    if isinstance(v, str) or not v:
+                        continue
                 if not self._loop(body):
                     break
 
     def _x_define(self, node):
         name = node[1].lower()
         if len(node[1]) < 2:
-            raise UnsupportedError(f"redefining the single-letter command '{node[1]}'",
-                                   "use :::= (Tier 2)")
+            raise CommandError(f"'{node[1]}' is a single-letter command; redefine it with "
+                               f"{node[1]} :::= {{ ... }}")
+        self._check_free(name, "command")
         if name in self.session.variables:
             del self.session.variables[name]
-        self.session.commands[name] = node[2]
+        self.session.commands[name] = Proc(name, [], node[2])
+
+    def _check_free(self, name, what):
+        s = self.session
+        from ..session import READ_ONLY
+        if name in READ_ONLY or name in s.settings or name in TOGGLES or \
+                (s.surface is not None and name in s.surface.quantities):
+            raise CommandError(f"'{name}' is a built-in name; it cannot be a {what}")
+
+    def _x_procdef(self, node):
+        proc = node[1]
+        if len(proc.name) < 2:
+            raise CommandError(f"'{proc.name}' is a single-letter command, not a "
+                               f"{'function' if proc.function else 'procedure'} name")
+        self._check_free(proc.name, "function" if proc.function else "procedure")
+        old = self.session.commands.get(proc.name)
+        if proc.body is None and old is not None and old.body is not None:
+            return                      # a prototype after the definition
+        self.session.variables.pop(proc.name, None)
+        self.session.commands[proc.name] = proc
+
+    def _x_redefine(self, node):
+        raw, body = node[1], node[2]
+        if len(raw) != 1:
+            raise CommandError(f":::= redefines single-letter commands; '{raw}' is not one "
+                               f"(use {raw} := {{ ... }})")
+        if body is None:
+            self.session.letters.pop(raw, None)
+        else:
+            self.session.letters[raw] = Proc(raw, [], body)
+
+    def _x_local(self, node):
+        if not self.env.scopes:
+            raise CommandError("'local' is only allowed inside a command body")
+        scope = self.env.scopes[-1]
+        for name in node[1]:
+            if len(name) < 2:
+                raise CommandError(f"'{name}' is a single-letter command, not a variable")
+            scope.setdefault(name, 0.0)
+
+    # -- procedures -------------------------------------------------------------
+    def run_proc(self, proc, args):
+        """Run a user command with argument values; returns the value of
+        ``return expr`` (functions) or None."""
+        if proc.body is None:
+            raise CommandError(f"'{proc.name}' is declared but not defined yet")
+        if len(args) != len(proc.params):
+            raise CommandError(f"{'function' if proc.function else 'procedure'} "
+                               f"'{proc.name}' needs {len(proc.params)} argument"
+                               f"{'s' if len(proc.params) != 1 else ''}, the call has "
+                               f"{len(args)}")
+        if len(self.env.scopes) > 900:
+            raise CommandError(f"'{proc.name}': calls nested too deeply")
+        scope = {name: v for (_, name), v in zip(proc.params, args)}
+        self.env.scopes.append(scope)
+        try:
+            self.execute(proc.body)
+        except _Return as r:
+            return r.value
+        except (_Break, _Continue):
+            return None
+        finally:
+            self.env.scopes.pop()
+        return None
+
+    def call_in_expr(self, name, arg_nodes):
+        s = self.session
+        if name == "sizeof":
+            if len(arg_nodes) != 1:
+                raise ExpressionError("sizeof() takes one argument")
+            a = arg_nodes[0]
+            if isinstance(a, N.Var) and a.name in s.arrays:
+                return float(s.arrays[a.name].size)
+            v = self.value(a)
+            if not isinstance(v, str):
+                raise ExpressionError("sizeof() needs a string or an array")
+            return float(len(v))
+        if name == "is_defined":
+            if len(arg_nodes) != 1:
+                raise ExpressionError("is_defined() takes one argument")
+            v = self.value(arg_nodes[0])
+            if not isinstance(v, str):
+                raise ExpressionError("is_defined() needs a name in a string")
+            return float(self.is_defined(v.lower()))
+        proc = s.commands.get(name)
+        if proc is None:
+            raise ExpressionError(f"unknown function '{name}'")
+        args = [self.value(a) for a in arg_nodes]
+        v = self.run_proc(proc, args)
+        if not proc.function:
+            raise ExpressionError(f"'{name}' is a procedure; it has no value")
+        if v is None:
+            raise ExpressionError(f"function '{name}' ended without 'return value'")
+        return v
+
+    def is_defined(self, name):
+        s = self.session
+        if name in s.commands or name in s.variables or name in s.arrays or \
+                (self.env.scopes and name in self.env.scopes[-1]):
+            return True
+        try:
+            s.internal(name)
+            return True
+        except PyEvolverError:
+            return False
+
+    def _x_call(self, node):
+        name, args = node[1], node[2]
+        proc = self.session.commands.get(name)
+        if proc is None:
+            if len(args) == 1 and name in ("g", "r", "u"):
+                return self._x_bare(("bare", name, args[0]))
+            raise CommandError(f"unknown procedure '{name}'")
+        self.run_proc(proc, [self.value(a) for a in args])
+
+    # -- arrays ----------------------------------------------------------------
+    def _x_define_array(self, node):
+        _, name, typ, dims = node
+        s = self.session
+        if len(name) < 2:
+            raise CommandError(f"'{name}' is a single-letter command, not a variable")
+        shape = []
+        for d in dims:
+            v = self.value(d)
+            if isinstance(v, str) or int(v) < 0:
+                raise CommandError(f"define {name}: array sizes must be numbers >= 0")
+            shape.append(int(v))
+        if not shape:                       # `define name real`: a plain variable
+            if name not in s.variables:
+                s.set_variable(name, "" if typ == "string" else 0.0)
+            return
+        old = s.arrays.get(name)
+        new = np.zeros(shape, dtype=object if typ == "string" else float)
+        if typ == "string":
+            new[...] = ""
+        if old is not None and old.ndim == new.ndim:     # redefining keeps the values
+            sl = tuple(slice(0, min(a, b)) for a, b in zip(old.shape, new.shape))
+            new[sl] = old[sl]
+        s.arrays[name] = new
+        s.array_types[name] = typ
+
+    def array_slot(self, name, idx):
+        s = self.session
+        arr = s.arrays.get(name)
+        if arr is None:
+            raise ExpressionError(f"'{name}' is not an array (define it first: "
+                                  f"define {name} real[n])")
+        if len(idx) != arr.ndim:
+            raise ExpressionError(f"array '{name}' has {arr.ndim} dimension"
+                                  f"{'s' if arr.ndim != 1 else ''}, got {len(idx)} indices")
+        pos = []
+        for k, n in zip(idx, arr.shape):
+            if isinstance(k, str):
+                raise ExpressionError(f"array '{name}': an index must be a number")
+            k = int(k)
+            if k < 1 or k > n:
+                raise ExpressionError(f"array '{name}': index {k} is outside 1..{n}")
+            pos.append(k - 1)
+        return arr, tuple(pos)
+
+    def _x_define_attr(self, node):
+        _, kind, name, typ, dims = node
+        shape = []
+        for d in dims:
+            v = self.value(d)
+            if isinstance(v, str) or int(v) < 0:
+                raise CommandError(f"define {kind} attribute {name}: sizes must be numbers >= 0")
+            shape.append(int(v))
+        self.session.define_attribute(kind, name, typ, shape)
 
     def _x_assign(self, node):
         self._store(node[1], self.value(node[2]))
@@ -682,9 +1119,11 @@ class Interpreter:
     def _load(self, lv):
         if lv[0] == "name":
             return self.env.lookup(lv[1].lower())
+        if lv[0] == "array":
+            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
+            return arr[pos]
         base = lv[1].ev(self.env)
-        idx = None if lv[3] is None else self.value(lv[3])
-        return self.session.get_attr(base, lv[2], idx)
+        return self.session.get_attr(base, lv[2], self._index(lv[3]))
 
     def _store(self, lv, value):
         s = self.session
@@ -696,20 +1135,72 @@ class Interpreter:
             for var, el in self.env.frames:
                 if var == name:
                     raise CommandError(f"cannot assign to loop variable '{name}'")
+            if self.env.scopes and name in self.env.scopes[-1]:
+                self.env.scopes[-1][name] = value
+                return
+            if name in s.commands:
+                del s.commands[name]
+            if name in s.arrays:
+                raise CommandError(f"'{name}' is an array; assign to {name}[i]")
             s.set_variable(name, value)
             return
+        if lv[0] == "array":
+            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
+            if arr.dtype == object:
+                arr[pos] = value if isinstance(value, str) else print_value(value).strip()
+            elif isinstance(value, str):
+                raise CommandError(f"array '{lv[1]}' holds numbers, not strings")
+            else:
+                arr[pos] = value
+            return
         base = lv[1].ev(self.env)
-        idx = None if lv[3] is None else self.value(lv[3])
-        s.set_attr(base, lv[2], idx, value)
+        s.set_attr(base, lv[2], self._index(lv[3]), value)
 
-    def _x_sprintf(self, node):
-        args = [self.value(a) for a in node[2]]
-        if not args or not isinstance(args[0], str):
-            raise CommandError("sprintf needs a format string first")
-        self._store(node[1], c_format(args[0], args[1:]))
+    def _index(self, idx):
+        if idx is None:
+            return None
+        if isinstance(idx, list):
+            return tuple(self.value(i) for i in idx)
+        return self.value(idx)
+
+    def _x_assign_array(self, node):
+        lv, items = node[1], node[2]
+        if lv[0] != "name":
+            raise CommandError("a {...} list can only be assigned to an array name")
+        name = lv[1].lower()
+
+        def shape(x):
+            return [len(x)] + shape(x[0]) if isinstance(x, list) else []
+
+        def flat(x):
+            if isinstance(x, list):
+                return [v for it in x for v in flat(it)]
+            v = self.value(x)
+            if isinstance(v, str):
+                raise CommandError(f"{name}: array values must be numbers")
+            return [float(v)]
+        vals = flat(items)
+        s = self.session
+        arr = s.arrays.get(name)
+        if arr is None:
+            dims = "".join(f"[{n}]" for n in shape(items))
+            raise CommandError(f"'{name}' is not an array; define it first "
+                               f"(define {name} real{dims})")
+        if arr.dtype == object:
+            raise CommandError(f"array '{name}' holds strings")
+        flat_arr = arr.reshape(-1)
+        if len(vals) > flat_arr.size:
+            raise CommandError(f"array '{name}' has {flat_arr.size} entries; the list has "
+                               f"{len(vals)}")
+        flat_arr[:len(vals)] = vals
 
     def _x_print(self, node):
-        v = self.value(node[1])
+        e = node[1]
+        if isinstance(e, N.Var) and e.name in self.session.arrays and \
+                not (self.env.scopes and e.name in self.env.scopes[-1]):
+            self.session.write(print_array(self.session.arrays[e.name]) + "\n")
+            return
+        v = self.value(e)
         self.session.write(print_value(v) + "\n")
 
     def _x_printf(self, node):
@@ -722,11 +1213,86 @@ class Interpreter:
         else:
             self.session.write(text)
 
+    def _var_elem(self, name):
+        for var, el in reversed(self.env.frames):
+            if var == name:
+                return el
+        return None
+
     def _x_list(self, node):
+        gen = node[1]
+        if gen.base[0] == "var" and self._var_elem(gen.base[1]) is None:
+            what = gen.base[1]
+            if what in ("topinfo", "bottominfo", "procedures", "attributes", "quantities",
+                        "method_instances", "constraints", "boundaries"):
+                raise UnsupportedError(f"list {what}")
+            raise CommandError(f"list: '{what}' is not an element (expected for example "
+                               f"list vertex[3] or list facets where area > 0.1)")
         self.session.list_elements(node[1], self.env)
 
     def _x_set(self, node):
-        self.session.set_elements(node[1], node[2], node[3], self.env, unset=False)
+        idx = node[4] if len(node) > 4 else None
+        self.session.set_elements(node[1], node[2], node[3], self.env, unset=False, idx=idx)
+
+    def _x_fix(self, node):
+        gen, on = node[1], node[2]
+        s = self.session
+        if gen.base[0] == "var" and gen.where is None and \
+                not isinstance(self._var_elem(gen.base[1]), ElemRef):
+            s.fix_name(gen.base[1], on)
+            return
+        els = s.generate(gen, self.env)
+        n = s.fix_elements(els, on)
+        s.write(f"{'Fixed' if on else 'Unfixed'}: {n}\n")
+
+    def _x_fix_name(self, node):
+        self.session.fix_name(node[1], node[2])
+
+    def _x_histogram(self, node):
+        gen, expr, log = node[1], node[2], node[3]
+        vals = []
+        for el in self.session.generate(gen, self.env):
+            with self.env.element(el, gen.var):
+                v = self.value(expr)
+            if isinstance(v, str):
+                raise CommandError("histogram needs numbers")
+            vals.append(float(v))
+        self.session.write(histogram_text(vals, log))
+
+    # -- files --------------------------------------------------------------------
+    def _x_redirect(self, node):
+        _, body, op, target = node
+        name = self.value(target)
+        if not isinstance(name, str) or not name:
+            raise CommandError(f"'{op}' needs a file name in quotes (for example: "
+                               f"do_off {op} \"out.off\")")
+        s = self.session
+        try:
+            fh = open(name, "w" if op == ">>>" else "a", encoding="latin-1", newline="")
+        except OSError as exc:
+            raise CommandError(f"cannot open '{name}' for output: {exc.strerror}") from None
+        old = s.out
+        s.out = fh
+        try:
+            self.execute(body)
+        finally:
+            s.out = old
+            fh.close()
+
+    def _x_pipe(self, node):
+        raise UnsupportedError("piping output to a command ('|')",
+                               "scripts never reach a shell; use >> or >>> to write a file")
+
+    def _x_read(self, node):
+        if node[1] is None:
+            raise UnsupportedError("read without a file name", "use read \"file\"")
+        name = self.value(node[1])
+        if not isinstance(name, str):
+            raise CommandError("read needs a file name in quotes (for example: read \"off.cmd\")")
+        self.session.read_file(name)
+
+    def _x_abort(self, node):
+        raise CommandError("Command aborted (abort).")
 
     def _x_unset(self, node):
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=True)
@@ -738,7 +1304,7 @@ class Interpreter:
         if kinds - {"edge", "facet"}:
             raise UnsupportedError("refine of " + ", ".join(sorted(kinds - {"edge", "facet"}))
                                    + "s", "'refine edges' and 'refine facets' are supported")
-        if node[1].kind == "facet":
+        if kinds == {"facet"}:
             s.refine_facets([el.i for el in els])
         else:
             s.refine_edges([el.i for el in els])
@@ -781,7 +1347,7 @@ class Interpreter:
         raise _Continue(1 if node[1] is None else int(self.value(node[1])))
 
     def _x_return(self, node):
-        raise _Return()
+        raise _Return(None if node[1] is None else self.value(node[1]))
 
     def _x_unsupported(self, node):
         raise UnsupportedError(node[1])
@@ -790,13 +1356,24 @@ class Interpreter:
         raw, arg = node[1], node[2]
         name = raw.lower()
         s = self.session
+        builtin = len(node) > 3
         if name in s.commands and len(raw) > 1:
+            proc = s.commands[name]
+            if proc.params:
+                if arg is None:
+                    raise CommandError(f"'{raw}' needs {len(proc.params)} argument"
+                                       f"{'s' if len(proc.params) != 1 else ''}: "
+                                       f"{raw}(...)")
+                self.run_proc(proc, [self.value(arg)])
+                return
             n = 1 if arg is None else self._count(arg)
             for _ in range(n):
-                try:
-                    self.execute(s.commands[name])
-                except _Return:
-                    pass
+                self.run_proc(proc, [])
+            return
+        if not builtin and raw in s.letters:
+            n = 1 if arg is None else self._count(arg)
+            for _ in range(n):
+                self.run_proc(s.letters[raw], [])
             return
         if raw in ("q",) or name in ("quit", "bye", "exit"):
             raise Quit(0 if arg is None else int(self.value(arg)))
