@@ -40,6 +40,14 @@ def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
+def _mm(A, B):
+    """``A @ B``; small products by einsum, which avoids the start-up cost of
+    threaded BLAS (large on a loaded machine: 10× for the 5×9 torus)."""
+    if B.shape[1] < 4096:
+        return np.einsum("ak,kb->ab", A, B)
+    return A @ B
+
+
 def densities(D):
     """Integrand densities per du dv from derivatives ``D (6, 3, ...)``
     (x, x_u, x_v, x_uu, x_uv, x_vv; xyz first).  Returns ``(W, A, V)``."""
@@ -141,7 +149,7 @@ class LoopEvaluator:
             Q, _, K = B.shape
             P = Xc[ctrl]                                      # (p, K, 3)
             Pt = P.transpose(1, 2, 0).reshape(K, -1)          # (K, 3p)
-            D = (B.reshape(Q * 6, K) @ Pt).reshape(Q, 6, 3, -1).transpose(1, 2, 0, 3)
+            D = _mm(B.reshape(Q * 6, K), Pt).reshape(Q, 6, 3, -1).transpose(1, 2, 0, 3)
             out.append(D)                                     # (6, 3, Q, p)
         self._key = X.copy()
         self._cache = out
@@ -156,6 +164,16 @@ class LoopEvaluator:
             for k, dens in zip(KINDS, densities(D)):
                 res[k] += np.bincount(owner, weights=w @ dens, minlength=self.nf)
         return res
+
+    def samples(self, X):
+        """Limit-surface points at all quadrature points and their area
+        weights: ``(P (M, 3), a (M,))`` with ``a.sum()`` the area."""
+        pts, wts = [], []
+        for D, (B, w, ctrl, owner) in zip(self._derivs(X), self.blocks):
+            _, A, _ = densities(D)
+            pts.append(D[0].reshape(3, -1).T)
+            wts.append((w[:, None] * A).ravel())
+        return np.concatenate(pts), np.concatenate(wts)
 
     def totals(self, X):
         v = self.values(X)
@@ -172,7 +190,7 @@ class LoopEvaluator:
             scale = w[:, None] if coef is None else w[:, None] * np.asarray(coef)[owner][None, :]
             Gd = Gd * scale
             Gq = Gd.transpose(2, 0, 1, 3).reshape(Q * 6, -1)  # (Q*6, 3p)
-            Gk = (B.reshape(Q * 6, K).T @ Gq).reshape(K, 3, -1)
+            Gk = _mm(B.reshape(Q * 6, K).T, Gq).reshape(K, 3, -1)
             flat = ctrl.T.ravel()                             # (K*p,) matching Gk[k, :, p]
             for i in range(3):
                 g[i] += np.bincount(flat, weights=Gk[:, i, :].ravel(), minlength=Xc_n)

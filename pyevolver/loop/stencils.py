@@ -194,8 +194,12 @@ def ev_levels(N, tol=1e-10, floor=1e-8):
 
 
 @lru_cache(maxsize=None)
-def patch_basis(N, n):
+def patch_basis(N, n, composite=None):
     """Quadrature basis of a patch with corner valence N and base rule ``n``.
+
+    ``composite`` (default: N != 6) integrates by the dyadic rings of regular
+    children; for N = 6 that is a cross-check of the recursive construction
+    against the box spline itself.
 
     Returns
     -------
@@ -207,7 +211,9 @@ def patch_basis(N, n):
     """
     u, v, w = triangle_rule(n)
     Breg = regular_basis(u, v)                     # (q, 6, 12)
-    if N == 6:
+    if composite is None:
+        composite = N != 6
+    if not composite:
         return Breg, w
     A, R = ev_structure(N)
     L = ev_levels(N)

@@ -87,9 +87,10 @@ def icosphere(level):
     return X, F
 
 
-def write_fe(path, X, F, header=""):
+def write_fe(path, X, F, header="", face_attrs=""):
     """Write ``(X, F)`` as an Evolver datafile (vertices, edges, faces with
-    signed edge ids); ``header`` (e.g. quantity declarations) goes on top."""
+    signed edge ids); ``header`` (e.g. quantity declarations) goes on top,
+    ``face_attrs`` (e.g. ``"tension 0"``) after every face."""
     E, idx = edges(F)
     sign = np.where(F == E[idx, 0], 1, -1)
     FE = sign * (idx + 1)
@@ -103,5 +104,5 @@ def write_fe(path, X, F, header=""):
             fh.write("%d %d %d\n" % (k + 1, a, b))
         fh.write("\nfaces\n")
         for k, row in enumerate(FE.tolist()):
-            fh.write("%d %d %d %d\n" % (k + 1, *row))
+            fh.write(("%d %d %d %d " % (k + 1, *row)) + face_attrs + "\n")
     return path
