@@ -218,10 +218,10 @@ def loop_subdivide(F, nv):
 class LoopTopology:
     """The patches of a closed control mesh ``F (nf, 3)`` with ``nv`` vertices.
 
-    If a triangle has two or more extraordinary corners, or its 1-ring
-    repeats a vertex (a very coarse mesh), the mesh is Loop-subdivided once
-    (repeatedly, at most 3 times) first: an exact re-parametrization of the
-    same limit surface, with control points ``S @ X``.
+    If a triangle has two or more extraordinary corners, the mesh is
+    Loop-subdivided once first (after one step extraordinary vertices are
+    isolated): an exact re-parametrization of the same limit surface, with
+    control points ``S @ X``.
 
     Attributes
     ----------
@@ -274,9 +274,8 @@ class LoopTopology:
         out = {}
         for N in np.unique(Nf):
             f = np.nonzero(Nf == N)[0]
-            ctrl = gather_ring(he, 3 * f + k0[f], int(N))
-            srt = np.sort(ctrl, 1)
-            if np.any(srt[:, 1:] == srt[:, :-1]):
-                return None
-            out[int(N)] = (ctrl, f)
+            # a 1-ring may list a vertex twice (a coarse mesh, or a valence-3
+            # corner next to a valence-4 vertex): harmless, the stencils used
+            # only involve the facets around a, b, c, which are distinct
+            out[int(N)] = (gather_ring(he, 3 * f + k0[f], int(N)), f)
         return out
