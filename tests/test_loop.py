@@ -41,7 +41,7 @@ def _ref_subdivide(X, F):
     e = idx + nv
     a, b, c = F.T
     F1 = np.concatenate([np.stack([a, e[:, 0], e[:, 2]], 1), np.stack([b, e[:, 1], e[:, 0]], 1),
-                         np.stack([c, e[:, 2], e[:, 1]], 1), np.stack([e[:, 0], e[:, 1], e[:, 2]], 1)])
+                         np.stack([c, e[:, 2], e[:, 1]], 1), e])
     return np.vstack([V, M]), F1
 
 
@@ -98,7 +98,7 @@ def irregular():
     v0 = 0
     nbrs = [int(w) for w in np.concatenate([E[E[:, 0] == v0, 1], E[E[:, 1] == v0, 0]])]
     # two non-adjacent neighbours: their edges to v0 share no facet
-    ring = [w for w in nbrs]
+    ring = list(nbrs)
     F1 = _flip(F, v0, ring[0])
     E1, _ = edges(F1)
     adj = {tuple(sorted(e)) for e in E1.tolist()}
@@ -359,6 +359,33 @@ def test_torus_5x9_minimiser_is_near_clifford():
     r10 = loop_torus.minimize_torus(10, 16, maxiter=200)
     assert CLIFFORD <= r10["W"] < r5["W"], (r10["W"], r5["W"])
     assert abs(r10["ratio"] / np.sqrt(2) - 1) <= 0.03
+
+
+def test_mesh_generators():
+    """torus_grid: m n vertices, all of valence 6, Euler characteristic 0,
+    outward (positive volume); icosphere: 10·4^L + 2 vertices on the unit
+    sphere, outward."""
+    for m, n in ((5, 9), (10, 16)):
+        X, F = torus_grid(m, n, R=2, r=1)
+        E, _ = edges(F)
+        assert len(X) == m * n and np.all(np.bincount(E.ravel()) == 6)
+        assert len(X) - len(E) + len(F) == 0
+        assert _pl_area_volume(X, F)[1] > 0
+        rho = np.hypot(X[:, 0], X[:, 1])
+        assert np.allclose((rho - 2) ** 2 + X[:, 2] ** 2, 1)
+    for lev in (0, 3):
+        X, F = icosphere(lev)
+        assert len(X) == 10 * 4 ** lev + 2 and np.allclose(np.linalg.norm(X, axis=1), 1)
+        assert _pl_area_volume(X, F)[1] > 0
+
+
+def test_study_writes_a_loadable_minimiser(tmp_path):
+    """The study's datafile loads, and its W and fixed area are the study's."""
+    out = str(tmp_path / "t.fe")
+    assert loop_torus.main(["--m", "5", "--n", "9", "--maxiter", "40", "--out", out]) == 0
+    t = Session.load(out, out=io.StringIO()).surface.evaluate()
+    assert t.quantity_values["willmore"] < 27.38
+    assert t.energy == pytest.approx(t.quantity_values["willmore"], rel=1e-14)
 
 
 def test_radius_ratio_of_exact_tori():

@@ -66,7 +66,6 @@ def density_gradients(D, kind):
     x, xu, xv, xuu, xuv, xvv = D
     n = _cross(xu, xv)
     Dn = _dot(n, n)
-    zero = np.zeros_like(Dn)
     g = np.zeros_like(np.asarray(D))
     with np.errstate(divide="ignore", invalid="ignore"):
         if kind == "W":
@@ -83,7 +82,6 @@ def density_gradients(D, kind):
                 g[3, i] = k * G * n[i]
                 g[4, i] = -2 * k * Fm * n[i]
                 g[5, i] = k * E * n[i]
-            del zero
         elif kind == "A":
             J = np.sqrt(Dn)
             a = [n[i] / J for i in range(3)]

@@ -175,7 +175,6 @@ def loop_subdivide(F, nv):
     F = np.asarray(F, np.int64)
     he = HalfEdges(F, nv)
     nh = len(he.tail)
-    h = np.arange(nh)
     # one edge per half-edge pair: the half-edge with tail < head, or a lone one
     rep = (he.twin < 0) | (he.tail < he.head)
     eid = np.full(nh, -1, np.int64)
@@ -211,7 +210,6 @@ def loop_subdivide(F, nv):
     ab, bc, ca = E[:, 0], E[:, 1], E[:, 2]
     F1 = np.stack([np.stack([a, ab, ca], 1), np.stack([b, bc, ab], 1),
                    np.stack([c, ca, bc], 1), np.stack([ab, bc, ca], 1)], 1).reshape(-1, 3)
-    del h
     return S, F1, ok
 
 
