@@ -161,3 +161,12 @@ def _register_harmonic():
 
 
 _register_harmonic()
+
+
+def _register_loop():
+    from . import loop as L
+    for name in L.KIND:
+        register_method(name, "vertex", L.values, L.gradient)
+
+
+_register_loop()
