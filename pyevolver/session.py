@@ -274,7 +274,11 @@ class Session:
                     r.warnings.append(f"Autochopped {nch} edges.")
             if echo:
                 for w in r.warnings:
-                    self.write(w + "\n")
+                    if w.startswith(("WARNING 1055", "Total difference")):
+                        # REF writes these to stderr, the pair followed by a blank line
+                        self.write_err(w + ("\n\n" if w.startswith("Total") else "\n"))
+                    else:
+                        self.write(w + "\n")
                 if r.printed and not self.toggles.get("quiet") and not self.toggles.get("quietgo"):
                     self.write(progress_line(k, r) + "\n")
             if r.message == "increase":

@@ -43,6 +43,11 @@ RUN = {
     "10_curvature_methods": "icosa_curv.fe",
     "11_blob_h0": "blob.fe",
     "12_blob_noh0": "blob0.fe",
+    # bending under fixed area and volume: REF's restoring loop fails to
+    # converge on the first step (WARNING 1055) and pyevolver follows it
+    "13_vesicle": "vesicle.fe",
+    # ADE: bending with h_zero under fixed area, volume and ∫H dA
+    "14_vesicle_ade": "vesicle_ade.fe",
     "15_legacy_sqcurv": "icosa_legacy.fe",
     "21_legacy_toggles": "blob_legacy.fe",
 }
@@ -103,12 +108,17 @@ MESH = {"02_cube_refine_counts", "04_quad_equi_V", "05_cube_V_rawv_rawestv", "16
 
 def _compare_other(ours, ref, rtol_result=1e-8):
     assert len(ours) == len(ref), "\n".join(ours) + "\n---- REF\n" + "\n".join(ref)
+    table_pressure = False        # rows under a `v` header ending in "pressure"
     for o, r in zip(ours, ref):
+        if not _NUM.findall(r):
+            table_pressure = r.split()[-1:] == ["pressure"]
         wo, wr = _NUM.split(o), _NUM.split(r)
         assert [w.strip() for w in wo] == [w.strip() for w in wr], (o, r)
         no, nr = _NUM.findall(o), _NUM.findall(r)
         names = [w.strip().split()[-1] if w.strip() else "" for w in wr[:-1]]
-        for name, a, b in zip(names, no, nr):
+        for j, (name, a, b) in enumerate(zip(names, no, nr)):
+            if table_pressure and j == len(nr) - 1:
+                name = "pressure"
             if name.startswith("scale"):
                 continue                                   # noise once converged
             if "." not in b and "e" not in b.lower():
@@ -128,7 +138,9 @@ def test_reference_check(evolver, check, tmp_path):
     ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=300)
     code, out, err = run_pyevolver(datafile, script + "q\n", cwd=str(tmp_path))
     assert code == 0, err
-    assert err == "", err
+    # stderr holds only the warnings REF also writes there (check 13)
+    assert all(not l.strip() or l.startswith(("WARNING 1055", "Total difference"))
+               for l in err.splitlines()), err
     po, oo = _classify(out)
     pr, orr = _classify(ref)
     # REF's line editor wraps the echo of long input lines; drop the pieces

@@ -133,7 +133,7 @@ class Iterator:
         return gs, us, A
 
     # -- one move ------------------------------------------------------------------
-    def _move(self, base, vel, scale, cons, us, A, mobile, targets, report):
+    def _move(self, base, vel, scale, cons, us, A, mobile, targets, report, trial=False):
         """Trial move M(scale) from the snapshot ``base`` (:func:`surface.state`):
         step, project, restore constraint values.  With ``us`` None the
         restoring directions are taken at the moved positions."""
@@ -151,15 +151,14 @@ class Iterator:
             # restore along the constraint gradients at the moved positions
             _, us, A = self._constrained_dirs(t, cons, mobile)
         cur_us, cur_A = us, A
-        half_next = False
+        start, d_start = state(s), d
+        factor = 1.0
         for it in range(10):
             try:
                 delta = np.linalg.solve(cur_A, d)
             except np.linalg.LinAlgError:
                 delta = np.linalg.lstsq(cur_A, d, rcond=None)[0]
-            if half_next:
-                delta = 0.5 * delta
-                half_next = False
+            delta = factor * delta
             prev = state(s)
             shift = sum(dl * u for dl, u in zip(delta, cur_us))
             displace(s, prev, shift)
@@ -167,6 +166,11 @@ class Iterator:
             t_new = s.evaluate()
             d_new = targets - cons.values(t_new)
             err_new = float(np.sum(np.abs(d_new) / cons.tolerances(t_new, tol)))
+            if err_new <= 1.0:
+                # converged: REF stops here even when the difference grew
+                # (itdebug on check 14, step 7: "Diff: 0.382765", one
+                # volume_restore(), done at 0.6068)
+                return t_new
             if err_new > 100 * err and err > 0:
                 if report is not None:
                     report.append(f"Total constraint difference would increase by factor of "
@@ -175,25 +179,39 @@ class Iterator:
                 restore_state(s, prev)
                 return s.evaluate()
             if err_new > 1.01 * err:
-                # REF (itdebug): "Diff increased. Restoring coords."; the next
-                # projection takes half the correction along gradients taken
-                # where it starts, and is judged against the increased value
-                # (REF's Old_diff).  Checked step for step on check 14.
-                restore_state(s, prev)
+                # REF (itdebug): "Diff increased. Restoring coords." puts back
+                # the coordinates the restoring started from (after the move
+                # and the projection), whatever corrections succeeded since;
+                # the next correction is computed there with gradients taken
+                # there, times a factor halved at each consecutive increase
+                # (reset by a success), and judged against the increased value
+                # (REF's Old_diff).  Checked step for step on checks 13 and 14.
+                restore_state(s, start)
                 t = s.evaluate()
+                d = d_start
                 _, cur_us, cur_A = self._constrained_dirs(t, cons, mobile)
                 self._carry = (cur_us, cur_A)
                 err = err_new
-                half_next = True
+                factor *= 0.5
                 continue
+            factor = 1.0
             improved = err_new < 0.5 * err
             t, d, err = t_new, d_new, err_new
-            if err <= 1.0:
-                return t
             if not improved:
                 _, cur_us, cur_A = self._constrained_dirs(t, cons, mobile)
             self._carry = (cur_us, cur_A)
-        if report is not None:
+        # REF's loop ends with one more correction that it does not check
+        # (itdebug: a last volume_restore() and no "Next diff" after the
+        # tenth check), then warns with the last difference it checked
+        try:
+            delta = np.linalg.solve(cur_A, d)
+        except np.linalg.LinAlgError:
+            delta = np.linalg.lstsq(cur_A, d, rcond=None)[0]
+        displace(s, state(s), sum(dl * u for dl, u in zip(factor * delta, cur_us)))
+        project_to_constraints(s, moved)
+        t = s.evaluate()
+        if report is not None and not trial:
+            # (REF reports this for the actual move only, not for trial moves)
             report.append("WARNING 1055: Volume or quantity constraints don't converge in "
                           "10 projections.")
             report.append(f"Total difference {err:g} times tolerance")
@@ -256,7 +274,8 @@ class Iterator:
         self._carry = (us, A)
 
         def E(scale):
-            t = self._move(X0, vel, scale, cons, us, A, mobile, targets, trial_msgs)
+            t = self._move(X0, vel, scale, cons, us, A, mobile, targets, trial_msgs,
+                           trial=True)
             e = t.energy
             return e if math.isfinite(e) else math.inf
 
