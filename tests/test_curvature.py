@@ -397,3 +397,20 @@ def test_every_method_matches_reference_on_blob0_and_its_refinement(evolver, tmp
     for a_row, b_row in zip(mine, ref):
         for n, a, b in zip(names, a_row, b_row):
             assert abs(a - b) <= 1e-12 * max(abs(b), 1.0), (n, a, b)
+
+
+def test_hessian_refuses_methods_without_one(tmp_path):
+    """circle_willmore (not smooth; REF has no Hessian either) and the Loop
+    methods (2-ring stencils) are refused by name, the surface unchanged."""
+    with open(os.path.join(CHECKS, "blob0.fe")) as fh:
+        body = "".join(l for l in fh if not l.startswith("quantity"))
+    path = tmp_path / "cw.fe"
+    path.write_text("quantity cw energy method circle_willmore global\n" + body)
+    out, err = io.StringIO(), io.StringIO()
+    s = Session.load(str(path), out=out, err=err)
+    s.run("g 1")
+    X = s.surface.X.copy()
+    from pyevolver.errors import CommandError
+    with pytest.raises(CommandError, match="hessian with method circle_willmore"):
+        s.run("hessian")
+    assert np.array_equal(s.surface.X, X)

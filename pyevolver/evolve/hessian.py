@@ -406,7 +406,7 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
 def _quantity_hessian(t, q, weight):
     """Hessian terms ``[(function, args)]`` of ``weight × q``, or None when
     one of its methods has no analytic Hessian."""
-    from ..methods import HESSIANS
+    from ..methods import HESSIANS, NO_HESSIAN
     s = t.surface
     out = []
     for m, etype, idx, sign in q.methods:
@@ -426,6 +426,8 @@ def _quantity_hessian(t, q, weight):
             out.append((edge_length_hessian, (t, np.asarray(idx, np.int64), w)))
         elif name in HESSIANS:
             out.append((HESSIANS[name], (t, m, np.asarray(idx, np.int64), w)))
+        elif name in NO_HESSIAN:
+            raise UnsupportedError(f"hessian with method {name}", NO_HESSIAN[name])
         else:
             return None
     return out

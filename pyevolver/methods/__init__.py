@@ -22,6 +22,14 @@ from .. import geometry as G
 METHODS = {}
 GRADIENTS = {}     # name -> fn(totals, method, idx, weights) -> (nv, 3)
 HESSIANS = {}      # name -> fn(totals, method, idx, weights, basis=None) -> sparse
+# Methods whose values couple vertices beyond a facet or an edge's two facets:
+# no Hessian (the coloured differences of the gradient assume that stencil).
+NO_HESSIAN = {
+    "circle_willmore": "Bobenko's energy is not smooth (REF has no Hessian for it); use g",
+    "loop_sq_mean_curvature": "Loop patches couple vertex 2-rings; use g",
+    "loop_area": "Loop patches couple vertex 2-rings; use g",
+    "loop_volume": "Loop patches couple vertex 2-rings; use g",
+}
 
 # Evolver methods pyevolver knows by name but does not implement (yet).
 CURVATURE_METHODS = {
