@@ -44,6 +44,17 @@ print((t1 - t0) / k, t3 - t2, repr(e))
 """
 
 
+def _bending_file(vesicle):
+    """The vesicle file without its fixed-area quantity and with tension 1."""
+    out = vesicle.replace("_vesicle.fe", "_bending.fe")
+    if not os.path.exists(out):
+        with open(vesicle) as fh:
+            lines = [ln for ln in fh if not ln.startswith("quantity surf")]
+        with open(out, "w") as fh:
+            fh.write("".join(ln.replace("tension 0\n", "tension 1\n") for ln in lines))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--levels", type=int, nargs="+", default=[4, 5, 6])
@@ -53,12 +64,17 @@ def main():
     ap.add_argument("--vesicle", action="store_true",
                     help="issue 5: star_perp_sq_mean_curvature energy, area fixed by a "
                          "quantity and the body volume fixed (no hessian column)")
+    ap.add_argument("--bending", action="store_true",
+                    help="star_perp_sq_mean_curvature energy plus unit surface tension, "
+                         "body volume fixed (no fixed quantity, so REF's hessian runs too)")
     a = ap.parse_args()
     env = dict(os.environ)
     env["PYTHONPATH"] = REPO + os.pathsep + env.get("PYTHONPATH", "")
     rows = []
     for lev in a.levels:
-        f = icosphere_file(lev, vesicle=a.vesicle)
+        f = icosphere_file(lev, vesicle=a.vesicle or a.bending)
+        if a.bending:
+            f = _bending_file(f)
         nf = 20 * 4 ** lev
         base, _ = wall([a.evolver, "-p1", f], "q\nq\n", a.repeat)
         gk, out = wall([a.evolver, "-p1", f], f"g 1\ng {a.steps}\nq\nq\n", a.repeat)

@@ -54,6 +54,7 @@ class QuantityDecl:
     tolerance: float = -1.0
     lagrange_multiplier: float = 0.0
     methods: list = field(default_factory=list)   # [MethodDecl]
+    function: object = None          # FUNCTION expression of ``inst.value`` names
     line: int = 0
 
 

@@ -1156,7 +1156,7 @@ class Session:
         t = self.totals
         b = s.bodies
         lines = []
-        qs = [q for q in s.quantities.values()]
+        qs = [q for q in s.quantities.values() if q.kind != "instance"]
         if not b.n and not qs:
             return "No bodies or quantities.\n"
         if b.n:

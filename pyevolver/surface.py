@@ -30,6 +30,9 @@ class Quantity:
     methods: list = field(default_factory=list)    # [(MethodDecl, etype, idx, sign)]
     value: float = 0.0
     pressure: float = 0.0
+    # FUNCTION quantities: a Formula of the global values of method instances,
+    # ``inst.value``; the instances are quantities of kind "instance"
+    function: object = None
 
 
 @dataclass
@@ -360,10 +363,28 @@ class Totals:
         per_facet = G.facet_gravity(self.facet_x0, self.facet_S)
         return float(G_ * (b.density @ (b.facet_matrix @ per_facet)))
 
+    def instance_values(self, q):
+        """``{"inst.value": value}`` of the method instances a FUNCTION reads."""
+        s = self.surface
+        return {f"{n}.value": self.quantity_value(s.quantities[n])
+                for n in (v[:-6] for v in q.function.node.names() if v.endswith(".value"))}
+
     def quantity_value(self, q, magnitude=False):
         """Value of a named quantity; with ``magnitude=True`` the sum of the
         absolute values of its element contributions instead (the scale of
-        its restoring tolerance)."""
+        its restoring tolerance).  A FUNCTION quantity's magnitude is its
+        linearization's: Σ_i |∂f/∂v_i| magnitude_i."""
+        if q.function is not None:
+            s = self.surface
+            env = self.instance_values(q)
+            params = s.param_env()
+            if not magnitude:
+                return q.modulus * float(q.function.values(params, env, 1)[0])
+            names = list(env)
+            d = q.function.gradient(params, env, 1, names)[0]
+            return abs(q.modulus) * float(sum(
+                abs(di) * self.quantity_value(s.quantities[n[:-6]], True)
+                for di, n in zip(d, names)))
         total = 0.0
         for m, etype, idx, sign in q.methods:
             _, fn = method_info(m.method)
@@ -910,6 +931,17 @@ class _Builder:
     def _quantities(self):
         sc, s = self.sc, self.s
         members = getattr(self, "members", {})
+        for name, m in sc.method_instances.items():
+            # a method instance: a quantity of its own (kind "instance": no
+            # energy, no constraint, not listed by v) whose value FUNCTION
+            # quantities read as ``name.value``
+            try:
+                etype, _ = method_info(m.method)
+            except UnsupportedError as exc:
+                raise self.error(f"method_instance {name}: {exc}") from None
+            q = Quantity(name, "instance")
+            q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
+            s.quantities[name] = q
         for name, qd in sc.quantities.items():
             q = Quantity(name, qd.kind, qd.target, qd.modulus, qd.tolerance)
             for m in qd.methods:
@@ -918,10 +950,18 @@ class _Builder:
                 except UnsupportedError as exc:
                     raise self.error(f"quantity {name}: {exc}", qd.line) from None
                 q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
+            if qd.function is not None:
+                for v in qd.function.names():
+                    inst = v[:-len(".value")] if v.endswith(".value") else None
+                    if inst is None or inst not in sc.method_instances:
+                        if v in sc.parameters:
+                            continue
+                        raise self.error(f"quantity {name}: FUNCTION uses {v!r}; expected "
+                                         "method_instance values (name.value) and parameters",
+                                         qd.line)
+                from .expr.nodes import Formula
+                q.function = Formula(qd.function)
             s.quantities[name] = q
-        for name, m in sc.method_instances.items():
-            raise self.error("not supported in pyevolver: METHOD_INSTANCE (method instances "
-                             "outside quantities)")
         # declared attributes that no element set still exist
         for (etype, name), (atype, size, dims) in sc.attributes.items():
             if (etype, name) not in s.extra:

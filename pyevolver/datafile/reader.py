@@ -195,6 +195,10 @@ class _TopTransformer(ExprTransformer):
     def q_function(self, _t, e):
         return ("function", e)
 
+    def qvalue(self, tok):
+        # ``inst.value``: the global value of a method instance (quantity FUNCTION)
+        return N.Var(str(tok), tok.line, tok.column)
+
     def quantity(self, kw, name, kind, *rest):
         return ("quantity", str(name).lower(), kind, list(rest), kw.line)
 
@@ -462,8 +466,7 @@ class Reader:
                 elif r[0] == "method":
                     q.methods.append(self._method(r[1], r[2], r[3], sec, line, name))
                 elif r[0] == "function":
-                    raise self.error("not supported in pyevolver: quantity FUNCTION "
-                                     "(combinations of method instances)", q.line)
+                    q.function = r[1]
             sc.quantities[name] = q
         elif kind == "method_instance":
             _, name, mname, opts, line = d

@@ -272,9 +272,18 @@ def body_volume_gradients(t):
 
 
 def quantity_gradient(t, q):
-    """Gradient (nv, 3) of a named quantity's value."""
+    """Gradient (nv, 3) of a named quantity's value (a FUNCTION quantity's:
+    Σ_i ∂f/∂v_i ∇v_i over the method instances it reads)."""
     s = t.surface
     g = np.zeros((s.nv, 3))
+    if q.function is not None:
+        env = t.instance_values(q)
+        names = list(env)
+        d = q.function.gradient(s.param_env(), env, 1, names)[0]
+        for di, n in zip(d, names):
+            if di:
+                g += (q.modulus * di) * quantity_gradient(t, s.quantities[n[:-6]])
+        return g
     for m, etype, idx, sign in q.methods:
         w = np.ones(len(idx)) if sign is None else np.asarray(sign, float)
         w = w * m.modulus * q.modulus

@@ -409,6 +409,23 @@ def _quantity_hessian(t, q, weight):
     from ..methods import HESSIANS, NO_HESSIAN
     s = t.surface
     out = []
+    if q.function is not None:
+        # Σ_i ∂f/∂v_i H_i; the rank terms ∂²f/∂v_i∂v_j ∇v_i ∇v_jᵀ would be dense
+        env = t.instance_values(q)
+        names = list(env)
+        params = s.param_env()
+        second = q.function.hessian(params, env, 1, names)[0]
+        if np.any(second != 0):
+            raise UnsupportedError(f"hessian with the quantity FUNCTION of {q.name}",
+                                   "only functions linear in the instance values")
+        d = q.function.gradient(params, env, 1, names)[0]
+        for di, n in zip(d, names):
+            if di:
+                part = _quantity_hessian(t, s.quantities[n[:-6]], weight * q.modulus * di)
+                if part is None:
+                    return None
+                out.extend(part)
+        return out
     for m, etype, idx, sign in q.methods:
         w = np.ones(len(idx)) if sign is None else np.asarray(sign, float)
         w = w * (m.modulus * q.modulus * weight)
