@@ -315,6 +315,73 @@ class Session:
             # surface is the one after the last complete iteration
             raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
+    def bfgs(self, n, echo=True, callback=None):
+        """``bfgs n``: at most ``n`` iterations of BFGS with a weak Wolfe line
+        search (:mod:`pyevolver.evolve.bfgs`; Lewis & Overton 2013), the
+        minimizer for nonsmooth energies such as ``circle_willmore``.  Free
+        surfaces only: fixed vertices stay, but bodies with fixed volumes,
+        FIXED quantities, level-set constraints and boundaries are refused.
+        Prints ``k. area: .. energy: ..`` per iteration (counting down, as
+        ``g``) and returns the :class:`~pyevolver.evolve.bfgs.BFGSResult`;
+        ``callback(result)`` may stop the run, and so does Ctrl-C (at the end
+        of the current iteration, the surface that of the last one)."""
+        import signal
+        import threading
+
+        from .evolve import bfgs as B
+        from .evolve.gradient import energy_gradient
+        from .evolve.iterate import _Constraints
+        s = self.surface
+        if s is None or s.nv == 0:
+            raise CommandError("bfgs: no surface loaded")
+        if len(_Constraints(s)):
+            raise UnsupportedError("bfgs with fixed volumes or FIXED quantities",
+                                   "the restoring of constraints is g's")
+        mobile = ~s.vattr["fixed"]
+        on = np.zeros(s.nv, bool)
+        for m in (s.vcon or {}).values():
+            on |= np.asarray(m, bool)
+        if "boundary" in s.vattr:
+            on |= s.vattr["boundary"] != 0
+        if np.any(on & mobile):
+            raise UnsupportedError("bfgs on vertices with level-set constraints or boundaries")
+        X0 = state(s)
+        idx = np.nonzero(mobile)[0]
+        flag = {"hit": False}
+
+        def fun(x):
+            s.X[idx] = x.reshape(-1, 3)
+            t = s.evaluate()
+            return t.energy, energy_gradient(t)[idx].ravel()
+
+        def cb(r):
+            if echo and not self.toggles.get("quiet"):
+                t = s.evaluate()
+                self.write("%3d. area: %#17.15g energy: %#17.15g  scale: %#g\n"
+                           % (n - r.nit, t.total_area, r.energy, r.step))
+            return flag["hit"] or (callback is not None and callback(r))
+        installed = False
+        if threading.current_thread() is threading.main_thread():
+            def handler(signum, frame):
+                flag["hit"] = True
+            try:
+                old = signal.signal(signal.SIGINT, handler)
+                installed = True
+            except (ValueError, OSError):
+                installed = False
+        try:
+            r = B.minimize(fun, s.X[idx].ravel().copy(), int(n), callback=cb)
+            s.X[idx] = r.x.reshape(-1, 3)
+        except Exception:
+            restore_state(s, X0)
+            self.recalc()
+            raise
+        finally:
+            if installed:
+                signal.signal(signal.SIGINT, old)
+        self.recalc()
+        return r
+
     def hessian(self, seek=False, max_scale=None, echo=True):
         """``hessian``: one Newton step on the constrained problem;
         ``hessian_seek [max]``: a line search along the Newton direction

@@ -63,3 +63,4 @@ def test_quantity_gradient(name):
     surf = perturbed(name)
     for q in surf.quantities.values():
         fd_check(surf, lambda t: t.quantity_values[q.name], lambda t: GR.quantity_gradient(t, q))
+

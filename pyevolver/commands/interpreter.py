@@ -1441,6 +1441,9 @@ class Interpreter:
         if raw == "u" or name == "equiangulate":
             s.equiangulate()
             return
+        if name == "bfgs":
+            s.bfgs(1 if arg is None else self._count(arg))
+            return
         if name in ("hessian", "hessian_seek"):
             if name == "hessian_seek" and arg is not None:
                 s.hessian(seek=True, max_scale=float(self.value(arg)))
