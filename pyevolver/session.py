@@ -161,6 +161,23 @@ class Session:
         self._scene_settings(scene)
         self.recalc()
 
+    def addload(self, name):
+        """``addload "file"``: the file's elements added to the surface,
+        numbered after the existing ones; its declarations override, its
+        read section is not run."""
+        from .mesh.merge import append_surface
+        scene, new = self._read_new("addload", name)
+        if self.surface is None:
+            raise CommandError("addload: no surface is loaded")
+        merged = append_surface(copy.deepcopy(self.surface), new)
+        self.variables.update(merged.params)
+        merged.params = self.variables
+        if "gravity_constant" in scene.values:
+            merged.gravity_constant = scene.values["gravity_constant"]
+        self.surface = merged
+        self._iterator = None
+        self.recalc()
+
     def _init_view_matrix(self):
         """The graphics view matrix (exporters read it): the Evolver's initial
         view fits the bounding box into [-1, 1]^3."""

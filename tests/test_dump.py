@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 from pyevolver import Session
-from pyevolver.datafile.writer import dump
+from pyevolver.commands.interpreter import parse_command
+from pyevolver.datafile.writer import dump, expr_text
+from pyevolver.expr import nodes as N
 from pyevolver.errors import PyEvolverError
 
 from conftest import example
@@ -29,6 +31,8 @@ CASES = [
     (example("tankex.fe"), "g 5"),
     (example("column.fe"), "g 5"),
     (example("qmound.fe"), "g 5"),
+    (example("sphere.fe"), "r; g 5"),
+    (example("twointor.fe"), "r; g 5"),
     (os.path.join(CHECKS, "vesicle.fe"), "g 3"),
     (os.path.join(CHECKS, "blob.fe"), "g 3"),
     (os.path.join(CHECKS, "blob_legacy.fe"), "g 3"),
@@ -180,7 +184,53 @@ def test_failing_load_leaves_the_surface(tmp_path):
         s2.run(f'replace_load "{example("cube.fe")}"')
 
 
-def test_addload_is_refused_by_name():
-    s = _session(example("cube.fe"))
-    with pytest.raises(PyEvolverError, match="addload"):
-        s.run(f'addload "{example("cube.fe")}"')
+def test_addload_example_matches_reference(evolver, tmp_path):
+    """addload_example.fe's read section addloads itself eight times."""
+    f = example("addload_example.fe")
+    s = _session(f)
+    t = s.surface.evaluate()
+    exprs = ["vertex_count", "edge_count", "facet_count", "body_count", "total_energy",
+             "total_area"] + [f"body[{k}].volume" for k in range(1, 10)]
+    ref = numbers(evolver, f, exprs, cwd=str(tmp_path))
+    ours = [s.surface.nv, s.surface.ne, s.surface.nf, s.surface.bodies.n, t.energy,
+            t.total_area] + list(t.volumes)
+    for k, a, b in zip(exprs, ours, ref):
+        assert _close(a, b), (k, a, b)
+    got = _continue(s, "re; g 5")
+    want = _progress("\n".join(run_reference(evolver, f, "re; g 5", cwd=str(tmp_path))))
+    assert len(got) == len(want) == 5
+    for (oa, oe), (ra, re_) in zip(got, want):
+        assert _close(oa, ra, 1e-9) and _close(oe, re_, 1e-9), (got, want)
+
+
+def test_addload_two_cubes(evolver, tmp_path):
+    f = example("cube.fe")
+    cmds = f'addload "{f}"; set vertex x x+2 where id > 8; recalc'
+    s = _session(f, cmds)
+    t = s.surface.evaluate()
+    exprs = ["vertex_count", "edge_count", "facet_count", "body_count", "total_energy",
+             "body[1].volume", "body[2].volume"]
+    ours = [s.surface.nv, s.surface.ne, s.surface.nf, s.surface.bodies.n, t.energy] + \
+        list(t.volumes)
+    lines = run_reference(evolver, f, cmds + "\n" + "".join(
+        f'printf "RESULT %.17g\\n", {e}\n' for e in exprs), cwd=str(tmp_path))
+    ref = [float(ln.split()[1]) for ln in lines if ln.startswith("RESULT")]
+    assert len(ref) == len(exprs), lines
+    for k, a, b in zip(exprs, ours, ref):
+        assert _close(a, b), (k, a, b)
+
+
+@pytest.mark.parametrize("text", [
+    "-x^2", "2^-y", "x-(y-z)", "(x/y)/z", "x/(y*z)", "-(x+y)*z", "x^y^2", "(x^y)^2",
+    "x % 3 + y imod 2", "x > y ? x - y : (y < 0 ? -y : y*2)", "!(x > 1) && y < 2 || z == 3",
+    "sqrt(x^2 + y^2) - 1e-17*atan2(y, x)", "-(-x)", "x*-1.5"])
+def test_formula_text_round_trip(text):
+    def expr_of(t):
+        return parse_command(f"print {t}")[1][0][1]
+    node = expr_of(text)
+    again = expr_of(expr_text(node))
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        env = N.MapEnv({k: float(v) for k, v in zip("xyz", rng.uniform(-3, 3, 3))})
+        a, b = node.ev(env), again.ev(env)
+        assert a == b or (np.isnan(a) and np.isnan(b)), (text, expr_text(node))

@@ -1319,7 +1319,10 @@ class Interpreter:
         if kw == "load":
             self.session.load_command(name)
             raise Loaded()              # the Evolver: the current command ends
-        self.session.replace_load(name)
+        elif kw == "addload":
+            self.session.addload(name)
+        else:
+            self.session.replace_load(name)
 
     def _x_abort(self, node):
         raise CommandError("Command aborted (abort).")

@@ -19,6 +19,7 @@ import math
 import re
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import UnsupportedError
 from ..expr import nodes as N
@@ -37,38 +38,56 @@ def num(v):
     return "%.17g" % v
 
 
+_PREC = {"+": 5, "-": 5, "*": 6, "/": 6, "%": 6, "mod": 6, "imod": 6, "idiv": 6, "^": 8}
+
+
 def expr_text(node):
-    """Source text of an expression tree (fully parenthesized)."""
+    """Source text of an expression tree (parentheses where precedence
+    needs them; numbers with 17 digits)."""
     if isinstance(node, N.Formula):
         node = node.node
+    return _text(node)[0]
+
+
+def _wrap(child, prec, strict=False):
+    text, p = _text(child)
+    return f"({text})" if p < prec or (strict and p == prec) else text
+
+
+def _text(node):
+    """(text, precedence of its outermost operator)."""
     if isinstance(node, N.Num):
         t = num(node.value)
-        return f"({t})" if t.startswith("-") else t
+        return (f"({t})", 9) if t.startswith("-") else (t, 9)
     if isinstance(node, N.Var):
-        return node.name
-    if isinstance(node, N.Neg):
-        return f"(-{expr_text(node.a)})"
-    if isinstance(node, N.Not):
-        return f"(!{expr_text(node.a)})"
-    if isinstance(node, N.Bin):
-        op = node.op if node.op in ("+", "-", "*", "/", "^", "%") else f" {node.op} "
-        return f"({expr_text(node.a)}{op}{expr_text(node.b)})"
-    if isinstance(node, N.Cmp):
-        return f"({expr_text(node.a)} {node.op} {expr_text(node.b)})"
-    if isinstance(node, N.And):
-        return f"({expr_text(node.a)} && {expr_text(node.b)})"
-    if isinstance(node, N.Or):
-        return f"({expr_text(node.a)} || {expr_text(node.b)})"
-    if isinstance(node, N.Cond):
-        return f"({expr_text(node.c)} ? {expr_text(node.a)} : {expr_text(node.b)})"
+        # the gravitational constant is G in the Evolver (g alone is its go command)
+        return ("G" if node.name == "g" else node.name), 9
     if isinstance(node, N.Func):
-        return f"{node.name}({', '.join(expr_text(a) for a in node.args)})"
+        return f"{node.name}({', '.join(expr_text(a) for a in node.args)})", 9
+    if isinstance(node, N.Neg):
+        return f"-{_wrap(node.a, 9)}", 7
+    if isinstance(node, N.Not):
+        return f"!{_wrap(node.a, 9)}", 7
+    if isinstance(node, N.Bin) and node.op in _PREC:
+        p = _PREC[node.op]
+        op = node.op if len(node.op) == 1 else f" {node.op} "
+        if node.op == "^":
+            return f"{_wrap(node.a, 9)}^{_wrap(node.b, 9)}", p
+        return f"{_wrap(node.a, p)}{op}{_wrap(node.b, p, strict=True)}", p
+    if isinstance(node, N.Cmp):
+        return f"{_wrap(node.a, 5)} {node.op} {_wrap(node.b, 5)}", 4
+    if isinstance(node, N.And):
+        return f"{_wrap(node.a, 4)} && {_wrap(node.b, 4)}", 3
+    if isinstance(node, N.Or):
+        return f"{_wrap(node.a, 3)} || {_wrap(node.b, 3)}", 2
+    if isinstance(node, N.Cond):
+        return f"{_wrap(node.c, 2)} ? {_wrap(node.a, 2)} : {_wrap(node.b, 2)}", 1
     raise UnsupportedError(f"dump: a formula with {type(node).__name__} "
                            "(it has no datafile form)")
 
 
 def _comps(letter, formulas):
-    return " ".join(f"{letter}{k + 1}: {expr_text(f)}" for k, f in enumerate(formulas))
+    return "\n".join(f"  {letter}{k + 1}: {expr_text(f)}" for k, f in enumerate(formulas))
 
 
 # ---------------------------------------------------------------------------
@@ -114,10 +133,12 @@ class _FeWriter:
         for key, arr in s.extra.items():
             if key[0] not in ("vertex", "edge", "facet", "body"):
                 self.refuse(f"{key[0]} attribute '{key[1]}'")
-        if s.bodies.n and s.bodies.facet_matrix is not None:
-            M = s.bodies.facet_matrix.tocoo()
-            if len(M.data) and np.any(np.abs(M.data) != 1):
-                self.refuse("a body listing a facet twice")
+        b = s.bodies
+        if b.n:
+            ob, of, osg = b.occurrences
+            M = sp.csr_matrix((osg, (ob, of)), shape=(b.n, s.nf))
+            if (M != b.facet_matrix.tocsr()).nnz:
+                self.refuse("bodies whose facet list differs from their facets")
 
     # -- top section -------------------------------------------------------------
     def _header(self):
@@ -170,18 +191,18 @@ class _FeWriter:
             self.w(f"CONSTRAINT {cid}{opts}")
             self.w(f"FORMULA: {expr_text(c.formula)} = 0")
             if c.energy:
-                self.w("ENERGY: " + _comps("e", c.energy))
+                self.w("ENERGY:\n" + _comps("e", c.energy))
             if c.content:
-                self.w("CONTENT: " + _comps("c", c.content))
+                self.w("CONTENT:\n" + _comps("c", c.content))
             self.w()
         for bid, b in sorted(s.boundaries.items()):
             opts = " CONVEX" if "convex" in b.flags else ""
             self.w(f"BOUNDARY {bid} PARAMETERS {b.nparams}{opts}")
             self.w(_comps("x", b.coords))
             if b.energy:
-                self.w("ENERGY: " + _comps("e", b.energy))
+                self.w("ENERGY:\n" + _comps("e", b.energy))
             if b.content:
-                self.w("CONTENT: " + _comps("c", b.content))
+                self.w("CONTENT:\n" + _comps("c", b.content))
             self.w()
         self._quantities()
 
@@ -198,7 +219,7 @@ class _FeWriter:
         if m.scalar is not None:
             out.append(f"scalar_integrand: {expr_text(m.scalar)}")
         if m.vector is not None:
-            out.append("vector_integrand: " + _comps("q", m.vector))
+            out.append("vector_integrand:\n" + _comps("q", m.vector))
         return " ".join(out)
 
     def _quantities(self):
@@ -360,13 +381,12 @@ class _FeWriter:
         b = self.s.bodies
         if not b.n:
             return
-        M = b.facet_matrix.tocsr()
+        ob, of, osg = b.occurrences
         self.w("bodies")
         for k in range(b.n):
-            row = M.getrow(k)
-            order = np.argsort(row.indices)
-            cols, vals = row.indices[order], row.data[order]
-            parts = [str(int(c) + 1) if v > 0 else str(-(int(c) + 1)) for c, v in zip(cols, vals)]
+            sel = ob == k
+            parts = [str(int(c) + 1) if v > 0 else str(-(int(c) + 1))
+                     for c, v in zip(of[sel], osg[sel])]
             if not np.isnan(b.target[k]):
                 parts.append(f"volume {num(b.target[k])}")
             if b.pressure is not None and not np.isnan(b.pressure[k]):
