@@ -73,6 +73,9 @@ class Session:
     def load_file(self, filename, run_read=True):
         scene = read_datafile(filename)
         surface = build_surface(scene)
+        return self._install(filename, scene, surface, run_read)
+
+    def _install(self, filename, scene, surface, run_read):
         self.filename = filename
         self.surface = surface
         self._iterator = None                  # no CG history, pressures not yet valid
@@ -83,11 +86,7 @@ class Session:
         self.toggles["gravity"] = int(scene.values.get("gravity_constant", 0) != 0 or
                                       bool(b.n and np.any(b.density)))
         self.variables = surface.params        # parameters and variables share one namespace
-        for k in ("scale_limit", "constraint_tolerance"):
-            if k in scene.values:
-                self.settings[k] = scene.values[k]
-        if "scale" in scene.values:
-            self.settings["scale"] = scene.values["scale"]
+        self._scene_settings(scene)
         self.commands = {}
         self.letters = {}
         self.arrays = {}
@@ -97,6 +96,87 @@ class Session:
             self.run(scene.read_text, where=filename, line=scene.read_line + 1,
                      stop_on_error=False)
         return self
+
+    def _scene_settings(self, scene):
+        for k in ("scale_limit", "constraint_tolerance"):
+            if k in scene.values:
+                self.settings[k] = scene.values[k]
+        if "scale" in scene.values:
+            self.settings["scale"] = scene.values["scale"]
+            if scene.values.get("scale_fixed"):
+                self.toggles["_fixed_scale"] = 1      # SCALE x FIXED: the m command
+
+    # -- dump and load (commands) --------------------------------------------------
+    def dump(self, name=None):
+        """``dump "file"``: write the surface as a datafile (no name: the
+        datafile name with ``.dmp`` appended, as the Evolver does)."""
+        from .datafile.writer import dump
+        if name is None:
+            name = (self.filename or "pyevolver") + ".dmp"
+        self.write(f"Dumping to {name}.\n")
+        try:
+            dump(self, name)
+        except OSError as exc:
+            raise CommandError(f"dump: cannot write '{name}': {exc.strerror}") from None
+
+    def _read_new(self, cmd, name):
+        import os
+        if not os.path.isfile(name):
+            raise CommandError(f"{cmd}: cannot find datafile '{name}'")
+        scene = read_datafile(name)
+        return scene, build_surface(scene)
+
+    def load_command(self, name):
+        """``load "file"``: a fresh start on another datafile (variables,
+        commands and toggles forgotten; its read section runs)."""
+        scene, surface = self._read_new("load", name)
+        out, err = self.out, self.err
+        self.__init__(out, err)
+        self._install(name, scene, surface, True)
+
+    def replace_load(self, name):
+        """``replace_load "file"``: the surface of another datafile replaces
+        the current one; variables, commands and toggles are kept, the new
+        file's parameters and settings override, its read section is not run."""
+        scene, surface = self._read_new("replace_load", name)
+        old = self.surface
+        if old is not None:
+            for qname in old.quantities:
+                if qname not in surface.quantities:
+                    raise UnsupportedError(
+                        f"replace_load: the quantity or method instance '{qname}' of the "
+                        f"current surface is not declared in {name}",
+                        "the Evolver would keep it for the new surface")
+            for cid, c in old.constraints.items():
+                if cid not in surface.constraints:
+                    raise UnsupportedError(
+                        f"replace_load: constraint {cid} of the current surface is not "
+                        f"declared in {name}", "the Evolver would keep it")
+        params = self.variables
+        params.update(surface.params)
+        surface.params = params
+        self.surface = surface
+        self.filename = name
+        self._iterator = None
+        self._scene_settings(scene)
+        self.recalc()
+
+    def addload(self, name):
+        """``addload "file"``: the file's elements added to the surface,
+        numbered after the existing ones; its declarations override, its
+        read section is not run."""
+        from .mesh.merge import append_surface
+        scene, new = self._read_new("addload", name)
+        if self.surface is None:
+            raise CommandError("addload: no surface is loaded")
+        merged = append_surface(copy.deepcopy(self.surface), new)
+        self.variables.update(merged.params)
+        merged.params = self.variables
+        if "gravity_constant" in scene.values:
+            merged.gravity_constant = scene.values["gravity_constant"]
+        self.surface = merged
+        self._iterator = None
+        self.recalc()
 
     def _init_view_matrix(self):
         """The graphics view matrix (exporters read it): the Evolver's initial
@@ -156,7 +236,7 @@ class Session:
             self.refresh()
             raise I.Interrupted("Interrupted: the surface is as it was before the command.") \
                 from None
-        except (I._Break, I._Continue, I._Return):
+        except (I._Break, I._Continue, I._Return, I.Loaded):
             pass
         except PyEvolverError as exc:
             self._restore(snap)

@@ -142,7 +142,7 @@ def _session():
     ('system "ls"', "system"),
     ('shell', "shell"),
     ('dissolve edge[1]', "dissolve"),
-    ('dump "x.dmp"', "dump"),
+    ('permload "x.fe"', "permload"),
     ('define constraint cc formula: x = 1', "define constraint"),
     ('list topinfo', "list topinfo"),
 ])

@@ -457,6 +457,12 @@ class _CmdTransformer(ExprTransformer):
     def read(self, _r, expr=None):
         return ("read", expr)
 
+    def dump(self, _d, expr=None):
+        return ("dump", expr)
+
+    def load_(self, kw, expr):
+        return ("load", str(kw).lower(), expr)
+
     def abort(self, _a):
         return ("abort",)
 
@@ -717,6 +723,10 @@ class _Return(Exception):
 
 class Interrupted(Exception):
     """Ctrl-C: the running command stops and the prompt returns."""
+
+
+class Loaded(Exception):
+    """``load`` replaced the session: the command that ran it ends."""
 
 
 class Quit(Exception):
@@ -1290,6 +1300,29 @@ class Interpreter:
         if not isinstance(name, str):
             raise CommandError("read needs a file name in quotes (for example: read \"off.cmd\")")
         self.session.read_file(name)
+
+    def _x_dump(self, node):
+        name = None
+        if node[1] is not None:
+            name = self.value(node[1])
+            if not isinstance(name, str):
+                raise CommandError("dump needs a file name in quotes (for example: "
+                                   "dump \"out.fe\")")
+        self.session.dump(name)
+
+    def _x_load(self, node):
+        kw = node[1]
+        name = self.value(node[2])
+        if not isinstance(name, str):
+            raise CommandError(f"{kw} needs a datafile name in quotes (for example: "
+                               f"{kw} \"cube.fe\")")
+        if kw == "load":
+            self.session.load_command(name)
+            raise Loaded()              # the Evolver: the current command ends
+        elif kw == "addload":
+            self.session.addload(name)
+        else:
+            self.session.replace_load(name)
 
     def _x_abort(self, node):
         raise CommandError("Command aborted (abort).")

@@ -216,7 +216,7 @@ class _TopTransformer(ExprTransformer):
         return ("flag", str(kw).lower(), kw.line)
 
     def value_decl(self, kw, e, fixed=None):
-        return ("value", str(kw).lower(), e, fixed is not None, kw.line)
+        return ("value", str(kw).lower().rstrip(":"), e, fixed is not None, kw.line)
 
     def periods(self, kw):
         return ("periods", [], kw.line)

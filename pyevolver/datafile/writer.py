@@ -1,0 +1,441 @@
+"""Writing a surface back as a datafile (the ``dump`` command).
+
+The writer turns the arrays of a :class:`pyevolver.surface.Surface` (and the
+settings of its session) into a datafile that both pyevolver and the
+Evolver load back to the same surface: the same elements in the same order,
+coordinates written with 17 significant digits (so every double comes back
+exactly), parameters, constraints, boundaries, quantities, method instances,
+element attributes, flags, tensions and bodies.  Formulas are written from
+their expression trees, fully parenthesized.  Whatever the surface holds
+that a datafile cannot express makes the writer refuse by name; it never
+writes a silently different surface.
+
+Writers are registered by format name (``WRITERS``), as meshio does;
+:func:`dump` picks one (the datafile format by default).
+"""
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import UnsupportedError
+from ..expr import nodes as N
+
+_CON_FLAGS = ("global", "convex", "nonwall", "nonnegative", "nonpositive")
+_NAME = re.compile(r"^[a-z_][a-z0-9_]*$", re.I)
+
+
+def num(v):
+    """A number written so that reading it gives back the same double."""
+    v = float(v)
+    if not math.isfinite(v):
+        raise UnsupportedError(f"dump: the value {v} (not a finite number)")
+    if v == int(v) and abs(v) < 1e15:
+        return str(int(v))
+    return "%.17g" % v
+
+
+_PREC = {"+": 5, "-": 5, "*": 6, "/": 6, "%": 6, "mod": 6, "imod": 6, "idiv": 6, "^": 8}
+
+
+def expr_text(node):
+    """Source text of an expression tree (parentheses where precedence
+    needs them; numbers with 17 digits)."""
+    if isinstance(node, N.Formula):
+        node = node.node
+    return _text(node)[0]
+
+
+def _wrap(child, prec, strict=False):
+    text, p = _text(child)
+    return f"({text})" if p < prec or (strict and p == prec) else text
+
+
+def _text(node):
+    """(text, precedence of its outermost operator)."""
+    if isinstance(node, N.Num):
+        t = num(node.value)
+        return (f"({t})", 9) if t.startswith("-") else (t, 9)
+    if isinstance(node, N.Var):
+        # the gravitational constant is G in the Evolver (g alone is its go command)
+        return ("G" if node.name == "g" else node.name), 9
+    if isinstance(node, N.Func):
+        return f"{node.name}({', '.join(expr_text(a) for a in node.args)})", 9
+    if isinstance(node, N.Neg):
+        return f"-{_wrap(node.a, 9)}", 7
+    if isinstance(node, N.Not):
+        return f"!{_wrap(node.a, 9)}", 7
+    if isinstance(node, N.Bin) and node.op in _PREC:
+        p = _PREC[node.op]
+        op = node.op if len(node.op) == 1 else f" {node.op} "
+        if node.op == "^":
+            return f"{_wrap(node.a, 9)}^{_wrap(node.b, 9)}", p
+        return f"{_wrap(node.a, p)}{op}{_wrap(node.b, p, strict=True)}", p
+    if isinstance(node, N.Cmp):
+        return f"{_wrap(node.a, 5)} {node.op} {_wrap(node.b, 5)}", 4
+    if isinstance(node, N.And):
+        return f"{_wrap(node.a, 4)} && {_wrap(node.b, 4)}", 3
+    if isinstance(node, N.Or):
+        return f"{_wrap(node.a, 3)} || {_wrap(node.b, 3)}", 2
+    if isinstance(node, N.Cond):
+        return f"{_wrap(node.c, 2)} ? {_wrap(node.a, 2)} : {_wrap(node.b, 2)}", 1
+    raise UnsupportedError(f"dump: a formula with {type(node).__name__} "
+                           "(it has no datafile form)")
+
+
+def _comps(letter, formulas):
+    return "\n".join(f"  {letter}{k + 1}: {expr_text(f)}" for k, f in enumerate(formulas))
+
+
+# ---------------------------------------------------------------------------
+
+
+class _FeWriter:
+    def __init__(self, surface, session=None):
+        self.s = surface
+        self.sess = session
+        self.lines = []
+
+    def w(self, text=""):
+        self.lines.append(text)
+
+    def refuse(self, what):
+        raise UnsupportedError(f"dump: {what} (a datafile cannot express it)")
+
+    def text(self):
+        s = self.s
+        if s.sdim != 3:
+            self.refuse(f"space dimension {s.sdim}")
+        self._check()
+        self._header()
+        self._vertices()
+        self._edges()
+        self._faces()
+        self._bodies()
+        self._read()
+        return "\n".join(self.lines) + "\n"
+
+    # -- what cannot be written ------------------------------------------------
+    def _check(self):
+        s = self.s
+        known_v = {"fixed", "original", "boundary", "params", "id"}
+        known_e = {"fixed", "original", "boundary", "tension", "no_refine", "color", "wrap", "id"}
+        known_f = {"fixed", "original", "boundary", "tension", "no_refine", "color", "frontcolor",
+                   "backcolor", "id"}
+        for what, attrs, known in (("vertex", s.vattr, known_v), ("edge", s.eattr, known_e),
+                                   ("facet", s.fattr, known_f)):
+            for k in attrs:
+                if k not in known:
+                    self.refuse(f"the {what} attribute '{k}'")
+        for key, arr in s.extra.items():
+            if key[0] not in ("vertex", "edge", "facet", "body"):
+                self.refuse(f"{key[0]} attribute '{key[1]}'")
+        b = s.bodies
+        if b.n:
+            ob, of, osg = b.occurrences
+            M = sp.csr_matrix((osg, (ob, of)), shape=(b.n, s.nf))
+            if (M != b.facet_matrix.tocsr()).nnz:
+                self.refuse("bodies whose facet list differs from their facets")
+
+    # -- top section -------------------------------------------------------------
+    def _header(self):
+        s, sess = self.s, self.sess
+        name = getattr(sess, "filename", "") if sess is not None else ""
+        self.w(f"// Dump of a surface by pyevolver{' (datafile ' + name + ')' if name else ''}")
+        self.w()
+        if s.periods is not None:
+            self.w("TORUS_FILLED" if s.torus_filled else "TORUS")
+            self.w("PERIODS")
+            for row in s.periods:
+                self.w(" ".join(num(v) for v in row))
+        if s.symmetric_content:
+            self.w("SYMMETRIC_CONTENT")
+        mode = getattr(s, "curvature_mode", "plain")
+        if mode == "eff":
+            self.w("EFFECTIVE_AREA")
+        elif mode == "norm":
+            self.w("NORMAL_CURVATURE")
+        if s.gravity_constant != 1.0:
+            self.w(f"GRAVITY_CONSTANT {num(s.gravity_constant)}")
+        if s.gap_constant != 1.0:
+            self.w(f"GAP_CONSTANT {num(s.gap_constant)}")
+        if s.sq_curvature_modulus:
+            self.w(f"SQUARED_CURVATURE {num(s.sq_curvature_modulus)}")
+        if sess is not None:
+            st = sess.settings
+            fixed = " FIXED" if sess.toggles.get("_fixed_scale") else ""
+            self.w(f"SCALE {num(st['scale'])}{fixed}")
+            self.w(f"SCALE_LIMIT {num(st['scale_limit'])}")
+            self.w(f"CONSTRAINT_TOLERANCE {num(st['constraint_tolerance'])}")
+        self.w()
+        for pname, v in s.params.items():
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.number)):
+                continue            # strings and arrays are not datafile parameters
+            if not _NAME.match(pname) or pname in N.CONSTANTS:
+                continue
+            self.w(f"PARAMETER {pname} = {num(v)}")
+        self.w()
+        types = getattr(self.sess, "attr_types", {}) if self.sess is not None else {}
+        for (etype, aname), arr in self.s.extra.items():
+            typ = types.get((etype, aname), "real")
+            if typ == "integer" and np.any(arr != np.round(arr)):
+                typ = "real"
+            dims = "".join(f"[{d}]" for d in arr.shape[1:])
+            self.w(f"define {etype} attribute {aname} {typ}{dims}")
+        self.w()
+        for cid, c in sorted(s.constraints.items()):
+            opts = "".join(f" {f.upper()}" for f in sorted(c.flags) if f in _CON_FLAGS)
+            self.w(f"CONSTRAINT {cid}{opts}")
+            self.w(f"FORMULA: {expr_text(c.formula)} = 0")
+            if c.energy:
+                self.w("ENERGY:\n" + _comps("e", c.energy))
+            if c.content:
+                self.w("CONTENT:\n" + _comps("c", c.content))
+            self.w()
+        for bid, b in sorted(s.boundaries.items()):
+            opts = " CONVEX" if "convex" in b.flags else ""
+            self.w(f"BOUNDARY {bid} PARAMETERS {b.nparams}{opts}")
+            self.w(_comps("x", b.coords))
+            if b.energy:
+                self.w("ENERGY:\n" + _comps("e", b.energy))
+            if b.content:
+                self.w("CONTENT:\n" + _comps("c", b.content))
+            self.w()
+        self._quantities()
+
+    def _method_text(self, m):
+        out = [m.method]
+        if m.is_global:
+            out.append("global")
+        if m.modulus != 1.0:
+            out.append(f"modulus {num(m.modulus)}")
+        if m.ignore_fixed:
+            out.append("ignore_fixed")
+        if m.ignore_constraints:
+            out.append("ignore_constraints")
+        if m.scalar is not None:
+            out.append(f"scalar_integrand: {expr_text(m.scalar)}")
+        if m.vector is not None:
+            out.append("vector_integrand:\n" + _comps("q", m.vector))
+        return " ".join(out)
+
+    def _quantities(self):
+        s = self.s
+        self.members = {"vertex": {}, "edge": {}, "facet": {}}
+        for name, q in s.quantities.items():
+            if q.kind == "instance":
+                (m, etype, idx, sign), = q.methods
+                self.w(f"METHOD_INSTANCE {name} METHOD {self._method_text(m)}")
+                self._add_members(name, etype, m, idx, sign)
+        for name, q in s.quantities.items():
+            if q.kind == "instance":
+                continue
+            if q.kind == "fixed":
+                head = f"QUANTITY {name} FIXED = {num(q.target)}"
+            elif q.kind in ("energy", "conserved", "info_only"):
+                head = f"QUANTITY {name} {q.kind.upper()}"
+            else:
+                self.refuse(f"quantity {name} of kind {q.kind}")
+            if q.modulus != 1.0:
+                head += f" MODULUS {num(q.modulus)}"
+            if q.tolerance != -1.0:
+                head += f" TOLERANCE {num(q.tolerance)}"
+            self.w(head)
+            seen = {}
+            for m, etype, idx, sign in q.methods:
+                kw = "METHOD"
+                self.w(f"  {kw} {self._method_text(m)}")
+                if not m.is_global:
+                    prev = seen.get(etype)
+                    if prev is not None and not (np.array_equal(prev[0], idx) and
+                                                 np.array_equal(prev[1], sign)):
+                        self.refuse(f"quantity {name}: two {etype} methods on different "
+                                    f"{etype}s")
+                    seen[etype] = (idx, sign)
+                    self._add_members(name, etype, m, idx, sign)
+            if q.function is not None:
+                self.w(f"  FUNCTION {expr_text(q.function)}")
+            self.w()
+
+    def _add_members(self, name, etype, m, idx, sign):
+        if m.is_global or idx is None:
+            return
+        d = self.members[etype]
+        seen = set()
+        for k, sg in zip(np.asarray(idx).tolist(),
+                         (np.ones(len(idx)) if sign is None else np.asarray(sign)).tolist()):
+            if (k, name) in seen:
+                self.refuse(f"{name}: an {etype} listed twice")
+            seen.add((k, name))
+            d.setdefault(k, []).append(name if sg > 0 else name + "-")
+
+    # -- elements -------------------------------------------------------------------
+    def _extra_text(self, etype, k):
+        out = []
+        for (et, aname), arr in self.s.extra.items():
+            if et != etype:
+                continue
+            v = arr[k]
+            if np.ndim(v) == 0:
+                if v != 0:
+                    out.append(f"{aname} {num(v)}")
+            elif np.any(v != 0):
+                out.append(aname + " " + " ".join(num(x) for x in np.ravel(v)))
+        return out
+
+    def _cons(self, table, k, signed=False):
+        ids = []
+        for cid, arr in sorted(table.items()):
+            if "global" in self.s.constraints[cid].flags:
+                continue
+            v = arr[k]
+            if v:
+                ids.append(str(-cid if signed and v < 0 else cid))
+        return f"constraints {' '.join(ids)}" if ids else None
+
+    def _vertices(self):
+        s = self.s
+        fixed = s.vattr.get("fixed")
+        bnd = s.vattr.get("boundary")
+        params = s.vattr.get("params")
+        self.w("vertices")
+        mem = self.members["vertex"]
+        for k in range(s.nv):
+            if bnd is not None and bnd[k]:
+                b = s.boundaries[int(bnd[k])]
+                parts = [num(v) for v in params[k, :b.nparams]] + [f"boundary {int(bnd[k])}"]
+            else:
+                parts = [num(v) for v in s.X[k]]
+            if fixed is not None and fixed[k]:
+                parts.append("fixed")
+            c = self._cons(s.vcon, k)
+            if c:
+                parts.append(c)
+            parts += mem.get(k, [])
+            parts += self._extra_text("vertex", k)
+            self.w(f"{k + 1} " + " ".join(parts))
+        self.w()
+
+    def _edges(self):
+        s = self.s
+        ea = s.eattr
+        wrap = ea.get("wrap") if s.periods is not None else None
+        if wrap is not None and np.any(~np.isin(wrap, (-1, 0, 1))):
+            self.refuse("an edge wrapping more than one period")
+        mem = self.members["edge"]
+        self.w("edges")
+        for k in range(s.ne):
+            a, b = s.E[k]
+            parts = [str(a + 1), str(b + 1)]
+            if wrap is not None:
+                parts += [{0: "*", 1: "+", -1: "-"}[int(v)] for v in wrap[k]]
+            if ea.get("fixed") is not None and ea["fixed"][k]:
+                parts.append("fixed")
+            if ea.get("boundary") is not None and ea["boundary"][k]:
+                parts.append(f"boundary {int(ea['boundary'][k])}")
+            c = self._cons(s.econ, k, signed=True)
+            if c:
+                parts.append(c)
+            if ea.get("tension") is not None and ea["tension"][k] != 0:
+                parts.append(f"density {num(ea['tension'][k])}")
+            if ea.get("no_refine") is not None and ea["no_refine"][k]:
+                parts.append("no_refine")
+            if ea.get("color") is not None and ea["color"][k]:
+                parts.append(f"color {int(ea['color'][k])}")
+            parts += mem.get(k, [])
+            parts += self._extra_text("edge", k)
+            self.w(f"{k + 1} " + " ".join(parts))
+        self.w()
+
+    def _faces(self):
+        s = self.s
+        fa = s.fattr
+        mem = self.members["facet"]
+        self.w("faces")
+        for k in range(s.nf):
+            parts = [str(int(e) + 1) if e >= 0 else str(int(e)) for e in s.FE[k]]
+            if fa.get("fixed") is not None and fa["fixed"][k]:
+                parts.append("fixed")
+            if fa.get("boundary") is not None and fa["boundary"][k]:
+                parts.append(f"boundary {int(fa['boundary'][k])}")
+            c = self._cons(s.fcon, k)
+            if c:
+                parts.append(c)
+            t = fa["tension"][k]
+            if t != 1.0:
+                parts.append(f"tension {num(t)}")
+            if fa.get("no_refine") is not None and fa["no_refine"][k]:
+                parts.append("no_refine")
+            for key in ("color", "frontcolor", "backcolor"):
+                if fa.get(key) is not None and fa[key][k]:
+                    parts.append(f"{key} {int(fa[key][k])}")
+            parts += mem.get(k, [])
+            parts += self._extra_text("facet", k)
+            self.w(f"{k + 1} " + " ".join(parts))
+        self.w()
+
+    def _bodies(self):
+        b = self.s.bodies
+        if not b.n:
+            return
+        ob, of, osg = b.occurrences
+        self.w("bodies")
+        for k in range(b.n):
+            sel = ob == k
+            parts = [str(int(c) + 1) if v > 0 else str(-(int(c) + 1))
+                     for c, v in zip(of[sel], osg[sel])]
+            if not np.isnan(b.target[k]):
+                parts.append(f"volume {num(b.target[k])}")
+            if b.pressure is not None and not np.isnan(b.pressure[k]):
+                parts.append(f"pressure {num(b.pressure[k])}")
+            if b.volconst is not None and b.volconst[k]:
+                parts.append(f"volconst {num(b.volconst[k])}")
+            if b.density is not None and b.density[k]:
+                parts.append(f"density {num(b.density[k])}")
+            parts += self._extra_text("body", k)
+            self.w(f"{k + 1} " + " ".join(parts))
+        self.w()
+
+    def _read(self):
+        """Toggles that change the energy, set as the surface had them."""
+        sess = self.sess
+        if sess is None:
+            return
+        out = []
+        b = self.s.bodies
+        if b.n and np.any(b.density) or self.s.gravity_constant != 1.0:
+            out.append(f"gravity {'on' if sess.toggles.get('gravity', 1) else 'off'}")
+        if out:
+            self.w("read")
+            self.w()
+            for line in out:
+                self.w(line)
+
+
+def write_fe(surface, path, session=None):
+    text = _FeWriter(surface, session).text()
+    with open(path, "w", encoding="latin-1") as fh:
+        fh.write(text)
+
+
+WRITERS = {"fe": write_fe}
+
+
+def dump(surface_or_session, path, fmt="fe"):
+    """Write a surface (or a session's surface with its settings) to ``path``
+    in the format ``fmt`` (a key of :data:`WRITERS`)."""
+    from ..session import Session
+    if isinstance(surface_or_session, Session):
+        sess, surface = surface_or_session, surface_or_session.surface
+    else:
+        sess, surface = None, surface_or_session
+    if surface is None:
+        raise UnsupportedError("dump: no surface is loaded")
+    try:
+        writer = WRITERS[fmt]
+    except KeyError:
+        raise UnsupportedError(f"dump format '{fmt}'", f"known: {', '.join(WRITERS)}") from None
+    writer(surface, path, session=sess)
