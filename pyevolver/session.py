@@ -9,6 +9,7 @@ The REPL, the CLI and the Python API share this object::
 """
 from __future__ import annotations
 
+import contextlib
 import copy
 import math
 import sys
@@ -37,6 +38,29 @@ DEFAULTS = {
     "hessian_epsilon": 1e-8, "sq_mean_mix": 0.0,
 }
 
+
+
+@contextlib.contextmanager
+def _deferred_sigint():
+    """Ctrl-C (SIGINT) only sets ``flag["hit"]`` while the block runs (so a
+    ``g`` or ``bfgs`` run can stop at the end of a complete iteration); the
+    previous handler is restored after.  Outside the main thread, a no-op."""
+    import signal
+    import threading
+    flag = {"hit": False}
+    old = None
+    if threading.current_thread() is threading.main_thread():
+        def handler(signum, frame):
+            flag["hit"] = True
+        try:
+            old = signal.signal(signal.SIGINT, handler)
+        except (ValueError, OSError):
+            old = None
+    try:
+        yield flag
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGINT, old)
 
 class Session:
     """A loaded surface with its variables, commands and output streams."""
@@ -373,23 +397,8 @@ class Session:
         Ctrl-C (SIGINT) during the run is deferred to the end of the current
         step: the step completes, the run stops and the surface is the one
         after that step."""
-        import signal
-        import threading
-        flag = {"hit": False}
-        installed = False
-        if threading.current_thread() is threading.main_thread():
-            def handler(signum, frame):
-                flag["hit"] = True
-            try:
-                old = signal.signal(signal.SIGINT, handler)
-                installed = True
-            except (ValueError, OSError):
-                installed = False
-        try:
+        with _deferred_sigint() as flag:
             self.g(n, echo=True, callback=lambda r: flag["hit"])
-        finally:
-            if installed:
-                signal.signal(signal.SIGINT, old)
         if flag["hit"]:
             # the rest of the command (an enclosing loop too) is abandoned; the
             # surface is the one after the last complete iteration
@@ -405,9 +414,6 @@ class Session:
         ``g``) and returns the :class:`~pyevolver.evolve.bfgs.BFGSResult`;
         ``callback(result)`` may stop the run, and so does Ctrl-C (at the end
         of the current iteration, the surface that of the last one)."""
-        import signal
-        import threading
-
         from .evolve import bfgs as B
         from .evolve.gradient import energy_gradient
         from .evolve.iterate import _Constraints
@@ -427,38 +433,32 @@ class Session:
             raise UnsupportedError("bfgs on vertices with level-set constraints or boundaries")
         X0 = state(s)
         idx = np.nonzero(mobile)[0]
-        flag = {"hit": False}
+        areas = {}                       # id of an evaluated point -> its area
 
         def fun(x):
             s.X[idx] = x.reshape(-1, 3)
             t = s.evaluate()
+            areas.clear()
+            areas[id(x)] = t.total_area
             return t.energy, energy_gradient(t)[idx].ravel()
 
-        def cb(r):
-            if echo and not self.toggles.get("quiet"):
-                t = s.evaluate()
-                self.write("%3d. area: %#17.15g energy: %#17.15g  scale: %#g\n"
-                           % (n - r.nit, t.total_area, r.energy, r.step))
-            return flag["hit"] or (callback is not None and callback(r))
-        installed = False
-        if threading.current_thread() is threading.main_thread():
-            def handler(signum, frame):
-                flag["hit"] = True
+        with _deferred_sigint() as flag:
+            def cb(r):
+                if echo and not self.toggles.get("quiet"):
+                    area = areas.get(id(r.x))
+                    if area is None:     # the line search kept an earlier point
+                        s.X[idx] = r.x.reshape(-1, 3)
+                        area = s.evaluate().total_area
+                    self.write("%3d. area: %#17.15g energy: %#17.15g  scale: %#g\n"
+                               % (n - r.nit, area, r.energy, r.step))
+                return flag["hit"] or (callback is not None and callback(r))
             try:
-                old = signal.signal(signal.SIGINT, handler)
-                installed = True
-            except (ValueError, OSError):
-                installed = False
-        try:
-            r = B.minimize(fun, s.X[idx].ravel().copy(), int(n), callback=cb)
-            s.X[idx] = r.x.reshape(-1, 3)
-        except Exception:
-            restore_state(s, X0)
-            self.recalc()
-            raise
-        finally:
-            if installed:
-                signal.signal(signal.SIGINT, old)
+                r = B.minimize(fun, s.X[idx].ravel().copy(), int(n), callback=cb)
+                s.X[idx] = r.x.reshape(-1, 3)
+            except Exception:
+                restore_state(s, X0)
+                self.recalc()
+                raise
         self.recalc()
         return r
 

@@ -33,16 +33,9 @@ import scipy.sparse.linalg as spla
 
 from .. import geometry as G
 from ..errors import UnsupportedError
+from ..methods.jets import skew
 from ..surface import boundary_eval, boundary_groups
 from . import gradient as GR
-
-
-def _skew(v):
-    """(n, 3) vectors -> (n, 3, 3) cross-product matrices [v]x."""
-    z = np.zeros(len(v))
-    return np.stack([np.stack([z, -v[:, 2], v[:, 1]], 1),
-                     np.stack([v[:, 2], z, -v[:, 0]], 1),
-                     np.stack([-v[:, 1], v[:, 0], z], 1)], 1)
 
 
 class Basis:
@@ -152,7 +145,7 @@ def facet_area_hessian(t, weights, basis=None):
     B -= c[:, :, None, :, None] * c[:, None, :, None, :]
     B[:, :, :, [0, 1, 2], [0, 1, 2]] += dots[:, :, :, None]
     B /= (2 * L)[:, None, None, None, None]
-    nx = _skew(n)
+    nx = skew(n)
     eps = np.zeros((3, 3))
     for a in range(3):
         eps[a, (a + 2) % 3] = 1.0
@@ -215,7 +208,7 @@ def facet_volume_hessian(t, weights, symmetric, basis=None):
                     continue
                 c = 3 - a - b
                 sign = 1.0 if (a, b, c) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) else -1.0
-                B[:, a, b] = sign * _skew(P[:, c]).transpose(0, 2, 1) / 6.0
+                B[:, a, b] = sign * skew(P[:, c]).transpose(0, 2, 1) / 6.0
                 # eps_ijk x^k = -[x]x_ij
     else:
         # v = (z0+z1+z2) cz / 6, cz bilinear in x and y

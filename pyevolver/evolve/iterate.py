@@ -16,6 +16,15 @@ from ..surface import displace, project_tangent, project_to_constraints, restore
 from . import gradient as GR
 
 
+def _solve(A, d):
+    """``A⁻¹ d``, least squares when A is singular (restoring coefficients,
+    multipliers)."""
+    try:
+        return np.linalg.solve(A, d)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(A, d, rcond=None)[0]
+
+
 @dataclass
 class StepResult:
     """What one ``g`` step did (``scipy.optimize``-style result)."""
@@ -154,11 +163,7 @@ class Iterator:
         start, d_start = state(s), d
         factor = 1.0
         for it in range(10):
-            try:
-                delta = np.linalg.solve(cur_A, d)
-            except np.linalg.LinAlgError:
-                delta = np.linalg.lstsq(cur_A, d, rcond=None)[0]
-            delta = factor * delta
+            delta = factor * _solve(cur_A, d)
             prev = state(s)
             shift = sum(dl * u for dl, u in zip(delta, cur_us))
             displace(s, prev, shift)
@@ -203,11 +208,8 @@ class Iterator:
         # REF's loop ends with one more correction that it does not check
         # (itdebug: a last volume_restore() and no "Next diff" after the
         # tenth check), then warns with the last difference it checked
-        try:
-            delta = np.linalg.solve(cur_A, d)
-        except np.linalg.LinAlgError:
-            delta = np.linalg.lstsq(cur_A, d, rcond=None)[0]
-        displace(s, state(s), sum(dl * u for dl, u in zip(factor * delta, cur_us)))
+        delta = factor * _solve(cur_A, d)
+        displace(s, state(s), sum(dl * u for dl, u in zip(delta, cur_us)))
         project_to_constraints(s, moved)
         t = s.evaluate()
         if report is not None and not trial:
@@ -235,10 +237,7 @@ class Iterator:
         if len(cons):
             gs, us, A = self._constrained_dirs(t0, cons, mobile)
             b = np.array([float(np.sum(f * g)) for g in gs])
-            try:
-                lam = np.linalg.solve(A, b)
-            except np.linalg.LinAlgError:
-                lam = np.linalg.lstsq(A, b, rcond=None)[0]
+            lam = _solve(A, b)
             vel = f - sum(l * u for l, u in zip(lam, us))
         else:
             us, A = [], np.zeros((0, 0))

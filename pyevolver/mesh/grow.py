@@ -106,20 +106,21 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
             rows[:] = _new_ids(arr, nv_new)
         va[key] = _append_rows(arr, rows)
     t.vattr = va
+    def inherited(cid):
+        # new vertices are on a constraint when the edge or facet they come from is
+        return np.concatenate([
+            s.econ[cid][ve] != 0 if cid in s.econ else np.zeros(len(ve), bool),
+            s.fcon[cid][vf] if cid in s.fcon else np.zeros(len(vf), bool)])
     t.vcon = {}
     for cid, on in s.vcon.items():
         if "global" in s.constraints[cid].flags:
             add = np.ones(nv_new, bool)
         else:
-            add = np.concatenate([
-                s.econ[cid][ve] != 0 if cid in s.econ else np.zeros(len(ve), bool),
-                s.fcon[cid][vf] if cid in s.fcon else np.zeros(len(vf), bool)])
+            add = inherited(cid)
         t.vcon[cid] = _append_rows(on, add)
     for cid in set(s.econ) | set(s.fcon):
         if cid not in t.vcon:
-            add = np.concatenate([
-                s.econ[cid][ve] != 0 if cid in s.econ else np.zeros(len(ve), bool),
-                s.fcon[cid][vf] if cid in s.fcon else np.zeros(len(vf), bool)])
+            add = inherited(cid)
             if add.any():
                 t.vcon[cid] = np.concatenate([np.zeros(s.nv, bool), add])
 

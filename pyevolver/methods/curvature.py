@@ -46,6 +46,13 @@ def _scatter(nv, idx, vals):
     return np.stack([np.bincount(idx, weights=vals[:, k], minlength=nv) for k in range(3)], 1)
 
 
+def vertex_weights(nv, idx, w):
+    """Per-vertex weights (nv,): ``w`` summed into the vertices ``idx``."""
+    wv = np.zeros(nv)
+    np.add.at(wv, np.asarray(idx, np.int64), np.asarray(w, float))
+    return wv
+
+
 def star_sums(t):
     """Per-vertex star area ``A`` (nv,), area gradient ``F`` (nv, 3) and sum
     of area vectors ``N`` (nv, 3), from the corners the :class:`Totals`
@@ -207,8 +214,7 @@ def vertex_gradient(t, m, idx, w):
     with np.errstate(all="ignore"):
         n = np.nan_to_num(t.facet_N2 / L[:, None])
     Ag = GR.facet_area_grad(t)
-    wv = np.zeros(s.nv)
-    np.add.at(wv, idx, w)
+    wv = vertex_weights(s.nv, idx, w)
     dF, dN, dA = dF * wv[:, None], dN * wv[:, None], dA * wv
     Fc = s.F
     g = _area_hvp(P, n, L, dF[Fc])                                # via F_v
@@ -344,8 +350,7 @@ def _gauss_grad(t, idx, w, square):
     s = t.surface
     _check_supported(s)
     K, A, P, dang = _gauss(t)
-    wv = np.zeros(s.nv)
-    np.add.at(wv, idx, w)
+    wv = vertex_weights(s.nv, idx, w)
     if square:
         dK = 2 * K / (A / 3.0) * wv
         dA = -3.0 * K * K / (A * A) * wv
@@ -465,8 +470,7 @@ def cotan_gradient(t, m, idx, w):
     s = t.surface
     _check_supported(s)
     P, cot, cg, Am, Amg, Sv, Av = _cotan_parts(t)
-    wv = np.zeros(s.nv)
-    np.add.at(wv, np.asarray(idx, np.int64), w)
+    wv = vertex_weights(s.nv, idx, w)
     with np.errstate(all="ignore"):
         uS = np.nan_to_num(Sv / (8.0 * Av)[:, None]) * wv[:, None]
         uA = np.nan_to_num(-np.einsum("ij,ij->i", Sv, Sv) / (16.0 * Av * Av)) * wv
@@ -553,8 +557,7 @@ def circle_willmore_values(ctx, m, idx):
 def circle_willmore_gradient(t, m, idx, w):
     s = t.surface
     _check_supported(s)
-    wv = np.zeros(s.nv)
-    np.add.at(wv, np.asarray(idx, np.int64), w)
+    wv = vertex_weights(s.nv, idx, w)
     e, i, j, k, l_ = _edge_quads(s)
     _, (gi, gj, gk, gl) = _bobenko_beta(s.X, i, j, k, l_, grad=True)
     coef = 0.5 * (wv[i] + wv[j])[:, None]

@@ -82,12 +82,6 @@ def _gauss_newton(Jm, M):
     return (Jm.T @ (Md @ Jm)).tocsr()
 
 
-def _vertex_weights(nv, idx, w):
-    wv = np.zeros(nv)
-    np.add.at(wv, np.asarray(idx, np.int64), np.asarray(w, float))
-    return wv
-
-
 def _facet_jets(P):
     """Corner jets, ``N = (x1−x0)×(x2−x0)``, ``|N|`` and the area of facets P (nf, 3, 3)."""
     x = J.points(P)
@@ -209,7 +203,7 @@ def vertex_hessian(t, m, idx, w, basis=None):
     C._check_supported(s)
     A, F, N = C.star_sums(t)
     _, dF, dN, dA = C._vertex_energy(s, A, F, N, m.method)
-    wv = _vertex_weights(s.nv, idx, w)
+    wv = C.vertex_weights(s.nv, idx, w)
     M = vertex_energy_hessian(s, A, F, N, m.method) * wv[:, None, None]
     return star_hessian(t, M, dA * wv, dF * wv[:, None], dN * wv[:, None], basis)
 
@@ -262,7 +256,7 @@ def _gauss_hessian(t, idx, w, square, basis):
     K, A, P, _ = C._gauss(t)
     nv, Fc = s.nv, s.F
     nf = len(P)
-    wv = _vertex_weights(nv, idx, w)
+    wv = C.vertex_weights(nv, idx, w)
     x, _, _, Aj = _facet_jets(P)
     ang = _angle_jets(x)
     with np.errstate(all="ignore"):
@@ -308,7 +302,7 @@ def cotan_hessian(t, m, idx, w, basis=None):
     P, cot, _, _, _, Sv, Av = C._cotan_parts(t)
     nv, Fc = s.nv, s.F
     nf = len(P)
-    wv = _vertex_weights(nv, idx, w)
+    wv = C.vertex_weights(nv, idx, w)
     x, _, _, Aj = _facet_jets(P)
     cj = []
     for a in range(3):

@@ -52,7 +52,7 @@ def values(ctx, m, idx):
 
 def gradient(t, m, idx, w):
     s = t.surface
-    wv = np.zeros(s.nv)
-    np.add.at(wv, np.asarray(idx, np.int64), w)
+    from .curvature import vertex_weights
+    wv = vertex_weights(s.nv, idx, w)
     coef = wv[s.F].sum(1) / 3.0
     return evaluator(s, m.method).gradient(s.X, KIND[m.method], coef)
