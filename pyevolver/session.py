@@ -459,6 +459,8 @@ class Session:
                 restore_state(s, X0)
                 self.recalc()
                 raise
+        if echo and r.nit == 0:
+            self.write(f"bfgs: no step taken ({r.message}).\n")
         self.recalc()
         return r
 
