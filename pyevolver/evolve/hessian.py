@@ -36,6 +36,7 @@ from ..errors import UnsupportedError
 from ..methods.jets import skew
 from ..surface import boundary_eval, boundary_groups
 from . import gradient as GR
+from .ordering import nested_dissection
 
 
 class Basis:
@@ -586,6 +587,9 @@ def constraint_curvature(s, grads, force_grad):
                          shape=(3 * s.nv, 3 * s.nv))
 
 
+_ND_MIN = 2000     # unknowns: below this CHOLMOD's own AMD order is as good
+
+
 def _cholmod():
     """scikit-sparse's CHOLMOD module, or None when it is not installed."""
     try:
@@ -595,7 +599,7 @@ def _cholmod():
     return cholmod
 
 
-def solve_bordered(K, B, r, d, method=None):
+def solve_bordered(K, B, r, d, method=None, points=None):
     """Solve ``[[K, B], [Bᵀ, 0]] [y; μ] = [r; d]``.
 
     K : sparse symmetric (n, n); B : (n, k) dense or None; r : (n,); d : (k,).
@@ -604,7 +608,10 @@ def solve_bordered(K, B, r, d, method=None):
     eliminates the k multipliers by the Schur complement ``Bᵀ K⁻¹ B``;
     "splu" factors the whole bordered matrix with SuperLU.  By default
     CHOLMOD when installed, SuperLU otherwise or when CHOLMOD meets a zero
-    pivot.
+    pivot.  ``points`` (n, 3), the position of each unknown, lets CHOLMOD
+    eliminate in the geometric nested-dissection order of
+    :func:`~pyevolver.evolve.ordering.nested_dissection` instead of its
+    own AMD order (about half the factorization time on large surfaces).
     """
     chol = _cholmod() if method in (None, "cholmod") else None
     if method == "cholmod" and chol is None:
@@ -613,12 +620,22 @@ def solve_bordered(K, B, r, d, method=None):
         try:
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                f = chol.cholesky(K.tocsc(), mode="simplicial")
-                if B is None:
-                    y = f(r)
-                    sol = y
+                perm = None
+                if points is not None and K.shape[0] > _ND_MIN:
+                    perm = nested_dissection(points, K)
+                    Kp = K.tocsr()[perm][:, perm].tocsc()
+                    f = chol.cholesky(Kp, mode="simplicial", ordering_method="natural")
                 else:
-                    Z = f(np.column_stack([r, B]))
+                    f = chol.cholesky(K.tocsc(), mode="simplicial")
+                R = r[:, None] if B is None else np.column_stack([r, B])
+                if perm is None:
+                    Z = f(R)
+                else:
+                    Z = np.empty_like(R)
+                    Z[perm] = f(R[perm])
+                if B is None:
+                    sol = Z[:, 0]
+                else:
                     S = B.T @ Z[:, 1:]
                     mu = np.linalg.solve(S, B.T @ Z[:, 0] - d)
                     y = Z[:, 0] - Z[:, 1:] @ mu
@@ -684,7 +701,7 @@ def newton_direction(it):
         Cm = np.stack([g.ravel() for g in gs], axis=1)          # (3nv, k)
         B = np.asarray(T.T @ Cm)
         d = cons.targets(s) - cons.values(t)
-    sol = solve_bordered(K, B, rhs, d)
+    sol = solve_bordered(K, B, rhs, d, points=np.repeat(s.X, basis.ndof, axis=0))
     dy = sol[:K.shape[0]]
     lam_new = -sol[K.shape[0]:] if len(cons) else lam
     dx = (T @ dy).reshape(-1, 3)
