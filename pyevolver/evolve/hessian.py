@@ -67,7 +67,8 @@ class Basis:
 
 
 def _assemble(nv, verts, blocks, basis=None):
-    """Sparse matrix from per-element blocks.
+    """Sparse matrix from per-element blocks, in COO form with the elements'
+    entries not yet summed (:func:`_sum` adds all parts in one conversion).
 
     verts : (m, k) vertex indices of each element; blocks : (m, k, k, 3, 3).
     Without ``basis`` the (3nv, 3nv) matrix; with a :class:`Basis` the
@@ -83,7 +84,7 @@ def _assemble(nv, verts, blocks, basis=None):
     cols = (3 * verts[:, None, :, None, None] + np.arange(3)[None, None, None, None, :])
     rows = np.broadcast_to(rows, (m, k, k, 3, 3)).ravel()
     cols = np.broadcast_to(cols, (m, k, k, 3, 3)).ravel()
-    return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(3 * nv, 3 * nv))
+    return sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(3 * nv, 3 * nv))
 
 
 def _assemble_projected(verts, blocks, basis):
@@ -96,9 +97,10 @@ def _assemble_projected(verts, blocks, basis):
     rows = np.broadcast_to(idx[:, :, None, :, None], (m, k, k, d, d)).ravel()
     cols = np.broadcast_to(idx[:, None, :, None, :], (m, k, k, d, d)).ravel()
     vals = blocks.ravel()
-    keep = (rows >= 0) & (cols >= 0)
-    return sp.csr_matrix((vals[keep], (rows[keep], cols[keep])),
-                         shape=(basis.n, basis.n))
+    if (basis.ndof[verts] < d).any():
+        keep = (rows >= 0) & (cols >= 0)
+        rows, cols, vals = rows[keep], cols[keep], vals[keep]
+    return sp.coo_matrix((vals, (rows, cols)), shape=(basis.n, basis.n))
 
 
 def facet_area_hessian(t, weights, basis=None):
@@ -389,12 +391,19 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
                 g = g + GR.corner_scatter(t, GR.facet_volume_grad(t, s.symmetric_content), fw)
         else:
             complete = False
-    H = None
-    if hessian:
-        for fn, args in parts:
-            h = fn(*args, basis=basis)
-            H = h if H is None else H + h
+    H = _sum([fn(*args, basis=basis) for fn, args in parts]) if hessian else None
     return H, g, complete
+
+
+def _sum(mats):
+    """CSR sum of sparse matrices of one shape: their COO entries
+    concatenated and converted once (duplicates summed)."""
+    coo = [m.tocoo() for m in mats]
+    if len(coo) == 1:
+        return coo[0].tocsr()
+    return sp.csr_matrix((np.concatenate([c.data for c in coo]),
+                          (np.concatenate([c.row for c in coo]),
+                           np.concatenate([c.col for c in coo]))), shape=coo[0].shape)
 
 
 def _quantity_hessian(t, q, weight):
