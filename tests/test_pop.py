@@ -8,10 +8,10 @@ import re
 
 import numpy as np
 import pytest
-
 from conftest import example
 from reference import run_reference
 from test_mesh import consistent
+
 from pyevolver import Session
 from pyevolver.errors import PyEvolverError
 
@@ -177,7 +177,9 @@ def test_unchecked_configurations_are_refused(tmp_path):
     _refused(path, "O", "more than four facets")
     # a FIXED four-facet edge (REF stops without a word)
     fixed = tmp_path / "octa_fixed.fe"
-    fixed.write_text(open(octa).read().replace("\n13  1  2\n", "\n13  1  2 fixed\n"))
+    with open(octa) as fh:
+        text = fh.read()
+    fixed.write_text(text.replace("\n13  1  2\n", "\n13  1  2 fixed\n"))
     _refused(str(fixed), "O", "FIXED edge")
     # vertex popping and autopop stay refused
     _refused(octa, "o", "vertex popping")
@@ -185,7 +187,7 @@ def test_unchecked_configurations_are_refused(tmp_path):
 
 
 def test_nothing_to_pop_reports_zero():
-    s, out = _ours(example("cube.fe"), "O")
+    _, out = _ours(example("cube.fe"), "O")
     assert out == ["Edges popped: 0"]
 
 

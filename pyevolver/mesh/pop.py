@@ -94,7 +94,7 @@ def _loop(s, e, first):
     d = d / L
     F = s.F
     sign = np.array([1 if e in s.FE[f] else -1 for f in fs])
-    c = np.array([[v for v in F[f] if v != a and v != b][0] for f in fs])
+    c = np.array([next(v for v in F[f] if v != a and v != b) for f in fs])
     w = s.X[c] - s.X[a]
     u = w - np.outer(w @ d, d)
     n = np.linalg.norm(u, axis=1)
