@@ -602,6 +602,16 @@ class Session:
             self.write(f"Number of edges notched: {n}\n")
         return n
 
+    def pop_edges(self, echo=True):
+        """``O``: pop the edges with four facets (pyevolver.mesh.pop)."""
+        from .mesh.pop import pop_edges
+        new, n = pop_edges(self.surface)
+        self._replace_surface(new)
+        self.counts["edge_pop"] = n             # REF: a later O with no pops prints 0
+        if echo:
+            self.write(f"Edges popped: {n}\n")
+        return n
+
     def _count(self, key, n):
         self.counts[key] = self.counts.get(key, 0) + n
 

@@ -445,6 +445,8 @@ class _Builder:
         self._bodies()
         self._quantities()
         self._project()
+        if s.nf:
+            record_edge_first_facet(s, first_facets_on_load(s.FE, self.facet_parent, s.ne))
         return s
 
     def _constraint_ids(self, vals, what, blk, pos):
@@ -984,6 +986,53 @@ class _Builder:
     # -- projection -------------------------------------------------------------------
     def _project(self):
         project_to_constraints(self.s, np.arange(self.s.nv))
+
+
+def first_facets_on_load(FE, parent, ne):
+    """(ne,) index of each edge's first facet, -1 where unknown.
+
+    The Evolver keeps the facets round an edge in a cyclic loop that starts
+    at the first face of the datafile listing the edge (checked with ``O`` on
+    octa.fe and on single four-facet edges, where the loop start breaks ties
+    between equal angles).  ``parent`` (nf,) is the datafile face position of
+    each facet; an edge whose first face was split on load into several
+    triangles containing it (a spoke) gets -1.
+    """
+    nf = len(FE)
+    e = np.where(FE >= 0, FE, ~FE).ravel()
+    f = np.repeat(np.arange(nf), 3)
+    p = np.asarray(parent)[f]
+    order = np.lexsort((f, p, e))
+    e, f, p = e[order], f[order], p[order]
+    head = np.ones(len(e), bool)
+    head[1:] = e[1:] != e[:-1]
+    first = np.full(ne, -1, np.int64)
+    h = np.nonzero(head)[0]
+    nxt = h + 1
+    tie = (nxt < len(e)) & (e[np.minimum(nxt, len(e) - 1)] == e[h]) & \
+        (p[np.minimum(nxt, len(e) - 1)] == p[h])
+    first[e[h]] = np.where(tie, -1, f[h])
+    return first
+
+
+def record_edge_first_facet(s, first):
+    """Attach the first facet of every edge's loop to ``s``, valid while its
+    connectivity stays what it is now (any change to ``E`` or ``FE`` drops
+    it; only the operations that know how the loop start moves keep it)."""
+    s._edge_first = (s.FE.copy(), s.E.copy(), np.asarray(first, np.int64))
+
+
+def edge_first_facet(s):
+    """(ne,) first facet of each edge's loop (-1 unknown), or None when the
+    connectivity changed since it was recorded."""
+    c = s.__dict__.get("_edge_first")
+    if c is None:
+        return None
+    FE, E, first = c
+    if FE.shape != s.FE.shape or E.shape != s.E.shape or \
+            not np.array_equal(FE, s.FE) or not np.array_equal(E, s.E):
+        return None
+    return first
 
 
 def convex_edges(s):

@@ -818,7 +818,7 @@ LETTER_LATER = {
     "g": "g (iteration) comes with the evolve issue",
     "U": "U (conjugate gradient) comes with the evolve issue",
     "m": "m (fixed scale) comes with the evolve issue",
-    "o": "o (vertex popping)", "O": "O (edge popping)",
+    "o": "o (vertex popping)",
     "G": "G (gravity) comes with the evolve issue",
     "e": "e (extrapolation)", "i": "i (information)", "Q": "Q (quantities)",
     "C": "C (consistency check)", "c": "c (counts)", "N": "N",
@@ -1470,6 +1470,9 @@ class Interpreter:
             return
         if raw == "V" or name in ("rawv", "rawestv"):
             s.vertex_average({"V": "V", "rawv": "raw", "rawestv": "rawest"}[raw])
+            return
+        if raw == "O":
+            s.pop_edges()
             return
         if raw == "u" or name == "equiangulate":
             s.equiangulate()
