@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from .api import SessionAPI, progress_bar
 from .commands import interpreter as I
 from .datafile.reader import read_datafile
 from .errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
@@ -62,8 +63,9 @@ def _deferred_sigint():
         if old is not None:
             signal.signal(signal.SIGINT, old)
 
-class Session:
-    """A loaded surface with its variables, commands and output streams."""
+class Session(SessionAPI):
+    """A loaded surface with its variables, commands and output streams
+    (the Python API's extras: :class:`pyevolver.api.SessionAPI`)."""
 
     def __init__(self, out=None, err=None):
         self.out = out or sys.stdout
@@ -86,6 +88,7 @@ class Session:
         self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
         self.iteration_counter = 0
         self.total_time = 0.0
+        self.history = []                      # (iteration, energy, area) of each g step
 
     # -- loading ---------------------------------------------------------------
     @classmethod
@@ -350,20 +353,35 @@ class Session:
         if self._iterator is not None:
             self._iterator.cg_history = None
 
-    def g(self, n=1, callback=None, echo=False):
+    def g(self, n=1, callback=None, echo=False, progress=None):
         """Run ``n`` iteration steps; returns the list of step results.
 
         ``callback(result)`` is called after each step; returning True stops
         the run.  With ``echo`` the Evolver's progress lines are printed.
+        ``progress``: a tqdm bar (True, False, or None for long runs at a
+        terminal or in a notebook; never with ``echo``).
         """
-        from .evolve.iterate import progress_line
         results = []
         if self.surface.nv == 0:                # e.g. after `t` removed everything (REF)
             self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")
             return results
+        bar = None if echo else progress_bar(n, progress, "g")
+        try:
+            self._steps(n, callback, echo, results, bar)
+        finally:
+            if bar is not None:
+                bar.close()
+        return results
+
+    def _steps(self, n, callback, echo, results, bar):
+        from .evolve.iterate import progress_line
         for k in range(n, 0, -1):
             r = self.iterator.step()
             results.append(r)
+            self.history.append((self.iteration_counter, r.energy, r.area))
+            if bar is not None:
+                bar.update(1)
+                bar.set_postfix(energy=f"{r.energy:.10g}", refresh=False)
             L = self.settings.get("autochop_length", 0.0)
             if self.toggles.get("autochop") and L > 0:
                 # autochop (spec §9.5): edges longer than autochop_length after
@@ -389,7 +407,6 @@ class Session:
                 break
             if callback is not None and callback(r):
                 break
-        return results
 
     def go(self, n):
         """``g n`` at the prompt: steps with progress lines.
