@@ -241,6 +241,9 @@ def run_point(spec, i, key, start=None):
     from .session import Session
     folder = point_dir(spec, i)
     os.makedirs(folder, exist_ok=True)
+    for name in os.listdir(folder):            # temporary files of a killed run
+        if name.startswith("."):
+            os.remove(os.path.join(folder, name))
     params = spec.points()[i]
     out = io.StringIO()
     t0 = time.perf_counter()
