@@ -64,11 +64,11 @@ def _split(obj):
     return None, obj
 
 
-def _facet_values(s, totals, field):
+def _facet_values(s, field):
     """Per-facet values of ``field`` (a facet field, or a vertex field
     averaged over each facet's corners) and its label."""
     from .fields import curvature_method, surface_fields
-    v, f = surface_fields(s, totals)
+    v, f = surface_fields(s)
     if field in f:
         return np.asarray(f[field], float), f"facet {field}"
     if field in v:
@@ -135,8 +135,7 @@ def snapshot(obj, path, field="mean_curvature", view=None, size=600, cmap="virid
     if field in (None, "none"):
         rgb = np.tile([0.78, 0.80, 0.84], (s.nf, 1))
     else:
-        totals = sess.totals if sess is not None else None
-        vals, label = _facet_values(s, totals, field)
+        vals, label = _facet_values(s, field)
         lo, hi = clim if clim is not None else (np.nanmin(vals), np.nanmax(vals))
         if not np.isfinite(lo) or not np.isfinite(hi):
             lo, hi = 0.0, 1.0

@@ -421,7 +421,7 @@ class Session(SessionAPI):
             # surface is the one after the last complete iteration
             raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
-    def bfgs(self, n, echo=True, callback=None):
+    def bfgs(self, n, echo=True, callback=None, progress=None):
         """``bfgs n``: at most ``n`` iterations of BFGS with a weak Wolfe line
         search (:mod:`pyevolver.evolve.bfgs`; Lewis & Overton 2013), the
         minimizer for nonsmooth energies such as ``circle_willmore``.  Free
@@ -430,7 +430,8 @@ class Session(SessionAPI):
         Prints ``k. area: .. energy: ..`` per iteration (counting down, as
         ``g``) and returns the :class:`~pyevolver.evolve.bfgs.BFGSResult`;
         ``callback(result)`` may stop the run, and so does Ctrl-C (at the end
-        of the current iteration, the surface that of the last one)."""
+        of the current iteration, the surface that of the last one).
+        ``progress``: a tqdm bar, as for :meth:`g` (never with ``echo``)."""
         from .evolve import bfgs as B
         from .evolve.gradient import energy_gradient
         from .evolve.iterate import _Constraints
@@ -468,7 +469,10 @@ class Session(SessionAPI):
                         area = s.evaluate().total_area
                     self.write("%3d. area: %#17.15g energy: %#17.15g  scale: %#g\n"
                                % (n - r.nit, area, r.energy, r.step))
+                if bar is not None:
+                    bar.update(1)
                 return flag["hit"] or (callback is not None and callback(r))
+            bar = None if echo else progress_bar(int(n), progress, "bfgs")
             try:
                 r = B.minimize(fun, s.X[idx].ravel().copy(), int(n), callback=cb)
                 s.X[idx] = r.x.reshape(-1, 3)
@@ -476,6 +480,9 @@ class Session(SessionAPI):
                 restore_state(s, X0)
                 self.recalc()
                 raise
+            finally:
+                if bar is not None:
+                    bar.close()
         if echo and r.nit == 0:
             self.write(f"bfgs: no step taken ({r.message}).\n")
         self.recalc()

@@ -2,6 +2,7 @@
 ``.run``, ``.surface``, ``.quantities``, ``.value``, ``.history`` and the
 progress bars, which never reach the Evolver-compatible output."""
 import io
+import os
 
 import numpy as np
 import pytest
@@ -52,3 +53,15 @@ def test_progress_bar_in_the_api_only(capsys):
     assert s.out.getvalue().count("area:") == 150
     assert progress_bar(500, None) is None               # not a terminal: no bar by default
     assert progress_bar(500, False) is None
+
+
+def test_bfgs_progress_bar(capsys):
+    torus = os.path.join(os.path.dirname(__file__), "..", "datafiles", "paper",
+                         "torus5x9_circle_willmore.fe")
+    s = pyevolver.load(torus, out=io.StringIO())
+    s.surface.X += 1e-3 * np.random.default_rng(0).standard_normal(s.surface.X.shape)
+    s.recalc()
+    r = s.bfgs(3, echo=False, progress=True)
+    assert r.nit == 3 and "/3 [" in capsys.readouterr().err
+    s.bfgs(3)                                       # echoed: the Evolver-style lines, no bar
+    assert capsys.readouterr().err == "" and s.out.getvalue().count("energy:") == 3

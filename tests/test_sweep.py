@@ -67,7 +67,8 @@ def test_local_sweep_writes_every_point(local):
         assert abs(s.total_energy - r["total_energy"]) <= 1e-12 * r["total_energy"]
         assert s.surface.nf == r["facet_count"] == 384
         assert abs(r["body_volumes"][0] - r["parameters"]["body[1].target"]) < 1e-4
-        last = open(os.path.join(d, "energies.csv")).read().splitlines()[-1].split(",")
+        with open(os.path.join(d, "energies.csv")) as fh:
+            last = fh.read().splitlines()[-1].split(",")
         assert last[0] == str(r["iterations"]) == "30"
     # the density pulls the drop down: lower top, higher energy, at each volume
     for a, b in zip(res.rows[0::2], res.rows[1::2]):

@@ -9,7 +9,8 @@ DATAFILES = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "dataf
 
 def blocks(path):
     """The ```python fenced blocks of a Markdown file, with their line numbers."""
-    text = open(path, encoding="utf-8").read()
+    with open(path, encoding="utf-8") as fh:
+        text = fh.read()
     out = []
     for m in re.finditer(r"^```python\n(.*?)^```", text, re.S | re.M):
         out.append((text.count("\n", 0, m.start()) + 2, m.group(1)))

@@ -56,7 +56,7 @@ def surface_mesh(obj, data=True):
     :func:`pyevolver.fields.surface_fields`."""
     import meshio
     from ..fields import surface_fields
-    sess, s = _split(obj)
+    _, s = _split(obj)
     if s is None:
         raise CommandError("export: no surface is loaded")
     if s.nf == 0:
@@ -67,8 +67,7 @@ def surface_mesh(obj, data=True):
                                "their vertices; dump writes it")
     point_data, cell_data = {}, {}
     if data:
-        t = sess.totals if sess is not None and sess.totals is not None else None
-        v, f = surface_fields(s, t)
+        v, f = surface_fields(s)             # evaluated afresh: X may have been set by hand
         point_data = v
         cell_data = {k: [a] for k, a in f.items()}
     itype = np.int32 if s.nv < 2 ** 31 else np.int64      # PLY has no 64-bit integers
