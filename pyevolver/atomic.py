@@ -46,8 +46,7 @@ def atomic_write(path, mode="w", **kwargs):
     without an exception (flushed and fsynced first)."""
     if not mode.startswith("w"):
         raise ValueError(f"atomic_write: mode must be 'w' or 'wb', not {mode!r}")
-    with atomic_path(path) as tmp:
-        with open(tmp, mode, **kwargs) as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
+    with atomic_path(path) as tmp, open(tmp, mode, **kwargs) as fh:
+        yield fh
+        fh.flush()
+        os.fsync(fh.fileno())

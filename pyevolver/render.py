@@ -181,7 +181,7 @@ def plot_history(obj, path, size=(6.4, 4.0), log=None):
     against the iteration number; written atomically.  ``log``: plot
     E − min E on a log scale (default: when the energy fell by more than a
     factor 100 of its final decrease)."""
-    mpl, Figure, FigureCanvasAgg = _matplotlib()
+    _, Figure, FigureCanvasAgg = _matplotlib()
     hist = getattr(obj, "history", None)
     if not hist:
         raise CommandError("plot_history: no iterations yet (run g first)")

@@ -14,7 +14,6 @@ import subprocess
 import sys
 import time
 
-import numpy as np
 import pytest
 
 from pyevolver import Session
@@ -55,7 +54,7 @@ def local(tmp_path_factory):
 
 
 def test_local_sweep_writes_every_point(local):
-    tmp, spec, res = local
+    _, spec, res = local
     assert res.computed == 8 and res.reused == 0 and not res.failed
     assert [r["parameters"] for r in res.rows] == spec.points()
     assert spec.points()[3] == {"body[1].target": 1.0, "body[1].density": 0.5}
@@ -81,7 +80,7 @@ def test_local_sweep_writes_every_point(local):
 
 
 def test_point_agrees_with_reference(local, evolver):
-    tmp, spec, res = local
+    tmp, _, res = local
     r = res.rows[5]                                    # target 1.2, density 0.5
     cmds = "body[1].target := 1.2; body[1].density := 0.5; recalc; " + COMMANDS
     lines = run_reference(evolver, DROP, cmds + '\nprintf "RESULT %.17g\\n", total_energy\n',
@@ -93,7 +92,7 @@ def test_point_agrees_with_reference(local, evolver):
 
 def test_dask_local_cluster_gives_identical_results(local):
     distributed = pytest.importorskip("distributed")
-    tmp, spec, res = local
+    tmp, spec, _ = local
     toml = _toml(tmp, "dask", snapshot=False)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                                   host="127.0.0.1", protocol="tcp", dashboard_address=None,
