@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from .api import SessionAPI, progress_bar
 from .commands import interpreter as I
 from .datafile.reader import read_datafile
 from .errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
@@ -62,8 +63,9 @@ def _deferred_sigint():
         if old is not None:
             signal.signal(signal.SIGINT, old)
 
-class Session:
-    """A loaded surface with its variables, commands and output streams."""
+class Session(SessionAPI):
+    """A loaded surface with its variables, commands and output streams
+    (the Python API's extras: :class:`pyevolver.api.SessionAPI`)."""
 
     def __init__(self, out=None, err=None):
         self.out = out or sys.stdout
@@ -86,6 +88,7 @@ class Session:
         self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
         self.iteration_counter = 0
         self.total_time = 0.0
+        self.history = []                      # (iteration, energy, area) of each g step
 
     # -- loading ---------------------------------------------------------------
     @classmethod
@@ -350,20 +353,35 @@ class Session:
         if self._iterator is not None:
             self._iterator.cg_history = None
 
-    def g(self, n=1, callback=None, echo=False):
+    def g(self, n=1, callback=None, echo=False, progress=None):
         """Run ``n`` iteration steps; returns the list of step results.
 
         ``callback(result)`` is called after each step; returning True stops
         the run.  With ``echo`` the Evolver's progress lines are printed.
+        ``progress``: a tqdm bar (True, False, or None for long runs at a
+        terminal or in a notebook; never with ``echo``).
         """
-        from .evolve.iterate import progress_line
         results = []
         if self.surface.nv == 0:                # e.g. after `t` removed everything (REF)
             self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")
             return results
+        bar = None if echo else progress_bar(n, progress, "g")
+        try:
+            self._steps(n, callback, echo, results, bar)
+        finally:
+            if bar is not None:
+                bar.close()
+        return results
+
+    def _steps(self, n, callback, echo, results, bar):
+        from .evolve.iterate import progress_line
         for k in range(n, 0, -1):
             r = self.iterator.step()
             results.append(r)
+            self.history.append((self.iteration_counter, r.energy, r.area))
+            if bar is not None:
+                bar.update(1)
+                bar.set_postfix(energy=f"{r.energy:.10g}", refresh=False)
             L = self.settings.get("autochop_length", 0.0)
             if self.toggles.get("autochop") and L > 0:
                 # autochop (spec §9.5): edges longer than autochop_length after
@@ -389,7 +407,6 @@ class Session:
                 break
             if callback is not None and callback(r):
                 break
-        return results
 
     def go(self, n):
         """``g n`` at the prompt: steps with progress lines.
@@ -404,7 +421,7 @@ class Session:
             # surface is the one after the last complete iteration
             raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
-    def bfgs(self, n, echo=True, callback=None):
+    def bfgs(self, n, echo=True, callback=None, progress=None):
         """``bfgs n``: at most ``n`` iterations of BFGS with a weak Wolfe line
         search (:mod:`pyevolver.evolve.bfgs`; Lewis & Overton 2013), the
         minimizer for nonsmooth energies such as ``circle_willmore``.  Free
@@ -413,7 +430,8 @@ class Session:
         Prints ``k. area: .. energy: ..`` per iteration (counting down, as
         ``g``) and returns the :class:`~pyevolver.evolve.bfgs.BFGSResult`;
         ``callback(result)`` may stop the run, and so does Ctrl-C (at the end
-        of the current iteration, the surface that of the last one)."""
+        of the current iteration, the surface that of the last one).
+        ``progress``: a tqdm bar, as for :meth:`g` (never with ``echo``)."""
         from .evolve import bfgs as B
         from .evolve.gradient import energy_gradient
         from .evolve.iterate import _Constraints
@@ -451,7 +469,10 @@ class Session:
                         area = s.evaluate().total_area
                     self.write("%3d. area: %#17.15g energy: %#17.15g  scale: %#g\n"
                                % (n - r.nit, area, r.energy, r.step))
+                if bar is not None:
+                    bar.update(1)
                 return flag["hit"] or (callback is not None and callback(r))
+            bar = None if echo else progress_bar(int(n), progress, "bfgs")
             try:
                 r = B.minimize(fun, s.X[idx].ravel().copy(), int(n), callback=cb)
                 s.X[idx] = r.x.reshape(-1, 3)
@@ -459,6 +480,9 @@ class Session:
                 restore_state(s, X0)
                 self.recalc()
                 raise
+            finally:
+                if bar is not None:
+                    bar.close()
         if echo and r.nit == 0:
             self.write(f"bfgs: no step taken ({r.message}).\n")
         self.recalc()

@@ -18,6 +18,7 @@ from ..errors import CommandError, ExpressionError, PyEvolverError, UnsupportedE
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
 from .cformat import c_format, print_array, print_value
+from .extensions import COMMANDS as EXTENSIONS, run_command
 
 _HERE = os.path.dirname(__file__)
 
@@ -1056,6 +1057,8 @@ class Interpreter:
         if proc is None:
             if len(args) == 1 and name in ("g", "r", "u"):
                 return self._x_bare(("bare", name, args[0]))
+            if name.lower() in EXTENSIONS:
+                return run_command(self.session, name, [self.value(a) for a in args])
             raise CommandError(f"unknown procedure '{name}'")
         self.run_proc(proc, [self.value(a) for a in args])
 
@@ -1408,6 +1411,8 @@ class Interpreter:
             for _ in range(n):
                 self.run_proc(s.letters[raw], [])
             return
+        if name in EXTENSIONS and len(raw) > 1:
+            return run_command(s, name, [] if arg is None else [self.value(arg)])
         if raw in ("q",) or name in ("quit", "bye", "exit"):
             raise Quit(0 if arg is None else int(self.value(arg)))
         if raw == "v" or name == "show_vol":

@@ -87,22 +87,25 @@ def icosphere(level):
     return X, F
 
 
-def write_fe(path, X, F, header="", face_attrs=""):
-    """Write ``(X, F)`` as an Evolver datafile (vertices, edges, faces with
-    signed edge ids); ``header`` (e.g. quantity declarations) goes on top,
-    ``face_attrs`` (e.g. ``"tension 0"``) after every face."""
+def fe_text(X, F, header="", face_attrs=""):
+    """``(X, F)`` as the text of an Evolver datafile (vertices, edges, faces
+    with signed edge ids); ``header`` (e.g. quantity declarations) goes on
+    top, ``face_attrs`` (e.g. ``"tension 0"``) after every face."""
     E, idx = edges(F)
     sign = np.where(F == E[idx, 0], 1, -1)
     FE = sign * (idx + 1)
+    out = [header.rstrip("\n") + "\n\n" if header else "", "vertices\n"]
+    out += ["%d %.17g %.17g %.17g\n" % (k + 1, x, y, z) for k, (x, y, z) in enumerate(X.tolist())]
+    out.append("\nedges\n")
+    out += ["%d %d %d\n" % (k + 1, a, b) for k, (a, b) in enumerate((E + 1).tolist())]
+    out.append("\nfaces\n")
+    out += [("%d %d %d %d " % (k + 1, *row)) + face_attrs + "\n"
+            for k, row in enumerate(FE.tolist())]
+    return "".join(out)
+
+
+def write_fe(path, X, F, header="", face_attrs=""):
+    """Write :func:`fe_text` of ``(X, F)`` to ``path``; returns ``path``."""
     with open(path, "w") as fh:
-        fh.write(header.rstrip("\n") + "\n\n" if header else "")
-        fh.write("vertices\n")
-        for k, (x, y, z) in enumerate(X.tolist()):
-            fh.write("%d %.17g %.17g %.17g\n" % (k + 1, x, y, z))
-        fh.write("\nedges\n")
-        for k, (a, b) in enumerate((E + 1).tolist()):
-            fh.write("%d %d %d\n" % (k + 1, a, b))
-        fh.write("\nfaces\n")
-        for k, row in enumerate(FE.tolist()):
-            fh.write(("%d %d %d %d " % (k + 1, *row)) + face_attrs + "\n")
+        fh.write(fe_text(X, F, header, face_attrs))
     return path
