@@ -135,6 +135,7 @@ class Session:
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
         from .datafile.writer import dump
+        self.no_string("dump")
         if name is None:
             name = (self.filename or "pyevolver") + ".dmp"
         self.write(f"Dumping to {name}.\n")
@@ -193,6 +194,9 @@ class Session:
         scene, new = self._read_new("addload", name)
         if self.surface is None:
             raise CommandError("addload: no surface is loaded")
+        if new.string:
+            self.no_string("addload", new)
+        self.no_string("addload")
         merged = append_surface(copy.deepcopy(self.surface), new)
         self.variables.update(merged.params)
         merged.params = self.variables
@@ -373,8 +377,11 @@ class Session:
                 from .mesh.edge_divide import edge_divide, long_edges
                 chop = long_edges(self.surface, L)
                 if len(chop):
-                    new, nch = edge_divide(self.surface, chop)
-                    self._replace_surface(new)
+                    if self.surface.string:
+                        nch = self._string_split(chop)
+                    else:
+                        new, nch = edge_divide(self.surface, chop)
+                        self._replace_surface(new)
                     r.warnings.append(f"Autochopped {nch} edges.")
             if echo:
                 for w in r.warnings:
@@ -384,7 +391,7 @@ class Session:
                     else:
                         self.write(w + "\n")
                 if r.printed and not self.toggles.get("quiet") and not self.toggles.get("quietgo"):
-                    self.write(progress_line(k, r) + "\n")
+                    self.write(progress_line(k, r, self.surface.string) + "\n")
             if r.message == "increase":
                 break
             if callback is not None and callback(r):
@@ -417,6 +424,7 @@ class Session:
         from .evolve import bfgs as B
         from .evolve.gradient import energy_gradient
         from .evolve.iterate import _Constraints
+        self.no_string("bfgs")
         s = self.surface
         if s is None or s.nv == 0:
             raise CommandError("bfgs: no surface loaded")
@@ -470,6 +478,7 @@ class Session:
         (scale at most ``max``, default 1).  Returns a :class:`StepResult`."""
         from .evolve.hessian import newton_direction
         from .evolve.iterate import StepResult, _Constraints
+        self.no_string("hessian")
         it = self.iterator
         s = self.surface
         if not it.pressures_valid and len(_Constraints(s)):
@@ -517,24 +526,47 @@ class Session:
         self.surface = new
         self.recalc()
 
+    def no_string(self, what, surface=None):
+        """Refuse ``what`` by name on a string-model surface."""
+        s = self.surface if surface is None else surface
+        if s is not None and s.string:
+            raise UnsupportedError(f"{what} in the string model")
+
+    def _string_split(self, edges):
+        from .string_model import split_edges
+        self._replace_surface(split_edges(self.surface, edges))
+        return len(edges)
+
     def refine(self, echo=True):
         """``r``: refine every edge and facet (spec §8.1)."""
         from .mesh import refine
-        self._replace_surface(refine(self.surface))
+        s = self.surface
+        if s.string:
+            self._string_split(np.nonzero(~s.eattr["no_refine"])[0])
+        else:
+            self._replace_surface(refine(s))
         if "edge_divide_length" in self.settings:
             self.settings["edge_divide_length"] /= 2
         if "areaweed_area" in self.settings:
             self.settings["areaweed_area"] /= 4
         if echo:
-            s = self.surface
-            self.write(f"Vertices: {s.nv}  Edges: {s.ne}  Facets: {s.nf}  "
-                       f"Bodies: {s.bodies.n}  Facetedges: {3 * s.nf}\n")
+            self.write(self.counts_line())
+
+    def counts_line(self):
+        """``Vertices: ..  Edges: ..`` as after ``r`` and ``c``."""
+        s = self.surface
+        return (f"Vertices: {s.nv}  Edges: {s.ne}  Facets: {s.n_facets}  "
+                f"Bodies: {s.bodies.n}  Facetedges: {self.internal('facetedge_count'):.0f}\n")
 
     def refine_edges(self, edges, echo=True):
         """``refine edges where ...``: bisect the given edges (spec §8)."""
         from .mesh.edge_divide import edge_divide
-        new, n = edge_divide(self.surface, np.asarray(edges, np.int64))
-        self._replace_surface(new)
+        edges = np.asarray(edges, np.int64)
+        if self.surface.string:
+            n = self._string_split(np.unique(edges))
+        else:
+            new, n = edge_divide(self.surface, edges)
+            self._replace_surface(new)
         if echo:
             self.write(f"Edges refined: {n}\n")
 
@@ -542,6 +574,7 @@ class Session:
         """``refine facets where ...``: split each facet into three at its
         centroid (REF's report "Facets refined: N")."""
         from .mesh.notch import split_facets_at_centre
+        self.no_string("refine facets")
         f = np.unique(np.asarray(facets, np.int64))
         self._replace_surface(split_facets_at_centre(self.surface, f))
         if echo:
@@ -550,6 +583,8 @@ class Session:
     def equiangulate(self, echo=True):
         """``u``: one equiangulation sweep (spec §8.2)."""
         from .mesh.equiangulate import equiangulate
+        if self.surface.string:
+            raise CommandError("Cannot equiangulate string model.")      # REF's ERROR 2200
         new, n = equiangulate(self.surface)
         self._replace_surface(new)
         self.counts["equi"] = n                 # REF: the last sweep's flips
@@ -561,6 +596,7 @@ class Session:
         """``edgeswap gen``: flip the listed edges that are diagonals of
         quadrilaterals, whatever the angles (manual: EDGESWAP)."""
         from .mesh.equiangulate import equiangulate
+        self.no_string("edgeswap")
         only = np.zeros(self.surface.ne, bool)
         only[np.asarray(edges, np.int64)] = True
         new, n = equiangulate(self.surface, threshold=np.inf, only=only)
@@ -571,8 +607,11 @@ class Session:
 
     def _bisect(self, edges, echo):
         from .mesh.edge_divide import edge_divide
-        new, n = edge_divide(self.surface, edges)
-        self._replace_surface(new)
+        if self.surface.string:
+            n = self._string_split(np.asarray(edges, np.int64))
+        else:
+            new, n = edge_divide(self.surface, edges)
+            self._replace_surface(new)
         self._count("refine", n)                # REF: l and K accumulate, r does not
         if echo:
             self.write(f"New edges: {n}\n")
@@ -588,13 +627,13 @@ class Session:
     def skinny(self, angle, echo=True):
         """``K θ``: bisect the longest edge of facets with an angle below θ."""
         from .mesh.edge_divide import skinny_edges
+        self.no_string("K (skinny triangles)")
         return self._bisect(skinny_edges(self.surface, angle), echo)
 
     def notch(self, angle, echo=True):
         """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""
         from .mesh.notch import notch
-        if self.surface.nf == 0:
-            raise UnsupportedError("notch in the string model")
+        self.no_string("notch")
         new, n = notch(self.surface, angle)
         self._replace_surface(new)
         self._count("notch", n)
@@ -608,6 +647,7 @@ class Session:
     def delete_short_edges(self, length, echo=True):
         """``t L`` / ``edgeweed L``: delete edges shorter than ``L`` (spec §8.4)."""
         from .mesh.delete_edges import delete_short_edges
+        self.no_string("t (edge weeding)")
         new, n = delete_short_edges(self.surface, length)
         self._replace_surface(new)
         self._count("edge_delete", n)
@@ -619,6 +659,7 @@ class Session:
         """``delete edges ...`` / ``delete facets ...``: delete the edges (or,
         per facet, its shortest deletable side) as ``t`` / ``w`` do."""
         from .mesh.delete_edges import delete_edges, delete_facets
+        self.no_string("delete")
         fn = delete_edges if kind == "edge" else delete_facets
         new, n = fn(self.surface, items)
         self._replace_surface(new)
@@ -642,7 +683,7 @@ class Session:
         new.__dict__.pop("_lift_cache", None)
         new.X = s.X.copy()
         idx = np.nonzero(move)[0]
-        new.X[idx] += sigma * self.rng.standard_normal((len(idx), 3))
+        new.X[idx, :s.sdim] += sigma * self.rng.standard_normal((len(idx), s.sdim))
         project_to_constraints(new, idx)
         self._replace_surface(new)
         if echo:
@@ -652,6 +693,8 @@ class Session:
         """``w A`` / ``areaweed A``: remove facets of area below ``A`` by
         deleting one of their edges, shortest first (spec §8.4)."""
         from .mesh.delete_edges import weed_small_facets
+        if self.surface.string:
+            raise CommandError("Can only do area weed on soapfilm model.")   # REF's ERROR 1339
         new, n = weed_small_facets(self.surface, area)
         self._replace_surface(new)
         self._count("edge_delete", n)
@@ -662,9 +705,11 @@ class Session:
     def vertex_average(self, mode="V", echo=True):
         """``V``, ``rawv``, ``rawestv``: vertex averaging (spec §8.3)."""
         from .mesh.vertex_average import vertex_average
-        if self.surface.nf == 0:
-            raise CommandError("vertex averaging needs facets (string model is not supported)")
-        self._replace_surface(vertex_average(self.surface, mode))
+        if self.surface.string:
+            from .string_model import vertex_average as string_average
+            self._replace_surface(string_average(self.surface, mode))
+        else:
+            self._replace_surface(vertex_average(self.surface, mode))
         if echo:
             self.write("Vertex averaging done.\n")
 
@@ -719,9 +764,9 @@ class Session:
             "total_area": lambda: t.total_area,
             "total_length": lambda: t.total_length,
             "vertex_count": lambda: s.nv, "edge_count": lambda: s.ne,
-            "facet_count": lambda: s.nf, "body_count": lambda: s.bodies.n,
-            "facetedge_count": lambda: 3 * s.nf,
-            "space_dimension": lambda: s.sdim, "surface_dimension": lambda: 2,
+            "facet_count": lambda: s.n_facets, "body_count": lambda: s.bodies.n,
+            "facetedge_count": lambda: self._facetedge_count(),
+            "space_dimension": lambda: s.sdim, "surface_dimension": lambda: 1 if s.string else 2,
             "torus": lambda: 1 if s.periods is not None else 0,
             "datafilename": lambda: self.filename,
             "gravity_constant": lambda: s.gravity_constant,
@@ -747,10 +792,17 @@ class Session:
         v = fn()
         return v if isinstance(v, str) else float(v)
 
+    def _facetedge_count(self):
+        s = self.surface
+        if s.string:
+            from .string_model import facetedge_count
+            return facetedge_count(s)
+        return 3 * s.nf
+
     # -- elements ------------------------------------------------------------------------
     def count(self, kind):
         s = self.surface
-        return {"vertex": s.nv, "edge": s.ne, "facet": s.nf, "body": s.bodies.n}[kind]
+        return {"vertex": s.nv, "edge": s.ne, "facet": s.n_facets, "body": s.bodies.n}[kind]
 
     def element(self, kind, index):
         if isinstance(index, str):
@@ -817,6 +869,8 @@ class Session:
     def sub_elements(self, el, kind):
         s = self.surface
         i = el.i
+        if s.string and "facet" in (el.kind, kind) and el.kind != "body":
+            return self._string_sub_elements(el, kind)
         if el.kind == "vertex":
             if kind == "edge":
                 # oriented away from the vertex (oid < 0 where it is the head);
@@ -861,6 +915,31 @@ class Session:
             return [I.ElemRef("facet", int(f), int(np.sign(v))) for f, v in zip(row.col, row.data)]
         raise ExpressionError(f"{el.kind} has no {kind}s")
 
+    def _string_sub_elements(self, el, kind):
+        """Facet navigation in the string model (facets are edge chains)."""
+        from . import string_model as SM
+        s = self.surface
+        i = el.i
+        if el.kind == "facet":
+            if kind == "vertex":
+                return [I.ElemRef("vertex", v) for v in SM.chain_vertices(s, i, el.sign)]
+            if kind == "edge":
+                enc = SM.chain(s, i)
+                if el.sign < 0:
+                    enc = ~enc[::-1]
+                return [I.ElemRef("edge", int(e if e >= 0 else ~e), 1 if e >= 0 else -1)
+                        for e in enc]
+            if kind == "body":
+                col = s.bodies.facet_matrix[:, i].tocoo()
+                return [I.ElemRef("body", int(b)) for b in col.row]
+        if el.kind == "edge" and kind == "facet":
+            return [I.ElemRef("facet", f, g * el.sign) for f, g in SM.facets_of_edge(s, i)]
+        if el.kind == "vertex" and kind == "facet":
+            owner, e, _, _, _ = SM.facet_entries(s)
+            mine = (s.E[e] == i).any(axis=1)
+            return [I.ElemRef("facet", int(f)) for f in np.unique(owner[mine])]
+        raise ExpressionError(f"{el.kind} has no {kind}s")
+
     # -- attributes ------------------------------------------------------------------------
     def get_attr(self, base, name, idx):
         if isinstance(base, I.QRef):
@@ -892,6 +971,8 @@ class Session:
             if k == "edge":
                 return float(bool(s.eattr["fixed"][i]) or
                              len(self.sub_elements(base, "facet")) != 2)
+        if s.sdim == 2 and name in ("z", "x3") and k in ("vertex", "edge", "facet"):
+            raise ExpressionError("Coordinate dimension exceeds space dimension.")  # REF 2475
         if k == "vertex":
             coords = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}
             if name == "x" and idx is not None:          # x[2] is y
@@ -944,12 +1025,18 @@ class Session:
                 return float(b is not None and b[i] == int(idx))
             if name == "valence":
                 return float(len(self.sub_elements(base, "facet")))
+            if name == "orientation":
+                return float(base.sign)
             if name in ("color", "colour"):
                 c = s.eattr.get("color")
                 return float(c[i]) if c is not None else 0.0
         elif k == "facet":
             if name == "area":
-                return float(t.facet_area[i])
+                return float((t.sfacet_area if s.string else t.facet_area)[i])
+            if s.string and name in ("x", "y", "z", "valence"):
+                if name == "valence":
+                    return float(s.sf_ptr[i + 1] - s.sf_ptr[i])
+                raise UnsupportedError(f"facet normal ({name}) in the string model")
             if name in ("x", "y", "z"):
                 j = "xyz".index(name)
                 if s.periods is None and s.sdim == 3:
@@ -1249,54 +1336,147 @@ class Session:
 
     # -- listing ---------------------------------------------------------------------------------
     def list_elements(self, gen, env):
-        s = self.surface
+        """``list gen``: datafile-style lines in REF's formats (measured on
+        evolver-nox-d: mound, catbody, column, twointor, string files)."""
         els = self.generate(gen, env)
         kind = gen.kind or (els[0].kind if els else None)
+        fn = {"vertex": self._list_vertex, "edge": self._list_edge,
+              "facet": self._list_facet, "body": self._list_body}.get(kind)
+        if fn is None:
+            return
+        self.write({"vertex": "// Id               X                Y" +
+                    ("               Z" if self.surface.sdim == 3 else ""),
+                    "edge": "// Id    endpoints", "facet": "// Id    edges",
+                    "body": "// Id    facets"}[kind] + "\n")
+        for el in els:
+            self.write(fn(el.i) + "\n")
+
+    @staticmethod
+    def _wrapped(items, indent):
+        """Ids ``"%d "`` each, a `` \\`` line break after every tenth (REF)."""
+        out = []
+        for k, it in enumerate(items, 1):
+            out.append(f"{it} ")
+            if k % 10 == 0:
+                out.append("\\\n" + " " * indent)
+        return "".join(out)
+
+    def _list_vertex(self, i):
+        s = self.surface
+        vid = s.ids("vertex")
+        sd = s.sdim
+        bnd = s.vattr.get("boundary")
+        if bnd is not None and bnd[i]:
+            b = s.boundaries[int(bnd[i])]
+            par = " ".join(f"{p:17.15g}" for p in s.vattr["params"][i, :b.nparams])
+            xyz = "".join(f" {x:17.15g}" for x in s.X[i, :sd])
+            line = f"{vid[i]:3d}  {par}  boundary {int(bnd[i])}  /* ({xyz}) */"
+        else:
+            line = f"{vid[i]:3d}  " + " ".join(f"{x:17.15g}" for x in s.X[i, :sd])
+        cons = [c for c in sorted(s.vcon) if s.vcon[c][i]]
+        if cons:
+            line += "  constraints " + " ".join(map(str, cons)) + " "
+        if s.vattr["fixed"][i]:
+            line += " fixed "
+        return line
+
+    @staticmethod
+    def _colour_name(c):
+        names = {v: k for k, v in N.COLOURS.items() if k != "transparent"}
+        return names.get(int(c), str(int(c)))
+
+    def _list_edge(self, i):
+        s = self.surface
         t = self.totals
-        w = self.write
-        vid, eid, fid = s.ids("vertex"), s.ids("edge"), s.ids("facet")
-        if kind == "vertex":
-            w("// Id               X                Y               Z\n")
-            for el in els:
-                x = s.X[el.i]
-                line = f"{vid[el.i]:3d}  {x[0]:17.15g} {x[1]:17.15g} {x[2]:17.15g}"
-                cons = [c for c in sorted(s.vcon) if s.vcon[c][el.i]]
-                if cons:
-                    line += "  constraints " + " ".join(map(str, cons)) + " "
-                if s.vattr["fixed"][el.i]:
-                    line += " fixed "
-                w(line + "\n")
-        elif kind == "edge":
-            w("// Id    endpoints\n")
-            for el in els:
-                a, b = vid[s.E[el.i]]
-                line = f"{eid[el.i]:3d}   {a:5d} {b:4d}     /*length {t.edge_length[el.i]:g}*/"
-                eorig = s.eattr.get("original")
-                if eorig is not None and eorig[el.i] and eorig[el.i] != eid[el.i]:
-                    line += f"  original {eorig[el.i]}"
-                if s.eattr["fixed"][el.i]:
-                    line += " fixed"
-                w(line + "\n")
-        elif kind == "facet":
+        vid, eid = s.ids("vertex"), s.ids("edge")
+        a, b = vid[s.E[i]]
+        line = f"{eid[i]:3d}   {a:5d} {b:4d}    "
+        w = s.eattr.get("wrap")
+        if w is not None:
+            line += " " + " ".join({0: "*", 1: "+", -1: "-"}.get(int(x), "?")
+                                   for x in w[i, :s.sdim])
+        ten = s.edge_tension[i]
+        if ten != (1.0 if s.string else 0.0):
+            line += f"  density {ten:g} "
+        cons = [c for c in sorted(s.econ) if s.econ[c][i]]
+        if cons:
+            line += "  constraints " + " ".join(
+                str(c * int(s.econ[c][i])) for c in cons) + " "
+        eb = s.eattr.get("boundary")
+        if eb is not None and eb[i]:
+            line += f"  boundary {int(eb[i])} "
+        if s.eattr["fixed"][i]:
+            line += "fixed "
+        if s.eattr["no_refine"][i]:
+            line += " no_refine "
+        col = s.eattr.get("color")
+        if col is not None and col[i] != 0:
+            line += f" color {self._colour_name(col[i])} "
+        line += f" /*length {t.edge_length[i]:g}*/ "
+        eorig = s.eattr.get("original")
+        if eorig is not None and eorig[i] and eorig[i] != eid[i]:
+            line += f" original {eorig[i]}"
+        return line
+
+    def _list_facet(self, i):
+        s = self.surface
+        t = self.totals
+        eid, fid = s.ids("edge"), s.ids("facet")
+        if s.string:
+            from .string_model import chain
+            enc = chain(s, i)
+            edges = [int(eid[e]) if e >= 0 else -int(eid[~e]) for e in enc]
+            area = t.sfacet_area[i]
+        else:
             from .geometry import edge_index
-            w("// Id    edges\n")
-            for el in els:
-                idx, sgn = edge_index(s.FE[el.i])
-                es = " ".join(str(int(eid[e] * g)) for e, g in zip(idx, sgn))
-                orig = s.fattr["original"][el.i]
-                line = f"{fid[el.i]:3d}   {es} /*area {t.facet_area[el.i]:g}*/"
-                if orig and orig != fid[el.i]:
-                    line += f" original {orig}"
-                w(line + "\n")
-        elif kind == "body":
-            w("// Id   facets\n")
-            b = s.bodies
-            for el in els:
-                line = f"{el.i + 1:3d}"
-                if not math.isnan(b.target[el.i]):
-                    line += f"   volume {b.target[el.i]:.15g}"
-                line += f" /*actual: {t.volumes[el.i]:.15g}*/ lagrange_multiplier {b.lagrange[el.i]:.15g}"
-                w(line + "\n")
+            idx, sgn = edge_index(s.FE[i])
+            edges = [int(eid[e] * g) for e, g in zip(idx, sgn)]
+            area = t.facet_area[i]
+        attrs = ""
+        cons = [c for c in sorted(s.fcon) if s.fcon[c][i]]
+        if cons:
+            attrs += " constraints " + " ".join(map(str, cons)) + "  "
+        if not s.string and s.facet_tension[i] != 1.0:
+            attrs += f" density {s.facet_tension[i]:g} "
+        if s.fattr["fixed"][i]:
+            attrs += " fixed "
+        if s.fattr["no_refine"][i]:
+            attrs += " no_refine "
+        front = s.fattr.get("frontcolor", s.fattr.get("color"))
+        back = s.fattr.get("backcolor", s.fattr.get("color"))
+        fc = int(front[i]) if front is not None else 15
+        bc = int(back[i]) if back is not None else 15
+        if fc != 15:
+            attrs += f"color {self._colour_name(fc)} "
+        if bc != fc:
+            attrs += (" " if attrs else "") + f"backcolor {self._colour_name(bc)} "
+        line = (f"{fid[i]:3d}   " + self._wrapped(edges, 15) + attrs + (" " if attrs else "")
+                + f"/*area {area:g}*/")
+        orig = s.fattr["original"][i]
+        if orig and orig != fid[i]:
+            line += f" original {orig}"
+        return line
+
+    def _list_body(self, i):
+        s = self.surface
+        t = self.totals
+        b = s.bodies
+        fid = s.ids("facet")
+        ob, of, osg = b.occurrences
+        sel = np.nonzero(ob == i)[0]
+        facets = [int(fid[f] * g) for f, g in zip(of[sel], osg[sel])]
+        line = f"{i + 1:3d}       " + self._wrapped(facets, 11)
+        if not math.isnan(b.target[i]):
+            line += (f" volume {b.target[i]:.15g}  /*actual: {t.volumes[i]:.15g}*/ "
+                     f"lagrange_multiplier {b.lagrange[i]:.15g}  ")
+        line += "centerofmass "
+        if not math.isnan(b.pressure[i]):
+            line += f"  pressure {b.pressure[i]:.15g}"
+        if b.volconst[i]:
+            line += f"  volconst {b.volconst[i]:.15g} "
+        if b.density[i]:
+            line += f"  density {b.density[i]:.15g} "
+        return line
 
     # -- reports ------------------------------------------------------------------------------------
     def show_vol(self):

@@ -1,0 +1,423 @@
+"""The string model: a one-dimensional surface (spec §3.2, §4, Tier 2).
+
+The Evolver's ``STRING`` (or ``SURFACE_DIMENSION 1``) datafiles describe
+curves: edges carry the energy (tension 1 unless given), and a *facet* is a
+chain of edges, not necessarily closed, that exists to give a body its
+"volume", the area of the facet (manual, "The string model").  Such files
+are two-dimensional (``SPACE_DIMENSION 2``: slidestr.fe) when they have
+bodies, or curves in space without facets (popstr.fe, knotty.fe).
+
+pyevolver keeps the coordinates of a two-dimensional surface in the same
+``(nv, 3)`` array as any other, with a z column that stays zero: no
+energy or constraint of a two-dimensional file can depend on z, so no force
+has a z component.
+
+Facet area and gravity use one-dimensional divergence theorems over the
+facet's edges, as REF does (the values below agree with ``evolver-nox-d``
+to round-off on slidestr.fe and test files):
+
+* area of the region left of a chain: ``A = Σ_e -∫ y dx``, per edge
+  ``-(x_h - x_t)(y_t + y_h)/2`` (t, h: the edge's tail and head as the
+  facet traverses it);
+* gravity of a body of density ρ: ``G ρ ∬ y dA = Σ_e -G ρ ∫ y²/2 dx``, per
+  edge ``-(x_h - x_t)(y_t² + y_t y_h + y_h²)/6``;
+* constraint CONTENT and ENERGY integrands are single functions of the
+  point, evaluated at the vertices on the constraint (manual, "Constraints");
+  energy adds ``E(v)`` for every such vertex, content adds ``C(head) -
+  C(tail)`` for each edge of a facet whose head or tail is on the
+  constraint (so only the ends of an open chain count: the content is the
+  integral along the constraint that closes the chain).  FIXED vertices
+  count too (REF).
+
+The facets are stored as one ragged array: ``s.sf_enc`` holds every
+facet's edges in chain order (edge index ``e`` forwards, ``~e`` backwards)
+and facet ``f`` is ``sf_enc[sf_ptr[f]:sf_ptr[f + 1]]``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import CommandError, UnsupportedError
+from .surface import Totals
+
+# quantity methods that make sense without facets
+STRING_METHODS = {"edge_length", "edge_tension", "edge_area", "vertex_scalar_integral",
+                  "edge_scalar_integral", "edge_vector_integral", "harmonic_energy"}
+
+
+# ---------------------------------------------------------------------------
+# facets as chains
+
+
+def facet_entries(s):
+    """``(owner, edge, sign, tail, head)`` for every (facet, edge) incidence,
+    arrays of shape (m,): the facet, the edge index, +1/-1 for the direction
+    of traversal, and the vertices the facet goes from and to."""
+    enc = s.sf_enc
+    owner = np.repeat(np.arange(len(s.sf_ptr) - 1), np.diff(s.sf_ptr))
+    fwd = enc >= 0
+    e = np.where(fwd, enc, ~enc)
+    tail = np.where(fwd, s.E[e, 0], s.E[e, 1])
+    head = np.where(fwd, s.E[e, 1], s.E[e, 0])
+    return owner, e, np.where(fwd, 1.0, -1.0), tail, head
+
+
+def chain(s, f):
+    """Encoded edges of facet ``f`` in chain order."""
+    return s.sf_enc[s.sf_ptr[f]:s.sf_ptr[f + 1]]
+
+
+def chain_vertices(s, f, sign=1):
+    """Vertices of facet ``f`` along its chain: n + 1 for an open chain of n
+    edges, n for a closed one (manual, facet ``vertices``); ``sign`` -1
+    walks it backwards."""
+    enc = chain(s, f)
+    if sign < 0:
+        enc = ~enc[::-1]
+    fwd = enc >= 0
+    e = np.where(fwd, enc, ~enc)
+    tails = np.where(fwd, s.E[e, 0], s.E[e, 1])
+    last = s.E[e[-1], 1] if fwd[-1] else s.E[e[-1], 0]
+    vs = list(tails)
+    if last != tails[0]:
+        vs.append(last)
+    return [int(v) for v in vs]
+
+
+def facets_of_edge(s, e):
+    """``[(facet, sign)]`` of the facets whose chain contains edge ``e``."""
+    owner, ee, sgn, _, _ = facet_entries(s)
+    hit = np.nonzero(ee == e)[0]
+    return [(int(owner[k]), int(sgn[k])) for k in hit]
+
+
+def facetedge_count(s):
+    """REF's facet-edge count: one per (facet, edge) incidence, and one for
+    each edge on no facet."""
+    on = np.bincount(facet_entries(s)[1], minlength=s.ne)
+    return int(np.maximum(on, 1).sum())
+
+
+# ---------------------------------------------------------------------------
+# energies and areas
+
+
+def _edge_area(X, t, h):
+    return -(X[h, 0] - X[t, 0]) * (X[t, 1] + X[h, 1]) / 2.0
+
+
+def _edge_gravity(X, t, h):
+    yt, yh = X[t, 1], X[h, 1]
+    return -(X[h, 0] - X[t, 0]) * (yt * yt + yt * yh + yh * yh) / 6.0
+
+
+def _vertex_integrand(s, which):
+    """``[(formula, vertex mask)]`` of constraint ENERGY / CONTENT integrands
+    (their single component) with the vertices on the constraint."""
+    out = []
+    for cid, on in s.vcon.items():
+        comps = getattr(s.constraints[cid], which)
+        if comps and on.any():
+            out.append((comps[0], on))
+    return out
+
+
+def _point_values(s, formula, idx):
+    P = s.X[idx]
+    coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+    return formula.values(s.param_env(), coords, len(idx))
+
+
+def _point_gradients(s, formula, idx):
+    P = s.X[idx]
+    coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+    return formula.gradient(s.param_env(), coords, len(idx))
+
+
+def content_coefficients(s, on):
+    """(nf, nv) counts head - tail of the vertices in ``on`` over each
+    facet's edges, as a dense-free list ``(facet, vertex, coef)``."""
+    owner, _, _, tail, head = facet_entries(s)
+    f = np.concatenate([owner, owner])
+    v = np.concatenate([head, tail])
+    c = np.concatenate([np.ones(len(head)), -np.ones(len(tail))])
+    keep = on[v]
+    return f[keep], v[keep], c[keep]
+
+
+def vertex_energy(s):
+    """Sum of the constraint ENERGY integrands at the vertices on them."""
+    total = 0.0
+    for formula, on in _vertex_integrand(s, "energy"):
+        total += float(np.sum(_point_values(s, formula, np.nonzero(on)[0])))
+    return total
+
+
+def facet_areas(s):
+    """(nf,) areas of the string facets, content integrals included."""
+    nsf = len(s.sf_ptr) - 1
+    owner, _, sgn, tail, head = facet_entries(s)
+    area = np.bincount(owner, weights=_edge_area(s.X, tail, head), minlength=nsf)
+    for formula, on in _vertex_integrand(s, "content"):
+        f, v, c = content_coefficients(s, on)
+        if len(f):
+            area += np.bincount(f, weights=c * _point_values(s, formula, v), minlength=nsf)
+    return area
+
+
+def facet_gravity(s):
+    """(nf,) ∬ y dA of each facet (per unit G ρ)."""
+    owner, _, _, tail, head = facet_entries(s)
+    return np.bincount(owner, weights=_edge_gravity(s.X, tail, head),
+                       minlength=len(s.sf_ptr) - 1)
+
+
+# ---------------------------------------------------------------------------
+# gradients
+
+
+def _chain_grad(s, per_facet, fn):
+    """Gradient of Σ_f w_f Σ_{edges of f} fn-term (fn gives the tail and head
+    derivatives, each (m, 3))."""
+    owner, _, _, tail, head = facet_entries(s)
+    w = per_facet[owner]
+    gt, gh = fn(s.X, tail, head)
+    out = np.zeros((s.nv, 3))
+    for k in range(2):
+        out[:, k] = (np.bincount(tail, weights=w * gt[:, k], minlength=s.nv)
+                     + np.bincount(head, weights=w * gh[:, k], minlength=s.nv))
+    return out
+
+
+def _area_derivs(X, t, h):
+    dx = X[h, 0] - X[t, 0]
+    sy = X[t, 1] + X[h, 1]
+    gt = np.stack([sy / 2.0, -dx / 2.0], axis=1)
+    gh = np.stack([-sy / 2.0, -dx / 2.0], axis=1)
+    return gt, gh
+
+
+def _gravity_derivs(X, t, h):
+    dx = X[h, 0] - X[t, 0]
+    yt, yh = X[t, 1], X[h, 1]
+    q = (yt * yt + yt * yh + yh * yh) / 6.0
+    gt = np.stack([q, -dx * (2 * yt + yh) / 6.0], axis=1)
+    gh = np.stack([-q, -dx * (yt + 2 * yh) / 6.0], axis=1)
+    return gt, gh
+
+
+def facet_area_gradient(s, per_facet):
+    """Gradient (nv, 3) of Σ_f w_f A_f, content integrals included."""
+    g = _chain_grad(s, per_facet, _area_derivs)
+    for formula, on in _vertex_integrand(s, "content"):
+        f, v, c = content_coefficients(s, on)
+        if len(f):
+            d = _point_gradients(s, formula, v) * (c * per_facet[f])[:, None]
+            for k in range(3):
+                g[:, k] += np.bincount(v, weights=d[:, k], minlength=s.nv)
+    return g
+
+
+def energy_gradient(t):
+    """Gradient (nv, 3) of the total energy of a string surface."""
+    from .evolve.gradient import edge_length_grad, quantity_gradient
+    s = t.surface
+    et = s.edge_tension
+    nz = np.nonzero(et)[0]
+    g = edge_length_grad(t, nz, et[nz])
+    for formula, on in _vertex_integrand(s, "energy"):
+        idx = np.nonzero(on)[0]
+        d = _point_gradients(s, formula, idx)
+        g[idx] += d
+    b = s.bodies
+    if b.n:
+        if s.gravity_constant != 0 and s.gravity_on and np.any(b.density):
+            w = s.gravity_constant * (b.facet_matrix.T @ b.density)
+            g += _chain_grad(s, np.asarray(w, float), _gravity_derivs)
+        pmask = ~np.isnan(b.pressure)
+        for i in np.nonzero(pmask)[0]:
+            g -= b.pressure[i] * body_gradient(s, i)
+    for q in s.quantities.values():
+        if q.kind == "energy":
+            g += quantity_gradient(t, q)
+    return g
+
+
+def body_gradient(s, i):
+    w = np.asarray(s.bodies.facet_matrix.getrow(i).todense()).ravel()
+    return facet_area_gradient(s, w)
+
+
+def volume_gradients(t):
+    """(nb, nv, 3) gradients of the body areas."""
+    s = t.surface
+    return np.stack([body_gradient(s, i) for i in range(s.bodies.n)]) if s.bodies.n else \
+        np.zeros((0, s.nv, 3))
+
+
+# ---------------------------------------------------------------------------
+# mesh operations
+
+
+def split_edges(s, R):
+    """Bisect the edges ``R`` (indices): midpoint vertices numbered in edge
+    order, the original edge keeps its tail half and the head halves are new
+    edges in the same order; each facet chain gets the new half next to its
+    parent (REF's numbering, ``list facets`` after ``r``)."""
+    from .mesh.grow import grow
+    from .surface import project_to_constraints
+    R = np.asarray(R, np.int64)
+    k = len(R)
+    t = grow(s, v_from_edge=R, e_from_edge=R)
+    nv, ne = s.nv, s.ne
+    mid = nv + np.arange(k)
+    half = ne + np.arange(k)
+    t.X[mid] = 0.5 * (s.X[s.E[R, 0]] + s.X[s.E[R, 1]])
+    t.E[half, 0] = mid
+    t.E[half, 1] = s.E[R, 1]
+    t.E[R, 1] = mid
+    # facet chains: e -> e, h ; ~e -> ~h, ~e
+    newh = np.full(ne, -1, np.int64)
+    newh[R] = half
+    enc = s.sf_enc
+    fwd = enc >= 0
+    e = np.where(fwd, enc, ~enc)
+    split = newh[e] >= 0
+    reps = np.where(split, 2, 1)
+    out = np.empty(int(reps.sum()), np.int64)
+    pos = np.concatenate([[0], np.cumsum(reps)[:-1]])
+    out[pos] = np.where(split & ~fwd, ~newh[e], enc)
+    sp = np.nonzero(split)[0]
+    out[pos[sp] + 1] = np.where(fwd[sp], newh[e[sp]], enc[sp])
+    owner = np.repeat(np.arange(len(s.sf_ptr) - 1), np.diff(s.sf_ptr))
+    t.sf_enc = out
+    t.sf_ptr = np.concatenate([[0], np.cumsum(np.bincount(owner, weights=reps,
+                                                           minlength=len(s.sf_ptr) - 1))]
+                              ).astype(np.int64)
+    if t.vcon:
+        on = np.zeros(t.nv, bool)
+        for m in t.vcon.values():
+            on |= m
+        sel = mid[on[mid]]
+        if len(sel):
+            project_to_constraints(t, sel)
+    return t
+
+
+def vertex_average(s, mode="V"):
+    """``V`` / ``rawv`` / ``rawestv`` on a string (measured on REF): a vertex
+    with two or more usable edges moves by a quarter of the mean of its
+    neighbours minus itself, ``D = Σ_e (x_e - x_v) / n``, ``x += D/4``;
+    ``V`` moves only vertices with exactly two edges and keeps only the
+    component of D along the chord between the two neighbours (the tangent:
+    the area is kept to first order).  Vertices that are FIXED, on a
+    boundary or at the end of a string do not move; for ``V`` and ``rawv`` a
+    vertex on constraints uses only edges on the same constraints (as in
+    the soapfilm model) and is projected back."""
+    import copy
+    from .surface import project_to_constraints, project_tangent
+    nv, ne = s.nv, s.ne
+    v = np.concatenate([s.E[:, 0], s.E[:, 1]])
+    other = np.concatenate([s.E[:, 1], s.E[:, 0]])
+    use = np.ones(2 * ne, bool)
+    if mode != "rawest" and s.vcon:
+        e = np.concatenate([np.arange(ne), np.arange(ne)])
+        for c, on_v in s.vcon.items():
+            on_e = s.econ.get(c)
+            on_e = np.zeros(ne, bool) if on_e is None else (on_e != 0)
+            use &= ~on_v[v] | on_e[e]
+    deg = np.bincount(v, minlength=nv)
+    cnt = np.bincount(v, weights=use.astype(float), minlength=nv)
+    vec = s.X[other] - s.X[v]
+    D = np.zeros((nv, 3))
+    for k in range(3):
+        D[:, k] = np.bincount(v, weights=np.where(use, vec[:, k], 0.0), minlength=nv)
+    movable = ~s.vattr["fixed"] & (cnt >= 2)
+    if mode == "V":
+        movable &= (cnt == 2) & (deg == 2)
+    bnd = s.vattr.get("boundary")
+    if bnd is not None:
+        movable &= bnd == 0
+    D[~movable] = 0.0
+    D[movable] /= cnt[movable, None]
+    if mode == "V":
+        mv = np.nonzero(movable)[0]
+        # chord between the two neighbours
+        nb = np.zeros((nv, 2), np.int64)
+        order = np.argsort(v, kind="stable")
+        first = np.searchsorted(v[order], mv)
+        nb_a = other[order[first]]
+        nb_b = other[order[first + 1]]
+        ch = s.X[nb_b] - s.X[nb_a]
+        n2 = np.einsum("ij,ij->i", ch, ch)
+        with np.errstate(all="ignore"):
+            tang = np.where(n2[:, None] > 0, ch * (np.einsum("ij,ij->i", D[mv], ch) / n2)[:, None],
+                            0.0)
+        D[mv] = tang
+        del nb
+        (D,) = project_tangent(s, [D])
+    new = copy.copy(s)
+    new.X = s.X + D / 4.0
+    if new.vcon:
+        project_to_constraints(new, np.nonzero(movable)[0])
+    return new
+
+
+def refuse(what):
+    """Commands that are not available in the string model."""
+    raise UnsupportedError(f"{what} in the string model")
+
+
+def check_no_facets_needed(s, what):
+    if s.string:
+        raise CommandError(f"{what} needs facets: not available in the string model")
+
+
+# ---------------------------------------------------------------------------
+# totals
+
+
+class StringTotals(Totals):
+    """Energy, length and body areas of a string surface (the attributes
+    of :class:`pyevolver.surface.Totals`; ``total_area`` is the total
+    length, as in REF)."""
+
+    def __init__(self, s):
+        self.surface = s
+        self.facet_area = np.zeros(0)
+        self.facet_volume = np.zeros(0)
+        self.facet_N2 = np.zeros((0, 3))
+        self.total_area = self.total_length
+        self.terms = {}
+        energy = float(self.edge_length @ s.edge_tension)
+        self.terms["edge_tension"] = energy
+        self.con_energy = vertex_energy(s)
+        self.con_content = None
+        energy += self.con_energy
+        b = s.bodies
+        self.sfacet_area = facet_areas(s) if len(s.sf_ptr) > 1 else np.zeros(0)
+        self.volumes = (b.facet_matrix @ self.sfacet_area + b.volconst) if b.n else \
+            np.zeros(0)
+        if b.n:
+            G_ = s.gravity_constant
+            if G_ != 0 and s.gravity_on and np.any(b.density):
+                grav = float(G_ * (b.density @ (b.facet_matrix @ facet_gravity(s))))
+                self.terms["gravity"] = grav
+                energy += grav
+            pmask = ~np.isnan(b.pressure)
+            if pmask.any():
+                energy -= float(b.pressure[pmask] @ self.volumes[pmask])
+        self.quantity_values = {}
+        for q in s.quantities.values():
+            v = self.quantity_value(q)
+            self.quantity_values[q.name] = v
+            if q.kind == "energy":
+                energy += v
+        self.energy = energy
+
+    def volume_magnitudes(self):
+        s = self.surface
+        owner, _, _, tail, head = facet_entries(s)
+        per = np.bincount(owner, weights=np.abs(_edge_area(s.X, tail, head)),
+                          minlength=len(s.sf_ptr) - 1)
+        return abs(s.bodies.facet_matrix) @ per
