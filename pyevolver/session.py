@@ -872,6 +872,9 @@ class Session:
         if s.string and "facet" in (el.kind, kind) and el.kind != "body":
             return self._string_sub_elements(el, kind)
         if el.kind == "vertex":
+            if kind == "edge" and "ring_time" in s.eattr:
+                from .string_model import vertex_edges
+                return [I.ElemRef("edge", e, g) for e, g in vertex_edges(s, i)]
             if kind == "edge":
                 # oriented away from the vertex (oid < 0 where it is the head);
                 # the Evolver's order on a freshly loaded surface: the first

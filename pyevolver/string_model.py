@@ -256,6 +256,67 @@ def volume_gradients(t):
 
 
 # ---------------------------------------------------------------------------
+# the edges around a vertex
+
+
+def init_rings(s):
+    """REF keeps the edges at a vertex in a ring with a first edge; a new
+    edge goes in right after the first, and when the first goes the next one
+    takes its place, so ``vv.edge`` lists the first edge, then the others
+    newest first.  ``eattr["ring_time"]`` (ne, 2) holds when each end of an
+    edge joined its vertex's ring, ``vattr["ring_head"]`` each vertex's
+    first edge.  On load edges join in datafile order."""
+    ne, nv = s.ne, s.nv
+    s.eattr["ring_time"] = np.repeat(np.arange(ne, dtype=np.int64)[:, None], 2, axis=1)
+    head = np.full(nv, ne, np.int64)
+    np.minimum.at(head, s.E[:, 0], np.arange(ne))
+    np.minimum.at(head, s.E[:, 1], np.arange(ne))
+    s.vattr["ring_head"] = np.where(head == ne, -1, head)
+
+
+def vertex_edges(s, v):
+    """Edges at vertex ``v`` in REF's order: ``[(edge, +1 if v is its tail
+    else -1)]``."""
+    ends = np.nonzero(s.E == v)
+    e, end = ends[0], ends[1]
+    t = s.eattr["ring_time"][e, end]
+    head = s.vattr["ring_head"][v]
+    key = np.where(e == head, np.iinfo(np.int64).max, t)
+    order = np.argsort(-key, kind="stable")
+    return [(int(e[k]), 1 if end[k] == 0 else -1) for k in order]
+
+
+def _ring_split(s, t, R, mid, half):
+    """Update the rings for edges ``R`` split at new vertices ``mid`` with
+    new head halves ``half`` (REF's order after ``r``, measured on
+    popstr.fe): edges are processed in order; the new vertex gets the new
+    half first, then the old edge; at the old head vertex the old edge
+    leaves its ring and the new half joins it."""
+    times = t.eattr["ring_time"]
+    head = t.vattr["ring_head"]
+    clock = int(times.max()) + 1 if len(times) else 0
+    # the edges as they are while the splits are done one after the other
+    E = np.vstack([s.E, np.full((len(R), 2), -1, np.int64)])
+    for e, m, n in zip(R.tolist(), mid.tolist(), half.tolist()):
+        h = int(E[e, 1])
+        E[e, 1] = m
+        head[m] = n
+        times[n, 0] = clock
+        times[e, 1] = clock + 1
+        if head[h] == e:
+            # the next in the ring: the newest of the others
+            at = np.nonzero((E == h).any(axis=1))[0]
+            if len(at):
+                tt = np.where(E[at, 0] == h, times[at, 0], times[at, 1])
+                head[h] = at[np.argmax(tt)]
+            else:
+                head[h] = n
+        E[n] = (m, h)
+        times[n, 1] = clock + 2
+        clock += 3
+
+
+# ---------------------------------------------------------------------------
 # mesh operations
 
 
@@ -276,6 +337,10 @@ def split_edges(s, R):
     t.E[half, 0] = mid
     t.E[half, 1] = s.E[R, 1]
     t.E[R, 1] = mid
+    if "ring_time" in s.eattr:
+        t.eattr["ring_time"] = t.eattr["ring_time"].copy()
+        t.vattr["ring_head"] = t.vattr["ring_head"].copy()
+        _ring_split(s, t, R, mid, half)
     # facet chains: e -> e, h ; ~e -> ~h, ~e
     newh = np.full(ne, -1, np.int64)
     newh[R] = half
@@ -285,7 +350,7 @@ def split_edges(s, R):
     split = newh[e] >= 0
     reps = np.where(split, 2, 1)
     out = np.empty(int(reps.sum()), np.int64)
-    pos = np.concatenate([[0], np.cumsum(reps)[:-1]])
+    pos = np.cumsum(reps) - reps
     out[pos] = np.where(split & ~fwd, ~newh[e], enc)
     sp = np.nonzero(split)[0]
     out[pos[sp] + 1] = np.where(fwd[sp], newh[e[sp]], enc[sp])

@@ -906,6 +906,8 @@ class _Builder:
                 f"vertex {orig[heads[j]]} but the next edge {flat[j + 1]} starts at vertex "
                 f"{orig[tails[j + 1]]}", blk.lines[k])
         s.sf_ptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
+        from .string_model import init_rings
+        init_rings(s)
         s.sf_enc = np.where(rev, ~eidx, eidx).astype(np.int64)
         self.split_children = {}
         self.facet_parent = np.arange(nface)
