@@ -647,6 +647,11 @@ class _CmdTransformer(ExprTransformer):
     def attr(self, base, name):
         return Attr(base, name)
 
+    def aggregate_juxt(self, op, gen, base, name):
+        # `sum(vv.edge eee, eee ecutmark)` means eee.ecutmark (cut.cmd; REF
+        # accepts a name and an attribute side by side)
+        return Aggregate(str(op), gen, Attr(self.var(base), str(name).lower()))
+
     def attr_index(self, base, name, *idx):
         return Attr(base, name, idx[0] if len(idx) == 1 else list(idx))
 
@@ -1028,6 +1033,15 @@ class Interpreter:
             if not isinstance(v, str):
                 raise ExpressionError("is_defined() needs a name in a string")
             return float(self.is_defined(v.lower()))
+        if name == "valid_element":
+            # 1 if the element exists (simply_connected.cmd: vertex[sc_startv])
+            if len(arg_nodes) != 1 or not isinstance(arg_nodes[0], ElemIndex):
+                raise ExpressionError("valid_element() takes one element, e.g. vertex[3]")
+            try:
+                arg_nodes[0].ev(self.env)
+            except ExpressionError:
+                return 0.0
+            return 1.0
         proc = s.commands.get(name)
         if proc is None:
             raise ExpressionError(f"unknown function '{name}'")
