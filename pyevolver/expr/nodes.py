@@ -50,13 +50,51 @@ FUNC1 = {
     "asinh": np.arcsinh, "acosh": np.arccosh, "atanh": np.arctanh,
     "exp": np.exp, "log": np.log, "ceil": np.ceil, "floor": np.floor,
 }
+def _domain(bad, msg):
+    if np.any(bad):
+        raise ExpressionError(msg)
+
+
+def _ellipk(m):
+    """Complete elliptic integral of the first kind K(m), parameter m
+    (Abramowitz & Stegun 17.3.1; the Evolver's convention)."""
+    from scipy.special import ellipk
+    _domain(np.asarray(m) >= 1, "ellipticK domain violation, parameter >= 1.")
+    return ellipk(m)
+
+
+def _ellipe(m):
+    """Complete elliptic integral of the second kind E(m) (A&S 17.3.3)."""
+    from scipy.special import ellipe
+    _domain(np.asarray(m) > 1, "ellipticE domain violation, parameter > 1.")
+    return ellipe(m)
+
+
+def _ellipf(phi, m):
+    """Incomplete elliptic integral of the first kind F(phi|m) (A&S 17.2.7)."""
+    from scipy.special import ellipkinc
+    _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
+            "incompleteEllipticF domain violation, m*sin(phi)^2 > 1.")
+    return ellipkinc(phi, m)
+
+
+def _ellipeinc(phi, m):
+    """Incomplete elliptic integral of the second kind E(phi|m) (A&S 17.2.8)."""
+    from scipy.special import ellipeinc
+    _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
+            "incompleteEllipticE domain violation, m*sin(phi)^2 > 1.")
+    return ellipeinc(phi, m)
+
+
+FUNC1["elliptick"] = _ellipk
+FUNC1["elliptice"] = _ellipe
 FUNC2 = {
     "atan2": np.arctan2, "pow": np.power, "maximum": np.maximum,
-    "minimum": np.minimum,
+    "minimum": np.minimum, "incompleteellipticf": _ellipf,
+    "incompleteelliptice": _ellipeinc,
 }
 # recognised but refused
 UNSUPPORTED_FUNCS = {
-    "elliptick", "elliptice", "incompleteellipticf", "incompleteelliptice",
     "wrap_compose", "wrap_inverse", "usr1", "usr2", "usr3", "usr4", "usr5",
     "usr6", "usr7", "usr8", "usr9", "usr10",
 }
@@ -448,6 +486,21 @@ def _d_func(n, var):
         if n.name in ("maximum", "minimum"):
             cmpop = ">=" if n.name == "maximum" else "<="
             return Cond(Cmp(cmpop, a, b), da, db)
+        if n.name in ("incompleteellipticf", "incompleteelliptice"):
+            # a = phi, b = m;  Delta = sqrt(1 - m sin^2 phi)  (A&S 17.2, DLMF 19.4)
+            F = Func("incompleteellipticf", [a, b])
+            E = Func("incompleteelliptice", [a, b])
+            sn = Func("sin", [a])
+            delta = Func("sqrt", [sub(ONE, mul(b, mul(sn, sn)))])
+            if n.name == "incompleteellipticf":
+                dphi = div(ONE, delta)
+                dm = sub(sub(div(E, mul(Num(2.0), mul(b, sub(ONE, b)))), div(F, mul(Num(2.0), b))),
+                         div(Func("sin", [mul(Num(2.0), a)]),
+                             mul(Num(4.0), mul(sub(ONE, b), delta))))
+            else:
+                dphi = delta
+                dm = div(sub(E, F), mul(Num(2.0), b))
+            return add(mul(dphi, da), mul(dm, db))
         raise ExpressionError(f"cannot differentiate {n.name}")
     a = args[0]
     da = diff(a, var)
@@ -492,6 +545,11 @@ def _d_func(n, var):
         g = div(ONE, sub(ONE, mul(a, a)))
     elif nm in ("ceil", "floor"):
         return ZERO
+    elif nm == "elliptick":     # dK/dm = (E - (1-m) K) / (2m(1-m))  (DLMF 19.4.1)
+        K, E = n, Func("elliptice", [a])
+        g = div(sub(E, mul(sub(ONE, a), K)), mul(Num(2.0), mul(a, sub(ONE, a))))
+    elif nm == "elliptice":     # dE/dm = (E - K) / (2m)
+        g = div(sub(n, Func("elliptick", [a])), mul(Num(2.0), a))
     else:
         raise ExpressionError(f"cannot differentiate {nm}")
     return mul(g, da)
