@@ -224,6 +224,12 @@ class Session:
         self.array_types["view_matrix"] = "real"
 
     # -- output -----------------------------------------------------------------
+    def note(self, text):
+        """A message that ``quiet`` suppresses (REF: counts after r, v, toggle
+        messages, mesh operation reports, the header of list)."""
+        if not self.toggles.get("quiet"):
+            self.write(text)
+
     def write(self, text):
         self.out.write(text)
 
@@ -550,7 +556,7 @@ class Session:
         if "areaweed_area" in self.settings:
             self.settings["areaweed_area"] /= 4
         if echo:
-            self.write(self.counts_line())
+            self.note(self.counts_line())
 
     def counts_line(self):
         """``Vertices: ..  Edges: ..`` as after ``r`` and ``c``."""
@@ -589,7 +595,7 @@ class Session:
         self._replace_surface(new)
         self.counts["equi"] = n                 # REF: the last sweep's flips
         if echo:
-            self.write(f"Edges switched in equiangulation: {n}\n")
+            self.note(f"Edges switched in equiangulation: {n}\n")
         return n
 
     def edgeswap(self, edges, echo=True):
@@ -614,7 +620,7 @@ class Session:
             self._replace_surface(new)
         self._count("refine", n)                # REF: l and K accumulate, r does not
         if echo:
-            self.write(f"New edges: {n}\n")
+            self.note(f"New edges: {n}\n")
         return n
 
     def edge_divide_long(self, length, echo=True):
@@ -638,7 +644,7 @@ class Session:
         self._replace_surface(new)
         self._count("notch", n)
         if echo:
-            self.write(f"Number of edges notched: {n}\n")
+            self.note(f"Number of edges notched: {n}\n")
         return n
 
     def _count(self, key, n):
@@ -652,7 +658,7 @@ class Session:
         self._replace_surface(new)
         self._count("edge_delete", n)
         if echo:
-            self.write(f"Deleted edges: {n}\n")
+            self.note(f"Deleted edges: {n}\n")
         return n
 
     def delete_elements(self, kind, items, echo=True):
@@ -699,7 +705,7 @@ class Session:
         self._replace_surface(new)
         self._count("edge_delete", n)
         if echo:
-            self.write(f"Skinny triangles weeded: {n}\n")
+            self.note(f"Skinny triangles weeded: {n}\n")
         return n
 
     def vertex_average(self, mode="V", echo=True):
@@ -711,7 +717,7 @@ class Session:
         else:
             self._replace_surface(vertex_average(self.surface, mode))
         if echo:
-            self.write("Vertex averaging done.\n")
+            self.note("Vertex averaging done.\n")
 
     def refresh(self):
         if self.toggles.get("autorecalc", 1):
@@ -1347,7 +1353,7 @@ class Session:
               "facet": self._list_facet, "body": self._list_body}.get(kind)
         if fn is None:
             return
-        self.write({"vertex": "// Id               X                Y" +
+        self.note({"vertex": "// Id               X                Y" +
                     ("               Z" if self.surface.sdim == 3 else ""),
                     "edge": "// Id    endpoints", "facet": "// Id    edges",
                     "body": "// Id    facets"}[kind] + "\n")

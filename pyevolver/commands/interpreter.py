@@ -857,6 +857,22 @@ SETTABLE_ATTRS = {"x", "y", "z", "x1", "x2", "x3", "color", "colour", "frontcolo
                   "tension", "density", "fixed", "no_refine", "target", "pressure", "volconst",
                   "constraint", "boundary", "opacity"}
 TOGGLE_DEFAULTS = {"hessian_normal": 1, "autorecalc": 1, "ribiere": 1}
+# how REF names a toggle in "NAME ON. (was off)" (measured; the others use
+# their own name)
+TOGGLE_WORDS = {
+    "check_increase": "Increase check", "conj_grad": "Conjugate gradient now",
+    "ribiere": "Polak-Ribiere conjugate gradient", "gravity": "Gravity",
+    "normal_motion": "Normal motion", "area_normalization": "Area normalization",
+    "autorecalc": "Autorecalc", "estimate": "Estimation", "volgrads_every": "Volgrads_every",
+    "verbose": "Verbose", "rgb_colors": "RGB colors", "runge_kutta": "Runge-Kutta",
+    "kraynikpopvertex": "Kraynik pop vertex mode", "kraynikpopedge": "Kraynik pop edge mode",
+    "post_project": "Post-projection", "visibility_test": "visibility test",
+    "smooth_graph": "smooth graph", "self_similar": "Self similarity mode",
+    "pinning": "Constraint pinning", "diffusion": "Diffusion",
+    "sqgauss": "Squared Gaussian curvature", "jiggle": "jiggling",
+    "break_after_warning": "Break after warning", "show_inner": "show inner",
+    "show_outer": "show outer", "memdebug": "Memory debugging",
+}
 
 
 class Interpreter:
@@ -1267,7 +1283,7 @@ class Interpreter:
             return
         els = s.generate(gen, self.env)
         n = s.fix_elements(els, on)
-        s.write(f"{'Fixed' if on else 'Unfixed'}: {n}\n")
+        s.note(f"{'Fixed' if on else 'Unfixed'}: {n}\n")
 
     def _x_fix_name(self, node):
         self.session.fix_name(node[1], node[2])
@@ -1425,7 +1441,7 @@ class Interpreter:
         if raw in ("q",) or name in ("quit", "bye", "exit"):
             raise Quit(0 if arg is None else int(self.value(arg)))
         if raw == "v" or name == "show_vol":
-            s.write(s.show_vol())
+            s.note(s.show_vol())
             return
         if name == "recalc":
             s.recalc()
@@ -1447,13 +1463,13 @@ class Interpreter:
             v = float(self.value(arg))
             s.settings["scale"] = v
             s.toggles["_fixed_scale"] = 1
-            s.write("Scale fixed at %g.\n" % v)
+            s.note("Scale fixed at %g.\n" % v)
             return
         if name in ("optimize", "optimise"):
             if arg is not None:
                 s.settings["scale_limit"] = float(self.value(arg))
             s.toggles["_fixed_scale"] = 0
-            s.write("Scale optimizing with bound %g.\n" % s.settings["scale_limit"])
+            s.note("Scale optimizing with bound %g.\n" % s.settings["scale_limit"])
             return
         if raw == "r":
             for _ in range(1 if arg is None else self._count(arg)):
@@ -1501,7 +1517,7 @@ class Interpreter:
             old = s.toggles.get("conj_grad", 0)
             s.toggles["conj_grad"] = 0 if old else 1
             s.reset_cg()
-            s.write(f"Conjugate gradient now {'OFF' if old else 'ON'}. (was {'on' if old else 'off'})\n")
+            s.note(f"Conjugate gradient now {'OFF' if old else 'ON'}. (was {'on' if old else 'off'})\n")
             return
         if raw == "G":
             old_on = s.toggles.get("gravity", 0)
@@ -1511,9 +1527,9 @@ class Interpreter:
             s.toggles["gravity"] = int(g != 0)
             was = "on" if old_on else "off"
             if g != 0:
-                s.write(f"Gravity is now ON with gravitational constant {g:g}. (was {was})\n")
+                s.note(f"Gravity is now ON with gravitational constant {g:g}. (was {was})\n")
             else:
-                s.write(f"Gravity is now OFF. (was {was})\n")
+                s.note(f"Gravity is now OFF. (was {was})\n")
             s.recalc()
             return
         if len(raw) == 1 and raw in LETTER_LATER:
@@ -1539,26 +1555,25 @@ class Interpreter:
         if name == "autopop" and new:
             raise UnsupportedError("autopop", "vertex and edge popping (o, O) is not implemented")
         s.toggles[name] = new
-        if name == "check_increase":
-            s.write(f"Increase check {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
-        elif name == "conj_grad":
-            s.write(f"Conjugate gradient now {'ON' if new else 'OFF'}. "
-                    f"(was {'on' if old else 'off'})\n")
-        elif name == "ribiere":
-            s.write(f"Polak-Ribiere conjugate gradient {'ON' if new else 'OFF'}. "
-                    f"(was {'on' if old else 'off'})\n")
+        was = "on" if old else "off"
+        now = "ON" if new else "OFF"
+        if name == "quietgo":               # REF prints this one even when quiet
+            s.write(f"QuietGo {now}. (was {was})\n")
+        elif name == "quiet":
+            if not new:                     # turning it on is silent
+                s.write(f"Quiet OFF. (was {was})\n")
         elif name == "autochop":
             if new:
-                s.write(f"Autochopping ON. Chop length {s.settings.get('autochop_length', 0.0):g}"
-                        f"  (was {'on' if old else 'off'})\n"
-                        "Set autochop length with  AUTOCHOP_LENGTH := value\n")
+                s.note(f"Autochopping ON. Chop length {s.settings.get('autochop_length', 0.0):g}"
+                       f"  (was {was})\n"
+                       "Set autochop length with  AUTOCHOP_LENGTH := value\n")
             else:
-                s.write(f"Autochopping OFF. (was {'on' if old else 'off'})\n")
-        elif name == "gravity":
-            s.write(f"Gravity {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
-            s.recalc()
+                s.note(f"Autochopping OFF. (was {was})\n")
         else:
-            s.write(f"{name} {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
+            word = TOGGLE_WORDS.get(name, name)
+            s.note(f"{word} {now}. (was {was})\n")
+        if name == "gravity":
+            s.recalc()
 
     # -- expressions ------------------------------------------------------------
     def value(self, expr):
