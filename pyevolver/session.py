@@ -86,6 +86,7 @@ class Session:
         self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
         self.iteration_counter = 0
         self.total_time = 0.0
+        self.fix_counts = [0, 0]               # fixed, unfixed by the current command
 
     # -- loading ---------------------------------------------------------------
     @classmethod
@@ -285,6 +286,10 @@ class Session:
             raise CommandError(f"{where}:{line}: recursion too deep") from None
         finally:
             del scopes[depth:]
+            counts, self.fix_counts = self.fix_counts, [0, 0]
+        for word, n in zip(("Fixed", "Unfixed"), counts):
+            if n:
+                self.note(f"{word}: {n}\n")
         self.refresh()
 
     def _snapshot(self):
@@ -761,6 +766,9 @@ class Session:
             return N.CONSTANTS[name]
         if s is not None and name in s.quantities:
             return I.QRef(name)
+        for cid, cname in getattr(s, "constraint_names", {}).items():
+            if cname == name:
+                return float(cid)
         if name in self.toggles or name in I.TOGGLES:
             return float(self.toggles.get(name, I.TOGGLE_DEFAULTS.get(name, 0)))
         if s is None:
@@ -1240,6 +1248,9 @@ class Session:
             raise UnsupportedError(f"unset {gen.kind} {attr}")
         if expr is None:
             raise UnsupportedError(f"set {gen.kind} {attr} (without a value)")
+        if attr == "constraint":
+            self.set_constraint(els, self.interp.value(expr))
+            return
         # compute every value first, then assign (like the Evolver's set)
         vals = []
         ix = None if idx is None else self.interp.value(idx)
@@ -1250,6 +1261,70 @@ class Session:
             self.set_attr(el, attr, ix, v)
         if gen.kind == "vertex" and attr in ("x", "y", "z"):
             project_to_constraints(self.surface, np.array([e.i for e in els], np.int64))
+
+    def set_constraint(self, els, cid):
+        """``set gen constraint n``: put the elements on level-set constraint
+        ``n`` (a number or a name from ``define constraint``); vertices are
+        projected onto it at once (REF)."""
+        s = self.surface
+        if isinstance(cid, str) or int(cid) not in s.constraints:
+            raise CommandError(f"constraint {cid if isinstance(cid, str) else int(cid)} "
+                               f"is not defined")
+        cid = int(cid)
+        moved = []
+        for el in els:
+            if el.kind == "vertex":
+                m = s.vcon.setdefault(cid, np.zeros(s.nv, bool))
+                m[el.i] = True
+                moved.append(el.i)
+            elif el.kind == "edge":
+                s.econ.setdefault(cid, np.zeros(s.ne, np.int8))[el.i] = 1
+            elif el.kind == "facet" and not s.string:
+                s.fcon.setdefault(cid, np.zeros(s.nf, bool))[el.i] = True
+            else:
+                raise CommandError("constraints belong to vertices, edges and facets")
+        if moved:
+            project_to_constraints(s, np.array(moved, np.int64))
+
+    def define_constraint(self, text):
+        """``define constraint NAME [flags] formula: expr [energy: ...] [content:
+        ...]`` at run time: a level-set constraint numbered after the existing
+        ones and known by its name (REF: ``list`` shows the name,
+        ``on_constraint NAME`` and ``set ... constraint NAME`` use it)."""
+        import re
+        from .datafile.preprocess import Section
+        from .datafile.reader import Reader
+        m = re.match(r"\s*define\s+constraint\s+([a-z_]\w*)(.*)\Z", text, re.I | re.S)
+        if m is None:
+            raise CommandError("define constraint: expected a name, e.g. "
+                               "define constraint cc formula: x^2 + y^2 = 1")
+        name, rest = m.group(1).lower(), m.group(2)
+        arr = re.search(r"([a-z_]\w*)\s*\[", rest, re.I)
+        if arr:
+            raise UnsupportedError(f"array elements in constraint formulas ({arr.group(1)}[...] "
+                                   f"in constraint {name})")
+        s = self.surface
+        names = getattr(s, "constraint_names", {})
+        cid = next((c for c, n in names.items() if n == name), None)
+        if cid is None:
+            if name in self.variables or name in self.commands:
+                raise CommandError(f"define constraint: '{name}' is already a variable or command")
+            cid = max(s.constraints, default=0) + 1
+        reader = Reader("<define constraint>", "")
+        reader.scene.parameters = {k: v for k, v in self.variables.items()
+                                   if isinstance(v, float)}
+        reader._top(Section("top", f"constraint {cid} {rest}\n", 1, [1]))
+        decl = reader.scene.constraints[cid]
+        s.constraints = {**s.constraints, cid: decl}
+        s.constraint_names = {**names, cid: name}
+        if "global" in decl.flags:
+            s.vcon[cid] = np.ones(s.nv, bool)
+            s.econ[cid] = np.ones(s.ne, np.int8)
+            project_to_constraints(s, np.arange(s.nv))
+
+    def constraint_label(self, cid):
+        """A constraint's number, or its name when defined at run time."""
+        return getattr(self.surface, "constraint_names", {}).get(cid, str(cid))
 
     def unset_constraint(self, els, cid):
         s = self.surface
@@ -1384,7 +1459,7 @@ class Session:
             line = f"{vid[i]:3d}  " + " ".join(f"{x:17.15g}" for x in s.X[i, :sd])
         cons = [c for c in sorted(s.vcon) if s.vcon[c][i]]
         if cons:
-            line += "  constraints " + " ".join(map(str, cons)) + " "
+            line += "  constraints " + " ".join(map(self.constraint_label, cons)) + " "
         if s.vattr["fixed"][i]:
             line += " fixed "
         return line
@@ -1410,7 +1485,7 @@ class Session:
         cons = [c for c in sorted(s.econ) if s.econ[c][i]]
         if cons:
             line += "  constraints " + " ".join(
-                str(c * int(s.econ[c][i])) for c in cons) + " "
+                ("-" if s.econ[c][i] < 0 else "") + self.constraint_label(c) for c in cons) + " "
         eb = s.eattr.get("boundary")
         if eb is not None and eb[i]:
             line += f"  boundary {int(eb[i])} "

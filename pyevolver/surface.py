@@ -1264,6 +1264,16 @@ def boundary_groups(s, mask=None):
     return out
 
 
+def solve_small(A, b):
+    """Batched ``A[n]⁻¹ b[n]`` for small (k, k) systems; a singular system
+    (a constraint gradient that vanishes, e.g. x² + y² = 1 at the origin)
+    gets the least-squares solution instead of an error."""
+    try:
+        return np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return np.einsum("nkl,nl->nk", np.linalg.pinv(A), b)
+
+
 def state(s):
     """Snapshot of the coordinates (and boundary parameters) of ``s``."""
     P = s.vattr.get("params")
@@ -1295,7 +1305,7 @@ def displace(s, base, dX):
         JtJ = np.einsum("nik,nil->nkl", J, J)
         rhs = np.einsum("nik,ni->nk", J, dX[rows])
         with np.errstate(all="ignore"):
-            dp = np.linalg.solve(JtJ, rhs[..., None])[..., 0]
+            dp = solve_small(JtJ, rhs)
         P[rows, :k] = P0[rows, :k] + np.nan_to_num(dp)
         s.X[rows], _ = boundary_eval(s, bid, P[rows])
     s.vattr["params"] = P
@@ -1327,7 +1337,7 @@ def project_tangent(s, vecs):
             for v in vecs:
                 rhs = np.einsum("nik,ni->nk", J, v[rr])
                 with np.errstate(all="ignore"):
-                    c = np.linalg.solve(JtJ, rhs[..., None])[..., 0]
+                    c = solve_small(JtJ, rhs)
                 v[rr] = np.einsum("nik,nk->ni", J, np.nan_to_num(c))
     if not s.vcon:
         return vecs
@@ -1351,7 +1361,7 @@ def project_tangent(s, vecs):
             w = v[rr]
             rhs = np.einsum("nik,ni->nk", Gm, w)
             with np.errstate(all="ignore"):
-                lam = np.linalg.solve(GtG, rhs[..., None])[..., 0]
+                lam = solve_small(GtG, rhs)
             lam = np.nan_to_num(lam)
             v[rr] = w - np.einsum("nik,nk->ni", Gm, lam)
     return out
@@ -1398,7 +1408,7 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
             Gm = np.stack(grads, axis=2)           # (n, 3, k)
             GtG = np.einsum("nik,nil->nkl", Gm, Gm)
             with np.errstate(all="ignore"):
-                lam = np.linalg.solve(GtG, phi[..., None])[..., 0]
+                lam = solve_small(GtG, phi)
             step = np.einsum("nik,nk->ni", Gm, lam)
             step = np.where(np.isfinite(step), step, 0.0)
             s.X[sel] = P - step

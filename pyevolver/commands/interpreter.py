@@ -499,6 +499,9 @@ class _CmdTransformer(ExprTransformer):
     def assign_array(self, lv, _a, items):
         return ("assign_array", lv, items)
 
+    def define_constraint(self, tok):
+        return ("define_constraint", str(tok))
+
     def define_other(self, _d, what, name):
         return ("unsupported", f"define {str(what).lower()}")
 
@@ -651,6 +654,10 @@ class _CmdTransformer(ExprTransformer):
         # `sum(vv.edge eee, eee ecutmark)` means eee.ecutmark (cut.cmd; REF
         # accepts a name and an attribute side by side)
         return Aggregate(str(op), gen, Attr(self.var(base), str(name).lower()))
+
+    def attr_on(self, base, kw, arg):
+        # vv.on_constraint 2, ee.on_boundary 1 (REF: no brackets)
+        return Attr(base, str(kw).lower(), arg)
 
     def attr_index(self, base, name, *idx):
         return Attr(base, name, idx[0] if len(idx) == 1 else list(idx))
@@ -1283,7 +1290,9 @@ class Interpreter:
             return
         els = s.generate(gen, self.env)
         n = s.fix_elements(els, on)
-        s.note(f"{'Fixed' if on else 'Unfixed'}: {n}\n")
+        # REF reports the elements fixed and unfixed by a whole command at
+        # its end ("Fixed: N" then "Unfixed: M", nonzero counts only)
+        s.fix_counts[0 if on else 1] += n
 
     def _x_fix_name(self, node):
         self.session.fix_name(node[1], node[2])
@@ -1411,6 +1420,9 @@ class Interpreter:
 
     def _x_return(self, node):
         raise _Return(None if node[1] is None else self.value(node[1]))
+
+    def _x_define_constraint(self, node):
+        self.session.define_constraint(node[1])
 
     def _x_unsupported(self, node):
         raise UnsupportedError(node[1])
