@@ -1001,6 +1001,8 @@ class Session:
                 return float(s.X[i, coords[name]])
             if name == "__x" and idx is not None:
                 return float(s.X[i, int(idx) - 1])
+            if name == "__x":
+                raise UnsupportedError("vector-valued attributes (vertex __x as a whole)")
             if name == "fixed":
                 return float(s.vattr["fixed"][i])
             if name in ("on_constraint", "hit_constraint"):
@@ -1028,6 +1030,13 @@ class Session:
                 return float(t.edge_length[i])
             if name in ("x", "y", "z"):
                 return float(t.edge_vec[i, "xyz".index(name)] * base.sign)
+            if name == "edge_vector":
+                if idx is None or isinstance(idx, tuple):
+                    raise UnsupportedError("vector-valued attributes (edge_vector as a whole)")
+                j = int(idx)
+                if j < 1 or j > s.sdim:
+                    raise ExpressionError(f"edge_vector[{j}]: index outside 1..{s.sdim}")
+                return float(t.edge_vec[i, j - 1] * base.sign)
             if name in ("tension", "density"):
                 return float(s.edge_tension[i])
             if name == "fixed":

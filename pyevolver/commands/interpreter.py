@@ -499,6 +499,13 @@ class _CmdTransformer(ExprTransformer):
     def assign_array(self, lv, _a, items):
         return ("assign_array", lv, items)
 
+    def compare_eq1(self, a, _op, b):
+        return N.Cmp("==", a, b)
+
+    def array_arith(self, lv, op, items):
+        # edge_tuber.cmd: evecs[inx] += { ... } (refused when it runs)
+        return ("unsupported", f"whole-array arithmetic ({op} {{...}})")
+
     def define_constraint(self, tok):
         return ("define_constraint", str(tok))
 
@@ -1056,6 +1063,8 @@ class Interpreter:
             if not isinstance(v, str):
                 raise ExpressionError("is_defined() needs a name in a string")
             return float(self.is_defined(v.lower()))
+        if name in ("new_vertex", "new_edge", "new_facet", "new_body"):
+            raise UnsupportedError(f"{name}() (creating elements from a script)")
         if name == "valid_element":
             # 1 if the element exists (simply_connected.cmd: vertex[sc_startv])
             if len(arg_nodes) != 1 or not isinstance(arg_nodes[0], ElemIndex):
