@@ -86,7 +86,9 @@ class Session:
         self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
         self.iteration_counter = 0
         self.total_time = 0.0
-        self.fix_counts = [0, 0]               # fixed, unfixed by the current command
+        # REF reports some counts once per command, summed, at its end
+        # ("Fixed: N", "Unfixed: N" first, then "Edges refined: N", ...)
+        self.pending = {"Fixed": 0, "Unfixed": 0}
 
     # -- loading ---------------------------------------------------------------
     @classmethod
@@ -286,11 +288,18 @@ class Session:
             raise CommandError(f"{where}:{line}: recursion too deep") from None
         finally:
             del scopes[depth:]
-            counts, self.fix_counts = self.fix_counts, [0, 0]
-        for word, n in zip(("Fixed", "Unfixed"), counts):
-            if n:
+            counts, self.pending = self.pending, {"Fixed": 0, "Unfixed": 0}
+        for word, n in counts.items():
+            if n and word in ("Fixed", "Unfixed"):
                 self.note(f"{word}: {n}\n")
+            elif n:
+                self.write(f"{word}: {n}\n")
         self.refresh()
+
+    def report(self, word, n):
+        """Add ``n`` to the count REF prints as ``word: total`` when the
+        current command ends."""
+        self.pending[word] = self.pending.get(word, 0) + n
 
     def _snapshot(self):
         s = self.surface
@@ -579,7 +588,7 @@ class Session:
             new, n = edge_divide(self.surface, edges)
             self._replace_surface(new)
         if echo:
-            self.write(f"Edges refined: {n}\n")
+            self.report("Edges refined", n)
 
     def refine_facets(self, facets, echo=True):
         """``refine facets where ...``: split each facet into three at its
@@ -589,7 +598,7 @@ class Session:
         f = np.unique(np.asarray(facets, np.int64))
         self._replace_surface(split_facets_at_centre(self.surface, f))
         if echo:
-            self.write(f"Facets refined: {len(f)}\n")
+            self.report("Facets refined", len(f))
 
     def equiangulate(self, echo=True):
         """``u``: one equiangulation sweep (spec §8.2)."""
@@ -613,7 +622,7 @@ class Session:
         new, n = equiangulate(self.surface, threshold=np.inf, only=only)
         self._replace_surface(new)
         if echo:
-            self.write(f"Edges swapped: {n}\n")
+            self.report("Edges swapped", n)
         return n
 
     def _bisect(self, edges, echo):
@@ -1471,7 +1480,25 @@ class Session:
             line += "  constraints " + " ".join(map(self.constraint_label, cons)) + " "
         if s.vattr["fixed"][i]:
             line += " fixed "
-        return line
+        extra = self._extra_text("vertex", i)
+        return line + extra + (" " if extra else "")
+
+    def _extra_text(self, kind, i):
+        """Defined attributes as REF lists them: `` name value`` each (reals
+        ``%2.15g``, integers ``%d``, arrays in braces)."""
+        out = []
+        for (k, name), arr in self.surface.extra.items():
+            if k != kind:
+                continue
+            integer = self.attr_types.get((k, name)) == "integer"
+            fmt = (lambda v: "%d" % int(v)) if integer else (lambda v: "%2.15g" % v)
+            v = arr[i]
+            if np.ndim(v):
+                txt = "{" + ",".join(fmt(x) for x in np.ravel(v)) + "}"
+            else:
+                txt = fmt(v)
+            out.append(f" {name} {txt}")
+        return "".join(out)
 
     @staticmethod
     def _colour_name(c):
@@ -1509,7 +1536,8 @@ class Session:
         eorig = s.eattr.get("original")
         if eorig is not None and eorig[i] and eorig[i] != eid[i]:
             line += f" original {eorig[i]}"
-        return line
+        extra = self._extra_text("edge", i)
+        return line + extra + (" " if extra else "")
 
     def _list_facet(self, i):
         s = self.surface
@@ -1548,7 +1576,7 @@ class Session:
         orig = s.fattr["original"][i]
         if orig and orig != fid[i]:
             line += f" original {orig}"
-        return line
+        return line + self._extra_text("facet", i)
 
     def _list_body(self, i):
         s = self.surface
@@ -1569,7 +1597,7 @@ class Session:
             line += f"  volconst {b.volconst[i]:.15g} "
         if b.density[i]:
             line += f"  density {b.density[i]:.15g} "
-        return line
+        return line + self._extra_text("body", i)
 
     # -- reports ------------------------------------------------------------------------------------
     def show_vol(self):

@@ -143,7 +143,7 @@ def _session():
     ('shell', "shell"),
     ('dissolve edge[1]', "dissolve"),
     ('permload "x.fe"', "permload"),
-    ('define constraint cc formula: x = 1', "define constraint"),
+    ('define boundary bb parameters 1 x1: p1', "define boundary"),
     ('list topinfo', "list topinfo"),
 ])
 def test_refused_by_name(cmd, word):

@@ -1301,7 +1301,7 @@ class Interpreter:
         n = s.fix_elements(els, on)
         # REF reports the elements fixed and unfixed by a whole command at
         # its end ("Fixed: N" then "Unfixed: M", nonzero counts only)
-        s.fix_counts[0 if on else 1] += n
+        s.report("Fixed" if on else "Unfixed", n)
 
     def _x_fix_name(self, node):
         self.session.fix_name(node[1], node[2])
@@ -1419,7 +1419,7 @@ class Interpreter:
                     v = gen.where.ev(self.env)
                 if not isinstance(v, str) and v:
                     n += s.delete_elements(gen.kind, [el.i])
-        s.write(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted: {n}\n")
+        s.report(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted", n)
 
     def _x_break(self, node):
         raise _Break(1 if node[1] is None else int(self.value(node[1])))
