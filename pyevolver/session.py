@@ -807,6 +807,7 @@ class Session:
             "quantity_count": lambda: len(s.quantities),
             "symmetry_group": lambda: 0, "simplex_representation": lambda: 0,
             "lagrange_order": lambda: 1, "linear": lambda: 1, "quadratic": lambda: 0,
+            "lagrange": lambda: 0,
             "date_and_time": lambda: time.strftime("%a %b %d %H:%M:%S %Y"),
         }
         fn = simple.get(name)
@@ -1011,7 +1012,7 @@ class Session:
             if name == "__x" and idx is not None:
                 return float(s.X[i, int(idx) - 1])
             if name == "__x":
-                raise UnsupportedError("vector-valued attributes (vertex __x as a whole)")
+                return N.array_value(s.X[i, :s.sdim])
             if name == "fixed":
                 return float(s.vattr["fixed"][i])
             if name in ("on_constraint", "hit_constraint"):
@@ -1023,15 +1024,18 @@ class Session:
             if name == "valence":
                 return float(np.count_nonzero((s.E == i).any(axis=1)))
             if name in ("vertexnormal", "vertex_normal"):
-                if idx is None or isinstance(idx, tuple):
+                if isinstance(idx, tuple):
                     raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
-                j = int(idx)
-                if j < 1 or j > s.sdim:
-                    raise ExpressionError(f"{name}[{j}]: index outside 1..{s.sdim}")
                 from .geometry import vertex_normals
                 if s.nf == 0:
                     raise UnsupportedError("vertex_normal in the string model")
-                return float(vertex_normals(s.F, t.facet_N2, s.nv)[i, j - 1])
+                nrm = vertex_normals(s.F, t.facet_N2, s.nv)[i]
+                if idx is None:
+                    return N.array_value(nrm)
+                j = int(idx)
+                if j < 1 or j > s.sdim:
+                    raise ExpressionError(f"{name}[{j}]: index outside 1..{s.sdim}")
+                return float(nrm[j - 1])
             if name in ("p1", "p2") and "params" in s.vattr:
                 return float(s.vattr["params"][i, int(name[1]) - 1])
         elif k == "edge":
@@ -1040,8 +1044,10 @@ class Session:
             if name in ("x", "y", "z"):
                 return float(t.edge_vec[i, "xyz".index(name)] * base.sign)
             if name == "edge_vector":
-                if idx is None or isinstance(idx, tuple):
-                    raise UnsupportedError("vector-valued attributes (edge_vector as a whole)")
+                if idx is None:
+                    return N.array_value(t.edge_vec[i, :s.sdim] * base.sign)
+                if isinstance(idx, tuple):
+                    raise ExpressionError("edge_vector takes one index")
                 j = int(idx)
                 if j < 1 or j > s.sdim:
                     raise ExpressionError(f"edge_vector[{j}]: index outside 1..{s.sdim}")
@@ -1159,8 +1165,16 @@ class Session:
     def set_attr(self, base, name, idx, value):
         if isinstance(value, str):
             raise CommandError(f"cannot assign a string to '.{name}'")
-        value = float(value)
         s = self.surface
+        if isinstance(value, N.ArrayValue):
+            key = (getattr(base, "kind", None), name)
+            arr = s.extra.get(key)
+            if arr is None or idx is not None or arr.shape[1:] != value.shape:
+                raise CommandError(f"cannot assign an array of shape {list(value.shape)} to "
+                                   f"'.{name}'")
+            arr[base.i] = np.asarray(value)
+            return
+        value = float(value)
         if isinstance(base, I.QRef):
             q = s.quantities[base.name]
             if name in ("target", "modulus", "tolerance"):

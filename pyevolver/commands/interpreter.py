@@ -260,6 +260,33 @@ class OnTest(N.Node):
         return env.session.get_attr(el, self.what, self.arg.ev(env))
 
 
+class ArrayLit(N.Node):
+    """``{a, b, c}`` (nested: ``{{..},{..}}``) as a whole-array value."""
+
+    __slots__ = ("items",)
+
+    def __init__(self, items):
+        self.items = items
+
+    def ev(self, env):
+        def val(x):
+            if isinstance(x, list):
+                return [val(y) for y in x]
+            v = env.session.interp.value(x)
+            if isinstance(v, str):
+                raise ExpressionError("array values must be numbers")
+            return float(v)
+        try:
+            return N.array_value(val(self.items))
+        except ValueError:
+            raise ExpressionError("the rows of an array list differ in length") from None
+
+    def children(self):
+        def walk(x):
+            return [n for y in x for n in walk(y)] if isinstance(x, list) else [x]
+        return tuple(walk(self.items))
+
+
 class UserCall(N.Node):
     """``name(args)`` in an expression: a user function or a string builtin."""
 
@@ -292,8 +319,10 @@ class ArrayRef(N.Node):
             # a bare indexed attribute inside a generator: form_factors[2]
             return env.session.get_attr(env.current(), self.name,
                                         idx[0] if len(idx) == 1 else tuple(idx))
-        arr, pos = interp.array_slot(self.name, idx)
+        arr, pos = interp.array_slot(self.name, idx, partial=True)
         v = arr[pos]
+        if np.ndim(v):
+            return N.array_value(v)
         return v if isinstance(v, str) else float(v)
 
     def children(self):
@@ -503,8 +532,8 @@ class _CmdTransformer(ExprTransformer):
         return N.Cmp("==", a, b)
 
     def array_arith(self, lv, op, items):
-        # edge_tuber.cmd: evecs[inx] += { ... } (refused when it runs)
-        return ("unsupported", f"whole-array arithmetic ({op} {{...}})")
+        # edge_tuber.cmd: evecs[inx] += { jeps*random, ... }
+        return self.opassign(lv, op, ArrayLit(items))
 
     def define_constraint(self, tok):
         return ("define_constraint", str(tok))
@@ -785,7 +814,10 @@ class Env:
         if name in s.variables:
             return s.variables[name]
         if name in s.arrays:
-            raise ExpressionError(f"'{name}' is an array; index it as {name}[i]")
+            arr = s.arrays[name]
+            if arr.dtype == object:
+                raise ExpressionError(f"'{name}' is an array of strings; index it as {name}[i]")
+            return N.array_value(arr)           # the whole array as a value
         if self.frames:
             el = self.frames[-1][1]
             try:
@@ -1121,6 +1153,10 @@ class Interpreter:
             if name not in s.variables:
                 s.set_variable(name, "" if typ == "string" else 0.0)
             return
+        if self.env.scopes and name in self.env.scopes[-1]:
+            # `local vn; define vn real[3]`: the name is the array from here on
+            # (pyevolver keeps arrays in one namespace)
+            del self.env.scopes[-1][name]
         old = s.arrays.get(name)
         new = np.zeros(shape, dtype=object if typ == "string" else float)
         if typ == "string":
@@ -1131,13 +1167,16 @@ class Interpreter:
         s.arrays[name] = new
         s.array_types[name] = typ
 
-    def array_slot(self, name, idx):
+    def array_slot(self, name, idx, partial=False):
+        """``(array, position)`` of ``name[idx...]``; with ``partial`` fewer
+        indices than dimensions name a sub-array (``evecs[2]`` of a
+        ``real[20][3]``)."""
         s = self.session
         arr = s.arrays.get(name)
         if arr is None:
             raise ExpressionError(f"'{name}' is not an array (define it first: "
                                   f"define {name} real[n])")
-        if len(idx) != arr.ndim:
+        if len(idx) != arr.ndim and not (partial and 0 < len(idx) < arr.ndim):
             raise ExpressionError(f"array '{name}' has {arr.ndim} dimension"
                                   f"{'s' if arr.ndim != 1 else ''}, got {len(idx)} indices")
         pos = []
@@ -1169,15 +1208,21 @@ class Interpreter:
         v = self.value(expr)
         if isinstance(old, str) or isinstance(v, str):
             raise CommandError(f"'{op}=' needs numbers")
-        new = {"+": old + v, "-": old - v, "*": old * v, "/": old / v if v else np.inf}[op]
+        if op == "/" and not isinstance(v, np.ndarray) and v == 0:
+            raise ExpressionError("Division by zero.")
+        if op == "*" and isinstance(old, N.ArrayValue) and isinstance(v, N.ArrayValue):
+            raise CommandError("'*=' of two arrays: use a := a * b for the dot product")
+        new = {"+": lambda: old + v, "-": lambda: old - v, "*": lambda: old * v,
+               "/": lambda: old / v}[op]()
         self._store(lv, new)
 
     def _load(self, lv):
         if lv[0] == "name":
             return self.env.lookup(lv[1].lower())
         if lv[0] == "array":
-            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
-            return arr[pos]
+            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]], partial=True)
+            v = arr[pos]
+            return N.array_value(v) if np.ndim(v) else v
         base = lv[1].ev(self.env)
         return self.session.get_attr(base, lv[2], self._index(lv[3]))
 
@@ -1197,12 +1242,21 @@ class Interpreter:
             if name in s.commands:
                 del s.commands[name]
             if name in s.arrays:
-                raise CommandError(f"'{name}' is an array; assign to {name}[i]")
+                self._fill(name, s.arrays[name], (), value)
+                return
+            if isinstance(value, N.ArrayValue):
+                raise CommandError(f"'{name}' is not an array; define it first "
+                                   f"(define {name} real" +
+                                   "".join(f"[{n}]" for n in value.shape) + ")")
             s.set_variable(name, value)
             return
         if lv[0] == "array":
-            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
-            if arr.dtype == object:
+            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]], partial=True)
+            if len(pos) < arr.ndim:
+                self._fill(lv[1], arr, pos, value)
+            elif isinstance(value, N.ArrayValue):
+                raise CommandError(f"{lv[1]}[...]: an array does not fit in one entry")
+            elif arr.dtype == object:
                 arr[pos] = value if isinstance(value, str) else print_value(value).strip()
             elif isinstance(value, str):
                 raise CommandError(f"array '{lv[1]}' holds numbers, not strings")
@@ -1211,6 +1265,21 @@ class Interpreter:
             return
         base = lv[1].ev(self.env)
         s.set_attr(base, lv[2], self._index(lv[3]), value)
+
+    @staticmethod
+    def _fill(name, arr, pos, value):
+        """Assign a number (to every entry) or an array of the same shape to
+        the (sub-)array ``arr[pos]``."""
+        if isinstance(value, str) or arr.dtype == object:
+            raise CommandError(f"array '{name}': whole-array assignment needs numbers")
+        target = arr[pos] if pos else arr
+        if isinstance(value, N.ArrayValue) and value.shape != target.shape:
+            raise CommandError(f"array '{name}': cannot assign shape {list(value.shape)} "
+                               f"to shape {list(target.shape)}")
+        if pos:
+            arr[pos] = np.asarray(value)
+        else:
+            arr[...] = np.asarray(value)
 
     def _index(self, idx):
         if idx is None:
@@ -1257,6 +1326,9 @@ class Interpreter:
             self.session.write(print_array(self.session.arrays[e.name]) + "\n")
             return
         v = self.value(e)
+        if isinstance(v, N.ArrayValue):
+            self.session.write(print_array(np.asarray(v)) + "\n")
+            return
         self.session.write(print_value(v) + "\n")
 
     def _x_printf(self, node):
@@ -1599,6 +1671,8 @@ class Interpreter:
     # -- expressions ------------------------------------------------------------
     def value(self, expr):
         v = expr.ev(self.env)
+        if isinstance(v, N.ArrayValue):
+            return v
         if isinstance(v, np.ndarray):
             v = float(v)
         if isinstance(v, (ElemRef, QRef)):

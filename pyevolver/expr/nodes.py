@@ -100,9 +100,19 @@ UNSUPPORTED_FUNCS = {
 }
 
 
+class ArrayValue(np.ndarray):
+    """A whole array as a value in the command language (``vn :=
+    ff.vertex[1].vertex_normal``, ``2*vn``, ``vn*vn`` the dot product), as
+    opposed to the per-point arrays of a vectorized formula evaluation."""
+
+
+def array_value(a):
+    return np.array(a, dtype=float).view(ArrayValue)
+
+
 def _num(v):
     """Python float for scalars, array otherwise."""
-    if isinstance(v, np.ndarray) and v.ndim == 0:
+    if isinstance(v, np.ndarray) and v.ndim == 0 and not isinstance(v, ArrayValue):
         return float(v)
     return v
 
@@ -284,7 +294,12 @@ class Bin(Node):
         with np.errstate(all="ignore"):
             if self.op == "/" and not isinstance(b, np.ndarray) and b == 0 \
                     and not isinstance(a, np.ndarray):
-                return math.copysign(math.inf, a) if a != 0 else math.nan
+                raise ExpressionError("Division by zero.")     # REF's ERROR 1258
+            if self.op == "*" and isinstance(a, ArrayValue) and isinstance(b, ArrayValue):
+                if a.shape != b.shape:
+                    raise ExpressionError(f"array product needs equal shapes, got "
+                                          f"{list(a.shape)} and {list(b.shape)}")
+                return float(np.sum(np.multiply(np.asarray(a), np.asarray(b))))  # dot product
             return _num(BINOPS[self.op](a, b))
 
     def children(self):
@@ -386,7 +401,11 @@ class Func(Node):
                 raise ExpressionError(f"{self.name}() needs a number, got a string")
         with np.errstate(all="ignore"):
             if len(vals) == 1:
-                return _num(FUNC1[self.name](vals[0]))
+                v = vals[0]
+                if self.name == "sqrt" and not isinstance(v, np.ndarray) and v < 0:
+                    # REF's ERROR 1263
+                    raise ExpressionError(f"Square root of negative number {v:g}.")
+                return _num(FUNC1[self.name](v))
             return _num(FUNC2[self.name](vals[0], vals[1]))
 
     def children(self):
