@@ -1101,6 +1101,12 @@ class Session:
                 return float(c[i]) if c is not None else 15.0     # white (REF default)
             if name == "valence":
                 return 3.0
+            if name in ("frontbody", "backbody"):
+                # the body the facet bounds positively (front) or negatively
+                col = s.bodies.facet_matrix[:, i].tocoo()
+                want = 1 if name == "frontbody" else -1
+                hit = [int(b) + 1 for b, v in zip(col.row, col.data) if np.sign(v) == want]
+                return float(hit[0]) if hit else 0.0
         elif k == "body":
             b = s.bodies
             if name == "volume":
@@ -1190,6 +1196,8 @@ class Session:
                 value = float(int(value))            # C conversion truncates
             if arr.ndim == 1:
                 arr[i] = value
+            elif idx is None:
+                arr[i] = value                  # every entry (REF: set vertex vec 0)
             else:
                 arr[(i,) + self._attr_pos(k, name, arr, idx)] = value
             return

@@ -1335,7 +1335,11 @@ class Interpreter:
         args = [self.value(a) for a in node[1]]
         if not args or not isinstance(args[0], str):
             raise CommandError("printf needs a format string first")
-        text = c_format(args[0], args[1:])
+        # REF prints a lone format string as it is ("%%" stays "%%": xray.cmd)
+        if len(args) == 1 and "%" in args[0].replace("%%", ""):
+            raise CommandError(f"{'ERR' if node[2] else ''}PRINTF string has formats, but "
+                               "there are no arguments.")          # REF's ERROR 1928
+        text = c_format(args[0], args[1:]) if len(args) > 1 else args[0]
         if node[2]:
             self.session.write_err(text)
         else:
