@@ -258,7 +258,14 @@ class Session:
                 self.write_err(f"{exc}\n")
 
     def run_one(self, text, where="<command>", line=1):
+        stripped = text.strip()
+        if stripped.startswith("!") and not stripped.startswith("!="):
+            # !!, !n, !prefix: a command from the history, echoed (manual)
+            old = self._from_history(stripped[1:].strip())
+            self.write(old + "\n\n")
+            return self.run_one(old, where, line)
         ast = I.parse_command(text, where, line)
+        self._remember(stripped)
         snap = self._snapshot()
         scopes = self.interp.env.scopes
         depth = len(scopes)
@@ -295,6 +302,37 @@ class Session:
             elif n:
                 self.write(f"{word}: {n}\n")
         self.refresh()
+
+    HISTORY_SIZE = 100
+
+    def _remember(self, text):
+        """Successfully parsed commands go into the history list (the last
+        100, numbered from 1), as in REF."""
+        self.history_count = getattr(self, "history_count", 0) + 1
+        h = getattr(self, "history", [])
+        h.append((self.history_count, text))
+        self.history = h[-self.HISTORY_SIZE:]
+
+    def _from_history(self, key):
+        h = getattr(self, "history", [])
+        if key == "!":
+            if h:
+                return h[-1][1]
+        elif key.isdigit():
+            for num, text in h:
+                if num == int(key):
+                    return text
+            raise CommandError("Command not in history list.")      # REF's ERROR 1587
+        else:
+            for num, text in reversed(h):
+                if text.startswith(key):
+                    return text
+        raise CommandError("Command not found in history.")          # REF's ERROR 1588
+
+    def show_history(self):
+        """``history``: the saved commands, ``n) text``."""
+        for num, text in getattr(self, "history", []):
+            self.write(f"{num}) {text}\n")
 
     def report(self, word, n):
         """Add ``n`` to the count REF prints as ``word: total`` when the

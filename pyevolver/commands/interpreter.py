@@ -656,7 +656,8 @@ class _CmdTransformer(ExprTransformer):
         word = words[0].lower()
         if word == "define" and len(words) > 1:
             word = "define " + words[1].lower() + " (at run time)"
-        return ("unsupported", word)
+        reason = UNSUPPORTED_REASONS.get(word)
+        return ("unsupported", word) if reason is None else ("unsupported", word, reason)
 
     def generator(self, base, *rest):
         var = None
@@ -902,6 +903,14 @@ GRAPHICS = {"s", "P", "show", "show_expr", "transforms", "transform_expr", "geom
 SETTABLE_ATTRS = {"x", "y", "z", "x1", "x2", "x3", "color", "colour", "frontcolor", "backcolor",
                   "tension", "density", "fixed", "no_refine", "target", "pressure", "volconst",
                   "constraint", "boundary", "opacity"}
+UNSUPPORTED_REASONS = {
+    "permload": "use replace_load, as the Evolver's manual advises; ::= permanent "
+                "variables are not supported either",
+    "system": "scripts never run programs", "shell": "scripts never run programs",
+    "exec": "scripts never run programs",
+    "detorus": "the torus model cannot be unwrapped yet",
+    "dissolve": "removing elements one by one is not implemented; delete merges edges",
+}
 TOGGLE_DEFAULTS = {"hessian_normal": 1, "autorecalc": 1, "ribiere": 1}
 # how REF names a toggle in "NAME ON. (was off)" (measured; the others use
 # their own name)
@@ -1510,7 +1519,7 @@ class Interpreter:
         self.session.define_constraint(node[1])
 
     def _x_unsupported(self, node):
-        raise UnsupportedError(node[1])
+        raise UnsupportedError(*node[1:])
 
     def _x_bare(self, node):
         raw, arg = node[1], node[2]
@@ -1542,6 +1551,9 @@ class Interpreter:
             return
         if name == "recalc":
             s.recalc()
+            return
+        if name == "history" and arg is None:
+            s.show_history()
             return
         if raw in GRAPHICS or name in GRAPHICS:
             return
