@@ -1540,8 +1540,7 @@ class Session:
             line += "  constraints " + " ".join(map(self.constraint_label, cons)) + " "
         if s.vattr["fixed"][i]:
             line += " fixed "
-        extra = self._extra_text("vertex", i)
-        return line + extra + (" " if extra else "")
+        return line + self._extra_text("vertex", i)
 
     def _extra_text(self, kind, i):
         """Defined attributes as REF lists them: `` name value`` each (reals
@@ -1554,7 +1553,7 @@ class Session:
             fmt = (lambda v: "%d" % int(v)) if integer else (lambda v: "%2.15g" % v)
             v = arr[i]
             if np.ndim(v):
-                txt = "{" + ",".join(fmt(x) for x in np.ravel(v)) + "}"
+                txt = "{" + ",".join(fmt(x) for x in np.ravel(v)) + "} "
             else:
                 txt = fmt(v)
             out.append(f" {name} {txt}")
@@ -1596,8 +1595,7 @@ class Session:
         eorig = s.eattr.get("original")
         if eorig is not None and eorig[i] and eorig[i] != eid[i]:
             line += f" original {eorig[i]}"
-        extra = self._extra_text("edge", i)
-        return line + extra + (" " if extra else "")
+        return line + self._extra_text("edge", i)
 
     def _list_facet(self, i):
         s = self.surface

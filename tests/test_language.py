@@ -36,6 +36,22 @@ def test_procedures_and_queries_match_reference(evolver, tmp_path):
     assert _same(_lines(out), _lines(ref)), (out, ref)
 
 
+def test_more_language_matches_reference(evolver, tmp_path):
+    """history and !!, quiet, REF's toggle wording, Fixed/Unfixed and refine
+    counts per command, define constraint at run time, on_constraint by name,
+    defined attributes in list, whole arrays (vertex_normal, __x,
+    edge_vector, {..} literals, dot products), a single = in comparisons, a
+    lone printf format, elliptic integrals, `eee length` in aggregates, set
+    gen.attr, valid_element, frontbody (tests/data/language_more.cmd on
+    mound.fe)."""
+    with open(os.path.join(HERE, "data", "language_more.cmd")) as fh:
+        script = fh.read()
+    ref = run_reference(evolver, example("mound.fe"), script, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(example("mound.fe"), script + "q\n", cwd=str(tmp_path))
+    assert err == ""
+    assert _same(_lines(out), _lines(ref)), (out, ref)
+
+
 # exporter script -> command it defines; the output file is named after the command
 EXPORTERS = [("off", "do_off"), ("stl", "stl"), ("dxf", "dxf"), ("obj", "obj"),
              ("obj", "obj_edge_lines"), ("ply", "ply"), ("povray", "povray"),
@@ -45,7 +61,8 @@ EXPORTERS = [("off", "do_off"), ("stl", "stl"), ("dxf", "dxf"), ("obj", "obj"),
              ("iges114", "iges114"), ("iges128", "iges128"), ("iges136", "iges136"),
              ("iges144", "iges144"), ("ansys", "ansys"), ("ansurf", "ansurf"),
              ("polyfilm", "polyfilm"), ("coff", "coff"), ("save_view", "save_view"),
-             ("maya", "maya"), ("maya1", "maya1"), ("collada", "collada")]
+             ("maya", "maya"), ("maya1", "maya1"), ("collada", "collada"),
+             ("dxf_thick", "dxf_thick")]
 # lines that hold the time of the run (date_and_time)
 TIMESTAMPED = ("// Date:", "    <created>", "    <modified>")
 
