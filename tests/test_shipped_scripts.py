@@ -70,6 +70,11 @@ list vertices
     "triangle": ("quad.fe", 'read "dirichlet_to_disk.cmd"\nr\nto_triangle\nlist vertices\n'
                             'foreach facet ff do printf "%g %g %g\\n", ff.form_factors[1], '
                             'ff.form_factors[2], ff.form_factors[3]\n', []),
+    # adjoint.cmd (Polthier's conjugate surface; autodisplay toggle) and
+    # band.cmd on quad.fe
+    "adjoint": ("quad.fe", 'read "adjoint.cmd"\nr\nr\ng 10\nadjoint\nlist vertices\n'
+                           'read "band.cmd"\nbandcolor := red\nbandwidth := 0.1\nmakeband\n'
+                           'print facet_count\n', []),
     # foamface.cmd on the torus foam (frontbody/backbody)
     "foam": ("twointor.fe", 'read "foamface.cmd"\nfoamface_mark\nfoamface_min\nfoam_signature\n',
              []),

@@ -896,7 +896,7 @@ TOGGLES = {
     "labelflag", "self_similar", "pinning", "diffusion", "sqgauss", "interp_bdry_param",
     "h_inverse_metric", "jiggle", "break_after_warning", "full_bounding_box",
     "show_all_quantities", "show_inner", "show_outer", "colormap", "bezier_basis",
-    "volgrads_every", "zener_drag", "backcull", "debug",
+    "volgrads_every", "zener_drag", "backcull", "debug", "autodisplay",
 }
 GRAPHICS = {"s", "P", "show", "show_expr", "transforms", "transform_expr", "geomview",
             "postscript", "showq", "view_transforms", "ps", "oogl", "gv", "screen"}
@@ -926,7 +926,7 @@ TOGGLE_WORDS = {
     "pinning": "Constraint pinning", "diffusion": "Diffusion",
     "sqgauss": "Squared Gaussian curvature", "jiggle": "jiggling",
     "break_after_warning": "Break after warning", "show_inner": "show inner",
-    "show_outer": "show outer", "memdebug": "Memory debugging",
+    "show_outer": "show outer", "memdebug": "Memory debugging", "autodisplay": "Autodisplay",
 }
 
 
