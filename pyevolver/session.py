@@ -62,6 +62,11 @@ def _deferred_sigint():
         if old is not None:
             signal.signal(signal.SIGINT, old)
 
+# motion options that change what g does; refused rather than ignored
+UNSUPPORTED_MOTION = ("area_normalization", "normal_motion", "runge_kutta",
+                      "approximate_curvature", "diffusion", "autopop", "jiggle")
+
+
 class Session:
     """A loaded surface with its variables, commands and output streams."""
 
@@ -114,6 +119,12 @@ class Session:
                                       bool(b.n and np.any(b.density)))
         self.variables = surface.params        # parameters and variables share one namespace
         self._scene_settings(scene)
+        for flag in ("area_normalization", "autopop", "conj_grad"):
+            if flag in scene.flags:             # top-section toggles (100grain.fe)
+                self.toggles[flag] = 1
+        if scene.values.get("autochop"):
+            self.toggles["autochop"] = 1
+            self.settings["autochop_length"] = float(scene.values["autochop"])
         self.commands = {}
         self.letters = {}
         self.arrays = {}
@@ -419,6 +430,10 @@ class Session:
         the run.  With ``echo`` the Evolver's progress lines are printed.
         """
         from .evolve.iterate import progress_line
+        for name in UNSUPPORTED_MOTION:
+            if self.toggles.get(name):
+                raise UnsupportedError(f"g with {name} on", "only the plain gradient motion "
+                                       "is implemented")
         results = []
         if self.surface.nv == 0:                # e.g. after `t` removed everything (REF)
             self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")

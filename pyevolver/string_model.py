@@ -49,6 +49,25 @@ STRING_METHODS = {"edge_length", "edge_tension", "edge_area", "vertex_scalar_int
 # facets as chains
 
 
+def chain_points(s, t=None):
+    """``(Pt, Ph)`` (m, 3): the tail and head points of every (facet, edge)
+    incidence as the facet traverses them.  On a torus the chain is unwrapped
+    from the tail of its first edge (edge vectors with their period shifts
+    added up along the chain), so areas and gravity see one connected curve."""
+    owner, e, sgn, tail, head = facet_entries(s)
+    if s.periods is None:
+        return s.X[tail], s.X[head]
+    from .geometry import edge_vectors
+    ev = t.edge_vec if t is not None else edge_vectors(s.X, s.E, s.wrap_shift())
+    d = ev[e] * sgn[:, None]
+    if not len(d):
+        return s.X[tail], s.X[head]
+    cs = np.cumsum(d, axis=0) - d               # sum of the edges before each one
+    start = s.sf_ptr[:-1]
+    Pt = s.X[tail[start]][owner] + cs - cs[start][owner]
+    return Pt, Pt + d
+
+
 def facet_entries(s):
     """``(owner, edge, sign, tail, head)`` for every (facet, edge) incidence,
     arrays of shape (m,): the facet, the edge index, +1/-1 for the direction
@@ -102,13 +121,13 @@ def facetedge_count(s):
 # energies and areas
 
 
-def _edge_area(X, t, h):
-    return -(X[h, 0] - X[t, 0]) * (X[t, 1] + X[h, 1]) / 2.0
+def _edge_area(Pt, Ph):
+    return -(Ph[:, 0] - Pt[:, 0]) * (Pt[:, 1] + Ph[:, 1]) / 2.0
 
 
-def _edge_gravity(X, t, h):
-    yt, yh = X[t, 1], X[h, 1]
-    return -(X[h, 0] - X[t, 0]) * (yt * yt + yt * yh + yh * yh) / 6.0
+def _edge_gravity(Pt, Ph):
+    yt, yh = Pt[:, 1], Ph[:, 1]
+    return -(Ph[:, 0] - Pt[:, 0]) * (yt * yt + yt * yh + yh * yh) / 6.0
 
 
 def _vertex_integrand(s, which):
@@ -153,11 +172,11 @@ def vertex_energy(s):
     return total
 
 
-def facet_areas(s):
+def facet_areas(s, t=None):
     """(nf,) areas of the string facets, content integrals included."""
     nsf = len(s.sf_ptr) - 1
-    owner, _, sgn, tail, head = facet_entries(s)
-    area = np.bincount(owner, weights=_edge_area(s.X, tail, head), minlength=nsf)
+    owner = facet_entries(s)[0]
+    area = np.bincount(owner, weights=_edge_area(*chain_points(s, t)), minlength=nsf)
     for formula, on in _vertex_integrand(s, "content"):
         f, v, c = content_coefficients(s, on)
         if len(f):
@@ -165,10 +184,10 @@ def facet_areas(s):
     return area
 
 
-def facet_gravity(s):
+def facet_gravity(s, t=None):
     """(nf,) ∬ y dA of each facet (per unit G ρ)."""
-    owner, _, _, tail, head = facet_entries(s)
-    return np.bincount(owner, weights=_edge_gravity(s.X, tail, head),
+    owner = facet_entries(s)[0]
+    return np.bincount(owner, weights=_edge_gravity(*chain_points(s, t)),
                        minlength=len(s.sf_ptr) - 1)
 
 
@@ -181,7 +200,7 @@ def _chain_grad(s, per_facet, fn):
     derivatives, each (m, 3))."""
     owner, _, _, tail, head = facet_entries(s)
     w = per_facet[owner]
-    gt, gh = fn(s.X, tail, head)
+    gt, gh = fn(*chain_points(s))
     out = np.zeros((s.nv, 3))
     for k in range(2):
         out[:, k] = (np.bincount(tail, weights=w * gt[:, k], minlength=s.nv)
@@ -189,17 +208,17 @@ def _chain_grad(s, per_facet, fn):
     return out
 
 
-def _area_derivs(X, t, h):
-    dx = X[h, 0] - X[t, 0]
-    sy = X[t, 1] + X[h, 1]
+def _area_derivs(Pt, Ph):
+    dx = Ph[:, 0] - Pt[:, 0]
+    sy = Pt[:, 1] + Ph[:, 1]
     gt = np.stack([sy / 2.0, -dx / 2.0], axis=1)
     gh = np.stack([-sy / 2.0, -dx / 2.0], axis=1)
     return gt, gh
 
 
-def _gravity_derivs(X, t, h):
-    dx = X[h, 0] - X[t, 0]
-    yt, yh = X[t, 1], X[h, 1]
+def _gravity_derivs(Pt, Ph):
+    dx = Ph[:, 0] - Pt[:, 0]
+    yt, yh = Pt[:, 1], Ph[:, 1]
     q = (yt * yt + yt * yh + yh * yh) / 6.0
     gt = np.stack([q, -dx * (2 * yt + yh) / 6.0], axis=1)
     gh = np.stack([-q, -dx * (yt + 2 * yh) / 6.0], axis=1)
@@ -333,7 +352,13 @@ def split_edges(s, R):
     nv, ne = s.nv, s.ne
     mid = nv + np.arange(k)
     half = ne + np.arange(k)
-    t.X[mid] = 0.5 * (s.X[s.E[R, 0]] + s.X[s.E[R, 1]])
+    if s.periods is None:
+        t.X[mid] = 0.5 * (s.X[s.E[R, 0]] + s.X[s.E[R, 1]])
+    else:                                 # the head as seen from the tail
+        from .geometry import edge_vectors
+        t.X[mid] = s.X[s.E[R, 0]] + 0.5 * edge_vectors(s.X, s.E, s.wrap_shift())[R]
+    if "wrap" in t.eattr:
+        t.eattr["wrap"][R] = 0.0          # the tail half stays in the tail's cell
     t.E[half, 0] = mid
     t.E[half, 1] = s.E[R, 1]
     t.E[R, 1] = mid
@@ -393,7 +418,9 @@ def vertex_average(s, mode="V"):
             use &= ~on_v[v] | on_e[e]
     deg = np.bincount(v, minlength=nv)
     cnt = np.bincount(v, weights=use.astype(float), minlength=nv)
-    vec = s.X[other] - s.X[v]
+    from .geometry import edge_vectors
+    ev = edge_vectors(s.X, s.E, s.wrap_shift())
+    vec = np.concatenate([ev, -ev])
     D = np.zeros((nv, 3))
     for k in range(3):
         D[:, k] = np.bincount(v, weights=np.where(use, vec[:, k], 0.0), minlength=nv)
@@ -407,19 +434,16 @@ def vertex_average(s, mode="V"):
     D[movable] /= cnt[movable, None]
     if mode == "V":
         mv = np.nonzero(movable)[0]
-        # chord between the two neighbours
-        nb = np.zeros((nv, 2), np.int64)
+        # the chord between the two neighbours, as seen from the vertex
+        # (torus wraps included)
         order = np.argsort(v, kind="stable")
         first = np.searchsorted(v[order], mv)
-        nb_a = other[order[first]]
-        nb_b = other[order[first + 1]]
-        ch = s.X[nb_b] - s.X[nb_a]
+        ch = vec[order[first + 1]] - vec[order[first]]
         n2 = np.einsum("ij,ij->i", ch, ch)
         with np.errstate(all="ignore"):
             tang = np.where(n2[:, None] > 0, ch * (np.einsum("ij,ij->i", D[mv], ch) / n2)[:, None],
                             0.0)
         D[mv] = tang
-        del nb
         (D,) = project_tangent(s, [D])
     new = copy.copy(s)
     new.X = s.X + D / 4.0
@@ -460,13 +484,13 @@ class StringTotals(Totals):
         self.con_content = None
         energy += self.con_energy
         b = s.bodies
-        self.sfacet_area = facet_areas(s) if len(s.sf_ptr) > 1 else np.zeros(0)
+        self.sfacet_area = facet_areas(s, self) if len(s.sf_ptr) > 1 else np.zeros(0)
         self.volumes = (b.facet_matrix @ self.sfacet_area + b.volconst) if b.n else \
             np.zeros(0)
         if b.n:
             G_ = s.gravity_constant
             if G_ != 0 and s.gravity_on and np.any(b.density):
-                grav = float(G_ * (b.density @ (b.facet_matrix @ facet_gravity(s))))
+                grav = float(G_ * (b.density @ (b.facet_matrix @ facet_gravity(s, self))))
                 self.terms["gravity"] = grav
                 energy += grav
             pmask = ~np.isnan(b.pressure)
@@ -482,7 +506,7 @@ class StringTotals(Totals):
 
     def volume_magnitudes(self):
         s = self.surface
-        owner, _, _, tail, head = facet_entries(s)
-        per = np.bincount(owner, weights=np.abs(_edge_area(s.X, tail, head)),
+        owner = facet_entries(s)[0]
+        per = np.bincount(owner, weights=np.abs(_edge_area(*chain_points(s, self))),
                           minlength=len(s.sf_ptr) - 1)
         return abs(s.bodies.facet_matrix) @ per

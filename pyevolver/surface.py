@@ -447,8 +447,8 @@ class _Builder:
         if s.sdim != 3 and not (s.string and s.sdim == 2):
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
                              f"(3, or 2 in the string model)")
-        if s.string and sc.torus:
-            raise self.error("not supported in pyevolver: TORUS in the string model")
+        if s.string and sc.torus and s.sdim != 2:
+            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model")
         s.constraints = dict(sc.constraints)
         s.boundaries = dict(sc.boundaries)
         s.symmetric_content = "symmetric_content" in sc.flags
@@ -458,7 +458,10 @@ class _Builder:
         s.sq_curvature_modulus = float(sc.values.get("squared_curvature", 0.0))
         if sc.torus:
             vals = sc.values.get("_periods")
-            P = np.eye(3) if vals is None else np.array(vals).reshape(3, 3)
+            sd = s.sdim
+            P = np.eye(3)
+            if vals is not None:            # a 2-d torus keeps z out of its cell
+                P[:sd, :sd] = np.array(vals).reshape(sd, sd)
             s.periods = P
         self._vertices()
         self._edges()
@@ -635,7 +638,7 @@ class _Builder:
         if s.periods is not None:
             w = np.zeros((n, 3))
             for pos, wr in sc.wraps.items():
-                w[pos] = wr
+                w[pos, :len(wr)] = wr
             s.eattr["wrap"] = w
         for cid, c in sc.constraints.items():
             if "global" in c.flags:

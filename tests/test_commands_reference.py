@@ -102,10 +102,11 @@ def test_read_sections_of_examples_parse(evolver, name):
             parse_command(chunk, path, sec.line + ln)
 
 
-# Tier 1 and 2 examples of the spec (100grain.fe's string torus and knotty.fe's
-# knot energies are refused by name: tests/test_string_model.py)
+# Tier 1 and 2 examples of the spec (knotty.fe's knot energies are refused by
+# name: tests/test_string_model.py)
 TIER12 = ["cube", "mound", "catbody", "cat", "catman", "twointor", "column", "quad", "sphere",
-          "qmound", "tankex", "octa", "phelanc", "addload_example", "slidestr", "popstr"]
+          "qmound", "tankex", "octa", "phelanc", "addload_example", "slidestr", "popstr",
+          "100grain"]
 
 
 @pytest.mark.parametrize("name", TIER12)

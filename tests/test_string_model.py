@@ -177,11 +177,30 @@ def test_string_refusals(cmd, text):
     assert np.array_equal(s.surface.X, X)
 
 
-def test_unsupported_string_files(tmp_path):
-    """100grain.fe's string torus and knotty.fe's knot energies are refused by
-    name when loaded."""
+def test_string_torus(evolver, tmp_path):
+    """100grain.fe's 2-d foam of 100 cells on the unit torus without its
+    motion options (autopop, autochop, area normalization, fixed scale):
+    cell areas from chains unwrapped across the cell, g, V, rawv, r, list."""
+    with open(example("100grain.fe")) as fh:
+        text = "".join(l for l in fh if not l.startswith(
+            ("autopop", "autochop", "area_normalization", "scale 5e-006")))
+    path = tmp_path / "grain.fe"
+    path.write_text(text)
+    _compare(evolver, str(path), "print sum(body, volume)\nv\ng 5\nV\nrawv\ng 2\nr\ng 2\n"
+             "print sum(body, volume)\nlist body[3]\nlist edge[5]\nlist facet[2]\n", tmp_path)
+
+
+def test_unsupported_string_files(evolver, tmp_path):
+    """knotty.fe's knot energies are refused by name when loaded; 100grain.fe
+    loads (its read section runs) but its g needs autopop and area
+    normalization, refused by name."""
     from pyevolver.errors import PyEvolverError
-    for name, word in (("100grain.fe", "TORUS in the string model"),
-                       ("knotty.fe", "sqcurve_string")):
-        with pytest.raises(PyEvolverError, match=word):
-            _session(example(name))
+    with pytest.raises(PyEvolverError, match="sqcurve_string"):
+        _session(example("knotty.fe"))
+    s = _session(example("100grain.fe"))
+    ref = run_reference(evolver, example("100grain.fe"), 'printf "%.15g\\n", total_length',
+                        cwd=str(tmp_path))
+    ref = [l for l in ref if l.strip()]
+    assert abs(s.totals.total_length - float(ref[0])) < 1e-12
+    with pytest.raises(PyEvolverError, match="g with area_normalization on"):
+        s.run("g 1")
