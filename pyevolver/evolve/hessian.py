@@ -661,6 +661,11 @@ def solve_bordered(K, B, r, d, method=None, points=None):
     try:
         return spla.splu(M).solve(rhs)
     except RuntimeError as exc:
+        # exactly singular (e.g. no energy on the free vertices): the
+        # minimum-norm least-squares step, which is zero along the null space
+        sol, istop = spla.lsqr(M, rhs, atol=1e-15, btol=1e-15, iter_lim=10 * M.shape[0])[:2]
+        if istop in (0, 1, 2, 4, 5) and np.all(np.isfinite(sol)):
+            return sol
         raise UnsupportedError("hessian on a singular Hessian",
                                f"the bordered Hessian could not be factored ({exc})") from None
 
