@@ -94,6 +94,8 @@ class Session(SessionAPI):
         self.iteration_counter = 0
         self.total_time = 0.0
         self.history = []                      # (iteration, energy, area) of each g step
+        self.command_history = []              # (number, text) of `history`, `!!` (REF: last 100)
+        self.command_count = 0
         # REF reports some counts once per command, summed, at its end
         # ("Fixed: N", "Unfixed: N" first, then "Edges refined: N", ...)
         self.pending = {"Fixed": 0, "Unfixed": 0}
@@ -322,13 +324,13 @@ class Session(SessionAPI):
     def _remember(self, text):
         """Successfully parsed commands go into the history list (the last
         100, numbered from 1), as in REF."""
-        self.history_count = getattr(self, "history_count", 0) + 1
-        h = getattr(self, "history", [])
-        h.append((self.history_count, text))
-        self.history = h[-self.HISTORY_SIZE:]
+        self.command_count = self.command_count + 1
+        h = self.command_history
+        h.append((self.command_count, text))
+        self.command_history = h[-self.HISTORY_SIZE:]
 
     def _from_history(self, key):
-        h = getattr(self, "history", [])
+        h = self.command_history
         if key == "!":
             if h:
                 return h[-1][1]
@@ -345,7 +347,7 @@ class Session(SessionAPI):
 
     def show_history(self):
         """``history``: the saved commands, ``n) text``."""
-        for num, text in getattr(self, "history", []):
+        for num, text in self.command_history:
             self.write(f"{num}) {text}\n")
 
     def report(self, word, n):
