@@ -22,13 +22,13 @@ CLIFFORD = 2 * math.pi ** 2
 def test_unregularized_effarea_collapses_far_below_the_clifford_bound():
     """W_EffAreaCur on the 10×16 torus, 50 damped Newton steps: far below
     2π² (every smooth torus has W ≥ 2π²) with collapsed triangles."""
-    row = F3.newton_run(10, 16, "EffArea", None, steps=50)
+    row = F3.newton_run(10, 16, "EffArea", None, steps=50, moebius=False)
     assert row["W"] < 0.9 * CLIFFORD and row["min_angle_deg"] < 1.0, row
 
 
 @pytest.mark.slow
 def test_unregularized_normalcur_collapses_far_below_the_clifford_bound():
-    row = F3.newton_run(10, 16, "NormalCur", None, steps=300)
+    row = F3.newton_run(10, 16, "NormalCur", None, steps=300, moebius=False)
     assert row["W"] < 0.9 * CLIFFORD and row["min_angle_deg"] < 1.0, row
 
 
@@ -39,11 +39,11 @@ def test_fixed_lambda_regularization_keeps_the_torus_healthy(energy):
     """W + 0.25 E on the offset 10×16 grid: smallest angle above 10°, W not
     below 2π²(1 − 1%), a torus of revolution (circle fit within 5%) with
     R/r within 3.5% of √2."""
-    row = F3.newton_run(10, 16, energy, 0.25)
+    row = F3.newton_run(10, 16, energy, 0.25, moebius=False)
     assert row["min_angle_deg"] > 10.0, row
     assert row["W"] >= CLIFFORD * 0.99, row
-    assert row["circle_dev"] < 0.05, row
-    assert abs(row["R_over_r"] / math.sqrt(2) - 1) < 0.035, row
+    assert row["revolution_dev"] < 0.05, row
+    assert abs(row["R_over_r_plain"] / math.sqrt(2) - 1) < 0.035, row
 
 
 def test_paper_grid_regularized_minimizer_is_not_a_torus_of_revolution():
@@ -51,9 +51,9 @@ def test_paper_grid_regularized_minimizer_is_not_a_torus_of_revolution():
     sheared lattice: with λ = 0.5 the minimizer is far from any torus of
     revolution (circle-fit deviation above 10%), on the offset grid it is one
     (below 5%)."""
-    paper = F3.newton_run(10, 16, "NormalCur", 0.5, grid="paper")
-    offset = F3.newton_run(10, 16, "NormalCur", 0.5, grid="offset")
-    assert paper["circle_dev"] > 0.1 and offset["circle_dev"] < 0.05, (paper, offset)
+    paper = F3.newton_run(10, 16, "NormalCur", 0.5, grid="paper", moebius=False)
+    offset = F3.newton_run(10, 16, "NormalCur", 0.5, grid="offset", moebius=False)
+    assert paper["revolution_dev"] > 0.1 and offset["revolution_dev"] < 0.05, (paper, offset)
     assert paper["min_angle_deg"] > 5 and offset["min_angle_deg"] > 10
 
 
@@ -63,7 +63,7 @@ def test_continuation_in_lambda_stays_healthy_and_near_the_clifford_torus(energy
     ≥ 10° (the undone ones below), the result is healthy, its W not below
     2π²(1 − 1%), and the Loop surface of the mesh (a smooth torus, so
     W_Loop ≥ 2π² by Marques–Neves) within 1% of 2π²."""
-    row, stages = F3.continuation_run(10, 16, energy)
+    row, stages = F3.continuation_run(10, 16, energy, moebius=False)
     assert stages and stages[0]["lambda"] == 0.25
     for st in stages:
         assert (st["minangle"] >= 10.0) == (st["status"] == "healthy"), st
@@ -87,7 +87,7 @@ def test_continuation_20x32(energy):
 def test_evolver_recipe_runs_unchanged_in_the_reference(evolver):
     """fig3_evolver_recipe.cmd (g, V, u, n) for two short rounds: the Evolver
     and pyevolver print the same rounds (W to 1e-9, angles to 1e-6, counts)."""
-    rows, recs = F3.recipe_run(10, 16, "NormalCur", rounds=2, gsteps=10)
+    rows, recs = F3.recipe_run(10, 16, "NormalCur", rounds=2, gsteps=10, moebius=False)
     py = [r for r in recs if r["program"] == "pyevolver"]
     ref = [r for r in recs if r["program"] == "evolver"]
     assert len(py) == len(ref) == 3
@@ -118,18 +118,23 @@ def test_plain_and_star_spellings_agree_with_the_reference(evolver, tmp_path):
 
 # -- measurements ------------------------------------------------------------------------------
 
-def test_radius_ratio_of_sampled_tori_and_a_cyclide():
+def test_radius_ratio_of_sampled_tori_and_cyclides():
     """A sampled torus of revolution gives its R/r with no deviation from the
-    circle; its image under an inversion (a cyclide: same W) does not fit."""
+    circle; its images under inversions (cyclides: same W) do not fit, and
+    the Möbius-normalized fit recovers R/r."""
     for R, r in [(math.sqrt(2), 1.0), (1.7, 0.6)]:
         X, _ = torus_grid(20, 32, R, r)
         X = X @ np.array([[0.6, 0.8, 0.0], [-0.8, 0.6, 0.0], [0.0, 0.0, 1.0]]).T + [1, 2, 3]
         ratio, dev = F3.radius_ratio(X)
         assert abs(ratio - R / r) < 1e-12 and dev < 1e-12
-    X, _ = torus_grid(20, 32, math.sqrt(2), 1.0)
-    c = np.array([4.0, 0.0, 0.0])
-    Y = c + (X - c) / np.sum((X - c) ** 2, axis=1)[:, None]        # inversion about c
-    assert F3.radius_ratio(Y)[1] > 0.05
+    for R, r in [(math.sqrt(2), 1.0), (1.7, 0.6)]:
+        X, _ = torus_grid(20, 32, R, r)
+        for c in ([4.0, 1.0, 0.5], [-2.0, 3.0, 1.0]):
+            c = np.array(c)
+            Y = c + (X - c) / np.sum((X - c) ** 2, axis=1)[:, None]    # inversion about c
+            assert F3.radius_ratio(Y)[1] > 0.05                          # a cyclide
+            ratio, dev, _ = F3.moebius_radius_ratio(Y)
+            assert abs(ratio - R / r) < 1e-6 and dev < 1e-6, (R / r, ratio, dev)
 
 
 def test_min_angle_of_an_equilateral_and_a_right_triangle():
@@ -167,13 +172,15 @@ def test_proposition1_bobenko_energy_decreases_to_4pi():
 
 def test_chart_records_have_the_lead_s_keys(monkeypatch):
     monkeypatch.setitem(F3.SIZES, "small", [(5, 10)])
-    monkeypatch.setattr(F3, "_recipe_rounds", lambda m: 2)
+    monkeypatch.setattr(F3, "_recipe_rounds", lambda m: 1)
+    monkeypatch.setattr(F3, "ENERGIES", {"NormalCur": F3.ENERGIES["NormalCur"]})
     recs = F3.chart_records(full=False)
     keys = {"method", "resolution", "seconds", "energy", "reference", "rel_error",
             "min_angle_deg"}
     assert recs and all(set(r) == keys for r in recs)
-    assert {r["method"] for r in recs} >= {"NormalCur+harmonic(cont.)",
-                                           "EffArea+harmonic(cont.)"}
+    assert {r["method"] for r in recs} == {"NormalCur+harmonic(cont.)",
+                                           "NormalCur+harmonic(cont.) Loop W",
+                                           "NormalCur Evolver recipe (g,V,u,n)"}
     for r in recs:
         assert r["resolution"] == 50 and r["reference"] == CLIFFORD
         assert math.isfinite(r["energy"]) and r["seconds"] > 0
