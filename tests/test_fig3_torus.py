@@ -43,7 +43,7 @@ def test_fixed_lambda_regularization_keeps_the_torus_healthy(energy):
     assert row["min_angle_deg"] > 10.0, row
     assert row["W"] >= CLIFFORD * 0.99, row
     assert row["revolution_dev"] < 0.05, row
-    assert abs(row["R_over_r_plain"] / math.sqrt(2) - 1) < 0.035, row
+    assert abs(row["R_over_r"] / math.sqrt(2) - 1) < 0.035, row
 
 
 def test_paper_grid_regularized_minimizer_is_not_a_torus_of_revolution():
@@ -193,5 +193,10 @@ def test_study_small_writes_its_outputs(tmp_path):
     assert F3.main(["--size", "small", "--out", out]) == 0
     import os
     for name in ("fig3_torus.csv", "fig3_stages.csv", "fig3_recipe.csv", "fig3_prop1.csv",
-                 "fig3_torus.png"):
+                 "fig3_chart.csv", "fig3_torus.png"):
         assert os.path.getsize(os.path.join(out, name)) > 100
+    import csv
+    with open(os.path.join(out, "fig3_chart.csv")) as fh:
+        recs = list(csv.DictReader(fh))
+    assert {r["method"] for r in recs} >= {"NormalCur Evolver recipe (g,V,u,n)",
+                                           "EffArea+harmonic(cont.)"}

@@ -17,11 +17,10 @@ def _flat_grid(tmp_path, k=6, seed=0):
     i, j = np.meshgrid(np.arange(k), np.arange(k), indexing="xy")
     i, j = i.ravel().astype(float), j.ravel().astype(float)
     X = np.stack([i, j, 0.3 * i - 0.2 * j + 1.0], 1)
-    v = lambda a, b: a + k * b                                     # noqa: E731
     a, b = np.meshgrid(np.arange(k - 1), np.arange(k - 1), indexing="xy")
     a, b = a.ravel(), b.ravel()
-    F = np.concatenate([np.stack([v(a, b), v(a + 1, b), v(a + 1, b + 1)], 1),
-                        np.stack([v(a, b), v(a + 1, b + 1), v(a, b + 1)], 1)])
+    F = np.concatenate([np.stack([a + k * b, a + 1 + k * b, a + 1 + k * (b + 1)], 1),
+                        np.stack([a + k * b, a + 1 + k * (b + 1), a + k * (b + 1)], 1)])
     inner = (i > 0) & (i < k - 1) & (j > 0) & (j < k - 1)
     rng = np.random.default_rng(seed)
     Y = X.copy()
@@ -90,7 +89,7 @@ def test_newton_with_a_fixed_volume_reaches_the_evolvers_full_newton_minimum(evo
     path = os.path.join(os.path.dirname(__file__), "..", "datafiles", "cube.fe")
     lines = run_reference(evolver, path, "r\ng 30\nhessian_normal off\n" + "hessian\n" * 5 +
                           'printf "RESULT %.17g\\n", total_energy\n')
-    ref = [float(ln.split()[1]) for ln in lines if ln.startswith("RESULT")][0]
+    ref = next(float(ln.split()[1]) for ln in lines if ln.startswith("RESULT"))
     b = Session.load(path, out=io.StringIO())
     b.run("r; g 30")
     r = b.newton(50, echo=False)

@@ -124,7 +124,8 @@ def datafile(m, n, energy, regularized, grid="offset", directory=None):
              "// tension; the area is fixed at its initial value (W is scale invariant).",
              "// Written by pyevolver.studies.fig3_torus."]
     if regularized:
-        lines += ["// Regularized: + lambda * harmonic_energy, the paper's E = (1/sqrt 3) sum |e|^2;",
+        lines += ["// Regularized: + lambda * harmonic_energy, the paper's",
+                  "// E = (1/sqrt 3) sum |e|^2;",
                   "// lambda is the modulus of the quantity harmonic (harmonic.modulus := 0.1).",
                   "// loop_w (info only) is the Willmore energy of the Loop subdivision surface.",
                   "// pyevolver only: Surface Evolver has neither method."]
@@ -202,8 +203,10 @@ def moebius_radius_ratio(X, starts=16, seed=0):
     two opposite meridian circles being invariant).  The vertices, centred
     and scaled to unit rms radius, are moved by :func:`special_conformal`
     with the ``b`` that minimizes the squared fit deviation among ring fits
-    with R/r > 1.05 (near-horn fits of a nearly spherical image are
-    spurious), by BFGS from b = 0 and ``starts`` seeded random points
+    with R/r > 1.1 (near-horn fits of a nearly spherical image are spurious
+    and, on coarse or noisy meshes, can fit as well as the true one: trust
+    the result only when its deviation is far below the plain fit's), by BFGS
+    from b = 0 and ``starts`` seeded random points
     (|b| ≈ 0.3); similarities do not change the fit, and with these
     transformations they give every orientation-preserving Möbius
     transformation.  Returns ``(R/r, dev, b)``; checked on inverted tori
@@ -221,7 +224,7 @@ def moebius_radius_ratio(X, starts=16, seed=0):
         if not np.all(np.isfinite(Z)) or np.max(np.abs(Z)) > 1e6:
             return 1e6
         ratio, d = radius_ratio(Z)
-        return d * d if ratio > 1.05 else 1e6
+        return d * d if ratio > 1.1 else 1e6
     rng = np.random.default_rng(seed)
     best = None
     with warnings.catch_warnings():
@@ -251,19 +254,22 @@ def loop_energy(X, F):
 
 
 def measure(session, moebius=True):
-    """W (the quantity willmore), relative error, W_Loop, R/r and its fit
-    deviation after Möbius normalization (:func:`moebius_radius_ratio`),
-    the plain fit's R/r and deviation (``revolution_dev``: how far the mesh
-    itself is from a torus of revolution), smallest angle and vertex count
-    of the session's surface (without ``moebius`` the normalized fit is NaN)."""
+    """W (the quantity willmore), relative error, W_Loop, R/r of the fitted
+    torus of revolution and the fit's deviation (``revolution_dev``: how far
+    the mesh is from a torus of revolution, :func:`radius_ratio`), the same
+    after Möbius normalization (``R_over_r_moebius``, ``moebius_dev``:
+    :func:`moebius_radius_ratio`, meaningful when that deviation is much
+    smaller than the plain one, i.e. for a cyclide), smallest angle and vertex
+    count of the session's surface (without ``moebius`` the normalized fit
+    is NaN)."""
     s = session.surface
     W = float(session.totals.quantity_values["willmore"])
     plain, plain_dev = radius_ratio(s.X)
     ratio, dev, _ = moebius_radius_ratio(s.X) if moebius else (math.nan, math.nan, None)
     WL = loop_energy(s.X, s.F)
     return {"vertices": int(s.nv), "W": W, "rel_error": W / CLIFFORD - 1.0, "W_loop": WL,
-            "loop_rel_error": WL / CLIFFORD - 1.0, "R_over_r": ratio, "circle_dev": dev,
-            "revolution_dev": plain_dev, "R_over_r_plain": plain,
+            "loop_rel_error": WL / CLIFFORD - 1.0, "R_over_r": plain,
+            "revolution_dev": plain_dev, "R_over_r_moebius": ratio, "moebius_dev": dev,
             "min_angle_deg": min_angle(s.X, s.F)}
 
 
@@ -309,7 +315,7 @@ def run_evolver(path, text, exe="evolver-nox-d"):
             fh.write(text + "q\nq\n")
         t0 = time.perf_counter()
         p = subprocess.run([exe, "-p1", "-f", cmd, path], stdin=subprocess.DEVNULL,
-                           capture_output=True, text=True, timeout=3600)
+                           capture_output=True, text=True, timeout=3600, check=False)
         dt = time.perf_counter() - t0
     return p.stdout.splitlines(), dt
 
@@ -340,8 +346,8 @@ def newton_run(m, n, energy, lam=None, grid="offset", steps=300, directory=None,
     (:func:`measure`)."""
     path = datafile(m, n, energy, lam is not None, grid, directory)
     before = "" if lam is None else f"harmonic.modulus := {lam!r}"
-    s, lines, dt, its = run_pyevolver(path, script("fig3_newton.cmd", f"minimize({steps})"),
-                                      before, "fig3_newton.cmd")
+    s, _, dt, its = run_pyevolver(path, script("fig3_newton.cmd", f"minimize({steps})"),
+                                  before, "fig3_newton.cmd")
     label = energy + ("" if lam is None else f"+harmonic(λ={lam:g})")
     if grid != "offset":
         label += f" [{grid} grid]"
@@ -501,13 +507,14 @@ def _record(method, row):
 # -- the study ----------------------------------------------------------------------------------
 
 def _write_csv(path, rows):
+    import csv
     keys = []
     for r in rows:
         keys += [k for k in r if k not in keys]
-    with open(path, "w") as fh:
-        fh.write(",".join(keys) + "\n")
-        for r in rows:
-            fh.write(",".join("" if r.get(k) is None else str(r.get(k)) for k in keys) + "\n")
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=keys)
+        w.writeheader()
+        w.writerows(rows)
 
 
 def _line(r):
@@ -516,8 +523,9 @@ def _line(r):
     if "W_loop" in r:
         parts.append(f"Loop {r['W_loop']:.5f} ({100 * r['loop_rel_error']:+.3f}%)")
     if "R_over_r" in r:
-        parts.append(f"R/r {r['R_over_r']:.4f} (dev {r['circle_dev']:.1e}; "
-                     f"revolution dev {r['revolution_dev']:.1e})")
+        parts.append(f"R/r {r['R_over_r']:.4f} (dev {r['revolution_dev']:.1e}; "
+                     f"Möbius-normalized {r['R_over_r_moebius']:.4f}, "
+                     f"dev {r['moebius_dev']:.1e})")
     parts.append(f"min angle {r['min_angle_deg']:.3g}°  {r['iterations']} its  "
                  f"{r['seconds']:.1f} s")
     return "  ".join(parts)
@@ -533,7 +541,7 @@ def main(argv=None):
     os.makedirs(a.out, exist_ok=True)
     full = a.size == "full"
     sizes = SIZES[a.size]
-    rows, stages, recs, snaps = [], [], [], {}
+    rows, stages, recs = [], [], []
 
     def show(r, key=None, s=None):
         rows.append(r)
@@ -585,21 +593,21 @@ def _plot(path, rows, stages, prop):
     except ImportError:
         print("matplotlib not installed: no PNG")
         return
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.4))
-    for (mesh, energy), grp in _groups(stages).items():
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.6))
+    for k, ((mesh, energy), grp) in enumerate(_groups(stages).items()):
+        grp = sorted(grp, key=lambda s: s["lambda"])
         lam = [s["lambda"] for s in grp]
-        ax[0].semilogx(lam, [100 * (s["W"] / CLIFFORD - 1) for s in grp], "o-",
-                       label=f"{energy} {mesh}: W")
-        ax[0].semilogx(lam, [100 * (s["loop_w"] / CLIFFORD - 1) for s in grp], "x--",
-                       label=f"{energy} {mesh}: W_Loop")
-    ax[0].axhline(0, color="k", lw=0.5)
-    ax[0].set_xlabel("λ (continuation stages)")
-    ax[0].set_ylabel("error to 2π² (%)")
-    ax[0].set_ylim(-5, 15)
-    ax[0].legend(fontsize=6)
-    for (mesh, energy), grp in _groups(stages).items():
-        ax[1].semilogx([s["lambda"] for s in grp], [s["minangle"] for s in grp], "o-",
+        c = f"C{k % 10}"
+        ax[0].semilogx(lam, [100 * (s["W"] / CLIFFORD - 1) for s in grp], "o-", color=c,
                        label=f"{energy} {mesh}")
+        ax[0].semilogx(lam, [100 * (s["loop_w"] / CLIFFORD - 1) for s in grp], "x--", color=c)
+        ax[1].semilogx(lam, [s["minangle"] for s in grp], "o-", color=c,
+                       label=f"{energy} {mesh}")
+    ax[0].axhline(0, color="k", lw=0.5)
+    ax[0].set_xlabel("λ (healthy continuation stages)")
+    ax[0].set_ylabel("error to 2π² (%): W solid, W_Loop dashed")
+    ax[0].set_ylim(-5, 10)
+    ax[0].legend(fontsize=6)
     ax[1].axhline(10, color="r", lw=0.5)
     ax[1].set_xlabel("λ")
     ax[1].set_ylabel("smallest angle (°)")
