@@ -154,7 +154,7 @@ def damped_newton(session, n, callback=None, delta0=None, rtol=1e-10):
             if f is None:
                 delta *= 4.0
                 continue
-            dy, _ = _solve(f, B, -gy, d if d is not None else None)
+            dy, _ = _solve(f, B, -gy, d)
             pred = -(gy @ dy + 0.5 * dy @ (K @ dy))
             if not (pred > 0) or not np.all(np.isfinite(dy)):
                 delta *= 4.0
@@ -192,6 +192,7 @@ def damped_newton(session, n, callback=None, delta0=None, rtol=1e-10):
             b.lagrange[:] = 0.0
             for kk, i in enumerate(cons.bodies):
                 b.lagrange[i] = lam[kk]
+        it.pressures_valid = True
         session.recalc()
         res.energy, res.nit, res.delta = session.totals.energy, k, delta
         res.history.append(res.energy)
