@@ -178,7 +178,8 @@ KEYWORDS = sorted({
     "printf", "errprintf", "sprintf", "list", "set", "unset", "fix", "unfix", "refine",
     "delete", "edgeswap", "histogram", "loghistogram", "read", "abort", "quit", "recalc",
     "vertex", "vertices", "edge", "edges", "facet", "facets", "body", "bodies",
-    "sum", "avg", "max", "min", "count", "hessian", "hessian_seek", "equiangulate",
+    "sum", "avg", "max", "min", "count", "hessian", "hessian_seek", "equiangulate", "bfgs",
+    "newton",
     "show_vol", "optimize", "integer", "real", "string", "on", "off",
 })
 ATTRIBUTES = ["id", "oid", "original", "x", "y", "z", "length", "area", "volume", "target",

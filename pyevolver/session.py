@@ -31,6 +31,7 @@ READ_ONLY = {
     "vertex_pop_count", "edge_pop_count", "notch_count", "refine_count", "where_count",
     "iteration_counter", "total_time", "random", "quantity_count", "symmetry_group",
     "simplex_representation", "lagrange_order", "date_and_time", "linear", "quadratic",
+    "clock",
 }
 DEFAULTS = {
     "scale": 0.1, "scale_limit": 1.0, "scale_scale": 1.0, "target_tolerance": 1e-4,
@@ -571,6 +572,37 @@ class Session(SessionAPI):
         self.recalc()
         return r
 
+    def newton(self, n, echo=True, callback=None):
+        """``newton n``: at most ``n`` damped Newton (Levenberg–Marquardt)
+        steps with the exact Hessian on all free coordinates
+        (:mod:`pyevolver.evolve.newton`); fixed volumes, FIXED quantities
+        and level-set constraints are honoured as in ``hessian``.  Prints
+        ``k. area: .. energy: ..  delta: ..`` per step (counting down, as
+        ``g``) and returns the :class:`~pyevolver.evolve.newton.NewtonResult`;
+        ``callback(result)`` may stop the run, and so does Ctrl-C (after the
+        current step)."""
+        from .evolve.newton import damped_newton
+        s = self.surface
+        if s is None or s.nv == 0:
+            raise CommandError("newton: no surface loaded")
+        with _deferred_sigint() as flag:
+            def cb(r):
+                if echo and not self.toggles.get("quiet"):
+                    self.write("%3d. area: %#17.15g energy: %#17.15g  delta: %#g\n"
+                               % (n - r.nit, self.totals.total_area, r.energy, r.delta))
+                return flag["hit"] or (callback is not None and callback(r))
+            X0 = state(s)
+            try:
+                r = damped_newton(self, n, callback=cb)
+            except Exception:
+                restore_state(self.surface, X0)
+                self.recalc()
+                raise
+        if echo and r.nit == 0:
+            self.write(f"newton: no step taken ({r.message}).\n")
+        self.recalc()
+        return r
+
     def hessian(self, seek=False, max_scale=None, echo=True):
         """``hessian``: one Newton step on the constrained problem;
         ``hessian_seek [max]``: a line search along the Newton direction
@@ -898,6 +930,8 @@ class Session(SessionAPI):
             "lagrange_order": lambda: 1, "linear": lambda: 1, "quadratic": lambda: 0,
             "lagrange": lambda: 0,
             "date_and_time": lambda: time.strftime("%a %b %d %H:%M:%S %Y"),
+            # elapsed seconds since the session started, as REF's clock
+            "clock": lambda: time.time() - self.start_time,
         }
         fn = simple.get(name)
         if fn is None:

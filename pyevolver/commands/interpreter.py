@@ -1624,6 +1624,9 @@ class Interpreter:
         if name == "bfgs":
             s.bfgs(1 if arg is None else self._count(arg))
             return
+        if name == "newton":
+            s.newton(1 if arg is None else self._count(arg))
+            return
         if name in ("hessian", "hessian_seek"):
             if name == "hessian_seek" and arg is not None:
                 s.hessian(seek=True, max_scale=float(self.value(arg)))

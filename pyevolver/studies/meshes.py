@@ -42,6 +42,43 @@ def torus_grid(m, n, R=2.0, r=1.0):
     return X, _outward(X, F)
 
 
+def torus_offset(m, n, R=2.0, r=1.0):
+    """The regular torus with offset rows: ``m`` points around the minor
+    circle, ``n`` (even) rows around the major circle, odd rows turned by
+    half a step (φ = 2π(i + ½)/m), each row joined to the next by a strip of
+    triangles.  Every vertex has valence 6, as in :func:`torus_grid`.
+
+    The two grids differ in their conformal structure when every triangle
+    is taken equilateral (the structure of the paper's ``harmonic_energy``):
+    with one diagonal direction the period lattice is spanned by ``m·(1, 0)``
+    and ``n·(½, √3/2)``, a sheared lattice that no torus of revolution has;
+    with offset rows it is ``m·(1, 0)`` and ``n·(0, √3/2)``, rectangular, the
+    conformal class of a torus of revolution with ``√((R/r)² − 1) =
+    n√3/(2m)`` (the Clifford torus, R/r = √2, is the square class).
+
+    Vertex ``(i, j)`` has index ``i + m j``.  Returns ``X (m n, 3)``,
+    ``F (2 m n, 3)``.
+    """
+    if m < 3 or n < 4 or n % 2:
+        raise ValueError("torus_offset needs m >= 3 and an even n >= 4")
+    i, j = np.meshgrid(np.arange(m), np.arange(n), indexing="xy")
+    i, j = i.ravel(), j.ravel()
+    phi = 2 * np.pi * (i + 0.5 * (j % 2)) / m
+    th = 2 * np.pi * j / n
+    rho = R + r * np.cos(phi)
+    X = np.stack([rho * np.cos(th), rho * np.sin(th), r * np.sin(phi)], 1)
+
+    def v(a, b):
+        return (a % m) + m * (b % n)
+    even = (j % 2 == 0)[:, None]
+    # even row j: (i, j+1) lies half a step past (i, j); odd row: half a step before
+    F1 = np.where(even, np.stack([v(i, j), v(i + 1, j), v(i, j + 1)], 1),
+                  np.stack([v(i, j), v(i + 1, j), v(i + 1, j + 1)], 1))
+    F2 = np.where(even, np.stack([v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)], 1),
+                  np.stack([v(i, j), v(i + 1, j + 1), v(i, j + 1)], 1))
+    return X, _outward(X, np.concatenate([F1, F2]))
+
+
 def icosahedron():
     """The unit icosahedron: ``X (12, 3)``, ``F (20, 3)``."""
     p = (1 + 5 ** 0.5) / 2
