@@ -30,6 +30,7 @@ READ_ONLY = {
     "vertex_pop_count", "edge_pop_count", "notch_count", "refine_count", "where_count",
     "iteration_counter", "total_time", "random", "quantity_count", "symmetry_group",
     "simplex_representation", "lagrange_order", "date_and_time", "linear", "quadratic",
+    "clock",
 }
 DEFAULTS = {
     "scale": 0.1, "scale_limit": 1.0, "scale_scale": 1.0, "target_tolerance": 1e-4,
@@ -740,6 +741,9 @@ class Session:
             "symmetry_group": lambda: 0, "simplex_representation": lambda: 0,
             "lagrange_order": lambda: 1, "linear": lambda: 1, "quadratic": lambda: 0,
             "date_and_time": lambda: time.strftime("%a %b %d %H:%M:%S %Y"),
+            # REF: "total elapsed Evolver execution time in seconds"; here the
+            # processor time of the process
+            "clock": time.process_time,
         }
         fn = simple.get(name)
         if fn is None:
