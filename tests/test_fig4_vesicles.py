@@ -86,7 +86,9 @@ def _revolve(r, z, m=64):
     X.append([0.0, 0.0, z[-1]])
     X = np.array(X)
     F = []
-    ring = lambda k, j: 1 + k * m + j % m                          # noqa: E731
+
+    def ring(k, j):
+        return 1 + k * m + j % m
     for j in range(m):
         F.append([0, ring(0, j + 1), ring(0, j)])
         for k in range(rings - 1):
@@ -119,7 +121,7 @@ def test_normal_harmonic_162(shape):
     the continuation: the right type, W within 3% of the reference, every
     angle above 20° (the collapse the continuation guards against ends
     below 10°)."""
-    s, rows = F4.run(shape, "normal", max_nv=162)
+    _, rows = F4.run(shape, "normal", max_nv=162)
     r = rows[0]
     assert r["converged"] and r["lambda"] < 1.0
     assert r["type"] == shape, r
@@ -159,7 +161,7 @@ def test_newton_step_is_quadratic_near_the_minimum():
 
 def test_recipe_newton_162_prolate():
     """Fifteen cycles of V, u, g 5 and two hessian_seek steps."""
-    s, rows = F4.run("prolate", "perp_newton", max_nv=162, recipe_vars={"recipe_max": 15})
+    _, rows = F4.run("prolate", "perp_newton", max_nv=162, recipe_vars={"recipe_max": 15})
     r = rows[0]
     assert r["type"] == "prolate" and abs(r["rel_error"]) < 0.03, r
     assert r["min_angle_deg"] > 20.0
@@ -201,15 +203,40 @@ def test_chart_records_keys():
 
 # -- acceptance at 2,562 vertices (slow) ---------------------------------------------------------
 
+# known failures (docs/paper.md): NormalCur+harmonic ends 1.4% above the
+# stomatocyte's W (its regularization keeps too few vertices in the inner
+# bulb and Newton crawls where H ≈ 0 at the neck); the plain Evolver recipe
+# loses the stomatocyte at 162 vertices (V unfolds the cup into a prolate)
+KNOWN = {("normal", "stomatocyte"): "NormalCur+harmonic: W 1.4% high on the stomatocyte",
+         ("perp", "stomatocyte"): "the plain recipe turns the stomatocyte into a prolate"}
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("method", ["normal", "perp_newton"])
+@pytest.mark.parametrize("method", ["normal", "perp", "perp_newton"])
 @pytest.mark.parametrize("shape", list(F4.SHAPES))
-def test_acceptance_2562(shape, method):
+def test_acceptance_2562(shape, method, request):
     """Issue 7: at 2,562 vertices the shape is of the right type and W is
-    within 1% of the axisymmetric reference."""
+    within 1% of the axisymmetric reference (the two known failures are
+    strict xfails: they are reported if they start to pass)."""
+    if (method, shape) in KNOWN:
+        request.applymarker(pytest.mark.xfail(strict=True, reason=KNOWN[(method, shape)]))
     _, rows = F4.run(shape, method, max_nv=2562)
     r = rows[-1]
     assert r["resolution"] == 2562
+    assert r["min_angle_deg"] > 10.0, r
     assert r["type"] == shape, r
     assert abs(r["rel_error"]) < 0.01, r
-    assert r["min_angle_deg"] > 10.0, r
+    ref = F4.reference_descriptors(F4.reference(shape))
+    assert abs(r["height_width"] - ref["height_width"]) < 0.05 * ref["height_width"], r
+
+
+@pytest.mark.slow
+def test_stomatocyte_reference_converged():
+    """The reference's own accuracy on its hardest branch: W at 128 modes
+    (the study's) agrees with 256 modes to 1e-7 relative (measured 9.5e-8;
+    192 and 384 modes agree with 256 to 2e-9 and 1e-12)."""
+    from pyevolver.studies.axisymmetric import canham_reference
+    a = canham_reference(0.5, "stomatocyte", n=128)
+    b = canham_reference(0.5, "stomatocyte", n=256, coef0=a.coef)
+    assert abs(a.W - b.W) < 1e-7 * b.W
+    assert abs(a.W - F4.reference("stomatocyte").W) < 1e-12

@@ -36,11 +36,15 @@ converge again, ... through 642, 2,562 (and 10,242) vertices.  A row per
 resolution reports the cumulative time.
 
     python -m pyevolver.studies.fig4_vesicles [--size small|full] [--out DIR]
-        [--evolver]
+        [--max-nv N] [--methods normal,perp,perp_newton]
+        [--shapes stomatocyte,discocyte,prolate] [--no-evolver]
 
-writes ``fig4_vesicles.csv`` and ``fig4_vesicles.png`` (the meshes' profiles
-over the reference's).  ``small`` stops at 642 vertices, ``full`` at 2,562
-(``--max-nv 10242`` goes further).
+writes ``fig4_vesicles.csv`` (one row per method, shape and resolution,
+and the references' descriptors) and ``fig4_vesicles.png`` (the final
+meshes' profiles over the reference's, and the error against time).
+``small`` stops at 642 vertices, ``full`` at 2,562 (``--max-nv 10242`` goes
+further).  The recipe is also run in ``evolver-nox-d`` when it is
+installed (``--no-evolver``: not).  Numbers and discussion: docs/paper.md.
 """
 from __future__ import annotations
 
@@ -48,7 +52,6 @@ import argparse
 import io
 import math
 import os
-import re
 import shutil
 import subprocess
 import tempfile
@@ -323,7 +326,7 @@ def harmonic_continuation(session, lam_min=1e-3, factor=2.0, min_angle_deg=10.0,
     def healthy(surf):
         return min_angle(surf.X, surf.F) >= min_angle_deg
     lam = q.modulus
-    ok, n, g = newton_lm(session, maxit=maxit)
+    ok, n, _ = newton_lm(session, maxit=maxit)
     good = (ok or not require_converged) and healthy(s)
     if log is not None:
         log.append({"lambda": lam, "converged": ok, "steps": n, "kept": good,
@@ -335,7 +338,7 @@ def harmonic_continuation(session, lam_min=1e-3, factor=2.0, min_angle_deg=10.0,
         keep = state(s)
         q.modulus = lam / factor
         session.recalc()
-        ok, n, g = newton_lm(session, maxit=maxit, guard=healthy)
+        ok, n, _ = newton_lm(session, maxit=maxit, guard=healthy)
         good = (ok or not require_converged) and healthy(s)
         if log is not None:
             log.append({"lambda": q.modulus, "converged": ok, "steps": n,
@@ -437,7 +440,7 @@ def mesh_descriptors(X, F):
     hw = H / (2 * r.max())
     return {"type": _classify(hw, dlo, dhi), "height_width": float(hw),
             "pole_depth_min": float(min(dlo, dhi)), "pole_depth_max": float(max(dlo, dhi)),
-            "axis_crossings": int(len(hits)),
+            "axis_crossings": len(hits),
             "axisym_dev": float(abs(ev[lat[1]] - ev[lat[0]]) / ev[lat[1]])}
 
 
@@ -475,8 +478,10 @@ def record(shape, label, X, F, W, area, volume, seconds, cpu_seconds, **extra):
     descriptors (see :func:`mesh_descriptors`)."""
     v0 = SHAPES[shape][0]
     ref = reference(shape).W
-    row = {"method": label, "shape": shape, "v0": v0, "resolution": int(len(X)),
-           "seconds": float(seconds), "cpu_seconds": float(cpu_seconds), "energy": float(W),
+    row = {"method": label, "shape": shape, "v0": v0, "resolution": len(X),
+           "seconds": float(seconds),
+           "cpu_seconds": None if cpu_seconds is None else float(cpu_seconds),
+           "energy": float(W),
            "reference": float(ref), "rel_error": float((W - ref) / ref),
            "min_angle_deg": min_angle(X, F),
            "area_error": float(area - 4 * np.pi),
@@ -574,10 +579,10 @@ def run_evolver(shape, max_nv=642, first_nv=162, directory=PAPER,
         if not solve:
             continue
         lines += ["relax", "report",
-                  "foreach vertex vv do printf \"VX %d %.17g %.17g %.17g\\n\", "
-                  "vv.id, vv.x, vv.y, vv.z",
-                  "foreach facet ff do printf \"FC %d %d %d\\n\", ff.vertex[1].id, "
-                  "ff.vertex[2].id, ff.vertex[3].id",
+                  ("foreach vertex vv do printf \"VX %d %.17g %.17g %.17g\\n\", "
+                   "vv.id, vv.x, vv.y, vv.z"),
+                  ("foreach facet ff do printf \"FC %d %d %d\\n\", ff.vertex[1].id, "
+                   "ff.vertex[2].id, ff.vertex[3].id"),
                   "printf \"END\\n\""]
     script = "\n".join(lines) + "\nq\nq\n"
     with tempfile.TemporaryDirectory() as tmp:
@@ -586,7 +591,7 @@ def run_evolver(shape, max_nv=642, first_nv=162, directory=PAPER,
         w0 = time.perf_counter()
         out = subprocess.run([exe, "-p1", "-f", os.path.basename(cmd), os.path.basename(fe)],
                              input=script, capture_output=True, text=True, cwd=tmp,
-                             timeout=timeout).stdout
+                             timeout=timeout, check=False).stdout
         wall = time.perf_counter() - w0
     rows = []
     start = None
@@ -609,9 +614,10 @@ def run_evolver(shape, max_nv=642, first_nv=162, directory=PAPER,
             index = {v: i for i, v in enumerate(ids)}
             X = np.array([V[v] for v in ids])
             F = np.array([[index[v] for v in f] for f in Fc])
-            cpu = float(rep[6]) - (start or 0.0)
+            # the Evolver's clock: its elapsed execution time (no processor time)
+            elapsed = float(rep[6]) - (start or 0.0)
             rows.append(record(shape, METHODS["perp"][1] + " (REF)", X, F, float(rep[2]),
-                               float(rep[3]), float(rep[4]), cpu, cpu,
+                               float(rep[3]), float(rep[4]), elapsed, None,
                                cycles=int(rep[5])))
             rep = None
     if len(rows) != sum(solve for _, solve in levels):
@@ -684,10 +690,12 @@ def plot(path, results):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     shapes = [s for s in SHAPES if any(k[0] == s for k in results)]
-    labels = []
-    for (_, label) in results:
-        if label not in labels:
+    labels, timed = [], []
+    for (_, label), (mesh, _) in results.items():
+        if mesh is not None and label not in labels:
             labels.append(label)
+        if label not in timed:
+            timed.append(label)
     fig, axes = plt.subplots(len(shapes), len(labels) + 1,
                              figsize=(3.2 * (len(labels) + 1), 3.2 * len(shapes)),
                              squeeze=False)
@@ -713,13 +721,13 @@ def plot(path, results):
             ax.set_xticks([])
             ax.set_yticks([])
         ax = axes[i, -1]
-        for label in labels:
+        for label in timed:
             item = results.get((shape, label))
             if item is None:
                 continue
             rows = item[1]
-            ax.loglog([r["seconds"] for r in rows], [abs(r["rel_error"]) for r in rows], "o-",
-                      label=label, ms=3)
+            ax.loglog([r["seconds"] for r in rows], [abs(r["rel_error"]) for r in rows],
+                      "o-" if item[0] is not None else "s--", label=label, ms=3)
         ax.axhline(0.01, color="0.6", lw=0.5)
         ax.set_xlabel("seconds", fontsize=7)
         ax.set_ylabel("|W - W_ref| / W_ref", fontsize=7)
@@ -785,6 +793,7 @@ def main(argv=None):
                 for x in r:
                     show(x)
                 rows.extend(r)
+                results[(shape, r[0]["method"])] = (None, r)
     csv = os.path.join(a.out, "fig4_vesicles.csv")
     _write_csv(csv, rows)
     try:
