@@ -56,3 +56,13 @@ def test_vertex_assignment_then_recalc():
     s = session()
     s.run("vertex[5].z := 2; recalc")
     assert s.total_area > 6
+
+
+def test_clock_is_processor_time_and_read_only():
+    """``clock`` (REF: elapsed execution time) grows over a run and cannot
+    be assigned."""
+    s = session()
+    s.run("c0 := clock; ss := 0; for (ii := 1; ii <= 20000; ii++) ss += ii; c1 := clock")
+    assert 0 < s.variables["c0"] < s.variables["c1"]
+    with pytest.raises(CommandError, match="read-only"):
+        s.run("clock := 3")
