@@ -464,7 +464,7 @@ def proposition1(grids=((5, 10), (10, 20), (20, 40)),
 
 # -- the chart ----------------------------------------------------------------------------------
 
-def chart_records(full=False, directory=None, evolver=False):
+def chart_records(full=False, directory=None, evolver=False, sizes=None):
     """Points for the accuracy-versus-time chart: one per method and mesh
     resolution (5×10, 10×16 with ``full`` False; also 20×32 and 40×64).
 
@@ -475,11 +475,12 @@ def chart_records(full=False, directory=None, evolver=False):
     ``min_angle_deg``.  Methods: the continuation (c) for both energies
     (label ``<energy>+harmonic(cont.)``, plus ``... Loop W`` with the Loop
     surface's energy of the same mesh), the Evolver's recipe (d) in pyevolver
-    and, with ``evolver``, in evolver-nox-d.
+    and, with ``evolver``, in evolver-nox-d.  ``sizes``: the (m, n) grids
+    instead (e.g. ``[(5, 10)]`` for the chart CI regenerates).
     """
     directory = directory or tempfile.mkdtemp(prefix="fig3_")
     out = []
-    for m, n in SIZES["full" if full else "small"]:
+    for m, n in sizes or SIZES["full" if full else "small"]:
         for energy in ENERGIES:
             row, _ = continuation_run(m, n, energy, directory=directory, moebius=False)
             out.append(_record(row["label"], row))
