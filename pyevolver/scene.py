@@ -43,6 +43,7 @@ class MethodDecl:
     name: str = ""                   # instance name
     ignore_fixed: bool = False
     ignore_constraints: bool = False
+    line: int | None = None          # source line of a METHOD_INSTANCE declaration
 
 
 @dataclass
@@ -94,6 +95,7 @@ class Scene:
     read_text: str | None = None
     read_line: int = 0
     wraps: dict = field(default_factory=dict)          # edge position -> wrap list
+    source_lines: list | None = None                   # the text's lines (error excerpts)
 
     @property
     def space_dimension(self):

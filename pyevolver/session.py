@@ -19,7 +19,8 @@ import numpy as np
 
 from .commands import interpreter as I
 from .datafile.reader import read_datafile
-from .errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
+from .errors import (CommandError, DatafileError, ExpressionError, PyEvolverError,
+                     UnsupportedError)
 from .expr import nodes as N
 from .surface import build_surface, project_to_constraints, restore_state, state
 
@@ -89,13 +90,15 @@ class Session:
 
     # -- loading ---------------------------------------------------------------
     @classmethod
-    def load(cls, filename, out=None, err=None, run_read=True):
+    def load(cls, filename, out=None, err=None, run_read=True, text=None):
+        """A session on the datafile ``filename`` (``text``: its contents,
+        when not to be read from disk)."""
         s = cls(out, err)
-        s.load_file(filename, run_read)
+        s.load_file(filename, run_read, text)
         return s
 
-    def load_file(self, filename, run_read=True):
-        scene = read_datafile(filename)
+    def load_file(self, filename, run_read=True, text=None):
+        scene = read_datafile(filename, text)
         surface = build_surface(scene)
         return self._install(filename, scene, surface, run_read)
 
@@ -115,7 +118,18 @@ class Session:
         self.letters = {}
         self.arrays = {}
         self._init_view_matrix()
-        self.recalc()
+        try:
+            self.recalc()
+        except DatafileError:
+            raise
+        except PyEvolverError as exc:
+            # the first evaluation failed (e.g. a method refused on this
+            # surface): located at the quantity's declaration when known
+            line = getattr(exc, "line", None)
+            lines = scene.source_lines
+            raise DatafileError(str(exc), filename, line, None,
+                                lines[line - 1] if line and lines and line <= len(lines)
+                                else None) from None
         if run_read and scene.read_text:
             self.run(scene.read_text, where=filename, line=scene.read_line + 1,
                      stop_on_error=False)
@@ -378,9 +392,10 @@ class Session:
                     r.warnings.append(f"Autochopped {nch} edges.")
             if echo:
                 for w in r.warnings:
-                    if w.startswith(("WARNING 1055", "Total difference")):
-                        # REF writes these to stderr, the pair followed by a blank line
-                        self.write_err(w + ("\n\n" if w.startswith("Total") else "\n"))
+                    if w.startswith(("WARNING 1055", "Total difference", "WARNING 1864")):
+                        # REF writes these to stderr, the pair (and 1864) followed by a
+                        # blank line
+                        self.write_err(w + ("\n" if w.startswith("WARNING 1055") else "\n\n"))
                     else:
                         self.write(w + "\n")
                 if r.printed and not self.toggles.get("quiet") and not self.toggles.get("quietgo"):
