@@ -69,6 +69,25 @@ class CommandError(PyEvolverError):
     """A command could not be parsed or executed; the surface is unchanged."""
 
 
+class InternalError(CommandError):
+    """A Python exception inside pyevolver (a bug): reported as a message,
+    never a traceback, and the surface is left as it was.  With the
+    environment variable ``PYEVOLVER_TRACEBACK=1`` the traceback is printed
+    to standard error as well."""
+
+    @classmethod
+    def from_exception(cls, exc, where):
+        import os
+        import sys
+        import traceback
+        if os.environ.get("PYEVOLVER_TRACEBACK"):
+            traceback.print_exception(type(exc), exc, exc.__traceback__, file=sys.stderr)
+        err = cls(f"{where}: internal error ({type(exc).__name__}: {exc}); the surface "
+                  f"is as it was")
+        err.original = exc
+        return err
+
+
 class ExpressionError(PyEvolverError):
     """An expression could not be evaluated (unknown name, bad argument)."""
 

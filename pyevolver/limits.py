@@ -26,7 +26,13 @@ MAX_NESTING = 200
 MAX_ARRAY_ENTRIES = 50_000_000
 
 #: most elements (vertices, edges or facets) a command may create
-MAX_ELEMENTS = 10_000_000
+MAX_ELEMENTS = 5_000_000
+
+#: widest field (or precision) of a ``printf`` conversion
+MAX_FORMAT_WIDTH = 10_000
+
+#: longest string ``printf``/``sprintf`` may produce
+MAX_STRING = 10_000_000
 
 #: longest line a ``#define`` expansion may produce
 MAX_EXPANDED_LINE = 100_000

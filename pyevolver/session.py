@@ -19,8 +19,8 @@ import numpy as np
 
 from .commands import interpreter as I
 from .datafile.reader import read_datafile
-from .errors import (CommandError, DatafileError, ExpressionError, PyEvolverError,
-                     UnsupportedError)
+from .errors import (CommandError, DatafileError, ExpressionError, InternalError,
+                     PyEvolverError, UnsupportedError)
 from .expr import nodes as N
 from .surface import build_surface, project_to_constraints, restore_state, state
 
@@ -87,6 +87,9 @@ class Session:
         self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
         self.iteration_counter = 0
         self.total_time = 0.0
+        # seconds one top-level command may run (None: no limit); a command
+        # that runs longer stops with an error and leaves the surface as it was
+        self.time_limit = None
 
     # -- loading ---------------------------------------------------------------
     @classmethod
@@ -168,8 +171,9 @@ class Session:
         """``load "file"``: a fresh start on another datafile (variables,
         commands and toggles forgotten; its read section runs)."""
         scene, surface = self._read_new("load", name)
-        out, err = self.out, self.err
+        out, err, limit = self.out, self.err, self.time_limit
         self.__init__(out, err)
+        self.time_limit = limit
         self._install(name, scene, surface, True)
 
     def replace_load(self, name):
@@ -264,8 +268,16 @@ class Session:
         scopes = self.interp.env.scopes
         depth = len(scopes)
         scopes.append({})
+        interp = self.interp
+        outer = interp.deadline is None         # commands run by `read` share the limit
+        if outer and self.time_limit:
+            interp.deadline = time.monotonic() + self.time_limit
         try:
-            self.interp.execute(ast)
+            interp.execute(ast)
+            if self.surface is not None and not np.all(np.isfinite(self.surface.X)):
+                # e.g. a huge jiggle or a boundary formula out of its domain
+                raise CommandError("the command would make vertex coordinates infinite or "
+                                   "NaN")
         except (I.Quit, I.Interrupted):
             self.refresh()
             raise
@@ -281,14 +293,22 @@ class Session:
             if isinstance(exc, CommandError) and str(exc).startswith(where):
                 raise
             raise CommandError(f"{where}:{line}: {exc}") from None
-        except (ArithmeticError, ValueError, TypeError, IndexError) as exc:
-            self._restore(snap)
-            raise CommandError(f"{where}:{line}: {type(exc).__name__}: {exc}") from None
         except RecursionError:
             self._restore(snap)
             raise CommandError(f"{where}:{line}: recursion too deep") from None
+        except MemoryError:
+            self._restore(snap)
+            raise CommandError(f"{where}:{line}: out of memory; the command was "
+                               f"abandoned") from None
+        except Exception as exc:
+            # a bug of pyevolver, not of the script: the session goes on, the
+            # surface as it was (PYEVOLVER_TRACEBACK=1 prints the traceback)
+            self._restore(snap)
+            raise InternalError.from_exception(exc, f"{where}:{line}") from None
         finally:
             del scopes[depth:]
+            if outer:
+                interp.deadline = None
         self.refresh()
 
     def _snapshot(self):
@@ -299,20 +319,40 @@ class Session:
                 dict(self.settings),
                 None if s is None else s.X.copy(),
                 None if b is None or not b.n else (b.target.copy(), b.pressure.copy(),
-                                                    b.volconst.copy(), b.density.copy()),
-                None if s is None else {k: (q.target, q.modulus, q.kind)
+                                                    b.volconst.copy(), b.density.copy(),
+                                                    b.lagrange.copy()),
+                None if s is None else {k: (q.target, q.modulus, q.kind, q.pressure,
+                                            q.tolerance)
                                         for k, q in s.quantities.items()},
                 None if s is None else {k: v.copy() for k, v in s.extra.items()},
                 None if s is None else {k: v.copy() for k, v in s.vattr.items()},
                 None if s is None else {k: v.copy() for k, v in s.eattr.items()},
                 None if s is None else {k: v.copy() for k, v in s.fattr.items()},
                 None if s is None else {k: m.copy() for k, m in s.vcon.items()},
-                s)
+                s, self.totals, self._iterator_state(),
+                None if s is None else ({k: m.copy() for k, m in s.econ.items()},
+                                        {k: m.copy() for k, m in s.fcon.items()},
+                                        s.gravity_constant, s.sq_curvature_modulus),
+                self.filename)
+
+    def _iterator_state(self):
+        it = self._iterator
+        if it is None:
+            return None
+        return (it.cg_history, it.cg_S_old, it.cg_f_old, it.pressures_valid)
 
     def _restore(self, snap):
         (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
-         fattr, vcon, surface) = snap
+         fattr, vcon, surface, totals, it_state, more, filename) = snap
+        self.filename = filename
         self.surface = surface
+        self.totals = totals            # the energies of the restored coordinates
+        if self._iterator is not None:
+            if it_state is None:
+                self._iterator = None
+            else:
+                (self._iterator.cg_history, self._iterator.cg_S_old, self._iterator.cg_f_old,
+                 self._iterator.pressures_valid) = it_state
         self.variables.clear()
         self.variables.update(vars_)
         self.commands = cmds
@@ -325,15 +365,16 @@ class Session:
             s.X = X
             if bod is not None:
                 b = s.bodies
-                b.target, b.pressure, b.volconst, b.density = bod
-            for k, (t, m, kind) in qs.items():
+                b.target, b.pressure, b.volconst, b.density, b.lagrange = bod
+            for k, (t, m, kind, p, tol) in qs.items():
                 q = s.quantities[k]
-                q.target, q.modulus, q.kind = t, m, kind
+                q.target, q.modulus, q.kind, q.pressure, q.tolerance = t, m, kind, p, tol
             s.extra = extra
             s.vattr = vattr
             s.eattr = eattr
             s.fattr = fattr
             s.vcon = vcon
+            s.econ, s.fcon, s.gravity_constant, s.sq_curvature_modulus = more
 
     # -- evaluation ------------------------------------------------------------------
     def recalc(self, keep_cg=False):
@@ -376,6 +417,7 @@ class Session:
             self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")
             return results
         for k in range(n, 0, -1):
+            self.interp.tick()
             r = self.iterator.step()
             results.append(r)
             L = self.settings.get("autochop_length", 0.0)
@@ -459,6 +501,7 @@ class Session:
 
         with _deferred_sigint() as flag:
             def cb(r):
+                self.interp.tick()
                 if echo and not self.toggles.get("quiet"):
                     area = areas.get(id(r.x))
                     if area is None:     # the line search kept an earlier point
@@ -648,6 +691,8 @@ class Session:
         so the numbers differ from the Evolver's)."""
         s = self.surface
         T = self.settings["jiggle_temperature"] if temperature is None else float(temperature)
+        if not math.isfinite(T):
+            raise CommandError(f"j: the temperature must be a finite number, got {T:g}")
         t = self.totals
         sigma = T * (float(np.mean(t.edge_length)) if s.ne else 0.0)
         move = ~s.vattr["fixed"]
@@ -701,10 +746,12 @@ class Session:
             raise CommandError(f"'{name}' is read-only")
         if name in self.commands:
             del self.commands[name]
+        if name in self.settings or name in ("gravity_constant", "sq_curvature_modulus"):
+            value = I.as_float(value, f"'{name}'")     # settings are numbers
         if name in self.settings:
-            self.settings[name] = value
             if name == "random_seed":
-                self.rng = np.random.default_rng(int(value))
+                self.rng = np.random.default_rng(I.as_int(value, "random_seed") & (2**63 - 1))
+            self.settings[name] = value
             return
         if name == "gravity_constant":
             self.surface.gravity_constant = float(value)
@@ -768,9 +815,7 @@ class Session:
         return {"vertex": s.nv, "edge": s.ne, "facet": s.nf, "body": s.bodies.n}[kind]
 
     def element(self, kind, index):
-        if isinstance(index, str):
-            raise ExpressionError(f"{kind} index must be a number")
-        k = int(index)
+        k = I.as_int(index, f"a {kind} index")
         n = self.count(kind)
         sign = -1 if k < 0 else 1
         attrs = {"vertex": "vattr", "edge": "eattr", "facet": "fattr"}.get(kind)
@@ -790,7 +835,9 @@ class Session:
         if gen.where is None:
             return els
         out = []
+        tick = self.interp.tick
         for el in els:
+            tick()
             with env.element(el, gen.var):
                 v = gen.where.ev(env)
             if not isinstance(v, str) and v:
@@ -822,7 +869,7 @@ class Session:
         for p in parents:
             subs = self.sub_elements(p, kind)
             if idx is not None:
-                k = int(env.session.interp.value(idx))
+                k = I.as_int(env.session.interp.value(idx), f"a {kind} index")
                 if k < 1 or k > len(subs):
                     raise ExpressionError(f"{p}.{kind}[{k}] does not exist")
                 subs = [subs[k - 1]]
@@ -878,6 +925,9 @@ class Session:
 
     # -- attributes ------------------------------------------------------------------------
     def get_attr(self, base, name, idx):
+        if idx is not None:                     # indices are integers (C truncation)
+            idx = tuple(I.as_int(j, f"the index of '{name}'") for j in idx) \
+                if isinstance(idx, tuple) else I.as_int(idx, f"the index of '{name}'")
         if isinstance(base, I.QRef):
             return self._quantity_attr(base.name, name)
         if not isinstance(base, I.ElemRef):
@@ -1050,9 +1100,12 @@ class Session:
         raise ExpressionError(f"quantity has no attribute '{name}'")
 
     def set_attr(self, base, name, idx, value):
+        if idx is not None:
+            idx = tuple(I.as_int(j, f"the index of '{name}'") for j in idx) \
+                if isinstance(idx, tuple) else I.as_int(idx, f"the index of '{name}'")
         if isinstance(value, str):
             raise CommandError(f"cannot assign a string to '.{name}'")
-        value = float(value)
+        value = I.as_float(value, f"the value of '.{name}'")
         s = self.surface
         if isinstance(base, I.QRef):
             q = s.quantities[base.name]
@@ -1078,6 +1131,8 @@ class Session:
                 j = int(idx) - 1 if not isinstance(idx, tuple) else -1
                 if j < 0 or j >= s.sdim:
                     raise CommandError(f"vertex x[{j + 1}]: index outside 1..{s.sdim}")
+            if not math.isfinite(value):
+                raise CommandError(f"vertex coordinates must be finite numbers, got {value:g}")
             s.X[i, j] = value
             return
         if k == "body":
@@ -1103,6 +1158,9 @@ class Session:
             attrs, n = (s.eattr, s.ne) if k == "edge" else (s.fattr, s.nf)
             name = name.replace("colour", "color")
             default = 0 if k == "edge" else 15
+            value = I.as_int(value, f"a {name}")
+            if abs(value) > 2**31 - 1:
+                raise CommandError(f"{name} {value} is out of range")
             if "color" not in attrs:
                 attrs["color"] = np.full(n, default, np.int64)
             if name == "color":
@@ -1163,6 +1221,7 @@ class Session:
         vals = []
         ix = None if idx is None else self.interp.value(idx)
         for el in els:
+            self.interp.tick()
             with env.element(el, gen.var):
                 vals.append(self.interp.value(expr))
         for el, v in zip(els, vals):

@@ -14,9 +14,12 @@ from __future__ import annotations
 
 import contextlib
 import glob
+import io
 import os
 import re
 import signal
+
+import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -175,3 +178,323 @@ def seed_scripts():
         if m:
             out.append((p + ":read", t[m.end():]))
     return out
+
+
+# ---------------------------------------------------------------------------
+# random commands: small, fast, and reaching every kind of statement
+
+_NUMS = ["0", "1", "2", "3", "-1", "0.5", "1e10", "-1e300", "1e308*10", "0/0", "1/0", "7.25",
+         "2^1000", "-0", "1e-300", "4294967296", "vertex_count", "edge_count+1", "facet_count",
+         "pi", "random", "total_energy"]
+_KINDS = ["vertex", "edge", "facet", "body", "facetedge"]
+_ATTRS = ["x", "y", "z", "id", "oid", "length", "area", "volume", "target", "pressure",
+          "tension", "fixed", "valence", "color", "original", "no_refine", "density",
+          "volconst", "on_constraint 1", "vertex_normal[1]", "x[2]", "edge[1]", "vertex[2]",
+          "facet[1]", "zz", "__class__"]
+_FORMATS = ['"%d\\n"', '"%g %s\\n"', '"%*d\\n"', '"%.*f\\n"', '"%c%c\\n"', '"%%%5.2e\\n"',
+            '"%x %o\\n"', '"%s\\n"', '"%n\\n"', '"%99999999d"', '"{0.__class__}\\n"', '"%-+ #020.10g"']
+_WORDS = ["g", "r", "u", "V", "t", "w", "l", "K", "n", "j", "m", "U", "G", "v", "q" if False else "v",
+          "recalc", "hessian", "hessian_seek", "bfgs", "optimize", "conj_grad", "quiet", "rawv",
+          "rawestv", "equiangulate", "check_increase", "autochop", "gravity", "ribiere",
+          "show_vol", "linear", "normal_curvature", "effective_area", "autopop", "edgeweed",
+          "areaweed", "notch", "edge_divide", "zoom", "o", "O", "s", "P", "saddle", "system",
+          "shell", "exec", "eval", "__import__", "os", "load_library"]
+
+
+def _num(rng):
+    return rng.choice(_NUMS)
+
+
+def _expr(rng, depth=0):
+    k = rng.randrange(9 if depth < 2 else 3)
+    if k == 0:
+        return _num(rng)
+    if k == 1:
+        return rng.choice(["aa", "bb", "arr[1]", "arr[0]", "arr[99]", "ss", "zz", "xx",
+                           "total_area", "body_count", "scale", "'q'", '"str"'])
+    if k == 2:
+        return f"{rng.choice(_KINDS[:4])}[{_num(rng)}].{rng.choice(_ATTRS)}"
+    if k == 3:
+        op = rng.choice(["+", "-", "*", "/", "^", "%", " mod ", " idiv ", "==", "<", "&&",
+                         "||", " imod ", "**"])
+        return f"({_expr(rng, depth + 1)}{op}{_expr(rng, depth + 1)})"
+    if k == 4:
+        f = rng.choice(["sin", "sqrt", "log", "exp", "atan2", "acos", "floor", "abs",
+                        "maximum", "sizeof", "is_defined", "sum", "max", "count", "avg"])
+        if f in ("sum", "max", "count", "avg"):
+            return f"{f}({rng.choice(_KINDS[:4])}, {_expr(rng, depth + 1)})"
+        if f in ("atan2", "maximum"):
+            return f"{f}({_expr(rng, depth + 1)}, {_expr(rng, depth + 1)})"
+        if f == "is_defined":
+            return f'is_defined("{rng.choice(["aa", "zz", "vertex", ""])}")'
+        return f"{f}({_expr(rng, depth + 1)})"
+    if k == 5:
+        return f"({_expr(rng, depth + 1)} ? {_expr(rng, depth + 1)} : {_expr(rng, depth + 1)})"
+    if k == 6:
+        return f'sprintf({rng.choice(_FORMATS)}, {_expr(rng, depth + 1)})'
+    if k == 7:
+        return f"-{_expr(rng, depth + 1)}"
+    return f"ff({_expr(rng, depth + 1)})"
+
+
+def _gen(rng):
+    kind = rng.choice(_KINDS)
+    g = rng.choice([kind, f"{kind}[{_num(rng)}]", f"{kind} vv", f"vertex[1].{kind}",
+                    f"{kind}[1].vertex", f"{kind}[2].edge[{_num(rng)}]"])
+    if rng.random() < 0.5:
+        g += f" where {_expr(rng, 2)}"
+    return g
+
+
+def random_command(rng, depth=0):
+    """One random command of the Evolver language (most of them fail:
+    wrong types, missing elements, huge counts; all must fail cleanly)."""
+    k = rng.randrange(30 if depth < 2 else 22)
+    e = _expr(rng)
+    if k == 0:
+        return f"{rng.choice(['aa', 'bb', 'ss', 'xx', 'arr[1]', 'arr[5][2]'])} := {e}"
+    if k == 1:
+        return f"{rng.choice(['aa', 'bb'])} {rng.choice(['+=', '-=', '*=', '/=', '++', '--'])} {e}"
+    if k == 2:
+        return f"print {e}"
+    if k == 3:
+        return f"printf {rng.choice(_FORMATS)}, {e}, {_expr(rng)}"
+    if k == 4:
+        return f"{rng.choice(_WORDS)} {rng.choice(['', _num(rng), e])}"
+    if k == 5:
+        return f"list {_gen(rng)}"
+    if k == 6:
+        return f"set {rng.choice(_KINDS[:4])} {rng.choice(_ATTRS[:18])} {e}"
+    if k == 7:
+        return f"{rng.choice(['fix', 'unfix'])} {_gen(rng)}"
+    if k == 8:
+        return f"{rng.choice(['refine', 'delete', 'edgeswap'])} {_gen(rng)}"
+    if k == 9:
+        return f"define arr {rng.choice(['real', 'integer', 'string'])}[{_num(rng)}]"
+    if k == 10:
+        return (f"define {rng.choice(_KINDS)} attribute zz "
+                f"{rng.choice(['real', 'integer'])}{rng.choice(['', '[2]', '[' + _num(rng) + ']'])}")
+    if k == 11:
+        return f"{rng.choice(_KINDS[:4])}[{_num(rng)}].{rng.choice(_ATTRS)} := {e}"
+    if k == 12:
+        return f"histogram({_gen(rng)}, {e})"
+    if k == 13:
+        return f"unset {rng.choice(_KINDS[:4])} {rng.choice(['fixed', 'target', 'constraint 1', 'zz'])}"
+    if k == 14:
+        return f'{rng.choice(["dump", "read", "load", "addload", "replace_load"])} ' \
+               f'{rng.choice(["", chr(34) + "out.fe" + chr(34), chr(34) + "/dev/zero" + chr(34), chr(34) + chr(34), e])}'
+    if k == 15:
+        return f"{{ {random_command(rng, depth + 1)} }} {rng.choice(['>>', '>>>', '|'])} " \
+               f'{rng.choice([chr(34) + "o.txt" + chr(34), chr(34) + "/dev/null" + chr(34), e])}'
+    if k == 16:
+        return f"{rng.choice(['quiet', 'conj_grad', 'autorecalc', 'gravity'])} {rng.choice(['on', 'off', e])}"
+    if k == 17:
+        return f"abort" if rng.random() < 0.2 else f"return {e}"
+    if k == 18:
+        return f"break {rng.choice(['', '2', e])}"
+    if k == 19:
+        return f"local aa; aa := {e}"
+    if k == 20:
+        return f"body[{_num(rng)}].{rng.choice(['target', 'pressure', 'volconst', 'density'])} := {e}"
+    if k == 21:
+        return f"{rng.choice(['g', 'r', 'u', 'V', 'hessian'])} {rng.choice(['', '2', _num(rng)])}"
+    inner = random_command(rng, depth + 1)
+    if k == 22:
+        return f"if {e} then {inner} else {random_command(rng, depth + 1)}"
+    if k == 23:
+        return f"for (aa := 0; aa < {rng.choice(['3', e])}; aa++) {{ {inner} }}"
+    if k == 24:
+        return f"foreach {_gen(rng)} do {{ {inner} }}"
+    if k == 25:
+        return f"while {e} do {{ {inner}; break }}"
+    if k == 26:
+        return f"do {{ {inner} }} while {e}"
+    if k == 27:
+        return f"gogo := {{ {inner} }}; gogo {rng.choice(['', '2', e])}"
+    if k == 28:
+        return (f"function real ff(real xx) {{ {inner}; return xx*2 }}; "
+                f"procedure pp(real yy) {{ {random_command(rng, depth + 1)} }}; pp({e})")
+    return f"{rng.choice(['cc', 'r', 'g'])} :::= {{ {inner} }}; {rng.choice(['cc', 'r', 'g'])}"
+
+
+def random_script(rng):
+    return "\n".join(random_command(rng) for _ in range(rng.randrange(1, 4)))
+
+
+def script_window(rng, scripts):
+    """A few lines of a shipped script, mutated."""
+    name, text = rng.choice(scripts)
+    lines = text.split("\n")
+    k = rng.randrange(len(lines))
+    window = "\n".join(lines[k:k + rng.randrange(1, 8)])
+    return name, mutate(window, rng, [t for _, t in scripts[:8]])
+
+
+# ---------------------------------------------------------------------------
+# the checks: a located error or a valid surface, never a traceback or a hang
+
+#: seconds after which one input counts as a hang
+HANG_SECONDS = 10.0
+
+#: inputs run by each fuzz target in this test session (reported at the end)
+COUNTS = {}
+
+
+def count(target, n=1):
+    COUNTS[target] = COUNTS.get(target, 0) + n
+
+
+class FuzzFailure(AssertionError):
+    """An input produced a traceback, an unlocated error or a hang."""
+
+
+def _fail(kind, what, text, exc=None):
+    import traceback
+    tb = "" if exc is None else "".join(traceback.format_exception(type(exc), exc,
+                                                                  exc.__traceback__))
+    raise FuzzFailure(f"{kind} on {what}:\n--- input ---\n{text[:3000]}\n--- end ---\n{tb}")
+
+
+def check_surface(s):
+    """The invariants of a valid surface: array shapes, indices in range,
+    finite coordinates, a computable energy."""
+    from pyevolver.geometry import edge_index
+    nv, ne, nf = s.nv, s.ne, s.nf
+    assert s.X.shape == (nv, 3), s.X.shape
+    assert np.all(np.isfinite(s.X)), "non-finite coordinates"
+    assert s.E.shape == (ne, 2) and (ne == 0 or (s.E.min() >= 0 and s.E.max() < nv))
+    if nf:
+        idx, _ = edge_index(s.FE)
+        assert idx.min() >= 0 and idx.max() < ne
+    for attrs, n in ((s.vattr, nv), (s.eattr, ne), (s.fattr, nf)):
+        for key, arr in attrs.items():
+            assert len(arr) == n, (key, len(arr), n)
+    b = s.bodies
+    if b.n:
+        assert b.facet_matrix.shape == (b.n, nf)
+    t = s.evaluate()
+    assert isinstance(t.energy, float)
+
+
+def check_datafile(name, text):
+    """Load ``text`` as the datafile ``name`` (reader, builder, first
+    evaluation; the read section is not run).  Returns ``"ok"`` or
+    ``"error"``; raises :class:`FuzzFailure` otherwise."""
+    from pyevolver.errors import DatafileError, PyEvolverError
+    from pyevolver.session import Session
+    try:
+        with time_limit(HANG_SECONDS):
+            sess = Session.load(name, out=io.StringIO(), err=io.StringIO(), run_read=False,
+                                text=text)
+    except DatafileError as exc:
+        if exc.filename != name or exc.line is None:
+            _fail("an unlocated error", name, text, exc)
+        first = str(exc).split("\n")[0]
+        if not first.startswith(f"{name}:{exc.line}"):
+            _fail("a badly located message", name, text, exc)
+        return "error"
+    except PyEvolverError as exc:
+        _fail("an error that is not a located DatafileError", name, text, exc)
+    except (Exception, Hang) as exc:
+        _fail("a traceback" if not isinstance(exc, Hang) else "a hang", name, text, exc)
+    try:
+        check_surface(sess.surface)
+    except Exception as exc:
+        _fail("an invalid surface", name, text, exc)
+    return "ok"
+
+
+def check_parse(text, where):
+    """Cut ``text`` into commands and parse each: a located syntax error or
+    a command tree.  Returns the number of commands that parsed."""
+    from pyevolver.commands import interpreter as I
+    from pyevolver.errors import CommandError
+    ok = 0
+    try:
+        with time_limit(HANG_SECONDS):
+            I.needs_more(text)
+            for chunk, ln in I.split_commands(text):
+                try:
+                    I.parse_command(chunk, where, ln)
+                    ok += 1
+                except CommandError as exc:
+                    if not str(exc).startswith(f"{where}:"):
+                        _fail("an unlocated command error", where, text, exc)
+    except FuzzFailure:
+        raise
+    except (Exception, Hang) as exc:
+        _fail("a traceback" if not isinstance(exc, Hang) else "a hang", where, text, exc)
+    return ok
+
+
+def surface_arrays(sess):
+    """Copies of the arrays that define the session's surface and settings
+    (compared before and after a failing command)."""
+    s = sess.surface
+    out = {"X": s.X.copy(), "E": s.E.copy(), "FE": s.FE.copy()}
+    for name, attrs in (("v", s.vattr), ("e", s.eattr), ("f", s.fattr)):
+        for k, a in attrs.items():
+            out[f"{name}.{k}"] = np.array(a, copy=True)
+    for k, a in s.extra.items():
+        out[f"extra.{k}"] = a.copy()
+    b = s.bodies
+    if b.n:
+        out["target"], out["pressure"] = b.target.copy(), b.pressure.copy()
+    out["energy"] = np.array(sess.totals.energy)
+    out["vars"] = {k: v for k, v in sess.variables.items() if not isinstance(v, np.ndarray)}
+    return out
+
+
+def same_arrays(a, b):
+    if a.keys() != b.keys():
+        return False
+    for k in a:
+        if k == "vars":
+            if a[k] != b[k] and not _nan_equal(a[k], b[k]):
+                return False
+        elif a[k].shape != b[k].shape or not np.array_equal(a[k], b[k], equal_nan=True):
+            return False
+    return True
+
+
+def _nan_equal(x, y):
+    if x.keys() != y.keys():
+        return False
+    for k in x:
+        u, v = x[k], y[k]
+        if u != v and not (isinstance(u, float) and isinstance(v, float) and u != u and v != v):
+            return False
+    return True
+
+
+def check_commands(sess, text, where):
+    """Run ``text`` command by command in ``sess``.  A failing command must
+    print a located message and leave the surface as it was (arrays
+    compared); nothing may raise a Python exception or hang.  Returns the
+    number of commands that failed."""
+    from pyevolver.commands import interpreter as I
+    from pyevolver.errors import CommandError, InternalError, PyEvolverError
+    failed = 0
+    try:
+        with time_limit(HANG_SECONDS):
+            for chunk, ln in I.split_commands(text):
+                before = surface_arrays(sess)
+                try:
+                    sess.run_one(chunk, where, ln)
+                except InternalError as exc:
+                    _fail("an internal error", where, text, exc.original)
+                except PyEvolverError as exc:
+                    failed += 1
+                    if not str(exc).startswith(f"{where}:"):
+                        _fail("an unlocated command error", where, text, exc)
+                    if not same_arrays(before, surface_arrays(sess)):
+                        _fail("a failing command that changed the surface", where,
+                              chunk + "\n--- error: " + str(exc), None)
+                except (I.Quit, I.Interrupted):
+                    break
+            check_surface(sess.surface)
+    except FuzzFailure:
+        raise
+    except (Exception, Hang) as exc:
+        _fail("a traceback" if not isinstance(exc, Hang) else "a hang", where, text, exc)
+    return failed
