@@ -40,6 +40,32 @@ _FIRST_WORD = re.compile(r"[A-CF-Za-cf-z_]|(?<![\d.])[DdEe]")
 _NUM_CHARS = re.compile(r"[ \t\d.eE+-]*")
 
 
+_ELEM_KWS = frozenset(
+    "fixed bare no_refine nodisplay no_display constraint constraints boundary tension "
+    "density volume volconst actual_volume pressure color colour frontcolor frontcolour "
+    "backcolor backcolour wrap orientation original opacity tag phase no_hessian_normal "
+    "hessian_normal_one axial_point triple_point tetra_point lagrange_multiplier".split())
+_WORD = re.compile(r"\S+")
+_PLAIN = re.compile(_NUMBER + r"\Z")
+
+
+def _plain_tail(tail, offset):
+    """The attributes after an element's numbers when they are only keywords
+    of ``fe_elements.lark`` (ELEM_KW) and plain numbers: the items the grammar
+    would give, without parsing (most element lines); else None."""
+    items = []
+    for m in _WORD.finditer(tail):
+        w = m.group(0)
+        lw = w.lower()
+        if lw in _ELEM_KWS:
+            items.append(("kw", lw, offset + m.start() + 1))
+        elif _PLAIN.match(w):
+            items.append(float(w))
+        else:
+            return None
+    return items
+
+
 class _Head:
     def __init__(self, end):
         self._end = end
@@ -342,6 +368,9 @@ class Reader:
                 if len(vals) != limit:
                     line = text.count("\n", 0, m.start()) + 1
                     raise _MatrixError(line, f"PERIODS needs {limit} numbers, found {len(vals)}")
+                if not all(math.isfinite(v) for v in vals):
+                    line = text.count("\n", 0, m.start()) + 1
+                    raise _MatrixError(line, "PERIODS: the numbers must be finite")
                 self.scene.values["_periods"] = vals
         return out
 
@@ -588,8 +617,11 @@ class Reader:
                 if head is not None and kind != "edges" or (head is not None and not torus):
                     nums_ = np.fromstring(line[:head.end()], dtype=float, sep=" ")
                     tail = line[head.end():]
-                    tree = line_parser().parse("0" + " " * (head.end() - 1) + tail, start=start)
-                    _, items = _LINE.transform(tree)
+                    items = _plain_tail(tail, head.end())
+                    if items is None:
+                        tree = line_parser().parse("0" + " " * (head.end() - 1) + tail,
+                                                   start=start)
+                        _, items = _LINE.transform(tree)
                     eid = int(line[:head.end()].split()[0])
                     items = nums_[1:].tolist() + items
                 else:
