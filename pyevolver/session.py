@@ -22,6 +22,7 @@ from .datafile.reader import read_datafile
 from .errors import (CommandError, DatafileError, ExpressionError, InternalError,
                      PyEvolverError, UnsupportedError)
 from .expr import nodes as N
+from .limits import MAX_NESTING
 from .surface import build_surface, project_to_constraints, restore_state, state
 
 READ_ONLY = {
@@ -163,6 +164,9 @@ class Session:
     def _read_new(self, cmd, name):
         import os
         if not os.path.isfile(name):
+            if os.path.exists(name):
+                raise CommandError(f"{cmd}: '{name}' is not a regular file (a directory, "
+                                   f"device or pipe)")
             raise CommandError(f"{cmd}: cannot find datafile '{name}'")
         scene = read_datafile(name)
         return scene, build_surface(scene)
@@ -703,7 +707,7 @@ class Session:
         new.X = s.X.copy()
         idx = np.nonzero(move)[0]
         new.X[idx] += sigma * self.rng.standard_normal((len(idx), 3))
-        project_to_constraints(new, idx)
+        self._project_or_fail(new, idx)
         self._replace_surface(new)
         if echo:
             self.write("One jiggle done.\n")
@@ -1227,7 +1231,16 @@ class Session:
         for el, v in zip(els, vals):
             self.set_attr(el, attr, ix, v)
         if gen.kind == "vertex" and attr in ("x", "y", "z"):
-            project_to_constraints(self.surface, np.array([e.i for e in els], np.int64))
+            self._project_or_fail(self.surface, np.array([e.i for e in els], np.int64))
+
+    def _project_or_fail(self, surface, idx):
+        """Project vertices to their constraints; a projection that diverges
+        fails the command (which leaves the surface as it was)."""
+        bad = project_to_constraints(surface, idx)
+        if len(bad):
+            vid = surface.ids("vertex")[bad[0]]
+            raise CommandError(f"the projection of vertex {vid} onto its constraints "
+                               f"diverges")
 
     def unset_constraint(self, els, cid):
         s = self.surface
@@ -1301,11 +1314,14 @@ class Session:
             for d in os.environ.get("EVOLVERPATH", "").split(os.pathsep):
                 if d:
                     cands.append(os.path.join(d, name))
-        path = next((c for c in cands if os.path.isfile(c)), None)
+        path = next((c for c in cands if os.path.exists(c)), None)
         if path is None:
             raise CommandError(f"read: cannot find file '{name}' (looked in the current "
                                f"directory and EVOLVERPATH)")
-        if len(self.interp.env.scopes) > 200:
+        if not os.path.isfile(path):       # /dev/zero, a FIFO, a directory: never read
+            raise CommandError(f"read: '{path}' is not a regular file (a directory, "
+                               f"device or pipe)")
+        if len(self.interp.env.scopes) > MAX_NESTING:
             raise CommandError(f"read \"{name}\": files read each other too deeply")
         try:
             with open(path, encoding="latin-1") as fh:

@@ -1282,7 +1282,8 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
     Uses ``x <- x - G (G^T G)^{-1} phi(x)`` over the vertex's active
     constraints (spec §6.1).  One-sided constraints are projected only when
     violated.  A vertex whose projection diverges (its coordinates or its
-    constraint values become infinite or NaN) is put back where it was.
+    constraint values become infinite or NaN, or it ends unconverged
+    farther from its constraints than it started) is put back where it was.
 
     Returns
     -------
@@ -1305,7 +1306,7 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
         sel = idx[anyon[inv == gi]]
         start = s.X[sel].copy()
         active = [c for c, on in zip(cids, key) if on]
-        phi = None
+        phi = phi0 = None
         for _ in range(maxit + 1):
             P = s.X[sel]
             coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
@@ -1321,6 +1322,8 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
                 phis.append(phi)
                 grads.append(c.formula.gradient(env, coords, len(sel)))
             phi = np.stack(phis, axis=1)           # (n, k)
+            if phi0 is None:
+                phi0 = np.max(np.abs(phi), axis=1)
             if np.max(np.abs(phi)) < tol or _ == maxit:
                 break
             Gm = np.stack(grads, axis=2)           # (n, 3, k)
@@ -1330,7 +1333,11 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
                 step = np.einsum("nik,nk->ni", Gm, lam)
             step = np.where(np.isfinite(step), step, 0.0)
             s.X[sel] = P - step
-        bad = ~(np.all(np.isfinite(s.X[sel]), axis=1) & np.all(np.isfinite(phi), axis=1))
+        res = np.max(np.abs(phi), axis=1)
+        bad = ~(np.all(np.isfinite(s.X[sel]), axis=1) & np.isfinite(res))
+        # not converged and farther from the constraint than at the start: the
+        # Newton iteration ran away (e.g. atan(z) = 0 from |z| > 1.39)
+        bad |= (res > tol) & (res > phi0)
         if bad.any():
             s.X[sel[bad]] = start[bad]
             failed = np.concatenate([failed, sel[bad]])
