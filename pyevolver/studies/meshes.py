@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..atomic import atomic_write
+
 
 def _outward(X, F):
     a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
@@ -94,7 +96,7 @@ def write_fe(path, X, F, header="", face_attrs=""):
     E, idx = edges(F)
     sign = np.where(F == E[idx, 0], 1, -1)
     FE = sign * (idx + 1)
-    with open(path, "w") as fh:
+    with atomic_write(path, "w", newline=None) as fh:
         fh.write(header.rstrip("\n") + "\n\n" if header else "")
         fh.write("vertices\n")
         for k, (x, y, z) in enumerate(X.tolist()):
