@@ -956,6 +956,7 @@ class _Builder:
                 etype, _ = method_info(m.method)
             except UnsupportedError as exc:
                 raise self.error(f"method_instance {name}: {exc}", m.line) from None
+            self._check_integrand(m, f"method_instance {name}", m.line)
             q = Quantity(name, "instance", line=m.line)
             q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
             s.quantities[name] = q
@@ -966,6 +967,7 @@ class _Builder:
                     etype, _ = method_info(m.method)
                 except UnsupportedError as exc:
                     raise self.error(f"quantity {name}: {exc}", qd.line) from None
+                self._check_integrand(m, f"quantity {name}", qd.line)
                 q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
             if qd.function is not None:
                 for v in qd.function.names():
@@ -984,6 +986,11 @@ class _Builder:
             if (etype, name) not in s.extra:
                 n = {"vertex": s.nv, "edge": s.ne, "facet": s.nf, "body": s.bodies.n}[etype]
                 s.extra[(etype, name)] = self._attr_array(etype, name, n, size)
+
+    def _check_integrand(self, m, what, line):
+        """The scalar integral methods need their SCALAR_INTEGRAND."""
+        if m.method.endswith("_scalar_integral") and m.scalar is None:
+            raise self.error(f"{what}: method {m.method} needs a SCALAR_INTEGRAND", line)
 
     def _instance(self, m, etype, mem):
         s = self.s

@@ -93,10 +93,85 @@ def _deep(rng):
     return "sin(" * depth + "1" + ")" * depth
 
 
+def _methods():
+    try:
+        from pyevolver.methods import METHODS
+        return sorted(METHODS) or ["facet_area"]
+    except ImportError:                 # pragma: no cover
+        return ["facet_area"]
+
+
+_VALUES = ["1", "0", "-1", "0.5", "1e300", "-1e300", "2^1000", "1/0", "0/0", "pi", "x", "z",
+           "p1", "1e-300", "99", "-0"]
+
+
+def _declaration(rng):
+    """A random top-section declaration (quantities with every registered
+    method, constraints, boundaries, attributes, settings)."""
+    v = lambda: rng.choice(_VALUES)                         # noqa: E731
+    k = rng.randrange(9)
+    if k == 0:
+        return (f"quantity q{rng.randrange(3)} {rng.choice(['energy', 'fixed = ' + v(), 'info_only', 'conserved'])} "
+                f"method {rng.choice(_methods())} {rng.choice(['global', ''])}")
+    if k == 1:
+        return (f"constraint {rng.randrange(1, 4)} {rng.choice(['', 'nonnegative', 'convex', 'global'])} "
+                f"formula: {rng.choice(['x', 'z', 'x^2+y^2', 'atan(z)', '0*x'])} = {v()}")
+    if k == 2:
+        return (f"boundary {rng.randrange(1, 3)} parameters {rng.randrange(0, 4)} "
+                f"x1: {v()} x2: {rng.choice(['p1', 'cos(p1)', v()])} x3: {v()}")
+    if k == 3:
+        return (f"define {rng.choice(['vertex', 'edge', 'facet', 'body'])} attribute "
+                f"aa{rng.randrange(2)} {rng.choice(['real', 'integer'])}{rng.choice(['', '[2]', '[0]'])}")
+    if k == 4:
+        return f"parameter {rng.choice(['pp', 'rad', 'x', 'pi'])} = {v()}"
+    if k == 5:
+        return (f"{rng.choice(['scale', 'scale_limit', 'gravity_constant', 'constraint_tolerance', 'space_dimension', 'integral_order', 'target_tolerance'])} {v()}")
+    if k == 6:
+        return f"method_instance mi{rng.randrange(2)} method {rng.choice(_methods())} {rng.choice(['global', ''])}"
+    if k == 7:
+        return rng.choice(["symmetric_content", "torus", "torus_filled", "periods 1 0 0 0 1 0 0 0 1",
+                           "string", "soapfilm", "linear", "keep_originals"])
+    return f"quantity qf energy function mi0.value * {v()}"
+
+
+def _attribute(rng):
+    """Random attributes for an element line."""
+    v = lambda: rng.choice(_VALUES[:10])                    # noqa: E731
+    return rng.choice([f"constraint {rng.randrange(0, 4)}", f"boundary {rng.randrange(0, 3)}",
+                       "fixed", f"tension {v()}", f"density {v()}", f"volume {v()}",
+                       f"pressure {v()}", f"color {v()}", "no_refine", f"q{rng.randrange(3)}",
+                       f"mi{rng.randrange(2)}", f"aa{rng.randrange(2)} {v()}", f"q0-",
+                       f"original {v()}", "* + -", "bare", f"volconst {v()}"])
+
+
+def _structured(text, rng):
+    """A declaration at the top, attributes on an element line, or a
+    section header moved."""
+    lines = text.split("\n")
+    k = rng.randrange(3)
+    if k == 0:
+        lines.insert(rng.randrange(min(len(lines), 8) + 1), _declaration(rng))
+    elif k == 1:
+        numeric = [i for i, l in enumerate(lines) if l[:1].isdigit()]
+        if numeric:
+            i = rng.choice(numeric)
+            lines[i] = lines[i] + " " + _attribute(rng)
+    else:
+        heads = [i for i, l in enumerate(lines)
+                 if l.strip().lower().split()[:1] in (["vertices"], ["edges"], ["faces"], ["bodies"])]
+        if heads:
+            i = rng.choice(heads)
+            head = lines.pop(i)
+            lines.insert(rng.randrange(len(lines) + 1), head)
+    return "\n".join(lines)
+
+
 def mutate(text, rng, others=()):
     """One to three random mutations of ``text`` (a string)."""
+    if rng.random() < 0.25:
+        text = _structured(text, rng)
     toks = tokens(text)
-    for _ in range(rng.choice((1, 1, 1, 2, 3))):
+    for _ in range(rng.choice((0, 1, 1, 1, 2, 3))):
         words = _words(toks)
         op = rng.randrange(12)
         if not words and op < 9:

@@ -443,8 +443,8 @@ class Reader:
             self._check_names(expr, allowed)
         return N.Formula(expr, text)
 
-    def _check_names(self, expr, allowed=("x", "y", "z", "w", "x1", "x2", "x3", "x4",
-                                           "p1", "p2", "p3", "g")):
+    def _check_names(self, expr, allowed=("x", "y", "z", "w", "x1", "x2", "x3", "x4", "g")):
+        # (boundary parametrizations name p1, p2, ... instead: see _decl)
         for name in expr.names():
             if (name in allowed or name in self.scene.parameters or name in N.CONSTANTS
                     or any(name == a[1] for a in self.scene.attributes)):
