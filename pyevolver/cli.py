@@ -15,7 +15,7 @@ import numpy as np
 
 from . import __version__
 from .commands import interpreter as I
-from .errors import PyEvolverError
+from .errors import InternalError, PyEvolverError
 from .session import Session
 
 PROMPT = "Enter command: "
@@ -64,6 +64,9 @@ EXIT_INTERRUPTED = 130
 def main(argv=None):
     try:
         return _main(argv)
+    except I.Quit as q:                 # `q` in the datafile's read section or a script
+        _flush_quietly()
+        return q.code
     except BrokenPipeError:
         # the reader of our output went away (e.g. `| head`): exit quietly
         try:
@@ -102,6 +105,11 @@ def _main(argv=None):
         return 1
     except MemoryError:
         sys.stderr.write(f"{path}: out of memory while loading the datafile\n")
+        return 1
+    except (I.Quit, I.Interrupted, KeyboardInterrupt):
+        raise
+    except Exception as exc:            # a bug of pyevolver: a message, not a traceback
+        sys.stderr.write(f"{InternalError.from_exception(exc, path)}\n")
         return 1
     try:
         if args.command_file:

@@ -91,3 +91,12 @@ def test_sigint_while_loading_exits_130(tmp_path):
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "Traceback" not in err, err
+
+
+def test_quit_in_the_read_section(tmp_path):
+    # `q` while the datafile's read section runs used to end in a traceback
+    text = open(CUBE).read().split("read")[0] + "read\nprint 7\nq 3\nprint 8\n"
+    (tmp_path / "quit.fe").write_text(text)
+    p = _run(["quit.fe"], "print 9\n", tmp_path)
+    assert p.returncode == 3 and p.stdout.split() == ["7"]
+    assert "Traceback" not in p.stderr and p.stderr == ""

@@ -376,3 +376,25 @@ def test_the_interpreter_reaches_no_eval():
         for word in ("eval(", "exec(", "subprocess", "os.system", "os.popen", "__import__",
                      "importlib", "pickle"):
             assert word not in src, (mod.__name__, word)
+
+
+def test_g_undoes_a_step_whose_projection_diverges(monkeypatch):
+    """The wiring in the g step: a projection that reports runaway vertices
+    (pyevolver.surface.project_to_constraints, tested above) makes the step
+    undone, with the warning and the coordinates before it."""
+    import pyevolver.evolve.iterate as it
+    s = _session(os.path.join(HERE, "data", "atan_constraint.fe"))
+    X0 = s.surface.X.copy()
+    calls = []
+
+    def diverging(surface, idx, *a, **k):
+        calls.append(len(idx))
+        return np.array([0])
+    monkeypatch.setattr(it, "project_to_constraints", diverging)
+    s.run("g 1")
+    assert calls
+    np.testing.assert_array_equal(s.surface.X, X0)
+    assert "WARNING 1864" in s.err.getvalue() and "area:" not in s.out.getvalue()
+    monkeypatch.undo()
+    s.run("g 1")
+    assert "area:" in s.out.getvalue()
