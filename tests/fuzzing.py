@@ -324,7 +324,7 @@ def _gen(rng):
 def random_command(rng, depth=0):
     """One random command of the Evolver language (most of them fail:
     wrong types, missing elements, huge counts; all must fail cleanly)."""
-    k = rng.randrange(30 if depth < 2 else 22)
+    k = rng.randrange(31 if depth < 2 else 22)
     e = _expr(rng)
     if k == 0:
         return f"{rng.choice(['aa', 'bb', 'ss', 'xx', 'arr[1]', 'arr[5][2]'])} := {e}"
@@ -389,7 +389,24 @@ def random_command(rng, depth=0):
     if k == 28:
         return (f"function real ff(real xx) {{ {inner}; return xx*2 }}; "
                 f"procedure pp(real yy) {{ {random_command(rng, depth + 1)} }}; pp({e})")
+    if k == 29:
+        q = rng.choice(_QNAMES)
+        return rng.choice([f"{q}.{rng.choice(['target', 'modulus', 'tolerance', 'value', 'pressure'])} := {e}",
+                           f"print {q}.{rng.choice(['value', 'target', 'pressure'])}",
+                           f"{rng.choice(['fix', 'unfix'])} {q}", f"set {q} target {e}",
+                           f"hessian_seek {e}", f"set body target {e}", f"unset body target",
+                           f"delete edge where length < {e}", f"refine edge where length > {e}",
+                           f"set edge tension {e}", f"bfgs {rng.choice(['1', '3', e])}"])
     return f"{rng.choice(['cc', 'r', 'g'])} :::= {{ {inner} }}; {rng.choice(['cc', 'r', 'g'])}"
+
+
+_QNAMES = ["q0", "mi0", "sqcurve", "bend", "surf", "tmc", "sqm", "willmore", "larea", "lvol",
+           "surface_area", "volume", "total_area"]
+
+
+#: run once in each interpreter session: the names random commands use
+PRELUDE = ('aa := 1; bb := 2; xx := 0.5; zz := 3; ss := "s"; define arr real[5][2]; '
+           'function real ff(real yy) { return yy/2 }')
 
 
 def random_script(rng):

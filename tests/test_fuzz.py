@@ -134,6 +134,7 @@ def _exec_fuzz(target, datafile, nightly=False):
     def session():
         s = Session.load(datafile, out=io.StringIO(), err=io.StringIO())
         s.time_limit = 0.05
+        s.run(F.PRELUDE)
         return s
 
     def body(rng):
