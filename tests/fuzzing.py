@@ -105,33 +105,37 @@ _VALUES = ["1", "0", "-1", "0.5", "1e300", "-1e300", "2^1000", "1/0", "0/0", "pi
            "p1", "1e-300", "99", "-0"]
 
 
+_SETTINGS = ["scale", "scale_limit", "gravity_constant", "constraint_tolerance",
+             "space_dimension", "integral_order", "target_tolerance"]
+_FLAGS = ["symmetric_content", "torus", "torus_filled", "periods 1 0 0 0 1 0 0 0 1", "string",
+          "soapfilm", "linear", "keep_originals"]
+
+# templates of top-section declarations: f(rng, v) with v() a random value
+_DECLARATIONS = [
+    lambda rng, v: (f"quantity q{rng.randrange(3)} "
+                    f"{rng.choice(['energy', 'fixed = ' + v(), 'info_only', 'conserved'])} "
+                    f"method {rng.choice(_methods())} {rng.choice(['global', ''])}"),
+    lambda rng, v: (f"constraint {rng.randrange(1, 4)} "
+                    f"{rng.choice(['', 'nonnegative', 'convex', 'global'])} formula: "
+                    f"{rng.choice(['x', 'z', 'x^2+y^2', 'atan(z)', '0*x'])} = {v()}"),
+    lambda rng, v: (f"boundary {rng.randrange(1, 3)} parameters {rng.randrange(0, 4)} "
+                    f"x1: {v()} x2: {rng.choice(['p1', 'cos(p1)', v()])} x3: {v()}"),
+    lambda rng, v: (f"define {rng.choice(['vertex', 'edge', 'facet', 'body'])} attribute "
+                    f"aa{rng.randrange(2)} {rng.choice(['real', 'integer'])}"
+                    f"{rng.choice(['', '[2]', '[0]'])}"),
+    lambda rng, v: f"parameter {rng.choice(['pp', 'rad', 'x', 'pi'])} = {v()}",
+    lambda rng, v: f"{rng.choice(_SETTINGS)} {v()}",
+    lambda rng, v: (f"method_instance mi{rng.randrange(2)} method {rng.choice(_methods())} "
+                    f"{rng.choice(['global', ''])}"),
+    lambda rng, v: rng.choice(_FLAGS),
+    lambda rng, v: f"quantity qf energy function mi0.value * {v()}",
+]
+
+
 def _declaration(rng):
     """A random top-section declaration (quantities with every registered
     method, constraints, boundaries, attributes, settings)."""
-    v = lambda: rng.choice(_VALUES)                         # noqa: E731
-    k = rng.randrange(9)
-    if k == 0:
-        return (f"quantity q{rng.randrange(3)} {rng.choice(['energy', 'fixed = ' + v(), 'info_only', 'conserved'])} "
-                f"method {rng.choice(_methods())} {rng.choice(['global', ''])}")
-    if k == 1:
-        return (f"constraint {rng.randrange(1, 4)} {rng.choice(['', 'nonnegative', 'convex', 'global'])} "
-                f"formula: {rng.choice(['x', 'z', 'x^2+y^2', 'atan(z)', '0*x'])} = {v()}")
-    if k == 2:
-        return (f"boundary {rng.randrange(1, 3)} parameters {rng.randrange(0, 4)} "
-                f"x1: {v()} x2: {rng.choice(['p1', 'cos(p1)', v()])} x3: {v()}")
-    if k == 3:
-        return (f"define {rng.choice(['vertex', 'edge', 'facet', 'body'])} attribute "
-                f"aa{rng.randrange(2)} {rng.choice(['real', 'integer'])}{rng.choice(['', '[2]', '[0]'])}")
-    if k == 4:
-        return f"parameter {rng.choice(['pp', 'rad', 'x', 'pi'])} = {v()}"
-    if k == 5:
-        return (f"{rng.choice(['scale', 'scale_limit', 'gravity_constant', 'constraint_tolerance', 'space_dimension', 'integral_order', 'target_tolerance'])} {v()}")
-    if k == 6:
-        return f"method_instance mi{rng.randrange(2)} method {rng.choice(_methods())} {rng.choice(['global', ''])}"
-    if k == 7:
-        return rng.choice(["symmetric_content", "torus", "torus_filled", "periods 1 0 0 0 1 0 0 0 1",
-                           "string", "soapfilm", "linear", "keep_originals"])
-    return f"quantity qf energy function mi0.value * {v()}"
+    return rng.choice(_DECLARATIONS)(rng, lambda: rng.choice(_VALUES))
 
 
 def _attribute(rng):
@@ -321,83 +325,77 @@ def _gen(rng):
     return g
 
 
+def _q(text):
+    return '"' + text + '"'
+
+
+# templates of simple commands: f(rng, e) with e a random expression
+_SIMPLE = [
+    lambda rng, e: f"{rng.choice(['aa', 'bb', 'ss', 'xx', 'arr[1]', 'arr[5][2]'])} := {e}",
+    lambda rng, e: f"{rng.choice(['aa', 'bb'])} {rng.choice(['+=', '-=', '*=', '/=', '++', '--'])} {e}",
+    lambda rng, e: f"print {e}",
+    lambda rng, e: f"printf {rng.choice(_FORMATS)}, {e}, {_expr(rng)}",
+    lambda rng, e: f"{rng.choice(_WORDS)} {rng.choice(['', _num(rng), e])}",
+    lambda rng, e: f"list {_gen(rng)}",
+    lambda rng, e: f"set {rng.choice(_KINDS[:4])} {rng.choice(_ATTRS[:18])} {e}",
+    lambda rng, e: f"{rng.choice(['fix', 'unfix'])} {_gen(rng)}",
+    lambda rng, e: f"{rng.choice(['refine', 'delete', 'edgeswap'])} {_gen(rng)}",
+    lambda rng, e: f"define arr {rng.choice(['real', 'integer', 'string'])}[{_num(rng)}]",
+    lambda rng, e: (f"define {rng.choice(_KINDS)} attribute zz {rng.choice(['real', 'integer'])}"
+                    f"{rng.choice(['', '[2]', '[' + _num(rng) + ']'])}"),
+    lambda rng, e: f"{rng.choice(_KINDS[:4])}[{_num(rng)}].{rng.choice(_ATTRS)} := {e}",
+    lambda rng, e: f"histogram({_gen(rng)}, {e})",
+    lambda rng, e: (f"unset {rng.choice(_KINDS[:4])} "
+                    f"{rng.choice(['fixed', 'target', 'constraint 1', 'zz'])}"),
+    lambda rng, e: (f'{rng.choice(["dump", "read", "load", "addload", "replace_load"])} '
+                    f'{rng.choice(["", _q("out.fe"), _q("/dev/zero"), _q(""), e])}'),
+    lambda rng, e: (f"{{ {random_command(rng, 2)} }} {rng.choice(['>>', '>>>', '|'])} "
+                    f'{rng.choice([_q("o.txt"), _q("/dev/null"), e])}'),
+    lambda rng, e: (f"{rng.choice(['quiet', 'conj_grad', 'autorecalc', 'gravity'])} "
+                    f"{rng.choice(['on', 'off', e])}"),
+    lambda rng, e: "abort" if rng.random() < 0.2 else f"return {e}",
+    lambda rng, e: f"break {rng.choice(['', '2', e])}",
+    lambda rng, e: f"local aa; aa := {e}",
+    lambda rng, e: (f"body[{_num(rng)}].{rng.choice(['target', 'pressure', 'volconst', 'density'])}"
+                    f" := {e}"),
+    lambda rng, e: f"{rng.choice(['g', 'r', 'u', 'V', 'hessian'])} {rng.choice(['', '2', _num(rng)])}",
+    lambda rng, e: _quantity_command(rng, e),
+]
+
+# templates of compound commands: f(rng, e, inner, other) with two random
+# inner commands
+_COMPOUND = [
+    lambda rng, e, a, b: f"if {e} then {a} else {b}",
+    lambda rng, e, a, b: f"for (aa := 0; aa < {rng.choice(['3', e])}; aa++) {{ {a} }}",
+    lambda rng, e, a, b: f"foreach {_gen(rng)} do {{ {a} }}",
+    lambda rng, e, a, b: f"while {e} do {{ {a}; break }}",
+    lambda rng, e, a, b: f"do {{ {a} }} while {e}",
+    lambda rng, e, a, b: f"gogo := {{ {a} }}; gogo {rng.choice(['', '2', e])}",
+    lambda rng, e, a, b: (f"function real ff(real xx) {{ {a}; return xx*2 }}; "
+                          f"procedure pp(real yy) {{ {b} }}; pp({e})"),
+    lambda rng, e, a, b: f"{rng.choice(['cc', 'r', 'g'])} :::= {{ {a} }}; {rng.choice(['cc', 'r', 'g'])}",
+]
+
+
+def _quantity_command(rng, e):
+    q = rng.choice(_QNAMES)
+    return rng.choice([
+        f"{q}.{rng.choice(['target', 'modulus', 'tolerance', 'value', 'pressure'])} := {e}",
+        f"print {q}.{rng.choice(['value', 'target', 'pressure'])}",
+        f"{rng.choice(['fix', 'unfix'])} {q}", f"set {q} target {e}", f"hessian_seek {e}",
+        f"set body target {e}", "unset body target", f"delete edge where length < {e}",
+        f"refine edge where length > {e}", f"set edge tension {e}",
+        f"bfgs {rng.choice(['1', '3', e])}"])
+
+
 def random_command(rng, depth=0):
     """One random command of the Evolver language (most of them fail:
     wrong types, missing elements, huge counts; all must fail cleanly)."""
-    k = rng.randrange(31 if depth < 2 else 22)
     e = _expr(rng)
-    if k == 0:
-        return f"{rng.choice(['aa', 'bb', 'ss', 'xx', 'arr[1]', 'arr[5][2]'])} := {e}"
-    if k == 1:
-        return f"{rng.choice(['aa', 'bb'])} {rng.choice(['+=', '-=', '*=', '/=', '++', '--'])} {e}"
-    if k == 2:
-        return f"print {e}"
-    if k == 3:
-        return f"printf {rng.choice(_FORMATS)}, {e}, {_expr(rng)}"
-    if k == 4:
-        return f"{rng.choice(_WORDS)} {rng.choice(['', _num(rng), e])}"
-    if k == 5:
-        return f"list {_gen(rng)}"
-    if k == 6:
-        return f"set {rng.choice(_KINDS[:4])} {rng.choice(_ATTRS[:18])} {e}"
-    if k == 7:
-        return f"{rng.choice(['fix', 'unfix'])} {_gen(rng)}"
-    if k == 8:
-        return f"{rng.choice(['refine', 'delete', 'edgeswap'])} {_gen(rng)}"
-    if k == 9:
-        return f"define arr {rng.choice(['real', 'integer', 'string'])}[{_num(rng)}]"
-    if k == 10:
-        return (f"define {rng.choice(_KINDS)} attribute zz "
-                f"{rng.choice(['real', 'integer'])}{rng.choice(['', '[2]', '[' + _num(rng) + ']'])}")
-    if k == 11:
-        return f"{rng.choice(_KINDS[:4])}[{_num(rng)}].{rng.choice(_ATTRS)} := {e}"
-    if k == 12:
-        return f"histogram({_gen(rng)}, {e})"
-    if k == 13:
-        return f"unset {rng.choice(_KINDS[:4])} {rng.choice(['fixed', 'target', 'constraint 1', 'zz'])}"
-    if k == 14:
-        return f'{rng.choice(["dump", "read", "load", "addload", "replace_load"])} ' \
-               f'{rng.choice(["", chr(34) + "out.fe" + chr(34), chr(34) + "/dev/zero" + chr(34), chr(34) + chr(34), e])}'
-    if k == 15:
-        return f"{{ {random_command(rng, depth + 1)} }} {rng.choice(['>>', '>>>', '|'])} " \
-               f'{rng.choice([chr(34) + "o.txt" + chr(34), chr(34) + "/dev/null" + chr(34), e])}'
-    if k == 16:
-        return f"{rng.choice(['quiet', 'conj_grad', 'autorecalc', 'gravity'])} {rng.choice(['on', 'off', e])}"
-    if k == 17:
-        return f"abort" if rng.random() < 0.2 else f"return {e}"
-    if k == 18:
-        return f"break {rng.choice(['', '2', e])}"
-    if k == 19:
-        return f"local aa; aa := {e}"
-    if k == 20:
-        return f"body[{_num(rng)}].{rng.choice(['target', 'pressure', 'volconst', 'density'])} := {e}"
-    if k == 21:
-        return f"{rng.choice(['g', 'r', 'u', 'V', 'hessian'])} {rng.choice(['', '2', _num(rng)])}"
-    inner = random_command(rng, depth + 1)
-    if k == 22:
-        return f"if {e} then {inner} else {random_command(rng, depth + 1)}"
-    if k == 23:
-        return f"for (aa := 0; aa < {rng.choice(['3', e])}; aa++) {{ {inner} }}"
-    if k == 24:
-        return f"foreach {_gen(rng)} do {{ {inner} }}"
-    if k == 25:
-        return f"while {e} do {{ {inner}; break }}"
-    if k == 26:
-        return f"do {{ {inner} }} while {e}"
-    if k == 27:
-        return f"gogo := {{ {inner} }}; gogo {rng.choice(['', '2', e])}"
-    if k == 28:
-        return (f"function real ff(real xx) {{ {inner}; return xx*2 }}; "
-                f"procedure pp(real yy) {{ {random_command(rng, depth + 1)} }}; pp({e})")
-    if k == 29:
-        q = rng.choice(_QNAMES)
-        return rng.choice([f"{q}.{rng.choice(['target', 'modulus', 'tolerance', 'value', 'pressure'])} := {e}",
-                           f"print {q}.{rng.choice(['value', 'target', 'pressure'])}",
-                           f"{rng.choice(['fix', 'unfix'])} {q}", f"set {q} target {e}",
-                           f"hessian_seek {e}", f"set body target {e}", f"unset body target",
-                           f"delete edge where length < {e}", f"refine edge where length > {e}",
-                           f"set edge tension {e}", f"bfgs {rng.choice(['1', '3', e])}"])
-    return f"{rng.choice(['cc', 'r', 'g'])} :::= {{ {inner} }}; {rng.choice(['cc', 'r', 'g'])}"
+    if depth < 2 and rng.random() < 0.25:
+        make = rng.choice(_COMPOUND)
+        return make(rng, e, random_command(rng, depth + 1), random_command(rng, depth + 1))
+    return rng.choice(_SIMPLE)(rng, e)
 
 
 _QNAMES = ["q0", "mi0", "sqcurve", "bend", "surf", "tmc", "sqm", "willmore", "larea", "lvol",
@@ -590,3 +588,17 @@ def check_commands(sess, text, where):
     except (Exception, Hang) as exc:
         _fail("a traceback" if not isinstance(exc, Hang) else "a hang", where, text, exc)
     return failed
+
+
+
+@contextlib.contextmanager
+def limit(name, value):
+    """Set ``pyevolver.limits.<name>`` for the block (small limits keep the
+    fuzzed surfaces small and fast)."""
+    from pyevolver import limits
+    old = getattr(limits, name)
+    setattr(limits, name, value)
+    try:
+        yield
+    finally:
+        setattr(limits, name, old)

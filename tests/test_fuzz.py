@@ -18,7 +18,6 @@ CI runs ``FUZZ_INPUTS`` (20,000) inputs per target, on the small seed files;
 every shipped file, with fresh random seeds.  The counts are printed at the
 end of the run ("fuzz inputs run").
 """
-import contextlib
 import io
 import os
 import random
@@ -234,16 +233,8 @@ def test_commands_with_odd_numbers(cmd, v):
     text = f"{cmd}{arg}]" if cmd.endswith("[") else f"{cmd} {arg}"
     s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
     s.time_limit = 0.2
-    with _limit("MAX_ELEMENTS", 3000):
+    with F.limit("MAX_ELEMENTS", 3000):
         F.check_commands(s, text, "prop")
     assert np.all(np.isfinite(s.surface.X))
 
 
-@contextlib.contextmanager
-def _limit(name, value):
-    old = getattr(limits, name)
-    setattr(limits, name, value)
-    try:
-        yield
-    finally:
-        setattr(limits, name, old)

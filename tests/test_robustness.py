@@ -8,7 +8,6 @@ warning text of an infinite energy, printf's negative ``*`` arguments,
 equiangulation across zero-length edges); elsewhere from the rule "a
 located message, and the surface as it was".
 """
-import contextlib
 import io
 import os
 import re
@@ -20,7 +19,6 @@ import pytest
 import fuzzing as F
 from conftest import example
 from pyevolver import limits
-from pyevolver.datafile.reader import read_datafile
 from pyevolver.errors import CommandError, DatafileError, InternalError
 from pyevolver.session import Session
 from pyevolver.surface import project_to_constraints
@@ -54,14 +52,6 @@ def _cube(old, new):
     return CUBE_TEXT.replace(old, new, 1)
 
 
-@contextlib.contextmanager
-def _limit(name, value):
-    old = getattr(limits, name)
-    setattr(limits, name, value)
-    try:
-        yield
-    finally:
-        setattr(limits, name, old)
 
 
 # ---------------------------------------------------------------------------
@@ -224,7 +214,7 @@ def test_failed_command_restores_energies_and_geometry():
     s = _session()
     e0 = s.total_energy
     before = F.surface_arrays(s)
-    with _limit("MAX_ELEMENTS", 500):
+    with F.limit("MAX_ELEMENTS", 500):
         with pytest.raises(CommandError, match="beyond"):
             s.run("r 10")
     assert F.same_arrays(before, F.surface_arrays(s))
@@ -241,7 +231,7 @@ def test_limits_in_commands():
                       ("{" * 150 + "print 1" + "}" * 150, "nested")]:
         with pytest.raises(CommandError, match=word):
             s.run(cmd)
-    with _limit("MAX_STRING", 1000):
+    with F.limit("MAX_STRING", 1000):
         with pytest.raises(CommandError, match="characters"):
             s.run('ss := "ab"; for (ii := 1; ii < 20; ii++) ss := sprintf("%s%s", ss, ss)')
 
@@ -253,7 +243,8 @@ def test_recursion_is_a_message():
     s.run("print 1")
 
 
-def test_time_limit_stops_a_command_and_restores():
+def test_time_limit_stops_a_command_and_restores(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     s = _session()
     s.time_limit = 0.3
     s.run("aa := 1")
