@@ -18,6 +18,12 @@ def _env():
     return env
 
 
+def _sigint_default():
+    # the child reacts to SIGINT even when this test process inherited it as
+    # ignored (a background job started by a shell without job control)
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _run(args, script, cwd, timeout=60):
     return subprocess.run([sys.executable, "-m", "pyevolver", *args], input=script,
                           capture_output=True, text=True, cwd=cwd, env=_env(),
@@ -64,7 +70,7 @@ def test_sigint_in_batch_mode_exits_130_writing_nothing(tmp_path, command):
     script = f'{command}\ndump "after.fe"\nq\n'
     proc = subprocess.Popen([sys.executable, "-m", "pyevolver", CUBE], stdin=subprocess.PIPE,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=tmp_path, env=_env())
+                            cwd=tmp_path, env=_env(), preexec_fn=_sigint_default)
     proc.stdin.write(script)
     proc.stdin.flush()
 
@@ -85,7 +91,8 @@ def test_sigint_while_loading_exits_130(tmp_path):
     df.write_text(text)
     proc = subprocess.Popen([sys.executable, "-u", "-m", "pyevolver", str(df)],
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=_env())
+                            stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=_env(),
+                            preexec_fn=_sigint_default)
     assert proc.stdout.readline().split() == ["12345"]      # the loop is about to run
     time.sleep(0.3)
     proc.send_signal(signal.SIGINT)

@@ -13,9 +13,10 @@ inputs about as much):
 * the interpreter: the same commands run on a cube, each failing command
   checked to leave the surface arrays as they were.
 
-CI runs ``FUZZ_INPUTS`` (20,000) inputs per target, on the small seed files;
-``pytest --nightly`` (or ``PYEVOLVER_NIGHTLY=1``) runs ten times as many on
-every shipped file, with fresh random seeds.  The counts are printed at the
+CI runs ``FUZZ_INPUTS`` (20,000; ``PYEVOLVER_FUZZ_INPUTS`` overrides) inputs
+per target, on the small seed files; ``pytest --nightly`` (or
+``PYEVOLVER_NIGHTLY=1``) runs ten times as many on every shipped file and on
+four more datafiles, with fresh random seeds.  The counts are printed at the
 end of the run ("fuzz inputs run").
 """
 import io
@@ -34,8 +35,8 @@ from pyevolver.session import Session
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
 
 NIGHTLY = os.environ.get("PYEVOLVER_NIGHTLY", "") not in ("", "0")
-FUZZ_INPUTS = 20_000
-BATCH = 25                       # inputs per hypothesis example
+FUZZ_INPUTS = int(os.environ.get("PYEVOLVER_FUZZ_INPUTS", "20000"))
+BATCH = 50                       # inputs per hypothesis example
 
 
 def _settings(n_inputs, nightly):
@@ -132,13 +133,13 @@ def _exec_fuzz(target, datafile, nightly=False):
 
     def session():
         s = Session.load(datafile, out=io.StringIO(), err=io.StringIO())
-        s.time_limit = 0.05
+        s.time_limit = 0.02
         s.run(F.PRELUDE)
         return s
 
     def body(rng):
         # a fresh session now and then; in between the state random-walks
-        if "s" not in state or rng.random() < 0.1 or state["s"].surface.nf > 2000:
+        if "s" not in state or rng.random() < 0.1 or state["s"].surface.nf > 1000:
             state["s"] = session()
         if rng.random() < 0.7:
             text = F.random_script(rng)

@@ -2,6 +2,7 @@
 multi-line input with the ``more> `` prompt, Tab completion, history kept
 across runs, and Ctrl-C during a long loop."""
 import os
+import signal
 import sys
 
 import pytest
@@ -20,9 +21,12 @@ def _spawn(tmp_path):
     env["PYEVOLVER_HISTORY"] = str(tmp_path / "history")
     env["TERM"] = "xterm"
     env["PROMPT_TOOLKIT_NO_CPR"] = "1"
+    # preexec_fn: Ctrl-C reaches the child even when this process inherited
+    # SIGINT as ignored (a background job of a shell without job control)
     child = pexpect.spawn(sys.executable, ["-m", "pyevolver", example("cube.fe")], env=env,
                           cwd=str(tmp_path), encoding="utf-8", timeout=30,
-                          dimensions=(40, 200))
+                          dimensions=(40, 200),
+                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     child.expect_exact("Enter command:")
     return child
 
