@@ -228,7 +228,8 @@ def test_limits_in_commands():
                       ("define vertex attribute qq real[1e8]", "entries"),
                       ('printf "%100000000d", 3', "width"),
                       ("print " + "sin(" * 300 + "1" + ")" * 300, "nested"),
-                      ("{" * 150 + "print 1" + "}" * 150, "nested")]:
+                      ("{" * 150 + "print 1" + "}" * 150, "nested"),
+                      ("define aa real[0][0x7fffffffffffffff]", "entries")]:
         with pytest.raises(CommandError, match=word):
             s.run(cmd)
     with F.limit("MAX_STRING", 1000):
@@ -389,3 +390,17 @@ def test_g_undoes_a_step_whose_projection_diverges(monkeypatch):
     monkeypatch.undo()
     s.run("g 1")
     assert "area:" in s.out.getvalue()
+
+
+def test_addload_of_an_attribute_with_another_shape(tmp_path, monkeypatch):
+    # a scalar attribute in the file, an array one in the session: the
+    # concatenation raised ValueError (found by the nightly interpreter fuzz)
+    monkeypatch.chdir(tmp_path)
+    s = _session()
+    s.run('define vertex attribute zz real; vertex[1].zz := 5; dump "one.fe"')
+    t = _session()
+    t.run("define vertex attribute zz real[2]")
+    t.run('addload "one.fe"')
+    zz = t.surface.extra[("vertex", "zz")]
+    assert zz.shape == (2 * s.surface.nv, 2)
+    assert zz[s.surface.nv, 0] == 5.0 and zz[s.surface.nv, 1] == 0.0

@@ -1166,6 +1166,8 @@ class Interpreter:
                 raise CommandError(f"{what}: array sizes must be numbers >= 0")
             shape.append(int(v))
             total *= int(v)
+            if int(v) > MAX_ARRAY_ENTRIES:      # real[0][huge] has no entries but
+                total = max(total, int(v))      # numpy cannot make the dimension
         if total > MAX_ARRAY_ENTRIES:
             raise CommandError(f"{what}: {total} entries is more than the "
                                f"{MAX_ARRAY_ENTRIES} allowed")
