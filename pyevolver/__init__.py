@@ -11,11 +11,16 @@ from .errors import (PyEvolverError, DatafileError, CommandError, UnsupportedErr
 from .datafile.reader import read_datafile  # noqa: E402
 from .surface import Surface, build_surface  # noqa: E402
 from .session import Session  # noqa: E402
+from .io.meshio_plugin import register as _register_meshio  # noqa: E402
+
+_register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)
 
 
-def load(filename):
-    """Load a datafile into a :class:`Session` (runs its ``read`` section)."""
-    return Session.load(filename)
+def load(filename, **kwargs):
+    """Load a datafile into a :class:`Session` (runs its ``read`` section);
+    keyword arguments go to :meth:`Session.load` (``out``, ``err``,
+    ``run_read``)."""
+    return Session.load(filename, **kwargs)
 
 
 __all__ = ["Session", "Surface", "load", "read_datafile", "build_surface", "PyEvolverError",

@@ -1,17 +1,20 @@
-"""Atomic file output: a crash or Ctrl-C never leaves a half-written file.
+"""Atomic file writes: a temporary file in the target's folder, renamed over
+the target only when writing succeeded.
 
-Everything pyevolver writes (``dump``, ``export``, ``>>``/``>>>``
-redirection, the studies' CSV files) goes through :func:`atomic_write`: the
-text is written to a temporary file in the same directory, flushed to disk
-and renamed over the target only when the block ends without an exception.
-On an exception the temporary file is removed and the target is as it was.
+A reader (or a sweep resumed after a crash) therefore sees either the old
+file or the complete new one, never a half-written file; a failed or
+interrupted write (an exception, Ctrl-C) leaves the old file as it was and
+no temporary file behind.  Everything pyevolver writes goes through here:
+``dump``, ``export``, ``>>``/``>>>`` redirection, pictures, the sweeps' and
+studies' files.  Devices, pipes and directories are refused
+(:func:`check_regular`): scripts write regular files only.
 """
 from __future__ import annotations
 
 import contextlib
 import os
+import secrets
 import stat
-import tempfile
 
 
 class NotRegularFile(OSError):
@@ -20,8 +23,8 @@ class NotRegularFile(OSError):
 
 def check_regular(path, for_writing=True):
     """Raise :class:`NotRegularFile` when ``path`` exists and is not a
-    regular file (``/dev/zero``, ``/dev/tty``, a FIFO, a directory): scripts
-    read and write files only.  A missing path is fine for writing."""
+    regular file (``/dev/zero``, ``/dev/tty``, a FIFO, a directory).  A
+    missing path is fine for writing (FileNotFoundError for reading)."""
     try:
         st = os.stat(path)
     except FileNotFoundError:
@@ -34,62 +37,72 @@ def check_regular(path, for_writing=True):
 
 
 @contextlib.contextmanager
-def atomic_write(path, mode="w", encoding="latin-1", newline="", durable=True):
-    """Open ``path`` for writing through a temporary file.
+def atomic_path(path, suffix=".tmp"):
+    """Yield the name of a fresh temporary file next to ``path``; when the
+    block ends without an exception it is renamed to ``path`` (``os.replace``,
+    atomic on POSIX and Windows), else removed.
+
+    For writers that want a file name (meshio, matplotlib's ``savefig``).
+    A symbolic link is followed: the file it points to is replaced.  The
+    new file keeps the permissions of the one it replaces (a new one gets
+    0666 less the umask, as ``open`` would give it).
+    """
+    path = os.fspath(path)
+    check_regular(path)
+    target = os.path.realpath(path)
+    folder = os.path.dirname(target)
+    while True:
+        tmp = os.path.join(folder, f".{os.path.basename(target)}.{secrets.token_hex(4)}{suffix}")
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+            break
+        except FileExistsError:
+            continue
+    try:
+        yield tmp
+        with contextlib.suppress(FileNotFoundError):
+            os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode))
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        raise
+
+
+@contextlib.contextmanager
+def atomic_write(path, mode="w", *, durable=True, **kwargs):
+    """``open(path, mode, **kwargs)`` written atomically.
 
     Parameters
     ----------
     path : str or os.PathLike
-        The file to write.  If it exists it must be a regular file
-        (:func:`check_regular`); a symbolic link is followed and the file it
-        points to is replaced.
-    mode : {"w", "a", "wb", "ab"}
+    mode : {"w", "wb", "a", "ab"}
         ``"w"`` replaces the file; ``"a"`` appends, by copying the existing
-        contents into the temporary file first.  ``"b"`` for bytes.
-    encoding, newline
-        As for :func:`open` (text modes only).
+        contents into the temporary file first.
     durable : bool
-        Also ``fsync`` the file before the rename (survives a power cut, not
-        only a crash; off for the many small appends of ``>>`` in a loop).
+        ``fsync`` the file before the rename (survives a power cut, not only
+        a crash; off for the many small appends of ``>>`` in a loop).
+    **kwargs
+        For :func:`open` (``encoding``, ``newline``).
 
     Yields
     ------
     file object
-        Write to it; the target changes only if the block completes.
+        Of the temporary file, which replaces ``path`` when the block ends
+        without an exception.
     """
-    if mode not in ("w", "a", "wb", "ab"):
-        raise ValueError(f"atomic_write: mode must be 'w', 'a', 'wb' or 'ab', not {mode!r}")
-    path = os.fspath(path)
-    check_regular(path)
-    target = os.path.realpath(path)
-    directory = os.path.dirname(target) or "."
-    binary = "b" in mode
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(target) + ".", suffix=".tmp",
-                               dir=directory)
-    try:
-        with os.fdopen(fd, "wb" if binary else "w",
-                       **({} if binary else {"encoding": encoding, "newline": newline})) as fh:
-            if mode.startswith("a") and os.path.exists(target):
-                with open(target, "rb") as old:
-                    data = old.read()
-                if binary:
-                    fh.write(data)
-                else:
-                    fh.flush()
-                    fh.buffer.write(data)
-            yield fh
-            fh.flush()
-            if durable:
-                os.fsync(fh.fileno())
-        try:
-            mode_bits = stat.S_IMODE(os.stat(target).st_mode)
-        except FileNotFoundError:
-            umask = os.umask(0)
-            os.umask(umask)
-            mode_bits = 0o666 & ~umask
-        os.chmod(tmp, mode_bits)
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+    if mode not in ("w", "wb", "a", "ab"):
+        raise ValueError(f"atomic_write: mode must be 'w', 'wb', 'a' or 'ab', not {mode!r}")
+    with atomic_path(path) as tmp, open(tmp, "w" + mode[1:], **kwargs) as fh:
+        if mode.startswith("a") and os.path.exists(path):
+            with open(path, "rb") as old:
+                data = old.read()
+            if "b" in mode:
+                fh.write(data)
+            else:
+                fh.flush()
+                fh.buffer.write(data)
+        yield fh
+        fh.flush()
+        if durable:
+            os.fsync(fh.fileno())

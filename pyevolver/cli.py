@@ -3,7 +3,8 @@
 ``pyevolver FILE.fe`` loads the datafile (running its ``read`` section) and
 then reads commands from the terminal (prompt ``Enter command: ``) or from
 standard input when it is not a terminal; ``-f FILE`` runs a command file
-after loading.  Errors become messages and exit codes here only.
+after loading.  ``pyevolver convert|show|sweep ...`` are the subcommands
+of :mod:`pyevolver.tools`.  Errors become messages and exit codes here only.
 """
 from __future__ import annotations
 
@@ -25,7 +26,9 @@ MORE = "more> "
 def build_parser():
     p = argparse.ArgumentParser(
         prog="pyevolver",
-        description="Surface Evolver datafiles and command scripts in Python.")
+        description="Surface Evolver datafiles and command scripts in Python.",
+        epilog="Other commands: pyevolver convert IN OUT | pyevolver show FILE.fe -o "
+               "shape.png | pyevolver sweep SPEC.toml  (each with --help)")
     p.add_argument("datafile", help="Surface Evolver datafile (.fe)")
     p.add_argument("-f", dest="command_file", help="command file to run after loading")
     p.add_argument("-p", dest="threads", type=int, default=1,
@@ -90,6 +93,11 @@ def _flush_quietly():
 
 
 def _main(argv=None):
+    from .tools import SUBCOMMANDS
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv and argv[0] in SUBCOMMANDS:        # a datafile named so: ./show
+        from .tools import main as tool_main
+        return tool_main(argv)
     args = build_parser().parse_args(argv)
     np.seterr(all="ignore")        # overflows are reported as Evolver warnings, not numpy's
     path = _find_datafile(args.datafile)
@@ -238,7 +246,8 @@ KEYWORDS = sorted({
     "printf", "errprintf", "sprintf", "list", "set", "unset", "fix", "unfix", "refine",
     "delete", "edgeswap", "histogram", "loghistogram", "read", "abort", "quit", "recalc",
     "vertex", "vertices", "edge", "edges", "facet", "facets", "body", "bodies",
-    "sum", "avg", "max", "min", "count", "hessian", "hessian_seek", "equiangulate",
+    "sum", "avg", "max", "min", "count", "hessian", "hessian_seek", "equiangulate", "bfgs",
+    "newton",
     "show_vol", "optimize", "integer", "real", "string", "on", "off",
 })
 ATTRIBUTES = ["id", "oid", "original", "x", "y", "z", "length", "area", "volume", "target",

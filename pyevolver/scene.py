@@ -102,5 +102,11 @@ class Scene:
         return int(self.values.get("space_dimension", 3))
 
     @property
+    def string(self):
+        """The string model (surface dimension 1: ``STRING`` or
+        ``SURFACE_DIMENSION 1``)."""
+        return "string" in self.flags or int(self.values.get("surface_dimension", 2)) == 1
+
+    @property
     def torus(self):
         return "torus" in self.flags or "torus_filled" in self.flags

@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from .api import SessionAPI, progress_bar
 from .commands import interpreter as I
 from .datafile.reader import read_datafile
 from .errors import (CommandError, DatafileError, ExpressionError, InternalError,
@@ -32,6 +33,7 @@ READ_ONLY = {
     "vertex_pop_count", "edge_pop_count", "notch_count", "refine_count", "where_count",
     "iteration_counter", "total_time", "random", "quantity_count", "symmetry_group",
     "simplex_representation", "lagrange_order", "date_and_time", "linear", "quadratic",
+    "clock",
 }
 DEFAULTS = {
     "scale": 0.1, "scale_limit": 1.0, "scale_scale": 1.0, "target_tolerance": 1e-4,
@@ -64,8 +66,14 @@ def _deferred_sigint():
         if old is not None:
             signal.signal(signal.SIGINT, old)
 
-class Session:
-    """A loaded surface with its variables, commands and output streams."""
+# motion options that change what g does; refused rather than ignored
+UNSUPPORTED_MOTION = ("area_normalization", "normal_motion", "runge_kutta",
+                      "approximate_curvature", "diffusion", "autopop", "jiggle")
+
+
+class Session(SessionAPI):
+    """A loaded surface with its variables, commands and output streams
+    (the Python API's extras: :class:`pyevolver.api.SessionAPI`)."""
 
     def __init__(self, out=None, err=None):
         self.out = out or sys.stdout
@@ -91,6 +99,12 @@ class Session:
         # seconds one top-level command may run (None: no limit); a command
         # that runs longer stops with an error and leaves the surface as it was
         self.time_limit = None
+        self.history = []                      # (iteration, energy, area) of each g step
+        self.command_history = []              # (number, text) of `history`, `!!` (REF: last 100)
+        self.command_count = 0
+        # REF reports some counts once per command, summed, at its end
+        # ("Fixed: N", "Unfixed: N" first, then "Edges refined: N", ...)
+        self.pending = {"Fixed": 0, "Unfixed": 0}
 
     # -- loading ---------------------------------------------------------------
     @classmethod
@@ -118,6 +132,12 @@ class Session:
                                       bool(b.n and np.any(b.density)))
         self.variables = surface.params        # parameters and variables share one namespace
         self._scene_settings(scene)
+        for flag in ("area_normalization", "autopop", "conj_grad"):
+            if flag in scene.flags:             # top-section toggles (100grain.fe)
+                self.toggles[flag] = 1
+        if scene.values.get("autochop"):
+            self.toggles["autochop"] = 1
+            self.settings["autochop_length"] = float(scene.values["autochop"])
         self.commands = {}
         self.letters = {}
         self.arrays = {}
@@ -153,6 +173,7 @@ class Session:
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
         from .datafile.writer import dump
+        self.no_string("dump")
         if name is None:
             name = (self.filename or "pyevolver") + ".dmp"
         self.write(f"Dumping to {name}.\n")
@@ -215,6 +236,9 @@ class Session:
         scene, new = self._read_new("addload", name)
         if self.surface is None:
             raise CommandError("addload: no surface is loaded")
+        if new.string:
+            self.no_string("addload", new)
+        self.no_string("addload")
         merged = append_surface(copy.deepcopy(self.surface), new)
         self.variables.update(merged.params)
         merged.params = self.variables
@@ -242,6 +266,12 @@ class Session:
         self.array_types["view_matrix"] = "real"
 
     # -- output -----------------------------------------------------------------
+    def note(self, text):
+        """A message that ``quiet`` suppresses (REF: counts after r, v, toggle
+        messages, mesh operation reports, the header of list)."""
+        if not self.toggles.get("quiet"):
+            self.write(text)
+
     def write(self, text):
         self.out.write(text)
 
@@ -267,7 +297,14 @@ class Session:
                 self.write_err(f"{exc}\n")
 
     def run_one(self, text, where="<command>", line=1):
+        stripped = text.strip()
+        if stripped.startswith("!") and not stripped.startswith("!="):
+            # !!, !n, !prefix: a command from the history, echoed (manual)
+            old = self._from_history(stripped[1:].strip())
+            self.write(old + "\n\n")
+            return self.run_one(old, where, line)
         ast = I.parse_command(text, where, line)
+        self._remember(stripped)
         snap = self._snapshot()
         scopes = self.interp.env.scopes
         depth = len(scopes)
@@ -313,7 +350,49 @@ class Session:
             del scopes[depth:]
             if outer:
                 interp.deadline = None
+            counts, self.pending = self.pending, {"Fixed": 0, "Unfixed": 0}
+        for word, n in counts.items():
+            if n and word in ("Fixed", "Unfixed"):
+                self.note(f"{word}: {n}\n")
+            elif n:
+                self.write(f"{word}: {n}\n")
         self.refresh()
+
+    HISTORY_SIZE = 100
+
+    def _remember(self, text):
+        """Successfully parsed commands go into the history list (the last
+        100, numbered from 1), as in REF."""
+        self.command_count = self.command_count + 1
+        h = self.command_history
+        h.append((self.command_count, text))
+        self.command_history = h[-self.HISTORY_SIZE:]
+
+    def _from_history(self, key):
+        h = self.command_history
+        if key == "!":
+            if h:
+                return h[-1][1]
+        elif key.isdigit():
+            for num, text in h:
+                if num == int(key):
+                    return text
+            raise CommandError("Command not in history list.")      # REF's ERROR 1587
+        else:
+            for num, text in reversed(h):
+                if text.startswith(key):
+                    return text
+        raise CommandError("Command not found in history.")          # REF's ERROR 1588
+
+    def show_history(self):
+        """``history``: the saved commands, ``n) text``."""
+        for num, text in self.command_history:
+            self.write(f"{num}) {text}\n")
+
+    def report(self, word, n):
+        """Add ``n`` to the count REF prints as ``word: total`` when the
+        current command ends."""
+        self.pending[word] = self.pending.get(word, 0) + n
 
     def _snapshot(self):
         s = self.surface
@@ -409,21 +488,40 @@ class Session:
         if self._iterator is not None:
             self._iterator.cg_history = None
 
-    def g(self, n=1, callback=None, echo=False):
+    def g(self, n=1, callback=None, echo=False, progress=None):
         """Run ``n`` iteration steps; returns the list of step results.
 
         ``callback(result)`` is called after each step; returning True stops
         the run.  With ``echo`` the Evolver's progress lines are printed.
+        ``progress``: a tqdm bar (True, False, or None for long runs at a
+        terminal or in a notebook; never with ``echo``).
         """
-        from .evolve.iterate import progress_line
+        for name in UNSUPPORTED_MOTION:
+            if self.toggles.get(name):
+                raise UnsupportedError(f"g with {name} on", "only the plain gradient motion "
+                                       "is implemented")
         results = []
         if self.surface.nv == 0:                # e.g. after `t` removed everything (REF)
             self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")
             return results
+        bar = None if echo else progress_bar(n, progress, "g")
+        try:
+            self._steps(n, callback, echo, results, bar)
+        finally:
+            if bar is not None:
+                bar.close()
+        return results
+
+    def _steps(self, n, callback, echo, results, bar):
+        from .evolve.iterate import progress_line
         for k in range(n, 0, -1):
             self.interp.tick()
             r = self.iterator.step()
             results.append(r)
+            self.history.append((self.iteration_counter, r.energy, r.area))
+            if bar is not None:
+                bar.update(1)
+                bar.set_postfix(energy=f"{r.energy:.10g}", refresh=False)
             L = self.settings.get("autochop_length", 0.0)
             if self.toggles.get("autochop") and L > 0:
                 # autochop (spec §9.5): edges longer than autochop_length after
@@ -433,8 +531,11 @@ class Session:
                 from .mesh.edge_divide import edge_divide, long_edges
                 chop = long_edges(self.surface, L)
                 if len(chop):
-                    new, nch = edge_divide(self.surface, chop)
-                    self._replace_surface(new)
+                    if self.surface.string:
+                        nch = self._string_split(chop)
+                    else:
+                        new, nch = edge_divide(self.surface, chop)
+                        self._replace_surface(new)
                     r.warnings.append(f"Autochopped {nch} edges.")
             if echo:
                 for w in r.warnings:
@@ -445,12 +546,11 @@ class Session:
                     else:
                         self.write(w + "\n")
                 if r.printed and not self.toggles.get("quiet") and not self.toggles.get("quietgo"):
-                    self.write(progress_line(k, r) + "\n")
+                    self.write(progress_line(k, r, self.surface.string) + "\n")
             if r.message == "increase":
                 break
             if callback is not None and callback(r):
                 break
-        return results
 
     def go(self, n):
         """``g n`` at the prompt: steps with progress lines.
@@ -465,7 +565,7 @@ class Session:
             # surface is the one after the last complete iteration
             raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
-    def bfgs(self, n, echo=True, callback=None):
+    def bfgs(self, n, echo=True, callback=None, progress=None):
         """``bfgs n``: at most ``n`` iterations of BFGS with a weak Wolfe line
         search (:mod:`pyevolver.evolve.bfgs`; Lewis & Overton 2013), the
         minimizer for nonsmooth energies such as ``circle_willmore``.  Free
@@ -474,10 +574,12 @@ class Session:
         Prints ``k. area: .. energy: ..`` per iteration (counting down, as
         ``g``) and returns the :class:`~pyevolver.evolve.bfgs.BFGSResult`;
         ``callback(result)`` may stop the run, and so does Ctrl-C (at the end
-        of the current iteration, the surface that of the last one)."""
+        of the current iteration, the surface that of the last one).
+        ``progress``: a tqdm bar, as for :meth:`g` (never with ``echo``)."""
         from .evolve import bfgs as B
         from .evolve.gradient import energy_gradient
         from .evolve.iterate import _Constraints
+        self.no_string("bfgs")
         s = self.surface
         if s is None or s.nv == 0:
             raise CommandError("bfgs: no surface loaded")
@@ -513,7 +615,10 @@ class Session:
                         area = s.evaluate().total_area
                     self.write("%3d. area: %#17.15g energy: %#17.15g  scale: %#g\n"
                                % (n - r.nit, area, r.energy, r.step))
+                if bar is not None:
+                    bar.update(1)
                 return flag["hit"] or (callback is not None and callback(r))
+            bar = None if echo else progress_bar(int(n), progress, "bfgs")
             try:
                 r = B.minimize(fun, s.X[idx].ravel().copy(), int(n), callback=cb)
                 s.X[idx] = r.x.reshape(-1, 3)
@@ -521,8 +626,42 @@ class Session:
                 restore_state(s, X0)
                 self.recalc()
                 raise
+            finally:
+                if bar is not None:
+                    bar.close()
         if echo and r.nit == 0:
             self.write(f"bfgs: no step taken ({r.message}).\n")
+        self.recalc()
+        return r
+
+    def newton(self, n, echo=True, callback=None):
+        """``newton n``: at most ``n`` damped Newton (Levenberg–Marquardt)
+        steps with the exact Hessian on all free coordinates
+        (:mod:`pyevolver.evolve.newton`); fixed volumes, FIXED quantities
+        and level-set constraints are honoured as in ``hessian``.  Prints
+        ``k. area: .. energy: ..  delta: ..`` per step (counting down, as
+        ``g``) and returns the :class:`~pyevolver.evolve.newton.NewtonResult`;
+        ``callback(result)`` may stop the run, and so does Ctrl-C (after the
+        current step)."""
+        from .evolve.newton import damped_newton
+        s = self.surface
+        if s is None or s.nv == 0:
+            raise CommandError("newton: no surface loaded")
+        with _deferred_sigint() as flag:
+            def cb(r):
+                if echo and not self.toggles.get("quiet"):
+                    self.write("%3d. area: %#17.15g energy: %#17.15g  delta: %#g\n"
+                               % (n - r.nit, self.totals.total_area, r.energy, r.delta))
+                return flag["hit"] or (callback is not None and callback(r))
+            X0 = state(s)
+            try:
+                r = damped_newton(self, n, callback=cb)
+            except Exception:
+                restore_state(self.surface, X0)
+                self.recalc()
+                raise
+        if echo and r.nit == 0:
+            self.write(f"newton: no step taken ({r.message}).\n")
         self.recalc()
         return r
 
@@ -532,6 +671,7 @@ class Session:
         (scale at most ``max``, default 1).  Returns a :class:`StepResult`."""
         from .evolve.hessian import newton_direction
         from .evolve.iterate import StepResult, _Constraints
+        self.no_string("hessian")
         it = self.iterator
         s = self.surface
         if not it.pressures_valid and len(_Constraints(s)):
@@ -579,65 +719,95 @@ class Session:
         self.surface = new
         self.recalc()
 
+    def no_string(self, what, surface=None):
+        """Refuse ``what`` by name on a string-model surface."""
+        s = self.surface if surface is None else surface
+        if s is not None and s.string:
+            raise UnsupportedError(f"{what} in the string model")
+
+    def _string_split(self, edges):
+        from .string_model import split_edges
+        self._replace_surface(split_edges(self.surface, edges))
+        return len(edges)
+
     def refine(self, echo=True):
         """``r``: refine every edge and facet (spec §8.1)."""
         from .mesh import refine
-        self._replace_surface(refine(self.surface))
+        s = self.surface
+        if s.string:
+            self._string_split(np.nonzero(~s.eattr["no_refine"])[0])
+        else:
+            self._replace_surface(refine(s))
         if "edge_divide_length" in self.settings:
             self.settings["edge_divide_length"] /= 2
         if "areaweed_area" in self.settings:
             self.settings["areaweed_area"] /= 4
         if echo:
-            s = self.surface
-            self.write(f"Vertices: {s.nv}  Edges: {s.ne}  Facets: {s.nf}  "
-                       f"Bodies: {s.bodies.n}  Facetedges: {3 * s.nf}\n")
+            self.note(self.counts_line())
+
+    def counts_line(self):
+        """``Vertices: ..  Edges: ..`` as after ``r`` and ``c``."""
+        s = self.surface
+        return (f"Vertices: {s.nv}  Edges: {s.ne}  Facets: {s.n_facets}  "
+                f"Bodies: {s.bodies.n}  Facetedges: {self.internal('facetedge_count'):.0f}\n")
 
     def refine_edges(self, edges, echo=True):
         """``refine edges where ...``: bisect the given edges (spec §8)."""
         from .mesh.edge_divide import edge_divide
-        new, n = edge_divide(self.surface, np.asarray(edges, np.int64))
-        self._replace_surface(new)
+        edges = np.asarray(edges, np.int64)
+        if self.surface.string:
+            n = self._string_split(np.unique(edges))
+        else:
+            new, n = edge_divide(self.surface, edges)
+            self._replace_surface(new)
         if echo:
-            self.write(f"Edges refined: {n}\n")
+            self.report("Edges refined", n)
 
     def refine_facets(self, facets, echo=True):
         """``refine facets where ...``: split each facet into three at its
         centroid (REF's report "Facets refined: N")."""
         from .mesh.notch import split_facets_at_centre
+        self.no_string("refine facets")
         f = np.unique(np.asarray(facets, np.int64))
         self._replace_surface(split_facets_at_centre(self.surface, f))
         if echo:
-            self.write(f"Facets refined: {len(f)}\n")
+            self.report("Facets refined", len(f))
 
     def equiangulate(self, echo=True):
         """``u``: one equiangulation sweep (spec §8.2)."""
         from .mesh.equiangulate import equiangulate
+        if self.surface.string:
+            raise CommandError("Cannot equiangulate string model.")      # REF's ERROR 2200
         new, n = equiangulate(self.surface)
         self._replace_surface(new)
         self.counts["equi"] = n                 # REF: the last sweep's flips
         if echo:
-            self.write(f"Edges switched in equiangulation: {n}\n")
+            self.note(f"Edges switched in equiangulation: {n}\n")
         return n
 
     def edgeswap(self, edges, echo=True):
         """``edgeswap gen``: flip the listed edges that are diagonals of
         quadrilaterals, whatever the angles (manual: EDGESWAP)."""
         from .mesh.equiangulate import equiangulate
+        self.no_string("edgeswap")
         only = np.zeros(self.surface.ne, bool)
         only[np.asarray(edges, np.int64)] = True
         new, n = equiangulate(self.surface, threshold=np.inf, only=only)
         self._replace_surface(new)
         if echo:
-            self.write(f"Edges swapped: {n}\n")
+            self.report("Edges swapped", n)
         return n
 
     def _bisect(self, edges, echo):
         from .mesh.edge_divide import edge_divide
-        new, n = edge_divide(self.surface, edges)
-        self._replace_surface(new)
+        if self.surface.string:
+            n = self._string_split(np.asarray(edges, np.int64))
+        else:
+            new, n = edge_divide(self.surface, edges)
+            self._replace_surface(new)
         self._count("refine", n)                # REF: l and K accumulate, r does not
         if echo:
-            self.write(f"New edges: {n}\n")
+            self.note(f"New edges: {n}\n")
         return n
 
     def edge_divide_long(self, length, echo=True):
@@ -650,18 +820,28 @@ class Session:
     def skinny(self, angle, echo=True):
         """``K θ``: bisect the longest edge of facets with an angle below θ."""
         from .mesh.edge_divide import skinny_edges
+        self.no_string("K (skinny triangles)")
         return self._bisect(skinny_edges(self.surface, angle), echo)
 
     def notch(self, angle, echo=True):
         """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""
         from .mesh.notch import notch
-        if self.surface.nf == 0:
-            raise UnsupportedError("notch in the string model")
+        self.no_string("notch")
         new, n = notch(self.surface, angle)
         self._replace_surface(new)
         self._count("notch", n)
         if echo:
-            self.write(f"Number of edges notched: {n}\n")
+            self.note(f"Number of edges notched: {n}\n")
+        return n
+
+    def pop_edges(self, echo=True):
+        """``O``: pop the edges with four facets (pyevolver.mesh.pop)."""
+        from .mesh.pop import pop_edges
+        new, n = pop_edges(self.surface)
+        self._replace_surface(new)
+        self.counts["edge_pop"] = n             # REF: a later O with no pops prints 0
+        if echo:
+            self.note(f"Edges popped: {n}\n")
         return n
 
     def _count(self, key, n):
@@ -670,17 +850,19 @@ class Session:
     def delete_short_edges(self, length, echo=True):
         """``t L`` / ``edgeweed L``: delete edges shorter than ``L`` (spec §8.4)."""
         from .mesh.delete_edges import delete_short_edges
+        self.no_string("t (edge weeding)")
         new, n = delete_short_edges(self.surface, length)
         self._replace_surface(new)
         self._count("edge_delete", n)
         if echo:
-            self.write(f"Deleted edges: {n}\n")
+            self.note(f"Deleted edges: {n}\n")
         return n
 
     def delete_elements(self, kind, items, echo=True):
         """``delete edges ...`` / ``delete facets ...``: delete the edges (or,
         per facet, its shortest deletable side) as ``t`` / ``w`` do."""
         from .mesh.delete_edges import delete_edges, delete_facets
+        self.no_string("delete")
         fn = delete_edges if kind == "edge" else delete_facets
         new, n = fn(self.surface, items)
         self._replace_surface(new)
@@ -706,7 +888,7 @@ class Session:
         new.__dict__.pop("_lift_cache", None)
         new.X = s.X.copy()
         idx = np.nonzero(move)[0]
-        new.X[idx] += sigma * self.rng.standard_normal((len(idx), 3))
+        new.X[idx, :s.sdim] += sigma * self.rng.standard_normal((len(idx), s.sdim))
         self._project_or_fail(new, idx)
         self._replace_surface(new)
         if echo:
@@ -716,21 +898,25 @@ class Session:
         """``w A`` / ``areaweed A``: remove facets of area below ``A`` by
         deleting one of their edges, shortest first (spec §8.4)."""
         from .mesh.delete_edges import weed_small_facets
+        if self.surface.string:
+            raise CommandError("Can only do area weed on soapfilm model.")   # REF's ERROR 1339
         new, n = weed_small_facets(self.surface, area)
         self._replace_surface(new)
         self._count("edge_delete", n)
         if echo:
-            self.write(f"Skinny triangles weeded: {n}\n")
+            self.note(f"Skinny triangles weeded: {n}\n")
         return n
 
     def vertex_average(self, mode="V", echo=True):
         """``V``, ``rawv``, ``rawestv``: vertex averaging (spec §8.3)."""
         from .mesh.vertex_average import vertex_average
-        if self.surface.nf == 0:
-            raise CommandError("vertex averaging needs facets (string model is not supported)")
-        self._replace_surface(vertex_average(self.surface, mode))
+        if self.surface.string:
+            from .string_model import vertex_average as string_average
+            self._replace_surface(string_average(self.surface, mode))
+        else:
+            self._replace_surface(vertex_average(self.surface, mode))
         if echo:
-            self.write("Vertex averaging done.\n")
+            self.note("Vertex averaging done.\n")
 
     def refresh(self):
         if self.toggles.get("autorecalc", 1):
@@ -776,6 +962,9 @@ class Session:
             return N.CONSTANTS[name]
         if s is not None and name in s.quantities:
             return I.QRef(name)
+        for cid, cname in getattr(s, "constraint_names", {}).items():
+            if cname == name:
+                return float(cid)
         if name in self.toggles or name in I.TOGGLES:
             return float(self.toggles.get(name, I.TOGGLE_DEFAULTS.get(name, 0)))
         if s is None:
@@ -785,9 +974,9 @@ class Session:
             "total_area": lambda: t.total_area,
             "total_length": lambda: t.total_length,
             "vertex_count": lambda: s.nv, "edge_count": lambda: s.ne,
-            "facet_count": lambda: s.nf, "body_count": lambda: s.bodies.n,
-            "facetedge_count": lambda: 3 * s.nf,
-            "space_dimension": lambda: s.sdim, "surface_dimension": lambda: 2,
+            "facet_count": lambda: s.n_facets, "body_count": lambda: s.bodies.n,
+            "facetedge_count": lambda: self._facetedge_count(),
+            "space_dimension": lambda: s.sdim, "surface_dimension": lambda: 1 if s.string else 2,
             "torus": lambda: 1 if s.periods is not None else 0,
             "datafilename": lambda: self.filename,
             "gravity_constant": lambda: s.gravity_constant,
@@ -805,7 +994,10 @@ class Session:
             "quantity_count": lambda: len(s.quantities),
             "symmetry_group": lambda: 0, "simplex_representation": lambda: 0,
             "lagrange_order": lambda: 1, "linear": lambda: 1, "quadratic": lambda: 0,
+            "lagrange": lambda: 0,
             "date_and_time": lambda: time.strftime("%a %b %d %H:%M:%S %Y"),
+            # elapsed seconds since the session started, as REF's clock
+            "clock": lambda: time.time() - self.start_time,
         }
         fn = simple.get(name)
         if fn is None:
@@ -813,10 +1005,17 @@ class Session:
         v = fn()
         return v if isinstance(v, str) else float(v)
 
+    def _facetedge_count(self):
+        s = self.surface
+        if s.string:
+            from .string_model import facetedge_count
+            return facetedge_count(s)
+        return 3 * s.nf
+
     # -- elements ------------------------------------------------------------------------
     def count(self, kind):
         s = self.surface
-        return {"vertex": s.nv, "edge": s.ne, "facet": s.nf, "body": s.bodies.n}[kind]
+        return {"vertex": s.nv, "edge": s.ne, "facet": s.n_facets, "body": s.bodies.n}[kind]
 
     def element(self, kind, index):
         k = I.as_int(index, f"a {kind} index")
@@ -883,7 +1082,12 @@ class Session:
     def sub_elements(self, el, kind):
         s = self.surface
         i = el.i
+        if s.string and "facet" in (el.kind, kind) and el.kind != "body":
+            return self._string_sub_elements(el, kind)
         if el.kind == "vertex":
+            if kind == "edge" and "ring_time" in s.eattr:
+                from .string_model import vertex_edges
+                return [I.ElemRef("edge", e, g) for e, g in vertex_edges(s, i)]
             if kind == "edge":
                 # oriented away from the vertex (oid < 0 where it is the head);
                 # the Evolver's order on a freshly loaded surface: the first
@@ -927,6 +1131,31 @@ class Session:
             return [I.ElemRef("facet", int(f), int(np.sign(v))) for f, v in zip(row.col, row.data)]
         raise ExpressionError(f"{el.kind} has no {kind}s")
 
+    def _string_sub_elements(self, el, kind):
+        """Facet navigation in the string model (facets are edge chains)."""
+        from . import string_model as SM
+        s = self.surface
+        i = el.i
+        if el.kind == "facet":
+            if kind == "vertex":
+                return [I.ElemRef("vertex", v) for v in SM.chain_vertices(s, i, el.sign)]
+            if kind == "edge":
+                enc = SM.chain(s, i)
+                if el.sign < 0:
+                    enc = ~enc[::-1]
+                return [I.ElemRef("edge", int(e if e >= 0 else ~e), 1 if e >= 0 else -1)
+                        for e in enc]
+            if kind == "body":
+                col = s.bodies.facet_matrix[:, i].tocoo()
+                return [I.ElemRef("body", int(b)) for b in col.row]
+        if el.kind == "edge" and kind == "facet":
+            return [I.ElemRef("facet", f, g * el.sign) for f, g in SM.facets_of_edge(s, i)]
+        if el.kind == "vertex" and kind == "facet":
+            owner, e, _, _, _ = SM.facet_entries(s)
+            mine = (s.E[e] == i).any(axis=1)
+            return [I.ElemRef("facet", int(f)) for f in np.unique(owner[mine])]
+        raise ExpressionError(f"{el.kind} has no {kind}s")
+
     # -- attributes ------------------------------------------------------------------------
     def get_attr(self, base, name, idx):
         if idx is not None:                     # indices are integers (C truncation)
@@ -961,6 +1190,8 @@ class Session:
             if k == "edge":
                 return float(bool(s.eattr["fixed"][i]) or
                              len(self.sub_elements(base, "facet")) != 2)
+        if s.sdim == 2 and name in ("z", "x3") and k in ("vertex", "edge", "facet"):
+            raise ExpressionError("Coordinate dimension exceeds space dimension.")  # REF 2475
         if k == "vertex":
             coords = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}
             if name == "x" and idx is not None:          # x[2] is y
@@ -972,6 +1203,8 @@ class Session:
                 return float(s.X[i, coords[name]])
             if name == "__x" and idx is not None:
                 return float(s.X[i, int(idx) - 1])
+            if name == "__x":
+                return N.array_value(s.X[i, :s.sdim])
             if name == "fixed":
                 return float(s.vattr["fixed"][i])
             if name in ("on_constraint", "hit_constraint"):
@@ -983,15 +1216,18 @@ class Session:
             if name == "valence":
                 return float(np.count_nonzero((s.E == i).any(axis=1)))
             if name in ("vertexnormal", "vertex_normal"):
-                if idx is None or isinstance(idx, tuple):
+                if isinstance(idx, tuple):
                     raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
-                j = int(idx)
-                if j < 1 or j > s.sdim:
-                    raise ExpressionError(f"{name}[{j}]: index outside 1..{s.sdim}")
                 from .geometry import vertex_normals
                 if s.nf == 0:
                     raise UnsupportedError("vertex_normal in the string model")
-                return float(vertex_normals(s.F, t.facet_N2, s.nv)[i, j - 1])
+                nrm = vertex_normals(s.F, t.facet_N2, s.nv)[i]
+                if idx is None:
+                    return N.array_value(nrm)
+                j = int(idx)
+                if j < 1 or j > s.sdim:
+                    raise ExpressionError(f"{name}[{j}]: index outside 1..{s.sdim}")
+                return float(nrm[j - 1])
             if name in ("p1", "p2") and "params" in s.vattr:
                 return float(s.vattr["params"][i, int(name[1]) - 1])
         elif k == "edge":
@@ -999,6 +1235,15 @@ class Session:
                 return float(t.edge_length[i])
             if name in ("x", "y", "z"):
                 return float(t.edge_vec[i, "xyz".index(name)] * base.sign)
+            if name == "edge_vector":
+                if idx is None:
+                    return N.array_value(t.edge_vec[i, :s.sdim] * base.sign)
+                if isinstance(idx, tuple):
+                    raise ExpressionError("edge_vector takes one index")
+                j = int(idx)
+                if j < 1 or j > s.sdim:
+                    raise ExpressionError(f"edge_vector[{j}]: index outside 1..{s.sdim}")
+                return float(t.edge_vec[i, j - 1] * base.sign)
             if name in ("tension", "density"):
                 return float(s.edge_tension[i])
             if name == "fixed":
@@ -1013,12 +1258,18 @@ class Session:
                 return float(b is not None and b[i] == int(idx))
             if name == "valence":
                 return float(len(self.sub_elements(base, "facet")))
+            if name == "orientation":
+                return float(base.sign)
             if name in ("color", "colour"):
                 c = s.eattr.get("color")
                 return float(c[i]) if c is not None else 0.0
         elif k == "facet":
             if name == "area":
-                return float(t.facet_area[i])
+                return float((t.sfacet_area if s.string else t.facet_area)[i])
+            if s.string and name in ("x", "y", "z", "valence"):
+                if name == "valence":
+                    return float(s.sf_ptr[i + 1] - s.sf_ptr[i])
+                raise UnsupportedError(f"facet normal ({name}) in the string model")
             if name in ("x", "y", "z"):
                 j = "xyz".index(name)
                 if s.periods is None and s.sdim == 3:
@@ -1042,6 +1293,12 @@ class Session:
                 return float(c[i]) if c is not None else 15.0     # white (REF default)
             if name == "valence":
                 return 3.0
+            if name in ("frontbody", "backbody"):
+                # the body the facet bounds positively (front) or negatively
+                col = s.bodies.facet_matrix[:, i].tocoo()
+                want = 1 if name == "frontbody" else -1
+                hit = [int(b) + 1 for b, v in zip(col.row, col.data) if np.sign(v) == want]
+                return float(hit[0]) if hit else 0.0
         elif k == "body":
             b = s.bodies
             if name == "volume":
@@ -1109,8 +1366,16 @@ class Session:
                 if isinstance(idx, tuple) else I.as_int(idx, f"the index of '{name}'")
         if isinstance(value, str):
             raise CommandError(f"cannot assign a string to '.{name}'")
-        value = I.as_float(value, f"the value of '.{name}'")
         s = self.surface
+        if isinstance(value, N.ArrayValue):
+            key = (getattr(base, "kind", None), name)
+            arr = s.extra.get(key)
+            if arr is None or idx is not None or arr.shape[1:] != value.shape:
+                raise CommandError(f"cannot assign an array of shape {list(value.shape)} to "
+                                   f"'.{name}'")
+            arr[base.i] = np.asarray(value)
+            return
+        value = I.as_float(value, f"the value of '.{name}'")
         if isinstance(base, I.QRef):
             q = s.quantities[base.name]
             if name in ("target", "modulus", "tolerance"):
@@ -1126,6 +1391,8 @@ class Session:
                 value = float(int(value))            # C conversion truncates
             if arr.ndim == 1:
                 arr[i] = value
+            elif idx is None:
+                arr[i] = value                  # every entry (REF: set vertex vec 0)
             else:
                 arr[(i,) + self._attr_pos(k, name, arr, idx)] = value
             return
@@ -1221,6 +1488,9 @@ class Session:
             raise UnsupportedError(f"unset {gen.kind} {attr}")
         if expr is None:
             raise UnsupportedError(f"set {gen.kind} {attr} (without a value)")
+        if attr == "constraint":
+            self.set_constraint(els, self.interp.value(expr))
+            return
         # compute every value first, then assign (like the Evolver's set)
         vals = []
         ix = None if idx is None else self.interp.value(idx)
@@ -1241,6 +1511,70 @@ class Session:
             vid = surface.ids("vertex")[bad[0]]
             raise CommandError(f"the projection of vertex {vid} onto its constraints "
                                f"diverges")
+
+    def set_constraint(self, els, cid):
+        """``set gen constraint n``: put the elements on level-set constraint
+        ``n`` (a number or a name from ``define constraint``); vertices are
+        projected onto it at once (REF)."""
+        s = self.surface
+        if isinstance(cid, str) or int(cid) not in s.constraints:
+            raise CommandError(f"constraint {cid if isinstance(cid, str) else int(cid)} "
+                               f"is not defined")
+        cid = int(cid)
+        moved = []
+        for el in els:
+            if el.kind == "vertex":
+                m = s.vcon.setdefault(cid, np.zeros(s.nv, bool))
+                m[el.i] = True
+                moved.append(el.i)
+            elif el.kind == "edge":
+                s.econ.setdefault(cid, np.zeros(s.ne, np.int8))[el.i] = 1
+            elif el.kind == "facet" and not s.string:
+                s.fcon.setdefault(cid, np.zeros(s.nf, bool))[el.i] = True
+            else:
+                raise CommandError("constraints belong to vertices, edges and facets")
+        if moved:
+            project_to_constraints(s, np.array(moved, np.int64))
+
+    def define_constraint(self, text):
+        """``define constraint NAME [flags] formula: expr [energy: ...] [content:
+        ...]`` at run time: a level-set constraint numbered after the existing
+        ones and known by its name (REF: ``list`` shows the name,
+        ``on_constraint NAME`` and ``set ... constraint NAME`` use it)."""
+        import re
+        from .datafile.preprocess import Section
+        from .datafile.reader import Reader
+        m = re.match(r"\s*define\s+constraint\s+([a-z_]\w*)(.*)\Z", text, re.I | re.S)
+        if m is None:
+            raise CommandError("define constraint: expected a name, e.g. "
+                               "define constraint cc formula: x^2 + y^2 = 1")
+        name, rest = m.group(1).lower(), m.group(2)
+        arr = re.search(r"([a-z_]\w*)\s*\[", rest, re.I)
+        if arr:
+            raise UnsupportedError(f"array elements in constraint formulas ({arr.group(1)}[...] "
+                                   f"in constraint {name})")
+        s = self.surface
+        names = getattr(s, "constraint_names", {})
+        cid = next((c for c, n in names.items() if n == name), None)
+        if cid is None:
+            if name in self.variables or name in self.commands:
+                raise CommandError(f"define constraint: '{name}' is already a variable or command")
+            cid = max(s.constraints, default=0) + 1
+        reader = Reader("<define constraint>", "")
+        reader.scene.parameters = {k: v for k, v in self.variables.items()
+                                   if isinstance(v, float)}
+        reader._top(Section("top", f"constraint {cid} {rest}\n", 1, [1]))
+        decl = reader.scene.constraints[cid]
+        s.constraints = {**s.constraints, cid: decl}
+        s.constraint_names = {**names, cid: name}
+        if "global" in decl.flags:
+            s.vcon[cid] = np.ones(s.nv, bool)
+            s.econ[cid] = np.ones(s.ne, np.int8)
+            project_to_constraints(s, np.arange(s.nv))
+
+    def constraint_label(self, cid):
+        """A constraint's number, or its name when defined at run time."""
+        return getattr(self.surface, "constraint_names", {}).get(cid, str(cid))
 
     def unset_constraint(self, els, cid):
         s = self.surface
@@ -1339,54 +1673,164 @@ class Session:
 
     # -- listing ---------------------------------------------------------------------------------
     def list_elements(self, gen, env):
-        s = self.surface
+        """``list gen``: datafile-style lines in REF's formats (measured on
+        evolver-nox-d: mound, catbody, column, twointor, string files)."""
         els = self.generate(gen, env)
         kind = gen.kind or (els[0].kind if els else None)
+        fn = {"vertex": self._list_vertex, "edge": self._list_edge,
+              "facet": self._list_facet, "body": self._list_body}.get(kind)
+        if fn is None:
+            return
+        self.note({"vertex": "// Id               X                Y" +
+                    ("               Z" if self.surface.sdim == 3 else ""),
+                    "edge": "// Id    endpoints", "facet": "// Id    edges",
+                    "body": "// Id    facets"}[kind] + "\n")
+        for el in els:
+            self.write(fn(el.i) + "\n")
+
+    @staticmethod
+    def _wrapped(items, indent):
+        """Ids ``"%d "`` each, a `` \\`` line break after every tenth (REF)."""
+        out = []
+        for k, it in enumerate(items, 1):
+            out.append(f"{it} ")
+            if k % 10 == 0:
+                out.append("\\\n" + " " * indent)
+        return "".join(out)
+
+    def _list_vertex(self, i):
+        s = self.surface
+        vid = s.ids("vertex")
+        sd = s.sdim
+        bnd = s.vattr.get("boundary")
+        if bnd is not None and bnd[i]:
+            b = s.boundaries[int(bnd[i])]
+            par = " ".join(f"{p:17.15g}" for p in s.vattr["params"][i, :b.nparams])
+            xyz = "".join(f" {x:17.15g}" for x in s.X[i, :sd])
+            line = f"{vid[i]:3d}  {par}  boundary {int(bnd[i])}  /* ({xyz}) */"
+        else:
+            line = f"{vid[i]:3d}  " + " ".join(f"{x:17.15g}" for x in s.X[i, :sd])
+        cons = [c for c in sorted(s.vcon) if s.vcon[c][i]]
+        if cons:
+            line += "  constraints " + " ".join(map(self.constraint_label, cons)) + " "
+        if s.vattr["fixed"][i]:
+            line += " fixed "
+        return line + self._extra_text("vertex", i)
+
+    def _extra_text(self, kind, i):
+        """Defined attributes as REF lists them: `` name value`` each (reals
+        ``%2.15g``, integers ``%d``, arrays in braces)."""
+        out = []
+        for (k, name), arr in self.surface.extra.items():
+            if k != kind:
+                continue
+            integer = self.attr_types.get((k, name)) == "integer"
+            fmt = (lambda v: "%d" % int(v)) if integer else (lambda v: "%2.15g" % v)
+            v = arr[i]
+            if np.ndim(v):
+                txt = "{" + ",".join(fmt(x) for x in np.ravel(v)) + "} "
+            else:
+                txt = fmt(v)
+            out.append(f" {name} {txt}")
+        return "".join(out)
+
+    @staticmethod
+    def _colour_name(c):
+        names = {v: k for k, v in N.COLOURS.items() if k != "transparent"}
+        return names.get(int(c), str(int(c)))
+
+    def _list_edge(self, i):
+        s = self.surface
         t = self.totals
-        w = self.write
-        vid, eid, fid = s.ids("vertex"), s.ids("edge"), s.ids("facet")
-        if kind == "vertex":
-            w("// Id               X                Y               Z\n")
-            for el in els:
-                x = s.X[el.i]
-                line = f"{vid[el.i]:3d}  {x[0]:17.15g} {x[1]:17.15g} {x[2]:17.15g}"
-                cons = [c for c in sorted(s.vcon) if s.vcon[c][el.i]]
-                if cons:
-                    line += "  constraints " + " ".join(map(str, cons)) + " "
-                if s.vattr["fixed"][el.i]:
-                    line += " fixed "
-                w(line + "\n")
-        elif kind == "edge":
-            w("// Id    endpoints\n")
-            for el in els:
-                a, b = vid[s.E[el.i]]
-                line = f"{eid[el.i]:3d}   {a:5d} {b:4d}     /*length {t.edge_length[el.i]:g}*/"
-                eorig = s.eattr.get("original")
-                if eorig is not None and eorig[el.i] and eorig[el.i] != eid[el.i]:
-                    line += f"  original {eorig[el.i]}"
-                if s.eattr["fixed"][el.i]:
-                    line += " fixed"
-                w(line + "\n")
-        elif kind == "facet":
+        vid, eid = s.ids("vertex"), s.ids("edge")
+        a, b = vid[s.E[i]]
+        line = f"{eid[i]:3d}   {a:5d} {b:4d}    "
+        w = s.eattr.get("wrap")
+        if w is not None:
+            line += " " + " ".join({0: "*", 1: "+", -1: "-"}.get(int(x), "?")
+                                   for x in w[i, :s.sdim])
+        ten = s.edge_tension[i]
+        if ten != (1.0 if s.string else 0.0):
+            line += f"  density {ten:g} "
+        cons = [c for c in sorted(s.econ) if s.econ[c][i]]
+        if cons:
+            line += "  constraints " + " ".join(
+                ("-" if s.econ[c][i] < 0 else "") + self.constraint_label(c) for c in cons) + " "
+        eb = s.eattr.get("boundary")
+        if eb is not None and eb[i]:
+            line += f"  boundary {int(eb[i])} "
+        if s.eattr["fixed"][i]:
+            line += "fixed "
+        if s.eattr["no_refine"][i]:
+            line += " no_refine "
+        col = s.eattr.get("color")
+        if col is not None and col[i] != 0:
+            line += f" color {self._colour_name(col[i])} "
+        line += f" /*length {t.edge_length[i]:g}*/ "
+        eorig = s.eattr.get("original")
+        if eorig is not None and eorig[i] and eorig[i] != eid[i]:
+            line += f" original {eorig[i]}"
+        return line + self._extra_text("edge", i)
+
+    def _list_facet(self, i):
+        s = self.surface
+        t = self.totals
+        eid, fid = s.ids("edge"), s.ids("facet")
+        if s.string:
+            from .string_model import chain
+            enc = chain(s, i)
+            edges = [int(eid[e]) if e >= 0 else -int(eid[~e]) for e in enc]
+            area = t.sfacet_area[i]
+        else:
             from .geometry import edge_index
-            w("// Id    edges\n")
-            for el in els:
-                idx, sgn = edge_index(s.FE[el.i])
-                es = " ".join(str(int(eid[e] * g)) for e, g in zip(idx, sgn))
-                orig = s.fattr["original"][el.i]
-                line = f"{fid[el.i]:3d}   {es} /*area {t.facet_area[el.i]:g}*/"
-                if orig and orig != fid[el.i]:
-                    line += f" original {orig}"
-                w(line + "\n")
-        elif kind == "body":
-            w("// Id   facets\n")
-            b = s.bodies
-            for el in els:
-                line = f"{el.i + 1:3d}"
-                if not math.isnan(b.target[el.i]):
-                    line += f"   volume {b.target[el.i]:.15g}"
-                line += f" /*actual: {t.volumes[el.i]:.15g}*/ lagrange_multiplier {b.lagrange[el.i]:.15g}"
-                w(line + "\n")
+            idx, sgn = edge_index(s.FE[i])
+            edges = [int(eid[e] * g) for e, g in zip(idx, sgn)]
+            area = t.facet_area[i]
+        attrs = ""
+        cons = [c for c in sorted(s.fcon) if s.fcon[c][i]]
+        if cons:
+            attrs += " constraints " + " ".join(map(str, cons)) + "  "
+        if not s.string and s.facet_tension[i] != 1.0:
+            attrs += f" density {s.facet_tension[i]:g} "
+        if s.fattr["fixed"][i]:
+            attrs += " fixed "
+        if s.fattr["no_refine"][i]:
+            attrs += " no_refine "
+        front = s.fattr.get("frontcolor", s.fattr.get("color"))
+        back = s.fattr.get("backcolor", s.fattr.get("color"))
+        fc = int(front[i]) if front is not None else 15
+        bc = int(back[i]) if back is not None else 15
+        if fc != 15:
+            attrs += f"color {self._colour_name(fc)} "
+        if bc != fc:
+            attrs += (" " if attrs else "") + f"backcolor {self._colour_name(bc)} "
+        line = (f"{fid[i]:3d}   " + self._wrapped(edges, 15) + attrs + (" " if attrs else "")
+                + f"/*area {area:g}*/")
+        orig = s.fattr["original"][i]
+        if orig and orig != fid[i]:
+            line += f" original {orig}"
+        return line + self._extra_text("facet", i)
+
+    def _list_body(self, i):
+        s = self.surface
+        t = self.totals
+        b = s.bodies
+        fid = s.ids("facet")
+        ob, of, osg = b.occurrences
+        sel = np.nonzero(ob == i)[0]
+        facets = [int(fid[f] * g) for f, g in zip(of[sel], osg[sel])]
+        line = f"{i + 1:3d}       " + self._wrapped(facets, 11)
+        if not math.isnan(b.target[i]):
+            line += (f" volume {b.target[i]:.15g}  /*actual: {t.volumes[i]:.15g}*/ "
+                     f"lagrange_multiplier {b.lagrange[i]:.15g}  ")
+        line += "centerofmass "
+        if not math.isnan(b.pressure[i]):
+            line += f"  pressure {b.pressure[i]:.15g}"
+        if b.volconst[i]:
+            line += f"  volconst {b.volconst[i]:.15g} "
+        if b.density[i]:
+            line += f"  density {b.density[i]:.15g} "
+        return line + self._extra_text("body", i)
 
     # -- reports ------------------------------------------------------------------------------------
     def show_vol(self):

@@ -79,6 +79,11 @@ class Surface:
         self.gap_constant = 1.0
         self.sq_curvature_modulus = 0.0     # legacy SQUARED_CURVATURE c
         self.curvature_mode = "plain"       # toggles: effective_area -> eff, normal_curvature -> norm
+        # the string model (surface dimension 1): facets are edge chains kept in
+        # sf_ptr / sf_enc (pyevolver.string_model) and FE stays empty
+        self.string = False
+        self.sf_ptr = np.zeros(1, np.int64)
+        self.sf_enc = np.zeros(0, np.int64)
 
     # -- topology helpers ---------------------------------------------------
     @property
@@ -92,6 +97,12 @@ class Surface:
     @property
     def nf(self):
         return len(self.FE)
+
+    @property
+    def n_facets(self):
+        """Facets as the command language counts them: the edge chains in
+        the string model, the triangles otherwise."""
+        return len(self.sf_ptr) - 1 if self.string else len(self.FE)
 
     def topology(self):
         """Topology-derived arrays, cached while ``E`` and ``FE`` are the same
@@ -128,7 +139,7 @@ class Surface:
         after loading; deletions (``t``, ``w``, ...) leave gaps, as in the
         Evolver, and new elements take ids above the largest."""
         attrs = {"vertex": self.vattr, "edge": self.eattr, "facet": self.fattr}[kind]
-        n = {"vertex": self.nv, "edge": self.ne, "facet": self.nf}[kind]
+        n = {"vertex": self.nv, "edge": self.ne, "facet": self.n_facets}[kind]
         a = attrs.get("id")
         return a if a is not None else np.arange(1, n + 1)
 
@@ -154,6 +165,9 @@ class Surface:
     # -- evaluation --------------------------------------------------------
     def evaluate(self):
         """Compute energy, area, volumes and quantity values (a :class:`Totals`)."""
+        if self.string:
+            from .string_model import StringTotals
+            return StringTotals(self)
         return Totals(self)
 
 
@@ -433,9 +447,16 @@ class _Builder:
         sc, s = self.sc, self.s
         s.params = dict(sc.parameters)
         s.sdim = sc.space_dimension
-        if s.sdim != 3:
+        s.string = sc.string
+        sd = int(sc.values.get("surface_dimension", 1 if s.string else 2))
+        if sd not in (1, 2):
+            raise self.error(f"not supported in pyevolver: SURFACE_DIMENSION {sd} "
+                             f"(the simplex model)")
+        if s.sdim != 3 and not (s.string and s.sdim == 2):
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
-                             f"(only 3 is supported)")
+                             f"(3, or 2 in the string model)")
+        if s.string and sc.torus and s.sdim != 2:
+            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model")
         s.constraints = dict(sc.constraints)
         s.boundaries = dict(sc.boundaries)
         s.symmetric_content = "symmetric_content" in sc.flags
@@ -445,7 +466,10 @@ class _Builder:
         s.sq_curvature_modulus = float(sc.values.get("squared_curvature", 0.0))
         if sc.torus:
             vals = sc.values.get("_periods")
-            P = np.eye(3) if vals is None else np.array(vals).reshape(3, 3)
+            sd = s.sdim
+            P = np.eye(3)
+            if vals is not None:            # a 2-d torus keeps z out of its cell
+                P[:sd, :sd] = np.array(vals).reshape(sd, sd)
             s.periods = P
         self._vertices()
         self._edges()
@@ -453,6 +477,8 @@ class _Builder:
         self._bodies()
         self._quantities()
         self._project()
+        if s.nf:
+            record_edge_first_facet(s, first_facets_on_load(s.FE, self.facet_parent, s.ne))
         return s
 
     def _constraint_ids(self, vals, what, blk, pos):
@@ -473,20 +499,21 @@ class _Builder:
         n = len(blk.ids)
         self.vid = _IdMap(blk.ids, "vertex", sc.filename, blk.lines)
         X = np.zeros((n, 3))
+        sd = s.sdim                 # 2-d surfaces keep a zero z column
         fixed = np.zeros(n, bool)
         bnd = None
         params = None
         table = isinstance(blk.data, np.ndarray)
         if table:
-            if blk.data.shape[1] != 3:
-                raise self.error(f"vertex {blk.ids[0]}: expected 3 coordinates, got "
+            if blk.data.shape[1] != sd:
+                raise self.error(f"vertex {blk.ids[0]}: expected {sd} coordinates, got "
                                  f"{blk.data.shape[1]}", blk.lines[0])
-            X[:] = blk.data
+            X[:, :sd] = blk.data
             simple = range(n)
         else:
-            simple = [k for k, d in enumerate(blk.data) if len(d) == 3]
+            simple = [k for k, d in enumerate(blk.data) if len(d) == sd]
             if len(simple) == n and n:
-                X[:] = np.array(blk.data, dtype=float)
+                X[:, :sd] = np.array(blk.data, dtype=float)
         for pos, attrs in blk.attrs.items():
             for kw, vals in attrs:
                 if kw == "fixed":
@@ -520,11 +547,11 @@ class _Builder:
                     raise self.error(f"vertex {blk.ids[pos]}: boundary {b.id} needs "
                                      f"{b.nparams} parameter(s), got {len(d)}", blk.lines[pos])
                 params[pos, :len(d)] = d
-            elif len(d) != 3:
-                raise self.error(f"vertex {blk.ids[pos]}: expected 3 coordinates, got {len(d)}",
-                                 blk.lines[pos])
+            elif len(d) != sd:
+                raise self.error(f"vertex {blk.ids[pos]}: expected {sd} coordinates, got "
+                                 f"{len(d)}", blk.lines[pos])
             elif len(simple) != n:
-                X[pos] = d
+                X[pos, :sd] = d
         for cid, c in sc.constraints.items():
             if "global" in c.flags:
                 s.vcon[cid] = np.ones(n, bool)
@@ -575,7 +602,7 @@ class _Builder:
             raw = np.array(blk.data, dtype=np.int64)
             E[:] = self.vid.lookup(raw, blk.lines, "edge", blk.ids)
         fixed = np.zeros(n, bool)
-        tension = None
+        tension = np.ones(n) if s.string else None     # string edges: tension 1
         bnd = None
         no_refine = np.zeros(n, bool)
         for pos, attrs in blk.attrs.items():
@@ -621,7 +648,7 @@ class _Builder:
         if s.periods is not None:
             w = np.zeros((n, 3))
             for pos, wr in sc.wraps.items():
-                w[pos] = wr
+                w[pos, :len(wr)] = wr
             s.eattr["wrap"] = w
         for cid, c in sc.constraints.items():
             if "global" in c.flags:
@@ -633,6 +660,8 @@ class _Builder:
         blk = sc.faces
         nface = len(blk.ids)
         self.fid = _IdMap(blk.ids, "face", sc.filename, blk.lines)
+        if s.string:
+            return self._string_faces()
         ne0 = s.ne
         # per-face attributes
         fixed = np.zeros(nface, bool)
@@ -831,6 +860,79 @@ class _Builder:
         if s.periods is not None and nnew_v:
             self._torus_centers(big, starts, lengths, enc, nface)
 
+    def _string_faces(self):
+        """String model: a facet is a chain of edges, open or closed, kept as
+        it is (no triangulation)."""
+        sc, s = self.sc, self.s
+        blk = sc.faces
+        nface = len(blk.ids)
+        fixed = np.zeros(nface, bool)
+        tension = np.zeros(nface)
+        no_refine = np.zeros(nface, bool)
+        colors = {}
+        for pos, attrs in blk.attrs.items():
+            for kw, vals in attrs:
+                if kw == "fixed":
+                    fixed[pos] = True
+                elif kw in ("tension", "density"):
+                    tension[pos] = vals[0]
+                elif kw == "no_refine":
+                    no_refine[pos] = True
+                elif kw in ("color", "colour", "frontcolor", "frontcolour", "backcolor",
+                            "backcolour"):
+                    key = kw.replace("colour", "color")
+                    colors.setdefault(key, np.zeros(nface, np.int64))[pos] = int(vals[0])
+                elif kw == "attribute":
+                    self._attr("facet", nface, pos, vals)
+                elif kw in ("nodisplay", "no_display", "opacity", "original", "phase", "tag"):
+                    pass
+                elif kw == "quantity":
+                    raise self.error(f"face {blk.ids[pos]}: not supported in pyevolver: "
+                                     f"facet quantities in the string model", blk.lines[pos])
+                else:
+                    raise self.error(f"face {blk.ids[pos]}: '{kw}' is not a facet attribute "
+                                     f"in the string model", blk.lines[pos])
+        if isinstance(blk.data, np.ndarray):
+            lengths = np.full(nface, blk.data.shape[1], dtype=np.int64)
+            flat = blk.data.astype(np.int64).ravel()
+        else:
+            lengths = np.array([len(d) for d in blk.data], dtype=np.int64)
+            flat = np.fromiter((e for d in blk.data for e in d), np.int64, int(lengths.sum()))
+        empty = np.nonzero(lengths < 1)[0]
+        if len(empty):
+            k = empty[0]
+            raise self.error(f"face {blk.ids[k]}: a facet needs at least one edge",
+                             blk.lines[k])
+        owner = np.repeat(np.arange(nface), lengths)
+        eidx = self._signed_refs(blk, flat, owner, self.eid, "face", "edge")
+        rev = flat < 0
+        tails = np.where(rev, s.E[eidx, 1], s.E[eidx, 0])
+        heads = np.where(rev, s.E[eidx, 0], s.E[eidx, 1])
+        ends = np.cumsum(lengths) - 1
+        inner = np.ones(len(flat), bool)
+        inner[ends] = False
+        j = np.nonzero(inner & (heads != np.roll(tails, -1)))[0]
+        if len(j):
+            j = j[0]
+            k = owner[j]
+            orig = s.vattr["original"]
+            raise self.error(
+                f"face {blk.ids[k]}: the edges do not form a chain: edge {flat[j]} ends at "
+                f"vertex {orig[heads[j]]} but the next edge {flat[j + 1]} starts at vertex "
+                f"{orig[tails[j + 1]]}", blk.lines[k])
+        s.sf_ptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
+        from .string_model import init_rings
+        init_rings(s)
+        s.sf_enc = np.where(rev, ~eidx, eidx).astype(np.int64)
+        self.split_children = {}
+        self.facet_parent = np.arange(nface)
+        s.fattr["fixed"] = fixed
+        s.fattr["tension"] = tension
+        s.fattr["no_refine"] = no_refine
+        s.fattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        for key, arr in colors.items():
+            s.fattr[key] = arr
+
     def children(self, pos):
         return self.split_children.get(pos, [pos])
 
@@ -886,11 +988,16 @@ class _Builder:
             nkids = np.ones(len(self.facet_parent), np.int64)
             for p, kids in self.split_children.items():
                 nkids[p] = len(kids)
-            reps = nkids[pos]
-            kids = np.concatenate([self.children(p) for p in pos]) if len(pos) else pos
-            rows = np.repeat(owner, reps)
-            cols = kids
-            vals = np.repeat(sign, reps)
+            # each listed face first, in the order given, then the triangles
+            # split off faces, in facet order (REF's `list bodies`)
+            reps = nkids[pos] - 1
+            kids = np.concatenate([self.children(p)[1:] for p in pos]) if len(pos) else pos
+            krows = np.repeat(owner, reps)
+            kvals = np.repeat(sign, reps)
+            korder = np.lexsort((-kvals, krows, kids))
+            rows = np.concatenate([owner, krows[korder]])
+            cols = np.concatenate([pos, kids[korder]])
+            vals = np.concatenate([sign, kvals[korder]])
         else:
             rows, cols, vals = owner, pos, sign
         for pos, attrs in blk.attrs.items():
@@ -914,7 +1021,7 @@ class _Builder:
             if "volume" in kws and "pressure" in kws:
                 raise self.error(f"body {blk.ids[pos]}: VOLUME and PRESSURE exclude each other",
                                  blk.lines[pos])
-        b.facet_matrix = sp.csr_matrix((vals, (rows, cols)), shape=(nb, s.nf))
+        b.facet_matrix = sp.csr_matrix((vals, (rows, cols)), shape=(nb, s.n_facets))
         b.occurrences = (np.asarray(rows, np.int64), np.asarray(cols, np.int64),
                          np.asarray(vals, float))
         b.volume = None
@@ -969,6 +1076,12 @@ class _Builder:
                     raise self.error(f"quantity {name}: {exc}", qd.line) from None
                 self._check_integrand(m, f"quantity {name}", qd.line)
                 q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
+            if s.string:
+                from .string_model import STRING_METHODS
+                for m in qd.methods:
+                    if m.method not in STRING_METHODS:
+                        raise self.error(f"quantity {name}: not supported in pyevolver: method "
+                                         f"{m.method} in the string model", qd.line)
             if qd.function is not None:
                 for v in qd.function.names():
                     inst = v[:-len(".value")] if v.endswith(".value") else None
@@ -984,7 +1097,8 @@ class _Builder:
         # declared attributes that no element set still exist
         for (etype, name), (atype, size, dims) in sc.attributes.items():
             if (etype, name) not in s.extra:
-                n = {"vertex": s.nv, "edge": s.ne, "facet": s.nf, "body": s.bodies.n}[etype]
+                n = {"vertex": s.nv, "edge": s.ne, "facet": s.n_facets,
+                     "body": s.bodies.n}[etype]
                 s.extra[(etype, name)] = self._attr_array(etype, name, n, size)
 
     def _check_integrand(self, m, what, line):
@@ -1008,6 +1122,53 @@ class _Builder:
     # -- projection -------------------------------------------------------------------
     def _project(self):
         project_to_constraints(self.s, np.arange(self.s.nv))
+
+
+def first_facets_on_load(FE, parent, ne):
+    """(ne,) index of each edge's first facet, -1 where unknown.
+
+    The Evolver keeps the facets round an edge in a cyclic loop that starts
+    at the first face of the datafile listing the edge (checked with ``O`` on
+    octa.fe and on single four-facet edges, where the loop start breaks ties
+    between equal angles).  ``parent`` (nf,) is the datafile face position of
+    each facet; an edge whose first face was split on load into several
+    triangles containing it (a spoke) gets -1.
+    """
+    nf = len(FE)
+    e = np.where(FE >= 0, FE, ~FE).ravel()
+    f = np.repeat(np.arange(nf), 3)
+    p = np.asarray(parent)[f]
+    order = np.lexsort((f, p, e))
+    e, f, p = e[order], f[order], p[order]
+    head = np.ones(len(e), bool)
+    head[1:] = e[1:] != e[:-1]
+    first = np.full(ne, -1, np.int64)
+    h = np.nonzero(head)[0]
+    nxt = h + 1
+    tie = (nxt < len(e)) & (e[np.minimum(nxt, len(e) - 1)] == e[h]) & \
+        (p[np.minimum(nxt, len(e) - 1)] == p[h])
+    first[e[h]] = np.where(tie, -1, f[h])
+    return first
+
+
+def record_edge_first_facet(s, first):
+    """Attach the first facet of every edge's loop to ``s``, valid while its
+    connectivity stays what it is now (any change to ``E`` or ``FE`` drops
+    it; only the operations that know how the loop start moves keep it)."""
+    s._edge_first = (s.FE.copy(), s.E.copy(), np.asarray(first, np.int64))
+
+
+def edge_first_facet(s):
+    """(ne,) first facet of each edge's loop (-1 unknown), or None when the
+    connectivity changed since it was recorded."""
+    c = s.__dict__.get("_edge_first")
+    if c is None:
+        return None
+    FE, E, first = c
+    if FE.shape != s.FE.shape or E.shape != s.E.shape or \
+            not np.array_equal(FE, s.FE) or not np.array_equal(E, s.E):
+        return None
+    return first
 
 
 def convex_edges(s):
@@ -1179,6 +1340,21 @@ def boundary_groups(s, mask=None):
     return out
 
 
+def solve_small(A, b):
+    """Batched ``A[n]⁻¹ b[n]`` for small (k, k) systems; a singular system
+    (a constraint gradient that vanishes, e.g. x² + y² = 1 at the origin)
+    gets the least-squares solution instead of an error."""
+    with np.errstate(all="ignore"):
+        try:
+            return np.linalg.solve(A, b[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            # (an infinite or NaN system, from a runaway vertex, would make
+            # the SVD fail: it gets a zero matrix, hence a zero solution)
+            bad = ~np.all(np.isfinite(A), axis=(1, 2))
+            A = np.where(bad[:, None, None], 0.0, A)
+            return np.einsum("nkl,nl->nk", np.linalg.pinv(A), b)
+
+
 def state(s):
     """Snapshot of the coordinates (and boundary parameters) of ``s``."""
     P = s.vattr.get("params")
@@ -1210,7 +1386,7 @@ def displace(s, base, dX):
         JtJ = np.einsum("nik,nil->nkl", J, J)
         rhs = np.einsum("nik,ni->nk", J, dX[rows])
         with np.errstate(all="ignore"):
-            dp = np.linalg.solve(JtJ, rhs[..., None])[..., 0]
+            dp = solve_small(JtJ, rhs)
         P[rows, :k] = P0[rows, :k] + np.nan_to_num(dp)
         s.X[rows], _ = boundary_eval(s, bid, P[rows])
     s.vattr["params"] = P
@@ -1242,7 +1418,7 @@ def project_tangent(s, vecs):
             for v in vecs:
                 rhs = np.einsum("nik,ni->nk", J, v[rr])
                 with np.errstate(all="ignore"):
-                    c = np.linalg.solve(JtJ, rhs[..., None])[..., 0]
+                    c = solve_small(JtJ, rhs)
                 v[rr] = np.einsum("nik,nk->ni", J, np.nan_to_num(c))
     if not s.vcon:
         return vecs
@@ -1265,22 +1441,9 @@ def project_tangent(s, vecs):
         for v in out:
             w = v[rr]
             rhs = np.einsum("nik,ni->nk", Gm, w)
-            lam = np.nan_to_num(_batched_solve(GtG, rhs))
+            lam = np.nan_to_num(solve_small(GtG, rhs))
             v[rr] = w - np.einsum("nik,nk->ni", Gm, lam)
     return out
-
-
-def _batched_solve(A, b):
-    """Solve the stacked small systems ``A[n] x[n] = b[n]`` (A (n, k, k), b
-    (n, k)); singular systems (a constraint whose gradient vanishes) take
-    the least-squares solution of the pseudo-inverse."""
-    with np.errstate(all="ignore"):
-        try:
-            return np.linalg.solve(A, b[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            bad = ~np.all(np.isfinite(A), axis=(1, 2))
-            A = np.where(bad[:, None, None], 0.0, A)
-            return np.einsum("nkl,nl->nk", np.linalg.pinv(A), b)
 
 
 def project_to_constraints(s, idx, tol=None, maxit=20):
@@ -1335,7 +1498,7 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
                 break
             Gm = np.stack(grads, axis=2)           # (n, 3, k)
             GtG = np.einsum("nik,nil->nkl", Gm, Gm)
-            lam = _batched_solve(GtG, phi)
+            lam = solve_small(GtG, phi)
             with np.errstate(all="ignore"):
                 step = np.einsum("nik,nk->ni", Gm, lam)
             step = np.where(np.isfinite(step), step, 0.0)

@@ -1,15 +1,50 @@
-"""Atomic output (pyevolver/atomic.py): a failure while writing leaves the
-target as it was and no temporary file behind; dump and ``>>``/``>>>`` use it."""
+"""Atomic writes (pyevolver/atomic.py): the target is the old file or the
+complete new one, never a part, and no temporary file stays behind; dump and
+``>>``/``>>>`` use them."""
 import io
 import os
 
 import pytest
 
-from pyevolver.atomic import NotRegularFile, atomic_write, check_regular
+from pyevolver.atomic import NotRegularFile, atomic_path, atomic_write, check_regular
 from pyevolver.errors import CommandError
 from pyevolver.session import Session
 
 CUBE = os.path.join(os.path.dirname(__file__), "..", "datafiles", "cube.fe")
+
+
+def test_atomic_write_replaces_on_success(tmp_path):
+    p = tmp_path / "a.txt"
+    p.write_text("old")
+    with atomic_write(p) as fh:
+        fh.write("new")
+        assert p.read_text() == "old"          # not visible before the block ends
+    assert p.read_text() == "new"
+    assert os.listdir(tmp_path) == ["a.txt"]
+
+
+def test_atomic_write_keeps_old_file_on_error(tmp_path):
+    p = tmp_path / "a.txt"
+    p.write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_write(p) as fh:
+            fh.write("half")
+            raise RuntimeError("killed")
+    assert p.read_text() == "old"
+    assert os.listdir(tmp_path) == ["a.txt"]
+
+
+def test_atomic_path_mode_follows_umask(tmp_path):
+    old = os.umask(0o022)
+    try:
+        with atomic_path(tmp_path / "b.bin", ".bin") as tmp:
+            assert tmp.endswith(".bin") and os.path.dirname(tmp) == str(tmp_path)
+            with open(tmp, "wb") as fh:
+                fh.write(b"x")
+    finally:
+        os.umask(old)
+    assert (tmp_path / "b.bin").read_bytes() == b"x"
+    assert oct(os.stat(tmp_path / "b.bin").st_mode & 0o777) == oct(0o644)
 
 
 class Boom(Exception):
@@ -20,24 +55,7 @@ def _leftovers(d):
     return sorted(p for p in os.listdir(d) if p.endswith(".tmp"))
 
 
-def test_write_replaces_and_leaves_no_temporary(tmp_path):
-    p = tmp_path / "a.txt"
-    p.write_text("old\n")
-    with atomic_write(p) as fh:
-        fh.write("new\n")
-    assert p.read_text() == "new\n"
-    assert _leftovers(tmp_path) == []
-
-
-def test_failure_keeps_the_old_file(tmp_path):
-    p = tmp_path / "a.txt"
-    p.write_text("old\n")
-    with pytest.raises(Boom):
-        with atomic_write(p) as fh:
-            fh.write("half of the new")
-            raise Boom()
-    assert p.read_text() == "old\n"
-    assert _leftovers(tmp_path) == []
+def test_interrupt_leaves_nothing(tmp_path):
     q = tmp_path / "never.txt"
     with pytest.raises(KeyboardInterrupt):
         with atomic_write(q) as fh:

@@ -28,6 +28,8 @@ CASES = [
     (example("cube.fe"), "r; g 5"),
     (example("mound.fe"), "r; g 5"),
     (example("catbody.fe"), "r; g 5"),
+    (example("cat.fe"), "r; g 5"),
+    (example("quad.fe"), "r; g 5"),
     (example("tankex.fe"), "g 5"),
     (example("column.fe"), "g 5"),
     (example("qmound.fe"), "g 5"),
@@ -91,10 +93,13 @@ def test_dump_round_trip(evolver, path, cmds, tmp_path):
     assert s2.surface.nv == s.surface.nv and s2.surface.ne == s.surface.ne \
         and s2.surface.nf == s.surface.nf
     np.testing.assert_array_equal(s2.surface.X, s.surface.X)
-    # so does the Evolver
-    ref = numbers(evolver, out, list(want), cwd=str(tmp_path))
+    # so does the Evolver, with the same element counts
+    counts = {"vertex_count": s.surface.nv, "edge_count": s.surface.ne,
+              "facet_count": s.surface.nf, "body_count": s.surface.bodies.n}
+    ref = numbers(evolver, out, list(want) + list(counts), cwd=str(tmp_path))
     for k, r in zip(want, ref):
         assert _close(want[k], r), (k, want[k], r)
+    assert ref[len(want):] == list(counts.values()), (counts, ref[len(want):])
     # continuing after the reload prints what continuing without it prints
     a = _continue(s)
     b = _continue(s2)

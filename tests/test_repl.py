@@ -4,6 +4,7 @@ across runs, and Ctrl-C during a long loop."""
 import os
 import signal
 import sys
+import time
 
 import pytest
 
@@ -94,7 +95,6 @@ def test_ctrl_c_in_g_returns_within_one_iteration(tmp_path):
     iteration in progress, and the surface is that of the last complete
     iteration (its energy is the last one printed, and recalc agrees)."""
     import re
-    import time
     child = _spawn(tmp_path)
     child.sendline("r; r")
     child.expect_exact("Enter command:")
@@ -125,3 +125,60 @@ def test_ctrl_c_in_g_returns_within_one_iteration(tmp_path):
     assert int(child.match.group(2)) == 194         # the cube (14 vertices) refined twice
     child.expect_exact("Enter command:")
     _quit(child)
+
+
+def test_completion_of_variables_quantities_attributes(tmp_path):
+    """Tab completes a variable, a defined attribute and built-in attributes
+    at the terminal; !! repeats the last command (echoed, as REF does)."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
+    env["PYEVOLVER_HISTORY"] = str(tmp_path / "history")
+    env["TERM"] = "xterm"
+    env["PROMPT_TOOLKIT_NO_CPR"] = "1"
+    child = pexpect.spawn(sys.executable, ["-m", "pyevolver", example("qmound.fe")], env=env,
+                          cwd=str(tmp_path), encoding="utf-8", timeout=30,
+                          dimensions=(40, 200))
+    child.expect_exact("Enter command:")
+    child.sendline("zebra_width := 0.25")
+    child.expect_exact("Enter command:")
+    child.sendline("define vertex attribute wobble_amount real")
+    child.expect_exact("Enter command:")
+    def typed(*parts):
+        # each Tab completes before the next keys arrive
+        for p in parts:
+            child.send(p)
+            time.sleep(0.3)
+        child.send("\r")
+    typed("print zebra_w\t", " * 4")                  # a variable
+    child.expect(r"\s1\r\n")
+    child.expect_exact("Enter command:")
+    typed("print vol.targ\t")                        # a quantity's attribute
+    child.expect(r"\s1\r\n")
+    child.expect_exact("Enter command:")
+    typed("print vertex[3].wobble_am\t", " + vertex[3].vertex_norm\t", "[3]")  # attributes
+    child.expect(r"\s(-?[\d.e-]+)\r\n")
+    child.expect_exact("Enter command:")
+    child.sendline("!!")
+    child.expect_exact("print vertex[3].wobble_amount + vertex[3].vertex_normal[3]")
+    child.expect_exact("Enter command:")
+    _quit(child)
+
+
+def test_completer_offers_session_names():
+    """The completer's candidates: commands, variables, quantities, defined
+    attributes, toggles and keywords of the loaded session."""
+    import io
+    from prompt_toolkit.document import Document
+    from pyevolver import Session
+    from pyevolver.cli import _completer
+    s = Session.load(example("qmound.fe"), out=io.StringIO(), err=io.StringIO())
+    s.run("my_var := 3\ndefine edge attribute my_attr real\nmy_cmd := { print 1 }")
+    comp = _completer(s)
+
+    def words(text):
+        return {c.text for c in comp.get_completions(Document(text), None)}
+    assert words("print my_") == {"my_var", "my_attr", "my_cmd"}
+    assert "vol" in words("print vo")                   # the quantity
+    assert "conj_grad" in words("conj_")                # a toggle
+    assert "vertex_normal" in words("print vertex[1].vertex_n")
+    assert words("foreac") == {"foreach"}

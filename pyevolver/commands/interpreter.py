@@ -23,6 +23,7 @@ from ..limits import MAX_ARRAY_ENTRIES, MAX_NESTING, nesting_depth
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
 from .cformat import c_format, print_array, print_value
+from .extensions import COMMANDS as EXTENSIONS, run_command
 
 _HERE = os.path.dirname(__file__)
 
@@ -289,6 +290,33 @@ class OnTest(N.Node):
         return env.session.get_attr(el, self.what, self.arg.ev(env))
 
 
+class ArrayLit(N.Node):
+    """``{a, b, c}`` (nested: ``{{..},{..}}``) as a whole-array value."""
+
+    __slots__ = ("items",)
+
+    def __init__(self, items):
+        self.items = items
+
+    def ev(self, env):
+        def val(x):
+            if isinstance(x, list):
+                return [val(y) for y in x]
+            v = env.session.interp.value(x)
+            if isinstance(v, str):
+                raise ExpressionError("array values must be numbers")
+            return float(v)
+        try:
+            return N.array_value(val(self.items))
+        except ValueError:
+            raise ExpressionError("the rows of an array list differ in length") from None
+
+    def children(self):
+        def walk(x):
+            return [n for y in x for n in walk(y)] if isinstance(x, list) else [x]
+        return tuple(walk(self.items))
+
+
 class UserCall(N.Node):
     """``name(args)`` in an expression: a user function or a string builtin."""
 
@@ -321,8 +349,10 @@ class ArrayRef(N.Node):
             # a bare indexed attribute inside a generator: form_factors[2]
             return env.session.get_attr(env.current(), self.name,
                                         idx[0] if len(idx) == 1 else tuple(idx))
-        arr, pos = interp.array_slot(self.name, idx)
+        arr, pos = interp.array_slot(self.name, idx, partial=True)
         v = arr[pos]
+        if np.ndim(v):
+            return N.array_value(v)
         return v if isinstance(v, str) else float(v)
 
     def children(self):
@@ -534,6 +564,16 @@ class _CmdTransformer(ExprTransformer):
     def assign_array(self, lv, _a, items):
         return ("assign_array", lv, items)
 
+    def compare_eq1(self, a, _op, b):
+        return N.Cmp("==", a, b)
+
+    def array_arith(self, lv, op, items):
+        # edge_tuber.cmd: evecs[inx] += { jeps*random, ... }
+        return self.opassign(lv, op, ArrayLit(items))
+
+    def define_constraint(self, tok):
+        return ("define_constraint", str(tok))
+
     def define_other(self, _d, what, name):
         return ("unsupported", f"define {str(what).lower()}")
 
@@ -652,7 +692,8 @@ class _CmdTransformer(ExprTransformer):
         word = words[0].lower()
         if word == "define" and len(words) > 1:
             word = "define " + words[1].lower() + " (at run time)"
-        return ("unsupported", word)
+        reason = UNSUPPORTED_REASONS.get(word)
+        return ("unsupported", word) if reason is None else ("unsupported", word, reason)
 
     def generator(self, base, *rest):
         var = None
@@ -681,6 +722,15 @@ class _CmdTransformer(ExprTransformer):
 
     def attr(self, base, name):
         return Attr(base, name)
+
+    def aggregate_juxt(self, op, gen, base, name):
+        # `sum(vv.edge eee, eee ecutmark)` means eee.ecutmark (cut.cmd; REF
+        # accepts a name and an attribute side by side)
+        return Aggregate(str(op), gen, Attr(self.var(base), str(name).lower()))
+
+    def attr_on(self, base, kw, arg):
+        # vv.on_constraint 2, ee.on_boundary 1 (REF: no brackets)
+        return Attr(base, str(kw).lower(), arg)
 
     def attr_index(self, base, name, *idx):
         return Attr(base, name, idx[0] if len(idx) == 1 else list(idx))
@@ -812,7 +862,10 @@ class Env:
         if name in s.variables:
             return s.variables[name]
         if name in s.arrays:
-            raise ExpressionError(f"'{name}' is an array; index it as {name}[i]")
+            arr = s.arrays[name]
+            if arr.dtype == object:
+                raise ExpressionError(f"'{name}' is an array of strings; index it as {name}[i]")
+            return N.array_value(arr)           # the whole array as a value
         if self.frames:
             el = self.frames[-1][1]
             try:
@@ -865,7 +918,7 @@ LETTER_LATER = {
     "g": "g (iteration) comes with the evolve issue",
     "U": "U (conjugate gradient) comes with the evolve issue",
     "m": "m (fixed scale) comes with the evolve issue",
-    "o": "o (vertex popping)", "O": "O (edge popping)",
+    "o": "o (vertex popping)",
     "G": "G (gravity) comes with the evolve issue",
     "e": "e (extrapolation)", "i": "i (information)", "Q": "Q (quantities)",
     "C": "C (consistency check)", "c": "c (counts)", "N": "N",
@@ -891,14 +944,38 @@ TOGGLES = {
     "labelflag", "self_similar", "pinning", "diffusion", "sqgauss", "interp_bdry_param",
     "h_inverse_metric", "jiggle", "break_after_warning", "full_bounding_box",
     "show_all_quantities", "show_inner", "show_outer", "colormap", "bezier_basis",
-    "volgrads_every", "zener_drag", "backcull", "debug",
+    "volgrads_every", "zener_drag", "backcull", "debug", "autodisplay",
 }
 GRAPHICS = {"s", "P", "show", "show_expr", "transforms", "transform_expr", "geomview",
             "postscript", "showq", "view_transforms", "ps", "oogl", "gv", "screen"}
 SETTABLE_ATTRS = {"x", "y", "z", "x1", "x2", "x3", "color", "colour", "frontcolor", "backcolor",
                   "tension", "density", "fixed", "no_refine", "target", "pressure", "volconst",
                   "constraint", "boundary", "opacity"}
+UNSUPPORTED_REASONS = {
+    "permload": "use replace_load, as the Evolver's manual advises; ::= permanent "
+                "variables are not supported either",
+    "system": "scripts never run programs", "shell": "scripts never run programs",
+    "exec": "scripts never run programs",
+    "detorus": "the torus model cannot be unwrapped yet",
+    "dissolve": "removing elements one by one is not implemented; delete merges edges",
+}
 TOGGLE_DEFAULTS = {"hessian_normal": 1, "autorecalc": 1, "ribiere": 1}
+# how REF names a toggle in "NAME ON. (was off)" (measured; the others use
+# their own name)
+TOGGLE_WORDS = {
+    "check_increase": "Increase check", "conj_grad": "Conjugate gradient now",
+    "ribiere": "Polak-Ribiere conjugate gradient", "gravity": "Gravity",
+    "normal_motion": "Normal motion", "area_normalization": "Area normalization",
+    "autorecalc": "Autorecalc", "estimate": "Estimation", "volgrads_every": "Volgrads_every",
+    "verbose": "Verbose", "rgb_colors": "RGB colors", "runge_kutta": "Runge-Kutta",
+    "kraynikpopvertex": "Kraynik pop vertex mode", "kraynikpopedge": "Kraynik pop edge mode",
+    "post_project": "Post-projection", "visibility_test": "visibility test",
+    "smooth_graph": "smooth graph", "self_similar": "Self similarity mode",
+    "pinning": "Constraint pinning", "diffusion": "Diffusion",
+    "sqgauss": "Squared Gaussian curvature", "jiggle": "jiggling",
+    "break_after_warning": "Break after warning", "show_inner": "show inner",
+    "show_outer": "show outer", "memdebug": "Memory debugging", "autodisplay": "Autodisplay",
+}
 
 
 class Interpreter:
@@ -1085,6 +1162,17 @@ class Interpreter:
             if not isinstance(v, str):
                 raise ExpressionError("is_defined() needs a name in a string")
             return float(self.is_defined(v.lower()))
+        if name in ("new_vertex", "new_edge", "new_facet", "new_body"):
+            raise UnsupportedError(f"{name}() (creating elements from a script)")
+        if name == "valid_element":
+            # 1 if the element exists (simply_connected.cmd: vertex[sc_startv])
+            if len(arg_nodes) != 1 or not isinstance(arg_nodes[0], ElemIndex):
+                raise ExpressionError("valid_element() takes one element, e.g. vertex[3]")
+            try:
+                arg_nodes[0].ev(self.env)
+            except ExpressionError:
+                return 0.0
+            return 1.0
         proc = s.commands.get(name)
         if proc is None:
             raise ExpressionError(f"unknown function '{name}'")
@@ -1113,6 +1201,8 @@ class Interpreter:
         if proc is None:
             if len(args) == 1 and name in ("g", "r", "u"):
                 return self._x_bare(("bare", name, args[0]))
+            if name.lower() in EXTENSIONS:
+                return run_command(self.session, name, [self.value(a) for a in args])
             raise CommandError(f"unknown procedure '{name}'")
         self.run_proc(proc, [self.value(a) for a in args])
 
@@ -1127,6 +1217,10 @@ class Interpreter:
             if name not in s.variables:
                 s.set_variable(name, "" if typ == "string" else 0.0)
             return
+        if self.env.scopes and name in self.env.scopes[-1]:
+            # `local vn; define vn real[3]`: the name is the array from here on
+            # (pyevolver keeps arrays in one namespace)
+            del self.env.scopes[-1][name]
         old = s.arrays.get(name)
         new = np.zeros(shape, dtype=object if typ == "string" else float)
         if typ == "string":
@@ -1138,13 +1232,16 @@ class Interpreter:
         s.arrays[name] = new
         s.array_types[name] = typ
 
-    def array_slot(self, name, idx):
+    def array_slot(self, name, idx, partial=False):
+        """``(array, position)`` of ``name[idx...]``; with ``partial`` fewer
+        indices than dimensions name a sub-array (``evecs[2]`` of a
+        ``real[20][3]``)."""
         s = self.session
         arr = s.arrays.get(name)
         if arr is None:
             raise ExpressionError(f"'{name}' is not an array (define it first: "
                                   f"define {name} real[n])")
-        if len(idx) != arr.ndim:
+        if len(idx) != arr.ndim and not (partial and 0 < len(idx) < arr.ndim):
             raise ExpressionError(f"array '{name}' has {arr.ndim} dimension"
                                   f"{'s' if arr.ndim != 1 else ''}, got {len(idx)} indices")
         pos = []
@@ -1188,15 +1285,21 @@ class Interpreter:
         v = self.value(expr)
         if isinstance(old, str) or isinstance(v, str):
             raise CommandError(f"'{op}=' needs numbers")
-        new = {"+": old + v, "-": old - v, "*": old * v, "/": old / v if v else np.inf}[op]
+        if op == "/" and not isinstance(v, np.ndarray) and v == 0:
+            raise ExpressionError("Division by zero.")
+        if op == "*" and isinstance(old, N.ArrayValue) and isinstance(v, N.ArrayValue):
+            raise CommandError("'*=' of two arrays: use a := a * b for the dot product")
+        new = {"+": lambda: old + v, "-": lambda: old - v, "*": lambda: old * v,
+               "/": lambda: old / v}[op]()
         self._store(lv, new)
 
     def _load(self, lv):
         if lv[0] == "name":
             return self.env.lookup(lv[1].lower())
         if lv[0] == "array":
-            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
-            return arr[pos]
+            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]], partial=True)
+            v = arr[pos]
+            return N.array_value(v) if np.ndim(v) else v
         base = lv[1].ev(self.env)
         return self.session.get_attr(base, lv[2], self._index(lv[3]))
 
@@ -1216,12 +1319,21 @@ class Interpreter:
             if name in s.commands:
                 del s.commands[name]
             if name in s.arrays:
-                raise CommandError(f"'{name}' is an array; assign to {name}[i]")
+                self._fill(name, s.arrays[name], (), value)
+                return
+            if isinstance(value, N.ArrayValue):
+                raise CommandError(f"'{name}' is not an array; define it first "
+                                   f"(define {name} real" +
+                                   "".join(f"[{n}]" for n in value.shape) + ")")
             s.set_variable(name, value)
             return
         if lv[0] == "array":
-            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]])
-            if arr.dtype == object:
+            arr, pos = self.array_slot(lv[1], [self.value(i) for i in lv[2]], partial=True)
+            if len(pos) < arr.ndim:
+                self._fill(lv[1], arr, pos, value)
+            elif isinstance(value, N.ArrayValue):
+                raise CommandError(f"{lv[1]}[...]: an array does not fit in one entry")
+            elif arr.dtype == object:
                 arr[pos] = value if isinstance(value, str) else print_value(value).strip()
             elif isinstance(value, str):
                 raise CommandError(f"array '{lv[1]}' holds numbers, not strings")
@@ -1230,6 +1342,21 @@ class Interpreter:
             return
         base = lv[1].ev(self.env)
         s.set_attr(base, lv[2], self._index(lv[3]), value)
+
+    @staticmethod
+    def _fill(name, arr, pos, value):
+        """Assign a number (to every entry) or an array of the same shape to
+        the (sub-)array ``arr[pos]``."""
+        if isinstance(value, str) or arr.dtype == object:
+            raise CommandError(f"array '{name}': whole-array assignment needs numbers")
+        target = arr[pos] if pos else arr
+        if isinstance(value, N.ArrayValue) and value.shape != target.shape:
+            raise CommandError(f"array '{name}': cannot assign shape {list(value.shape)} "
+                               f"to shape {list(target.shape)}")
+        if pos:
+            arr[pos] = np.asarray(value)
+        else:
+            arr[...] = np.asarray(value)
 
     def _index(self, idx):
         if idx is None:
@@ -1273,13 +1400,20 @@ class Interpreter:
             self.session.write(print_array(self.session.arrays[e.name]) + "\n")
             return
         v = self.value(e)
+        if isinstance(v, N.ArrayValue):
+            self.session.write(print_array(np.asarray(v)) + "\n")
+            return
         self.session.write(print_value(v) + "\n")
 
     def _x_printf(self, node):
         args = [self.value(a) for a in node[1]]
         if not args or not isinstance(args[0], str):
             raise CommandError("printf needs a format string first")
-        text = c_format(args[0], args[1:])
+        # REF prints a lone format string as it is ("%%" stays "%%": xray.cmd)
+        if len(args) == 1 and "%" in args[0].replace("%%", ""):
+            raise CommandError(f"{'ERR' if node[2] else ''}PRINTF string has formats, but "
+                               "there are no arguments.")          # REF's ERROR 1928
+        text = c_format(args[0], args[1:]) if len(args) > 1 else args[0]
         if node[2]:
             self.session.write_err(text)
         else:
@@ -1315,7 +1449,9 @@ class Interpreter:
             return
         els = s.generate(gen, self.env)
         n = s.fix_elements(els, on)
-        s.write(f"{'Fixed' if on else 'Unfixed'}: {n}\n")
+        # REF reports the elements fixed and unfixed by a whole command at
+        # its end ("Fixed: N" then "Unfixed: M", nonzero counts only)
+        s.report("Fixed" if on else "Unfixed", n)
 
     def _x_fix_name(self, node):
         self.session.fix_name(node[1], node[2])
@@ -1342,7 +1478,8 @@ class Interpreter:
         with contextlib.ExitStack() as stack:
             try:
                 fh = stack.enter_context(atomic_write(name, "w" if op == ">>>" else "a",
-                                                      durable=False))
+                                                      durable=False, encoding="latin-1",
+                                                      newline=""))
             except OSError as exc:
                 raise CommandError(f"cannot open '{name}' for output: "
                                    f"{exc.strerror or exc}") from None
@@ -1440,7 +1577,7 @@ class Interpreter:
                     v = gen.where.ev(self.env)
                 if not isinstance(v, str) and v:
                     n += s.delete_elements(gen.kind, [el.i])
-        s.write(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted: {n}\n")
+        s.report(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted", n)
 
     def _x_break(self, node):
         raise _Break(1 if node[1] is None else as_int(self.value(node[1]), "break's count"))
@@ -1452,8 +1589,11 @@ class Interpreter:
     def _x_return(self, node):
         raise _Return(None if node[1] is None else self.value(node[1]))
 
+    def _x_define_constraint(self, node):
+        self.session.define_constraint(node[1])
+
     def _x_unsupported(self, node):
-        raise UnsupportedError(node[1])
+        raise UnsupportedError(*node[1:])
 
     def _x_bare(self, node):
         raw, arg = node[1], node[2]
@@ -1480,13 +1620,18 @@ class Interpreter:
                 self.tick()
                 self.run_proc(s.letters[raw], [])
             return
+        if name in EXTENSIONS and len(raw) > 1:
+            return run_command(s, name, [] if arg is None else [self.value(arg)])
         if raw in ("q",) or name in ("quit", "bye", "exit"):
             raise Quit(0 if arg is None else as_int(self.value(arg), "the exit status") & 255)
         if raw == "v" or name == "show_vol":
-            s.write(s.show_vol())
+            s.note(s.show_vol())
             return
         if name == "recalc":
             s.recalc()
+            return
+        if name == "history" and arg is None:
+            s.show_history()
             return
         if raw in GRAPHICS or name in GRAPHICS:
             return
@@ -1505,13 +1650,13 @@ class Interpreter:
             v = as_float(self.value(arg), f"the argument of {raw}")
             s.settings["scale"] = v
             s.toggles["_fixed_scale"] = 1
-            s.write("Scale fixed at %g.\n" % v)
+            s.note("Scale fixed at %g.\n" % v)
             return
         if name in ("optimize", "optimise"):
             if arg is not None:
                 s.settings["scale_limit"] = as_float(self.value(arg), f"the argument of {raw}")
             s.toggles["_fixed_scale"] = 0
-            s.write("Scale optimizing with bound %g.\n" % s.settings["scale_limit"])
+            s.note("Scale optimizing with bound %g.\n" % s.settings["scale_limit"])
             return
         if raw == "r":
             for _ in range(1 if arg is None else self._count(arg)):
@@ -1544,11 +1689,17 @@ class Interpreter:
         if raw == "V" or name in ("rawv", "rawestv"):
             s.vertex_average({"V": "V", "rawv": "raw", "rawestv": "rawest"}[raw])
             return
+        if raw == "O":
+            s.pop_edges()
+            return
         if raw == "u" or name == "equiangulate":
             s.equiangulate()
             return
         if name == "bfgs":
             s.bfgs(1 if arg is None else self._count(arg))
+            return
+        if name == "newton":
+            s.newton(1 if arg is None else self._count(arg))
             return
         if name in ("hessian", "hessian_seek"):
             if name == "hessian_seek" and arg is not None:
@@ -1560,7 +1711,7 @@ class Interpreter:
             old = s.toggles.get("conj_grad", 0)
             s.toggles["conj_grad"] = 0 if old else 1
             s.reset_cg()
-            s.write(f"Conjugate gradient now {'OFF' if old else 'ON'}. (was {'on' if old else 'off'})\n")
+            s.note(f"Conjugate gradient now {'OFF' if old else 'ON'}. (was {'on' if old else 'off'})\n")
             return
         if raw == "G":
             old_on = s.toggles.get("gravity", 0)
@@ -1570,9 +1721,9 @@ class Interpreter:
             s.toggles["gravity"] = int(g != 0)
             was = "on" if old_on else "off"
             if g != 0:
-                s.write(f"Gravity is now ON with gravitational constant {g:g}. (was {was})\n")
+                s.note(f"Gravity is now ON with gravitational constant {g:g}. (was {was})\n")
             else:
-                s.write(f"Gravity is now OFF. (was {was})\n")
+                s.note(f"Gravity is now OFF. (was {was})\n")
             s.recalc()
             return
         if len(raw) == 1 and raw in LETTER_LATER:
@@ -1598,30 +1749,31 @@ class Interpreter:
         if name == "autopop" and new:
             raise UnsupportedError("autopop", "vertex and edge popping (o, O) is not implemented")
         s.toggles[name] = new
-        if name == "check_increase":
-            s.write(f"Increase check {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
-        elif name == "conj_grad":
-            s.write(f"Conjugate gradient now {'ON' if new else 'OFF'}. "
-                    f"(was {'on' if old else 'off'})\n")
-        elif name == "ribiere":
-            s.write(f"Polak-Ribiere conjugate gradient {'ON' if new else 'OFF'}. "
-                    f"(was {'on' if old else 'off'})\n")
+        was = "on" if old else "off"
+        now = "ON" if new else "OFF"
+        if name == "quietgo":               # REF prints this one even when quiet
+            s.write(f"QuietGo {now}. (was {was})\n")
+        elif name == "quiet":
+            if not new:                     # turning it on is silent
+                s.write(f"Quiet OFF. (was {was})\n")
         elif name == "autochop":
             if new:
-                s.write(f"Autochopping ON. Chop length {s.settings.get('autochop_length', 0.0):g}"
-                        f"  (was {'on' if old else 'off'})\n"
-                        "Set autochop length with  AUTOCHOP_LENGTH := value\n")
+                s.note(f"Autochopping ON. Chop length {s.settings.get('autochop_length', 0.0):g}"
+                       f"  (was {was})\n"
+                       "Set autochop length with  AUTOCHOP_LENGTH := value\n")
             else:
-                s.write(f"Autochopping OFF. (was {'on' if old else 'off'})\n")
-        elif name == "gravity":
-            s.write(f"Gravity {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
-            s.recalc()
+                s.note(f"Autochopping OFF. (was {was})\n")
         else:
-            s.write(f"{name} {'ON' if new else 'OFF'}. (was {'on' if old else 'off'})\n")
+            word = TOGGLE_WORDS.get(name, name)
+            s.note(f"{word} {now}. (was {was})\n")
+        if name == "gravity":
+            s.recalc()
 
     # -- expressions ------------------------------------------------------------
     def value(self, expr):
         v = expr.ev(self.env)
+        if isinstance(v, N.ArrayValue):
+            return v
         if isinstance(v, np.ndarray):
             v = float(v)
         if isinstance(v, (ElemRef, QRef)):

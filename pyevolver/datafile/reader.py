@@ -474,11 +474,7 @@ class Reader:
             _, name, expr, line = d
             sc.parameters[name] = self._const(expr, self._src(sec, line), f"parameter {name}")
         elif kind == "flag":
-            flag = d[1]
-            if flag == "string":
-                raise self.error("not supported in pyevolver: STRING (the string model)",
-                                 self._src(sec, d[2]), 1)
-            sc.flags.add(flag)
+            sc.flags.add(d[1])
         elif kind == "value":
             _, name, expr, fixed, line = d
             name = VALUE_NAMES.get(name, name)

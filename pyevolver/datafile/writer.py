@@ -418,7 +418,7 @@ class _FeWriter:
 
 def write_fe(surface, path, session=None):
     text = _FeWriter(surface, session).text()
-    with atomic_write(path, "w", newline=None) as fh:
+    with atomic_write(path, "w", encoding="latin-1") as fh:
         fh.write(text)
 
 

@@ -173,6 +173,9 @@ def content_edge_terms(t):
 def energy_gradient(t):
     """Gradient (nv, 3) of the total energy of :class:`Totals` ``t``."""
     s = t.surface
+    if s.string:
+        from ..string_model import energy_gradient as string_gradient
+        return string_gradient(t)
     g = corner_scatter(t, facet_area_grad(t), s.facet_tension)
     et = s.eattr.get("tension")
     if et is not None and np.any(et):
@@ -239,6 +242,9 @@ def gap_energy_grad(t):
 def body_volume_gradients(t):
     """(nb, nv, 3) gradients of body volumes (content integrals included)."""
     s = t.surface
+    if s.string:
+        from ..string_model import volume_gradients
+        return volume_gradients(t)
     b = s.bodies
     vg = facet_volume_grad(t, s.symmetric_content)
     out = np.zeros((b.n, s.nv, 3))

@@ -50,21 +50,69 @@ FUNC1 = {
     "asinh": np.arcsinh, "acosh": np.arccosh, "atanh": np.arctanh,
     "exp": np.exp, "log": np.log, "ceil": np.ceil, "floor": np.floor,
 }
+def _domain(bad, msg):
+    if np.any(bad):
+        raise ExpressionError(msg)
+
+
+def _ellipk(m):
+    """Complete elliptic integral of the first kind K(m), parameter m
+    (Abramowitz & Stegun 17.3.1; the Evolver's convention)."""
+    from scipy.special import ellipk
+    _domain(np.asarray(m) >= 1, "ellipticK domain violation, parameter >= 1.")
+    return ellipk(m)
+
+
+def _ellipe(m):
+    """Complete elliptic integral of the second kind E(m) (A&S 17.3.3)."""
+    from scipy.special import ellipe
+    _domain(np.asarray(m) > 1, "ellipticE domain violation, parameter > 1.")
+    return ellipe(m)
+
+
+def _ellipf(phi, m):
+    """Incomplete elliptic integral of the first kind F(phi|m) (A&S 17.2.7)."""
+    from scipy.special import ellipkinc
+    _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
+            "incompleteEllipticF domain violation, m*sin(phi)^2 > 1.")
+    return ellipkinc(phi, m)
+
+
+def _ellipeinc(phi, m):
+    """Incomplete elliptic integral of the second kind E(phi|m) (A&S 17.2.8)."""
+    from scipy.special import ellipeinc
+    _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
+            "incompleteEllipticE domain violation, m*sin(phi)^2 > 1.")
+    return ellipeinc(phi, m)
+
+
+FUNC1["elliptick"] = _ellipk
+FUNC1["elliptice"] = _ellipe
 FUNC2 = {
     "atan2": np.arctan2, "pow": np.power, "maximum": np.maximum,
-    "minimum": np.minimum,
+    "minimum": np.minimum, "incompleteellipticf": _ellipf,
+    "incompleteelliptice": _ellipeinc,
 }
 # recognised but refused
 UNSUPPORTED_FUNCS = {
-    "elliptick", "elliptice", "incompleteellipticf", "incompleteelliptice",
     "wrap_compose", "wrap_inverse", "usr1", "usr2", "usr3", "usr4", "usr5",
     "usr6", "usr7", "usr8", "usr9", "usr10",
 }
 
 
+class ArrayValue(np.ndarray):
+    """A whole array as a value in the command language (``vn :=
+    ff.vertex[1].vertex_normal``, ``2*vn``, ``vn*vn`` the dot product), as
+    opposed to the per-point arrays of a vectorized formula evaluation."""
+
+
+def array_value(a):
+    return np.array(a, dtype=float).view(ArrayValue)
+
+
 def _num(v):
     """Python float for scalars, array otherwise."""
-    if isinstance(v, np.ndarray) and v.ndim == 0:
+    if isinstance(v, np.ndarray) and v.ndim == 0 and not isinstance(v, ArrayValue):
         return float(v)
     return v
 
@@ -129,6 +177,8 @@ def _what(v):
     """How a non-number is named in messages."""
     if isinstance(v, str):
         return "a string"
+    if isinstance(v, np.ndarray):
+        return f"an array of shape {list(v.shape)}"
     kind = getattr(v, "kind", None)
     if isinstance(kind, str):
         return f"a {kind}"
@@ -272,7 +322,12 @@ class Bin(Node):
         with np.errstate(all="ignore"):
             if self.op == "/" and not isinstance(b, np.ndarray) and b == 0 \
                     and not isinstance(a, np.ndarray):
-                return math.copysign(math.inf, a) if a != 0 else math.nan
+                raise ExpressionError("Division by zero.")     # REF's ERROR 1258
+            if self.op == "*" and isinstance(a, ArrayValue) and isinstance(b, ArrayValue):
+                if a.shape != b.shape:
+                    raise ExpressionError(f"array product needs equal shapes, got "
+                                          f"{list(a.shape)} and {list(b.shape)}")
+                return float(np.sum(np.multiply(np.asarray(a), np.asarray(b))))  # dot product
             return _num(BINOPS[self.op](a, b))
 
     def children(self):
@@ -377,7 +432,11 @@ class Func(Node):
                 raise ExpressionError(f"{self.name}() needs a number, got {_what(v)}")
         with np.errstate(all="ignore"):
             if len(vals) == 1:
-                return _num(FUNC1[self.name](vals[0]))
+                v = vals[0]
+                if self.name == "sqrt" and not isinstance(v, np.ndarray) and v < 0:
+                    # REF's ERROR 1263
+                    raise ExpressionError(f"Square root of negative number {v:g}.")
+                return _num(FUNC1[self.name](v))
             return _num(FUNC2[self.name](vals[0], vals[1]))
 
     def children(self):
@@ -477,6 +536,21 @@ def _d_func(n, var):
         if n.name in ("maximum", "minimum"):
             cmpop = ">=" if n.name == "maximum" else "<="
             return Cond(Cmp(cmpop, a, b), da, db)
+        if n.name in ("incompleteellipticf", "incompleteelliptice"):
+            # a = phi, b = m;  Delta = sqrt(1 - m sin^2 phi)  (A&S 17.2, DLMF 19.4)
+            F = Func("incompleteellipticf", [a, b])
+            E = Func("incompleteelliptice", [a, b])
+            sn = Func("sin", [a])
+            delta = Func("sqrt", [sub(ONE, mul(b, mul(sn, sn)))])
+            if n.name == "incompleteellipticf":
+                dphi = div(ONE, delta)
+                dm = sub(sub(div(E, mul(Num(2.0), mul(b, sub(ONE, b)))), div(F, mul(Num(2.0), b))),
+                         div(Func("sin", [mul(Num(2.0), a)]),
+                             mul(Num(4.0), mul(sub(ONE, b), delta))))
+            else:
+                dphi = delta
+                dm = div(sub(E, F), mul(Num(2.0), b))
+            return add(mul(dphi, da), mul(dm, db))
         raise ExpressionError(f"cannot differentiate {n.name}")
     a = args[0]
     da = diff(a, var)
@@ -521,6 +595,11 @@ def _d_func(n, var):
         g = div(ONE, sub(ONE, mul(a, a)))
     elif nm in ("ceil", "floor"):
         return ZERO
+    elif nm == "elliptick":     # dK/dm = (E - (1-m) K) / (2m(1-m))  (DLMF 19.4.1)
+        K, E = n, Func("elliptice", [a])
+        g = div(sub(E, mul(sub(ONE, a), K)), mul(Num(2.0), mul(a, sub(ONE, a))))
+    elif nm == "elliptice":     # dE/dm = (E - K) / (2m)
+        g = div(sub(n, Func("elliptick", [a])), mul(Num(2.0), a))
     else:
         raise ExpressionError(f"cannot differentiate {nm}")
     return mul(g, da)

@@ -226,3 +226,22 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     t.quantities = remap_quantities(s, t, add_children)
     t.topology_version = getattr(s, "topology_version", 0) + 1
     return t
+
+
+def reorder_new_edges(t, start, perm):
+    """Reorder, in place, the edges that :func:`grow` appended to ``t`` from
+    index ``start`` on: new edge ``start + j`` becomes the one grow put at
+    ``start + perm[j]`` (grow appends edge-born edges before facet-born ones;
+    an operation numbering them interleaved, as the Evolver does, permutes
+    them before filling in the connectivity).  Ids stay in index order."""
+    perm = np.asarray(perm, np.int64)
+    idx = np.concatenate([np.arange(start), start + perm])
+    inv = np.argsort(idx)
+    t.E = t.E[idx]
+    t.eattr = {k: (a if k == "id" else a[idx]) for k, a in t.eattr.items()}
+    t.econ = {c: a[idx] for c, a in t.econ.items()}
+    t.extra = {(et, n): (a[idx] if et == "edge" else a) for (et, n), a in t.extra.items()}
+
+    def move(etype, i, sgn):
+        return (inv[i], sgn) if etype == "edge" else (i, sgn)
+    t.quantities = remap_quantities(t, t, move)

@@ -103,7 +103,7 @@ def main(argv=None):
               f"min angle {row['min_angle_deg']:.3g} deg  {row['seconds']:.1f} s", flush=True)
     print(f"2 pi^2 = {2 * math.pi ** 2:.6f}, 4 pi = {4 * math.pi:.6f}")
     csv = os.path.join(a.out, "fig1_torus.csv")
-    with atomic_write(csv, "w", newline=None) as fh:
+    with atomic_write(csv, "w") as fh:
         keys = list(rows[0])
         fh.write(",".join(keys) + "\n")
         for r in rows:

@@ -77,7 +77,7 @@ def main(argv=None):
     a = ap.parse_args(argv)
     rows = table(a.n, a.hmax, a.steps)
     names = ["h", "H_HKS", "H_MDSB", "H_EffArea", "H_NormalCur"]
-    with atomic_write(a.out + ".csv", "w") as fh:
+    with atomic_write(a.out + ".csv", "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(names)
         w.writerows(rows.tolist())

@@ -44,6 +44,43 @@ def torus_grid(m, n, R=2.0, r=1.0):
     return X, _outward(X, F)
 
 
+def torus_offset(m, n, R=2.0, r=1.0):
+    """The regular torus with offset rows: ``m`` points around the minor
+    circle, ``n`` (even) rows around the major circle, odd rows turned by
+    half a step (φ = 2π(i + ½)/m), each row joined to the next by a strip of
+    triangles.  Every vertex has valence 6, as in :func:`torus_grid`.
+
+    The two grids differ in their conformal structure when every triangle
+    is taken equilateral (the structure of the paper's ``harmonic_energy``):
+    with one diagonal direction the period lattice is spanned by ``m·(1, 0)``
+    and ``n·(½, √3/2)``, a sheared lattice that no torus of revolution has;
+    with offset rows it is ``m·(1, 0)`` and ``n·(0, √3/2)``, rectangular, the
+    conformal class of a torus of revolution with ``√((R/r)² − 1) =
+    n√3/(2m)`` (the Clifford torus, R/r = √2, is the square class).
+
+    Vertex ``(i, j)`` has index ``i + m j``.  Returns ``X (m n, 3)``,
+    ``F (2 m n, 3)``.
+    """
+    if m < 3 or n < 4 or n % 2:
+        raise ValueError("torus_offset needs m >= 3 and an even n >= 4")
+    i, j = np.meshgrid(np.arange(m), np.arange(n), indexing="xy")
+    i, j = i.ravel(), j.ravel()
+    phi = 2 * np.pi * (i + 0.5 * (j % 2)) / m
+    th = 2 * np.pi * j / n
+    rho = R + r * np.cos(phi)
+    X = np.stack([rho * np.cos(th), rho * np.sin(th), r * np.sin(phi)], 1)
+
+    def v(a, b):
+        return (a % m) + m * (b % n)
+    even = (j % 2 == 0)[:, None]
+    # even row j: (i, j+1) lies half a step past (i, j); odd row: half a step before
+    F1 = np.where(even, np.stack([v(i, j), v(i + 1, j), v(i, j + 1)], 1),
+                  np.stack([v(i, j), v(i + 1, j), v(i + 1, j + 1)], 1))
+    F2 = np.where(even, np.stack([v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)], 1),
+                  np.stack([v(i, j), v(i + 1, j + 1), v(i, j + 1)], 1))
+    return X, _outward(X, np.concatenate([F1, F2]))
+
+
 def icosahedron():
     """The unit icosahedron: ``X (12, 3)``, ``F (20, 3)``."""
     p = (1 + 5 ** 0.5) / 2
@@ -89,22 +126,25 @@ def icosphere(level):
     return X, F
 
 
-def write_fe(path, X, F, header="", face_attrs=""):
-    """Write ``(X, F)`` as an Evolver datafile (vertices, edges, faces with
-    signed edge ids); ``header`` (e.g. quantity declarations) goes on top,
-    ``face_attrs`` (e.g. ``"tension 0"``) after every face."""
+def fe_text(X, F, header="", face_attrs=""):
+    """``(X, F)`` as the text of an Evolver datafile (vertices, edges, faces
+    with signed edge ids); ``header`` (e.g. quantity declarations) goes on
+    top, ``face_attrs`` (e.g. ``"tension 0"``) after every face."""
     E, idx = edges(F)
     sign = np.where(F == E[idx, 0], 1, -1)
     FE = sign * (idx + 1)
-    with atomic_write(path, "w", newline=None) as fh:
-        fh.write(header.rstrip("\n") + "\n\n" if header else "")
-        fh.write("vertices\n")
-        for k, (x, y, z) in enumerate(X.tolist()):
-            fh.write("%d %.17g %.17g %.17g\n" % (k + 1, x, y, z))
-        fh.write("\nedges\n")
-        for k, (a, b) in enumerate((E + 1).tolist()):
-            fh.write("%d %d %d\n" % (k + 1, a, b))
-        fh.write("\nfaces\n")
-        for k, row in enumerate(FE.tolist()):
-            fh.write(("%d %d %d %d " % (k + 1, *row)) + face_attrs + "\n")
+    out = [header.rstrip("\n") + "\n\n" if header else "", "vertices\n"]
+    out += ["%d %.17g %.17g %.17g\n" % (k + 1, x, y, z) for k, (x, y, z) in enumerate(X.tolist())]
+    out.append("\nedges\n")
+    out += ["%d %d %d\n" % (k + 1, a, b) for k, (a, b) in enumerate((E + 1).tolist())]
+    out.append("\nfaces\n")
+    out += [("%d %d %d %d " % (k + 1, *row)) + face_attrs + "\n"
+            for k, row in enumerate(FE.tolist())]
+    return "".join(out)
+
+
+def write_fe(path, X, F, header="", face_attrs=""):
+    """Write :func:`fe_text` of ``(X, F)`` to ``path``; returns ``path``."""
+    with atomic_write(path, "w") as fh:
+        fh.write(fe_text(X, F, header, face_attrs))
     return path

@@ -1,0 +1,93 @@
+"""The notebook side of :class:`pyevolver.Session`: values, data arrays,
+files and pictures (a mixin, so that the session's Evolver core stays in
+``session.py``)::
+
+    import pyevolver
+    s = pyevolver.load("cube.fe")
+    s.run("r; u; g 10")
+    s.quantities                 # {"name": value} of the named quantities
+    s.value("body[1].volume")    # any expression of the command language
+    s.export("cube.vtu")         # any meshio format, with data arrays
+    s.snapshot("cube.png", field="mean_curvature")
+    s.plot_history("energy.png")
+
+Progress bars (tqdm) are the API's only: :meth:`Session.g` shows one for
+long runs at a terminal or in a notebook, never in the Evolver-compatible
+text output of the commands.
+"""
+from __future__ import annotations
+
+import sys
+
+from .errors import CommandError
+
+#: ``progress=None`` shows a bar for runs of at least this many steps.
+PROGRESS_MIN_STEPS = 100
+
+
+def progress_bar(total, progress=None, desc=None):
+    """A tqdm bar of ``total`` steps, or None.
+
+    ``progress`` True: a bar (refused by name when tqdm is not installed);
+    False: none; None: a bar when ``total >= PROGRESS_MIN_STEPS``, tqdm is
+    installed and the output is a terminal or a notebook.
+    """
+    if progress is False or total <= 0:
+        return None
+    if progress is None:
+        interactive = "ipykernel" in sys.modules or sys.stderr.isatty()
+        if total < PROGRESS_MIN_STEPS or not interactive:
+            return None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        if progress:
+            from .errors import UnsupportedError
+            raise UnsupportedError("progress bars without tqdm", "pip install tqdm") from None
+        return None
+    return tqdm(total=total, desc=desc, leave=False)
+
+
+class SessionAPI:
+    """Methods that :class:`pyevolver.Session` offers to Python callers."""
+
+    @property
+    def quantities(self):
+        """``{name: value}`` of the named quantities and method instances at
+        the current coordinates (as ``v`` and ``name.value`` report them)."""
+        if self.totals is None:
+            return {}
+        return {k: float(v) for k, v in self.totals.quantity_values.items()}
+
+    def value(self, expr):
+        """The value of one expression of the command language, e.g.
+        ``"total_energy"``, ``"body[1].volume"``, ``"max(vertex, z)"``."""
+        from .commands import interpreter as I
+        ast = I.parse_command(f"print {expr}", "<value>")
+        stmts = ast[1] if ast[0] == "seq" else [ast]
+        if len(stmts) != 1 or stmts[0][0] != "print":
+            raise CommandError(f"value: '{expr}' is not one expression")
+        v = self.interp.value(stmts[0][1])
+        return v if isinstance(v, str) else float(v)
+
+    def export(self, path, fmt=None, data=True):
+        """Write the surface to ``path`` in a meshio format chosen by the
+        extension (``.vtu``, ``.ply``, ``.obj``, ``.stl``, ``.off``,
+        ``.xdmf``, ...; ``.fe`` is ``dump``) with the per-vertex and
+        per-facet data arrays of :func:`pyevolver.fields.surface_fields`;
+        returns the format name (:func:`pyevolver.io.export`)."""
+        from .io.meshio_plugin import export
+        return export(self, path, fmt, data)
+
+    def snapshot(self, path, field="mean_curvature", view=None, **kwargs):
+        """Render the surface to an image file, headless
+        (:func:`pyevolver.render.snapshot`; the camera is the session's
+        ``view_matrix`` unless ``view`` is given)."""
+        from .render import snapshot
+        return snapshot(self, path, field=field, view=view, **kwargs)
+
+    def plot_history(self, path, **kwargs):
+        """Plot the energy of every ``g`` step so far
+        (:func:`pyevolver.render.plot_history`)."""
+        from .render import plot_history
+        return plot_history(self, path, **kwargs)

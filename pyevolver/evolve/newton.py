@@ -1,0 +1,205 @@
+"""``newton N``: damped Newton steps with exact Hessians (pyevolver's own).
+
+The Evolver's ``hessian`` takes the plain Newton step.  Far from a minimum,
+or on energies whose Hessian is singular (rigid motions, the tangential
+motions of a scale- or Möbius-invariant energy such as the squared mean
+curvature, ``hessian_normal off``), that step can be an ascent direction or
+arbitrarily long.  ``newton`` takes the Levenberg–Marquardt step instead
+(Nocedal & Wright, *Numerical Optimization*, 2nd ed., §3.4 and §4.3; the
+bordered system of :mod:`.hessian`):
+
+    [ K + δI   C ] [ dy ]   [ −∇E ]
+    [ Cᵀ       0 ] [ −ν ] = [ t − v ]
+
+with ``K`` the Hessian of the Lagrangian on the free coordinates of every
+mobile vertex (all three directions, or the tangent space of its level-set
+constraints: tangential motion matters for energies that are not invariant
+under it, e.g. ``harmonic_energy``), ``C`` the gradients of the fixed
+volumes and quantities and the multipliers fitted to ``∇E`` by least
+squares.  δ is raised until ``K + δI`` is positive definite (a Cholesky
+factorization succeeds; CHOLMOD when installed) and adapted by the ratio
+of the actual decrease of the energy, after the fixed values are restored
+as in ``g``, to the decrease the quadratic model predicts: a step is taken
+only when the energy decreases.  δ > 0 also makes the rigid motions, whose
+Hessian eigenvalues are zero, harmless: the gradient has no component along
+them.  Near a nondegenerate minimum δ → 0 and the steps become Newton
+steps (quadratic convergence).
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from . import gradient as GR
+from .hessian import _cholmod, constraint_curvature, lagrangian_hessian, tangent_basis
+
+
+@dataclass
+class NewtonResult:
+    """Outcome of :func:`damped_newton` (also passed to the callback)."""
+    energy: float
+    nit: int = 0
+    nfev: int = 0
+    delta: float = 0.0
+    message: str = ""
+    success: bool = False
+    history: list = field(default_factory=list)      # energies after each step
+
+
+def _factor(M):
+    """Solve function for the symmetric matrix ``M`` when it is positive
+    definite, None when it is not.  Without CHOLMOD a sparse LU factorization
+    is returned unchecked (the ratio test then rejects non-descent steps)."""
+    chol = _cholmod()
+    if chol is not None:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                return chol.cholesky(M.tocsc(), mode="supernodal")
+        except chol.CholmodNotPositiveDefiniteError:
+            return None
+    try:
+        return spla.splu(M.tocsc()).solve
+    except RuntimeError:
+        return None
+
+
+def _solve(f, B, r, d):
+    """``[[M, B], [Bᵀ, 0]] [y; μ] = [r; d]`` with ``f`` solving M (Schur complement)."""
+    if B is None:
+        return f(r), None
+    Z = f(np.column_stack([r, B]))
+    S = B.T @ Z[:, 1:]
+    mu = np.linalg.lstsq(S, B.T @ Z[:, 0] - d, rcond=None)[0]
+    return Z[:, 0] - Z[:, 1:] @ mu, mu
+
+
+def damped_newton(session, n, callback=None, delta0=None, rtol=1e-10):
+    """At most ``n`` damped Newton steps on the session's surface.
+
+    Parameters
+    ----------
+    session : Session
+    n : int
+        Maximal number of (accepted) steps.
+    callback : callable, optional
+        ``callback(result)`` after every step; a true value stops the run.
+    delta0 : float, optional
+        Initial damping; by default the one the last run ended with, else
+        1e-4 times the mean absolute diagonal of ``K``.
+    rtol : float
+        Converged when the model predicts a decrease below ``rtol · |E|``:
+        near a minimum the predicted decrease falls quadratically, and along
+        nearly flat directions (the slightly indefinite tangential modes of
+        area or Willmore energies) the steps would only creep.
+
+    Returns
+    -------
+    NewtonResult
+    """
+    from ..surface import restore_state, state
+    from .iterate import _Constraints
+    it = session.iterator
+    res = NewtonResult(energy=session.surface.evaluate().energy)
+    delta = delta0 if delta0 is not None else getattr(session, "_newton_delta", None)
+    for k in range(1, int(n) + 1):
+        s = session.surface
+        mobile = it._mobile()
+        cons = _Constraints(s)
+        t = s.evaluate()
+        f0 = t.energy
+        basis, grads = tangent_basis(s, mobile, normal=False)
+        T = basis.matrix()
+        gE = GR.energy_gradient(t)
+        gE[~mobile] = 0.0
+        gy = T.T @ gE.ravel()
+        B = d = None
+        lam = np.zeros(len(cons))
+        gs = []
+        if len(cons):
+            gs, _, _ = it._constrained_dirs(t, cons, mobile)
+            B = np.asarray(T.T @ np.stack([g.ravel() for g in gs], axis=1))
+            lam = np.linalg.lstsq(B, gy, rcond=None)[0]
+            d = cons.targets(s) - cons.values(t)
+
+        def grad_L(tt, lam=lam, cons=cons):
+            g = GR.energy_gradient(tt)
+            for l, gg in zip(lam, cons.gradients(tt) if len(cons) else []):
+                g = g - l * gg
+            return g
+        K = lagrangian_hessian(s, cons, lam, grad_L, basis)
+        gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))
+        Hc = constraint_curvature(s, grads, gL)
+        if Hc is not None:
+            K = K - T.T @ Hc @ T
+        K = sp.csc_matrix(K)
+        diag = float(np.mean(np.abs(K.diagonal()))) if K.shape[0] else 0.0
+        if not diag > 0:
+            res.message = "no free coordinates or a zero Hessian"
+            break
+        floor = 1e-12 * diag
+        if delta is None:
+            delta = 1e-4 * diag
+        delta = max(delta, floor)
+        X0 = state(s)
+        targets = cons.targets(s)
+        accepted = False
+        for _trial in range(60):
+            f = _factor(K + delta * sp.identity(K.shape[0], format="csc"))
+            if f is None:
+                delta *= 4.0
+                continue
+            dy, _ = _solve(f, B, -gy, d)
+            pred = -(gy @ dy + 0.5 * dy @ (K @ dy))
+            if not (pred > 0) or not np.all(np.isfinite(dy)):
+                delta *= 4.0
+                continue
+            if pred <= rtol * max(abs(f0), 1e-300):
+                res.message, res.success = "converged (predicted decrease below rtol)", True
+                break
+            dx = (T @ dy).reshape(-1, 3)
+            t1 = it._move(X0, dx, 1.0, cons, None, None, mobile, targets, None, trial=True)
+            res.nfev += 1
+            f1 = t1.energy
+            ratio = (f0 - f1) / pred if math.isfinite(f1) else -math.inf
+            if f1 < f0 and ratio > 0.1:
+                accepted = True
+                if ratio > 0.75:
+                    delta = max(delta / 8.0, floor)
+                elif ratio < 0.25:
+                    delta *= 2.0
+                break
+            restore_state(s, X0)
+            delta *= 4.0
+        session._newton_delta = delta
+        if not accepted:
+            restore_state(s, X0)
+            session.recalc()
+            if not res.message:
+                res.message = "no decrease found (round-off or a kink)"
+                res.success = True
+            break
+        # multipliers for the pressures report, as g stores them
+        for kk, q in enumerate(cons.quantities):
+            q.pressure = lam[len(cons.bodies) + kk]
+        b = s.bodies
+        if b.n:
+            b.lagrange[:] = 0.0
+            for kk, i in enumerate(cons.bodies):
+                b.lagrange[i] = lam[kk]
+        it.pressures_valid = True
+        session.recalc()
+        res.energy, res.nit, res.delta = session.totals.energy, k, delta
+        res.history.append(res.energy)
+        if callback is not None and callback(res):
+            res.message = "stopped by the callback"
+            break
+    else:
+        res.message = res.message or "iteration limit"
+    res.energy = session.surface.evaluate().energy
+    return res
