@@ -479,10 +479,11 @@ class Reader:
             _, name, expr, fixed, line = d
             name = VALUE_NAMES.get(name, name)
             sc.values[name] = self._const(expr, self._src(sec, line), name)
-            if name == "space_dimension" and sc.values[name] != 3:
-                raise self.error(f"not supported in pyevolver: SPACE_DIMENSION "
-                                 f"{sc.values[name]:g} (only 3 is supported)",
-                                 self._src(sec, line))
+            sc.value_lines[name] = self._src(sec, line)
+            if name in ("space_dimension", "surface_dimension") and \
+                    sc.values[name] not in (1, 2, 3, 4):
+                raise self.error(f"not supported in pyevolver: {name.upper()} "
+                                 f"{sc.values[name]:g}", self._src(sec, line))
             if fixed:
                 sc.values[name + "_fixed"] = 1.0
         elif kind == "constraint":
