@@ -300,7 +300,10 @@ class Session(SessionAPI):
         stripped = text.strip()
         if stripped.startswith("!") and not stripped.startswith("!="):
             # !!, !n, !prefix: a command from the history, echoed (manual)
-            old = self._from_history(stripped[1:].strip())
+            try:
+                old = self._from_history(stripped[1:].strip())
+            except CommandError as exc:
+                raise CommandError(f"{where}:{line}: {exc}") from None
             self.write(old + "\n\n")
             return self.run_one(old, where, line)
         ast = I.parse_command(text, where, line)
@@ -1044,7 +1047,7 @@ class Session(SessionAPI):
             tick()
             with env.element(el, gen.var):
                 v = gen.where.ev(env)
-            if not isinstance(v, str) and v:
+            if I.is_true(v):
                 out.append(el)
         return out
 

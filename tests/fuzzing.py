@@ -456,18 +456,20 @@ def check_surface(s):
     finite coordinates, a computable energy."""
     from pyevolver.geometry import edge_index
     nv, ne, nf = s.nv, s.ne, s.nf
-    assert s.X.shape == (nv, 3), s.X.shape
+    assert s.X.ndim == 2 and s.X.shape[0] == nv, s.X.shape
     assert np.all(np.isfinite(s.X)), "non-finite coordinates"
     assert s.E.shape == (ne, 2) and (ne == 0 or (s.E.min() >= 0 and s.E.max() < nv))
     if nf:
         idx, _ = edge_index(s.FE)
         assert idx.min() >= 0 and idx.max() < ne
-    for attrs, n in ((s.vattr, nv), (s.eattr, ne), (s.fattr, nf)):
+    # (the string model's facets are edge chains, counted by n_facets)
+    n_facets = s.n_facets if getattr(s, "string", False) else nf
+    for attrs, n in ((s.vattr, nv), (s.eattr, ne), (s.fattr, n_facets)):
         for key, arr in attrs.items():
             assert len(arr) == n, (key, len(arr), n)
     b = s.bodies
     if b.n:
-        assert b.facet_matrix.shape == (b.n, nf)
+        assert b.facet_matrix.shape[0] == b.n
     t = s.evaluate()
     assert isinstance(t.energy, float)
 

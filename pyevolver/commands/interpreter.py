@@ -171,6 +171,18 @@ def as_float(v, what="a value"):
     return float(v)
 
 
+def is_true(v, what="a where condition"):
+    """The truth of a ``where`` condition: numbers other than 0 (a string
+    is false, as before); arrays and elements are refused."""
+    if isinstance(v, str):
+        return False
+    if isinstance(v, np.ndarray) and v.size == 1:
+        v = v.reshape(())[()]
+    if not N.is_number(v) or isinstance(v, np.ndarray):
+        raise ExpressionError(f"{what} must be a number, got {N._what(v)}")
+    return bool(v != 0)
+
+
 def as_int(v, what="a count"):
     """``v`` as an integer (truncated toward zero, as C converts): counts,
     indices, ids.  Strings, NaN and infinities are refused."""
@@ -882,36 +894,43 @@ class Env:
 def histogram_text(vals, log=False):
     """The ``histogram``/``loghistogram`` report: the Evolver's bins (21 equal
     bins from the least to the greatest value; 20 logarithmic bins over the
-    positive values, with a ``<= 0.0`` line counting the others)."""
-    vals = [v for v in vals if math.isfinite(v)]     # NaN and infinities have no bin
-    if not vals:
+    positive values, with a ``<= 0.0`` line counting the others).  NaN
+    values are counted on a last line ``NaN  n``, as REF does; with nothing
+    else, REF's empty bins (from its initial bounds 1e38 and -1e38, which
+    its logarithmic bins print as ``inf``).  Infinities are left out (REF
+    stops on them)."""
+    nan = sum(1 for v in vals if v != v)
+    vals = [v for v in vals if math.isfinite(v)]
+    if not vals and not nan:
         return "No qualifying values.\n"
     out = []
+    tail = ["NaN          %d" % nan] if nan else []
     if log:
         nonpos = sum(1 for v in vals if v <= 0)
         vals = [v for v in vals if v > 0]
         if nonpos:
             out.append("          <= 0.0           %d" % nonpos)
         if not vals:
-            return "\n".join(out) + "\n"
-    lo, hi = min(vals), max(vals)
-    if hi <= lo:
+            if nan:
+                out += ["%10.5g - %10.5g     0" % (math.inf, math.inf)] * 20
+            return "\n".join(out + tail) + "\n"
+    lo, hi = (min(vals), max(vals)) if vals else (1e38, -1e38)
+    if vals and hi <= lo:
         out.append("%10.5g - %10.5g     %d" % (lo, hi, len(vals)))
-        return "\n".join(out) + "\n"
+        return "\n".join(out + tail) + "\n"
     nbins = 20 if log else 21
     if log:
         a, b = np.log(lo), np.log(hi)
-        keys = [(np.log(v) - a) / (b - a) * nbins for v in vals]
         edges = [float(np.exp(a + (b - a) * k / nbins)) for k in range(nbins + 1)]
     else:
-        keys = [(v - lo) / (hi - lo) * nbins for v in vals]
         edges = [lo + (hi - lo) * k / nbins for k in range(nbins + 1)]
-    counts = [0] * nbins
-    for k in keys:
-        counts[min(nbins - 1, max(0, int(k)))] += 1
+    # a value on an edge counts in the bin below it (REF: 6 in 5.4286 - 6
+    # when the values are 2..14)
+    keys = np.searchsorted(np.array(edges[1:]), np.array(vals, dtype=float), side="left")
+    counts = np.bincount(np.minimum(keys, nbins - 1), minlength=nbins).tolist()
     for k in range(nbins):
         out.append("%10.5g - %10.5g     %d" % (edges[k], edges[k + 1], counts[k]))
-    return "\n".join(out) + "\n"
+    return "\n".join(out + tail) + "\n"
 
 
 LETTER_LATER = {
@@ -1064,7 +1083,7 @@ class Interpreter:
             with self.env.element(el, gen.var):
                 if gen.where is not None:
                     v = gen.where.ev(self.env)
-                    if isinstance(v, str) or not v:
+                    if not is_true(v):
                         continue
                 if not self._loop(body):
                     break
@@ -1575,7 +1594,7 @@ class Interpreter:
                 el = ElemRef(gen.kind, int(hit[0]))
                 with self.env.element(el, gen.var):
                     v = gen.where.ev(self.env)
-                if not isinstance(v, str) and v:
+                if is_true(v):
                     n += s.delete_elements(gen.kind, [el.i])
         s.report(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted", n)
 
@@ -1784,4 +1803,6 @@ class Interpreter:
         v = self.value(expr)
         if isinstance(v, str):
             return bool(v)
+        if isinstance(v, np.ndarray):
+            raise ExpressionError(f"a condition must be a number, got {N._what(v)}")
         return v != 0
