@@ -176,7 +176,7 @@ TYPE_CONFUSION = [
     'vertex[1].x := 1/0', 'set vertex z 0/0', 'random_seed := 0/0',
     # rows of a 2-d array are arrays (main's vector values): not conditions
     'define arr real[3][2]; while arr[1] do break', 'define arr real[3][2]; list vertex where arr[1]',
-    'define arr real[3][2]; if arr[2] then print 1', '!!', '!999', '!nosuchcommand',
+    'define arr real[3][2]; if arr[2] then print 1', '!999', '!nosuchcommand',
 ]
 
 
