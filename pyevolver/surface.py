@@ -232,13 +232,7 @@ class Totals:
                 energy -= float(b.pressure[pmask] @ self.volumes[pmask])
         self.quantity_values = {}
         for q in s.quantities.values():
-            try:
-                v = self.quantity_value(q)
-            except PyEvolverError as exc:
-                if getattr(exc, "line", None) is None:     # say which quantity failed
-                    exc.line = q.line
-                    exc.args = (f"quantity {q.name}: {exc}",)
-                raise
+            v = self.quantity_value(q)
             self.quantity_values[q.name] = v
             if q.kind == "energy":
                 energy += v
@@ -396,6 +390,15 @@ class Totals:
         absolute values of its element contributions instead (the scale of
         its restoring tolerance).  A FUNCTION quantity's magnitude is its
         linearization's: Σ_i |∂f/∂v_i| magnitude_i."""
+        try:
+            return self._quantity_value(q, magnitude)
+        except PyEvolverError as exc:
+            if getattr(exc, "line", None) is None:     # say which quantity failed, where
+                exc.line = q.line
+                exc.args = (f"quantity {q.name}: {exc}",)
+            raise
+
+    def _quantity_value(self, q, magnitude=False):
         if q.function is not None:
             s = self.surface
             env = self.instance_values(q)

@@ -113,6 +113,10 @@ def test_errors_once_without_a_line():
                       + CUBE_TEXT.replace("1   1 2 3 4 5 6  volume 1", "").replace(
                           "5   5  6  7   8", ""))
     assert exc.line == 3 and "quantity sq" in exc.message
+    # the same in the string model (its own evaluation loop, from main)
+    circle = F.read_text(os.path.join(HERE, "data", "string_circle.fe"))
+    exc = _load_error("method_instance mi method loop_volume\n" + circle)
+    assert exc.line == 1 and "loop_volume" in exc.message
 
 
 def test_boundary_declarations():
@@ -176,7 +180,8 @@ TYPE_CONFUSION = [
     'vertex[1].x := 1/0', 'set vertex z 0/0', 'random_seed := 0/0',
     # rows of a 2-d array are arrays (main's vector values): not conditions
     'define arr real[3][2]; while arr[1] do break', 'define arr real[3][2]; list vertex where arr[1]',
-    'define arr real[3][2]; if arr[2] then print 1', '!!', '!999', '!nosuchcommand',
+    'define arr real[3][2]; if arr[2] then print 1', '!999', '!nosuchcommand',
+    'define arr real[3][2]; quiet arr[1]',
 ]
 
 

@@ -1763,7 +1763,7 @@ class Interpreter:
             new = 1 if arg.name == "on" else 0
         else:
             v = self.value(arg)
-            new = 1 if v else 0
+            new = (1 if v else 0) if isinstance(v, str) else int(is_true(v, "a toggle value"))
         old = s.toggles.get(name, TOGGLE_DEFAULTS.get(name, 0))
         if name == "autopop" and new:
             raise UnsupportedError("autopop", "vertex and edge popping (o, O) is not implemented")
