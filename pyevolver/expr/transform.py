@@ -3,8 +3,7 @@ from __future__ import annotations
 
 import os
 
-from lark import v_args
-from lark.visitors import Transformer_NonRecursive
+from lark import Transformer, v_args
 
 from ..errors import UnsupportedError, ExpressionError
 from . import nodes as N
@@ -27,10 +26,8 @@ def parse_number(text):
 
 
 @v_args(inline=True)
-class ExprTransformer(Transformer_NonRecursive):
-    """Builds :mod:`pyevolver.expr.nodes` trees (iteratively: a deeply nested
-    expression cannot exhaust Python's recursion; its depth is checked after,
-    see :data:`pyevolver.limits.MAX_NESTING`)."""
+class ExprTransformer(Transformer):
+    """Builds :mod:`pyevolver.expr.nodes` trees."""
 
     def number(self, tok):
         return N.Num(parse_number(str(tok)))
@@ -45,14 +42,13 @@ class ExprTransformer(Transformer_NonRecursive):
         nm = str(name).lower()
         args = [a for a in args if a is not None]
         if nm in N.UNSUPPORTED_FUNCS:
-            raise _at(UnsupportedError(f"function {nm}()"), name)
+            raise UnsupportedError(f"function {nm}()")
         if nm in N.FUNC1:
             if len(args) != 1:
-                raise _at(ExpressionError(f"{nm}() takes one argument, got {len(args)}"), name)
+                raise ExpressionError(f"{nm}() takes one argument, got {len(args)}")
         elif nm in N.FUNC2:
             if len(args) != 2:
-                raise _at(ExpressionError(f"{nm}() takes two arguments, got {len(args)}"),
-                          name)
+                raise ExpressionError(f"{nm}() takes two arguments, got {len(args)}")
         else:
             return self.user_call(name, args)
         return N.Func(nm, args)
@@ -86,14 +82,6 @@ class ExprTransformer(Transformer_NonRecursive):
 
     def compare(self, a, op, b):
         return N.Cmp(str(op), a, b)
-
-
-def _at(exc, tok):
-    """``exc`` with the position of the token ``tok`` (``line``, ``column``
-    attributes, read by the datafile reader and the command parser)."""
-    exc.line = getattr(tok, "line", None)
-    exc.column = getattr(tok, "column", None)
-    return exc
 
 
 _ESCAPES = {"n": "\n", "r": "\r", "t": "\t", "b": "\b", "q": '"'}
