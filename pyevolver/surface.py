@@ -448,7 +448,8 @@ class _Builder:
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
                              f"(3, or 2 in the string model)")
         if s.string and sc.torus and s.sdim != 2:
-            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model")
+            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model",
+                             sc.value_lines.get("torus") or sc.value_lines.get("string"))
         s.constraints = dict(sc.constraints)
         s.boundaries = dict(sc.boundaries)
         s.symmetric_content = "symmetric_content" in sc.flags
@@ -1046,6 +1047,11 @@ class _Builder:
                 etype, _ = method_info(m.method)
             except UnsupportedError as exc:
                 raise self.error(f"method_instance {name}: {exc}") from None
+            if s.string:
+                from .string_model import STRING_METHODS
+                if m.method not in STRING_METHODS:
+                    raise self.error(f"method_instance {name}: not supported in pyevolver: method "
+                                     f"{m.method} in the string model", getattr(m, "line", None))
             q = Quantity(name, "instance")
             q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
             s.quantities[name] = q

@@ -1,6 +1,8 @@
 """C ``printf`` semantics for the Evolver's ``printf`` and ``print``."""
 from __future__ import annotations
 
+import numpy as np
+
 import math
 import re
 
@@ -31,6 +33,11 @@ def c_format(fmt, args):
             raise CommandError(f"printf: not enough arguments for format {fmt!r}")
         v = args[ai]
         ai += 1
+        if isinstance(v, np.ndarray):
+            if v.size != 1:
+                raise CommandError(f"printf: argument {ai} is an array of shape "
+                                   f"{list(v.shape)}, not a number")
+            v = v.reshape(()).item()
         return v
 
     for m in _SPEC.finditer(fmt):

@@ -1701,7 +1701,10 @@ class Interpreter:
         if isinstance(v, N.ArrayValue):
             return v
         if isinstance(v, np.ndarray):
-            v = float(v)
+            if v.size != 1:
+                raise CommandError(f"expected a number here, got an array of shape "
+                                   f"{list(v.shape)}")
+            v = float(v.reshape(()))
         if isinstance(v, (ElemRef, QRef)):
             raise CommandError("an element or quantity is not a value here")
         return v
