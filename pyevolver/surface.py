@@ -448,8 +448,7 @@ class _Builder:
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
                              f"(3, or 2 in the string model)")
         if s.string and sc.torus and s.sdim != 2:
-            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model",
-                             sc.value_lines.get("torus") or sc.value_lines.get("string"))
+            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model")
         s.constraints = dict(sc.constraints)
         s.boundaries = dict(sc.boundaries)
         s.symmetric_content = "symmetric_content" in sc.flags

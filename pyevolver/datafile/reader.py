@@ -430,7 +430,6 @@ class Reader:
             sc.parameters[name] = self._const(expr, self._src(sec, line), f"parameter {name}")
         elif kind == "flag":
             sc.flags.add(d[1])
-            sc.value_lines.setdefault(d[1], self._src(sec, d[2]))
         elif kind == "value":
             _, name, expr, fixed, line = d
             name = VALUE_NAMES.get(name, name)
