@@ -180,6 +180,17 @@ def test_recipe_runs_unchanged_in_the_evolver(evolver):
     assert ours["type"] == ref["type"] == "prolate"
 
 
+def test_bad_names_are_refused():
+    with pytest.raises(ValueError, match="unknown method 'cotan'"):
+        F4.run("prolate", "cotan")
+    with pytest.raises(ValueError, match="unknown shape 'torus'"):
+        F4.run("torus", "normal")
+    with pytest.raises(ValueError, match="resolution 100"):
+        F4.run("prolate", "normal", max_nv=100)
+    with pytest.raises(SystemExit):
+        F4.main(["--methods", "cotan", "--no-evolver"])
+
+
 def test_cli_writes_csv_and_png(tmp_path):
     out = str(tmp_path / "fig4")
     assert F4.main(["--max-nv", "162", "--methods", "normal", "--shapes", "prolate",
