@@ -245,7 +245,7 @@ def test_acceptance_2562(shape, method, request):
 def test_stomatocyte_reference_converged():
     """The reference's own accuracy on its hardest branch: W at 128 modes
     (the study's) agrees with 256 modes to 1e-7 relative (measured 9.5e-8;
-    192 and 384 modes agree with 256 to 2e-9 and 1e-12)."""
+    384 and 512 modes agree with 256 to 1.2e-12, docs/paper.md)."""
     from pyevolver.studies.axisymmetric import canham_reference
     a = canham_reference(0.5, "stomatocyte", n=128)
     b = canham_reference(0.5, "stomatocyte", n=256, coef0=a.coef)
