@@ -180,6 +180,17 @@ def test_recipe_runs_unchanged_in_the_evolver(evolver):
     assert ours["type"] == ref["type"] == "prolate"
 
 
+def test_bad_names_are_refused():
+    with pytest.raises(ValueError, match="unknown method 'cotan'"):
+        F4.run("prolate", "cotan")
+    with pytest.raises(ValueError, match="unknown shape 'torus'"):
+        F4.run("torus", "normal")
+    with pytest.raises(ValueError, match="resolution 100"):
+        F4.run("prolate", "normal", max_nv=100)
+    with pytest.raises(SystemExit):
+        F4.main(["--methods", "cotan", "--no-evolver"])
+
+
 def test_cli_writes_csv_and_png(tmp_path):
     out = str(tmp_path / "fig4")
     assert F4.main(["--max-nv", "162", "--methods", "normal", "--shapes", "prolate",
@@ -234,7 +245,7 @@ def test_acceptance_2562(shape, method, request):
 def test_stomatocyte_reference_converged():
     """The reference's own accuracy on its hardest branch: W at 128 modes
     (the study's) agrees with 256 modes to 1e-7 relative (measured 9.5e-8;
-    192 and 384 modes agree with 256 to 2e-9 and 1e-12)."""
+    384 and 512 modes agree with 256 to 1.2e-12, docs/paper.md)."""
     from pyevolver.studies.axisymmetric import canham_reference
     a = canham_reference(0.5, "stomatocyte", n=128)
     b = canham_reference(0.5, "stomatocyte", n=256, coef0=a.coef)

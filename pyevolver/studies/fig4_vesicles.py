@@ -520,6 +520,10 @@ def run(shape, method, max_nv=2562, first_nv=162, directory=PAPER, lam_min=1e-3,
     is called after each resolution.
     """
     from .. import Session
+    if shape not in SHAPES:
+        raise ValueError(f"unknown shape {shape!r}; expected one of {', '.join(SHAPES)}")
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
     label = METHODS[method][1]
     s = Session.load(datafile(shape, method, directory), out=io.StringIO(), err=io.StringIO())
     if method != "normal":
@@ -734,7 +738,7 @@ def plot(path, results):
         ax.tick_params(labelsize=6)
         ax.set_title(f"{shape}, v0 = {SHAPES[shape][0]}", fontsize=8)
         if i == 0:
-            ax.legend(fontsize=5)
+            ax.legend(fontsize=5, loc="best")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
