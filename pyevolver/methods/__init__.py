@@ -25,7 +25,7 @@ HESSIANS = {}      # name -> fn(totals, method, idx, weights, basis=None) -> spa
 # Methods whose values couple vertices beyond a facet or an edge's two facets:
 # no Hessian (the coloured differences of the gradient assume that stencil).
 NO_HESSIAN = {
-    "circle_willmore": "Bobenko's energy is not smooth (REF has no Hessian for it); use g",
+    "circle_willmore": "Bobenko's energy is not smooth (REF has no Hessian for it); use bfgs (or g)",
     "loop_sq_mean_curvature": "Loop patches couple vertex 2-rings; use g",
     "loop_area": "Loop patches couple vertex 2-rings; use g",
     "loop_volume": "Loop patches couple vertex 2-rings; use g",
