@@ -359,18 +359,33 @@ def newton_run(m, n, energy, lam=None, grid="offset", steps=300, directory=None,
 
 
 def continuation_run(m, n, energy, grid="offset", lam0=0.25, factor=0.7, lammin=1e-3,
-                     steps=100, maxrises=2, directory=None, moebius=True):
-    """(c): ``fig3_continuation.cmd``.  Returns (row, stages)."""
+                     steps=100, maxrises=2, directory=None, moebius=True, rule="loop",
+                     nbis=8):
+    """(c): ``fig3_continuation.cmd``.  Returns (row, stages).
+
+    ``rule``: ``"loop"`` keeps the stage with the lowest Loop energy (the
+    procedure ``continuation``, ``maxrises`` stages without a new lowest
+    stop it); ``"consistency"`` keeps the healthy stage where the discrete W
+    and the Loop energy agree best (the procedure ``consistency``: λ lowered
+    by ``factor`` while W > W_Loop, then ``nbis`` bisections in log λ of the
+    bracket where W − W_Loop changes sign).
+    """
     path = datafile(m, n, energy, True, grid, directory)
-    call = f"continuation({lam0!r}, {factor!r}, {lammin!r}, {steps}, {maxrises})"
+    if rule == "loop":
+        call = f"continuation({lam0!r}, {factor!r}, {lammin!r}, {steps}, {maxrises})"
+    elif rule == "consistency":
+        call = f"consistency({lam0!r}, {factor!r}, {lammin!r}, {steps}, {nbis})"
+    else:
+        raise ValueError(f"unknown rule {rule!r} (loop or consistency)")
     s, lines, dt, its = run_pyevolver(path, script("fig3_continuation.cmd", call),
                                       where="fig3_continuation.cmd")
-    stages = [dict(_fields(ln), mesh=f"{m}x{n}", energy=energy, grid=grid)
+    stages = [dict(_fields(ln), mesh=f"{m}x{n}", energy=energy, grid=grid, rule=rule)
               for ln in lines if ln.startswith("stage ")]
     res = [_fields(ln) for ln in lines if ln.startswith("result ")]
     if not res:
         raise RuntimeError(f"{path}: the continuation printed no result:\n" + "\n".join(lines))
-    row = {"label": energy + "+harmonic(cont.)", "energy": energy, "grid": grid,
+    label = energy + ("+harmonic(cont.)" if rule == "loop" else "+harmonic(W=W_Loop)")
+    row = {"label": label, "energy": energy, "grid": grid,
            "mesh": f"{m}x{n}", "lambda": res[-1]["lambda"], "minimizer": "newton",
            "iterations": its, "seconds": dt}
     row.update(measure(s, moebius))
