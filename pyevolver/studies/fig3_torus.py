@@ -27,6 +27,9 @@ scripts there, which a user can run by hand):
     ``fig3_newton.cmd`` on ``*_harmonic.fe`` after ``harmonic.modulus := λ``;
 (c) continuation in λ: ``fig3_continuation.cmd`` (λ lowered by 0.7 per stage
     while the smallest angle stays ≥ 10°, stopped by the Loop-energy guide);
+(c') the consistency rule for λ, the procedure ``consistency`` of the same
+    script: λ lowered while W > W_Loop, then the crossing W = W_Loop
+    bisected in log λ; the healthy stage where they agree best is kept;
 (d) the Evolver's recipe, ``fig3_evolver_recipe.cmd`` (``g 20; V; u; n 1.0;
     g 20`` per round), run in pyevolver and in evolver-nox-d.
 
@@ -575,6 +578,10 @@ def main(argv=None):
             row, st = continuation_run(m, n, energy, directory=a.out)       # (c)
             show(row)
             stages += st
+            row, st = continuation_run(m, n, energy, directory=a.out,       # (c')
+                                       rule="consistency")
+            show(row)
+            stages += st
             rr, rc = recipe_run(m, n, energy, rounds=_recipe_rounds(m),      # (d)
                                 evolver=not a.no_evolver, directory=a.out)
             for r in rr:
@@ -592,7 +599,7 @@ def main(argv=None):
     _write_csv(os.path.join(a.out, "fig3_prop1.csv"), prop)
     chart = [_record(r["label"] + ("" if r.get("program", "pyevolver") == "pyevolver"
                                    else " [evolver-nox-d]"), r)
-             for r in rows if r["label"].endswith(("(cont.)", "(g,V,u,n)"))]
+             for r in rows if r["label"].endswith(("(cont.)", "(W=W_Loop)", "(g,V,u,n)"))]
     chart += [_record(r["label"] + " Loop W", dict(r, W=r["W_loop"]))
               for r in rows if r["label"].endswith("(cont.)")]
     _write_csv(os.path.join(a.out, "fig3_chart.csv"), chart)
@@ -643,7 +650,7 @@ def _plot(path, rows, stages, prop):
 def _groups(stages):
     g = {}
     for s in stages:
-        if s.get("status") == "healthy":
+        if s.get("status") == "healthy" and s.get("rule", "loop") == "loop":
             g.setdefault((s["mesh"], s["energy"]), []).append(s)
     return g
 
