@@ -104,6 +104,7 @@ procedure consistency(real lam0, real fac, real lammin, integer steps, integer n
   local lam, lhi, llo, dd, bestd, bestlam, stage, done, kk;
   perturb;
   keep_healthy;
+  keep_best;                  // the start, should the first stage be undone
   lam := lam0; lhi := 0; llo := 0; bestd := 1e30; bestlam := lam0; stage := 0; done := 0;
   while done == 0 do {
     harmonic.modulus := lam;
