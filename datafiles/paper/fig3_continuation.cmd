@@ -16,6 +16,18 @@
 // One line per stage: stage, lambda, W (the quantity willmore), smallest angle,
 // loop_w, clock, healthy/undone; then "result ..." for the stage kept.
 // To change the schedule run  continuation(lam0, f, lammin, steps, maxrises).
+//
+// consistency(lam0, f, lammin, steps, nbis): the other rule for lambda, an
+//   a-posteriori consistency test.  W and loop_w estimate the same Willmore
+//   energy; while lambda's bias dominates W > loop_w, once the PL energy
+//   starts to cheat W < loop_w.  Lower lambda by f while the mesh is healthy
+//   and W > loop_w; the first stage with W <= loop_w (or unhealthy) brackets
+//   the crossing, which nbis bisections in log(lambda) (each from the last
+//   healthy W > loop_w stage) narrow down; the healthy stage with the smallest
+//   |W - loop_w| is kept.  Stage lines end in healthy (W > loop_w), crossed
+//   (healthy, W <= loop_w) or undone (unhealthy).
+//   To run it, replace the last line (the default run) by
+//     consistency(0.25, 0.7, 0.001, 100, 8)
 
 minangle_ok := 10
 function real cornermin(real e1, real e2, real e3) {
@@ -80,6 +92,64 @@ procedure continuation(real lam0, real fac0, real lammin, integer steps, integer
       lam := lam/fac;
       fac := sqrt(fac);
       if fac > 0.97 then done := 1 else lam := lam*fac
+    }
+  };
+  back_to_best;
+  harmonic.modulus := bestlam;
+  calc_minangle;
+  printf "result lambda %.10g W %.15g minangle %.6g loop_w %.15g clock %.3f\n", bestlam,
+    willmore.value, minangle, loop_w.value, clock
+}
+procedure consistency(real lam0, real fac, real lammin, integer steps, integer nbis) {
+  local lam, lhi, llo, dd, bestd, bestlam, stage, done, kk;
+  perturb;
+  keep_healthy;
+  keep_best;                  // the start, should the first stage be undone
+  lam := lam0; lhi := 0; llo := 0; bestd := 1e30; bestlam := lam0; stage := 0; done := 0;
+  while done == 0 do {
+    harmonic.modulus := lam;
+    stage_newton(steps);
+    stage := stage + 1;
+    dd := willmore.value - loop_w.value;
+    if minangle >= minangle_ok and dd > 0 then {
+      printf "stage %d lambda %.10g W %.15g minangle %.6g loop_w %.15g clock %.3f healthy\n",
+        stage, lam, willmore.value, minangle, loop_w.value, clock;
+      keep_healthy;
+      lhi := lam;
+      if dd < bestd then { bestd := dd; bestlam := lam; keep_best };
+      if lam*fac < lammin then done := 1 else lam := lam*fac
+    } else {
+      if minangle >= minangle_ok then {
+        printf "stage %d lambda %.10g W %.15g minangle %.6g loop_w %.15g clock %.3f crossed\n",
+          stage, lam, willmore.value, minangle, loop_w.value, clock;
+        if abs(dd) < bestd then { bestd := abs(dd); bestlam := lam; keep_best }
+      } else
+        printf "stage %d lambda %.10g W %.15g minangle %.6g loop_w %.15g clock %.3f undone\n",
+          stage, lam, willmore.value, minangle, loop_w.value, clock;
+      llo := lam;
+      done := 1
+    }
+  };
+  if lhi > 0 and llo > 0 then {
+    for ( kk := 1 ; kk <= nbis ; kk++ ) {
+      lam := sqrt(lhi*llo);
+      back_to_healthy;
+      harmonic.modulus := lam;
+      stage_newton(steps);
+      stage := stage + 1;
+      dd := willmore.value - loop_w.value;
+      if minangle >= minangle_ok then {
+        if dd > 0 then
+          printf "stage %d lambda %.10g W %.15g minangle %.6g loop_w %.15g clock %.3f healthy\n",
+            stage, lam, willmore.value, minangle, loop_w.value, clock
+        else
+          printf "stage %d lambda %.10g W %.15g minangle %.6g loop_w %.15g clock %.3f crossed\n",
+            stage, lam, willmore.value, minangle, loop_w.value, clock;
+        if abs(dd) < bestd then { bestd := abs(dd); bestlam := lam; keep_best }
+      } else
+        printf "stage %d lambda %.10g W %.15g minangle %.6g loop_w %.15g clock %.3f undone\n",
+          stage, lam, willmore.value, minangle, loop_w.value, clock;
+      if minangle >= minangle_ok and dd > 0 then { lhi := lam; keep_healthy } else llo := lam
     }
   };
   back_to_best;

@@ -27,6 +27,9 @@ scripts there, which a user can run by hand):
     ``fig3_newton.cmd`` on ``*_harmonic.fe`` after ``harmonic.modulus := λ``;
 (c) continuation in λ: ``fig3_continuation.cmd`` (λ lowered by 0.7 per stage
     while the smallest angle stays ≥ 10°, stopped by the Loop-energy guide);
+(c') the consistency rule for λ, the procedure ``consistency`` of the same
+    script: λ lowered while W > W_Loop, then the crossing W = W_Loop
+    bisected in log λ; the healthy stage where they agree best is kept;
 (d) the Evolver's recipe, ``fig3_evolver_recipe.cmd`` (``g 20; V; u; n 1.0;
     g 20`` per round), run in pyevolver and in evolver-nox-d.
 
@@ -359,18 +362,33 @@ def newton_run(m, n, energy, lam=None, grid="offset", steps=300, directory=None,
 
 
 def continuation_run(m, n, energy, grid="offset", lam0=0.25, factor=0.7, lammin=1e-3,
-                     steps=100, maxrises=2, directory=None, moebius=True):
-    """(c): ``fig3_continuation.cmd``.  Returns (row, stages)."""
+                     steps=100, maxrises=2, directory=None, moebius=True, rule="loop",
+                     nbis=8):
+    """(c): ``fig3_continuation.cmd``.  Returns (row, stages).
+
+    ``rule``: ``"loop"`` keeps the stage with the lowest Loop energy (the
+    procedure ``continuation``, ``maxrises`` stages without a new lowest
+    stop it); ``"consistency"`` keeps the healthy stage where the discrete W
+    and the Loop energy agree best (the procedure ``consistency``: λ lowered
+    by ``factor`` while W > W_Loop, then ``nbis`` bisections in log λ of the
+    bracket where W − W_Loop changes sign).
+    """
     path = datafile(m, n, energy, True, grid, directory)
-    call = f"continuation({lam0!r}, {factor!r}, {lammin!r}, {steps}, {maxrises})"
+    if rule == "loop":
+        call = f"continuation({lam0!r}, {factor!r}, {lammin!r}, {steps}, {maxrises})"
+    elif rule == "consistency":
+        call = f"consistency({lam0!r}, {factor!r}, {lammin!r}, {steps}, {nbis})"
+    else:
+        raise ValueError(f"unknown rule {rule!r} (loop or consistency)")
     s, lines, dt, its = run_pyevolver(path, script("fig3_continuation.cmd", call),
                                       where="fig3_continuation.cmd")
-    stages = [dict(_fields(ln), mesh=f"{m}x{n}", energy=energy, grid=grid)
+    stages = [dict(_fields(ln), mesh=f"{m}x{n}", energy=energy, grid=grid, rule=rule)
               for ln in lines if ln.startswith("stage ")]
     res = [_fields(ln) for ln in lines if ln.startswith("result ")]
     if not res:
         raise RuntimeError(f"{path}: the continuation printed no result:\n" + "\n".join(lines))
-    row = {"label": energy + "+harmonic(cont.)", "energy": energy, "grid": grid,
+    label = energy + ("+harmonic(cont.)" if rule == "loop" else "+harmonic(W=W_Loop)")
+    row = {"label": label, "energy": energy, "grid": grid,
            "mesh": f"{m}x{n}", "lambda": res[-1]["lambda"], "minimizer": "newton",
            "iterations": its, "seconds": dt}
     row.update(measure(s, moebius))
@@ -560,6 +578,10 @@ def main(argv=None):
             row, st = continuation_run(m, n, energy, directory=a.out)       # (c)
             show(row)
             stages += st
+            row, st = continuation_run(m, n, energy, directory=a.out,       # (c')
+                                       rule="consistency")
+            show(row)
+            stages += st
             rr, rc = recipe_run(m, n, energy, rounds=_recipe_rounds(m),      # (d)
                                 evolver=not a.no_evolver, directory=a.out)
             for r in rr:
@@ -577,7 +599,7 @@ def main(argv=None):
     _write_csv(os.path.join(a.out, "fig3_prop1.csv"), prop)
     chart = [_record(r["label"] + ("" if r.get("program", "pyevolver") == "pyevolver"
                                    else " [evolver-nox-d]"), r)
-             for r in rows if r["label"].endswith(("(cont.)", "(g,V,u,n)"))]
+             for r in rows if r["label"].endswith(("(cont.)", "(W=W_Loop)", "(g,V,u,n)"))]
     chart += [_record(r["label"] + " Loop W", dict(r, W=r["W_loop"]))
               for r in rows if r["label"].endswith("(cont.)")]
     _write_csv(os.path.join(a.out, "fig3_chart.csv"), chart)
@@ -628,7 +650,7 @@ def _plot(path, rows, stages, prop):
 def _groups(stages):
     g = {}
     for s in stages:
-        if s.get("status") == "healthy":
+        if s.get("status") == "healthy" and s.get("rule", "loop") == "loop":
             g.setdefault((s["mesh"], s["energy"]), []).append(s)
     return g
 
