@@ -13,6 +13,14 @@ tension.  Two discretisations of W, each with its cure for bad triangles:
     (``harmonic_energy``), minimised over all vertex coordinates by damped
     Newton steps (:func:`newton_lm`), with λ lowered by a continuation
     (:func:`harmonic_continuation`) while the mesh stays healthy.
+``NormalCur+harmonic+u``
+    the same energy and continuation, but each λ stage alternates Newton
+    solves with equiangulation ``u`` (edge flips) until a solve is followed
+    by no flip (:func:`_solve_stage`): the simplicial complex, and with it
+    the equilateral conformal structure the harmonic term measures against,
+    follows the surface.  On the stomatocyte this lets vertices flow through
+    the neck into the inner bulb; on the prolate and the discocyte no edge
+    flips and the runs are those of ``NormalCur+harmonic``.
 ``StarPerp+Evolver recipe``
     ``star_perp_sq_mean_curvature`` (h = (3/2) F·N/N·N) with the Evolver's
     smoothing recipe: cycles of vertex averaging ``V``, equiangulation ``u``
@@ -36,7 +44,7 @@ converge again, ... through 642, 2,562 (and 10,242) vertices.  A row per
 resolution reports the cumulative time.
 
     python -m pyevolver.studies.fig4_vesicles [--size small|full] [--out DIR]
-        [--max-nv N] [--methods normal,perp,perp_newton]
+        [--max-nv N] [--methods normal,normal_u,perp,perp_newton]
         [--shapes stomatocyte,discocyte,prolate] [--no-evolver]
 
 writes ``fig4_vesicles.csv`` (one row per method, shape and resolution,
@@ -72,6 +80,7 @@ REFERENCE_MODES = {"stomatocyte": 128, "discocyte": 24, "prolate": 24}
 LEVELS = {162: 2, 642: 3, 2562: 4, 10242: 5}
 METHODS = {
     "normal": ("normal_sq_mean_curvature", "NormalCur+harmonic"),
+    "normal_u": ("normal_sq_mean_curvature", "NormalCur+harmonic+u"),
     "perp": ("star_perp_sq_mean_curvature", "StarPerp+Evolver recipe"),
     "perp_newton": ("star_perp_sq_mean_curvature", "StarPerp+recipe+Newton"),
 }
@@ -168,7 +177,7 @@ def write_datafile(path, X, F, shape, method):
 def datafile(shape, method, directory=PAPER):
     """Path of the shipped 162-vertex start ``vesicle_<shape>_<perp|normal>.fe``
     (written by :func:`write_datafile` when missing)."""
-    kind = "normal" if method == "normal" else "perp"
+    kind = "normal" if method.startswith("normal") else "perp"
     path = os.path.join(directory, f"vesicle_{shape}_{kind}.fe")
     if not os.path.exists(path):
         os.makedirs(directory, exist_ok=True)
@@ -301,8 +310,32 @@ def newton_lm(session, tol=1e-9, maxit=80, mu=1e-2, guard=None):
     return False, maxit, gnorm
 
 
+def _solve_stage(session, maxit, guard, flips):
+    """Minimise at the current λ: :func:`newton_lm`; with ``flips`` > 0,
+    then equiangulate (``u`` sweeps until none flips) and solve again, at
+    most ``flips`` times, until a solve is followed by no flip.  Returns
+    ``(converged, Newton steps, edges flipped)``."""
+    ok, steps, _ = newton_lm(session, maxit=maxit, guard=guard)
+    flipped = 0
+    for _ in range(flips):
+        if guard is not None and not guard(session.surface):
+            break
+        n = 0
+        for _ in range(50):
+            k = session.equiangulate(echo=False)
+            n += k
+            if k == 0:
+                break
+        flipped += n
+        if n == 0:
+            break
+        ok, k, _ = newton_lm(session, maxit=maxit, guard=guard)
+        steps += k
+    return ok, steps, flipped
+
+
 def harmonic_continuation(session, lam_min=1e-3, factor=2.0, min_angle_deg=10.0,
-                          maxit=80, require_converged=False, log=None):
+                          maxit=80, require_converged=False, flips=0, log=None):
     """Lower λ (the modulus of quantity ``harm``) while the mesh stays healthy.
 
     At the current λ the surface is minimised by :func:`newton_lm` (at most
@@ -314,42 +347,51 @@ def harmonic_continuation(session, lam_min=1e-3, factor=2.0, min_angle_deg=10.0,
     refining, :func:`run` calls it again from the λ reached.  The failure it
     guards against is abrupt: measured on all three shapes, the smallest
     angle drops from 35–45° to below 10° within one halving of λ while W
-    drops sharply, mostly below the smooth minimum (docs/paper.md).  ``log`` (a list)
-    receives one dict per stage.
+    drops sharply, mostly below the smooth minimum (docs/paper.md).
+
+    ``flips`` > 0 lets the triangulation follow the surface: after each
+    Newton solve the mesh is equiangulated (``u``) and solved again (see
+    :func:`_solve_stage`), so the harmonic energy measures the distortion
+    from the equilateral structure of the *current*, Delaunay-like
+    triangulation instead of the icosphere's.  ``log`` (a list) receives
+    one dict per stage.
 
     Returns the final λ.
     """
-    from ..surface import restore_state, state
-    s = session.surface
-    q = s.quantities["harm"]
+    import copy
 
     def healthy(surf):
         return min_angle(surf.X, surf.F) >= min_angle_deg
-    lam = q.modulus
-    ok, n, _ = newton_lm(session, maxit=maxit)
-    good = (ok or not require_converged) and healthy(s)
+
+    def harm():
+        return session.surface.quantities["harm"]
+
+    def entry(lam, ok, n, nflip, good):
+        s = session.surface
+        return {"lambda": lam, "converged": ok, "steps": n, "flips": nflip, "kept": good,
+                "W": session.totals.quantity_values["willmore"],
+                "min_angle_deg": min_angle(s.X, s.F)}
+    lam = harm().modulus
+    ok, n, nflip = _solve_stage(session, maxit, None, flips)
+    good = (ok or not require_converged) and healthy(session.surface)
     if log is not None:
-        log.append({"lambda": lam, "converged": ok, "steps": n, "kept": good,
-                    "W": session.totals.quantity_values["willmore"],
-                    "min_angle_deg": min_angle(s.X, s.F)})
+        log.append(entry(lam, ok, n, nflip, good))
     if not good:
         return lam
     while lam / factor >= lam_min * (1 - 1e-12):
-        keep = state(s)
-        q.modulus = lam / factor
+        keep = copy.deepcopy(session.surface)
+        harm().modulus = lam / factor
         session.recalc()
-        ok, n, _ = newton_lm(session, maxit=maxit, guard=healthy)
-        good = (ok or not require_converged) and healthy(s)
+        ok, n, nflip = _solve_stage(session, maxit, healthy, flips)
+        good = (ok or not require_converged) and healthy(session.surface)
         if log is not None:
-            log.append({"lambda": q.modulus, "converged": ok, "steps": n,
-                        "W": session.totals.quantity_values["willmore"],
-                        "min_angle_deg": min_angle(s.X, s.F), "kept": good})
+            log.append(entry(lam / factor, ok, n, nflip, good))
         if not good:
-            restore_state(s, keep)
-            q.modulus = lam
+            session._replace_surface(keep)
+            harm().modulus = lam
             session.recalc()
             break
-        lam = q.modulus
+        lam = harm().modulus
     return lam
 
 
@@ -505,6 +547,9 @@ def _recipe_text(directory=PAPER):
         return fh.read()
 
 
+#: "normal_u": at most this many equiangulate-and-solve rounds per λ stage
+FLIP_ROUNDS = 10
+
 NEWTON_CYCLE = "cycle := { V; u; g 5; hessian_seek; hessian_seek }"
 
 
@@ -526,7 +571,8 @@ def run(shape, method, max_nv=2562, first_nv=162, directory=PAPER, lam_min=1e-3,
         raise ValueError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
     label = METHODS[method][1]
     s = Session.load(datafile(shape, method, directory), out=io.StringIO(), err=io.StringIO())
-    if method != "normal":
+    harmonic = method.startswith("normal")
+    if not harmonic:
         s.run(_recipe_text(directory))
         for name, value in (recipe_vars or {}).items():
             s.run(f"{name} := {value!r}")
@@ -540,15 +586,18 @@ def run(shape, method, max_nv=2562, first_nv=162, directory=PAPER, lam_min=1e-3,
         if not solve:
             continue
         extra = {}
-        if method == "normal":
+        if harmonic:
             log = []
-            lam = harmonic_continuation(s, lam_min=lam_min, log=log)
+            lam = harmonic_continuation(s, lam_min=lam_min, log=log,
+                                        flips=FLIP_ROUNDS if method == "normal_u" else 0)
             kept = [r for r in log if r.get("kept", r["converged"])]
             extra = {"lambda": lam, "newton_steps": sum(r["steps"] for r in log),
+                     "flips": sum(r["flips"] for r in log),
                      "converged": bool(kept),
                      "continuation": " ".join(
                          f"{r['lambda']:g}:{r['W']:.5f}/{r['min_angle_deg']:.1f}deg/"
                          f"{r['steps']}{'' if r.get('kept', r['converged']) else 'x'}"
+                         + (f"/u{r['flips']}" if r["flips"] else "")
                          for r in log)}
         else:
             s.run("relax")
