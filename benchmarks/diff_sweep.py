@@ -89,6 +89,13 @@ def datafiles(include_all=False):
     return out
 
 
+def gogo_sequences(fe):
+    """The ``gogoN := { ... }`` commands the datafile's read section defines."""
+    with open(fe, errors="replace") as f:
+        names = re.findall(r"^\s*(gogo\d*)\s*:=\s*\{", f.read(), re.M)
+    return [(n, [n], "evolve") for n in dict.fromkeys(names)]
+
+
 def run(cmd, cwd, timeout, env=None):
     try:
         p = subprocess.run(cmd, cwd=cwd, stdin=subprocess.DEVNULL, capture_output=True,
@@ -208,11 +215,13 @@ def main():
     ap.add_argument("--timeout", type=float, default=60)
     ap.add_argument("--json", help="write the results here")
     ap.add_argument("--all", action="store_true", help="every paper datafile too")
+    ap.add_argument("--gogo", action="store_true",
+                    help="only the datafiles' own gogo* commands (one case each)")
     ap.add_argument("--quiet", action="store_true", help="only the non-matching rows")
     a = ap.parse_args()
     files = [f for f in datafiles(a.all) if fnmatch.fnmatch(os.path.basename(f), a.files)]
     seqs = [s for s in SEQUENCES if not a.seqs or s[0] in a.seqs.split(",")]
-    cases = [(f, s) for f in files for s in seqs]
+    cases = [(f, s) for f in files for s in (gogo_sequences(f) if a.gogo else seqs)]
     results = []
     with cf.ThreadPoolExecutor(a.jobs) as ex:
         futs = [ex.submit(one_case, f, s, a.timeout) for f, s in cases]

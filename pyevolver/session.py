@@ -1024,16 +1024,18 @@ class Session(SessionAPI):
                 from .string_model import vertex_edges
                 return [I.ElemRef("edge", e, g) for e, g in vertex_edges(s, i)]
             if kind == "edge":
-                # oriented away from the vertex (oid < 0 where it is the head);
-                # the Evolver's order on a freshly loaded surface: the first
-                # edge, then the others newest first
-                es = np.nonzero((s.E == i).any(axis=1))[0]
-                ids = s.ids("edge")[es]
-                es = es[np.argsort(ids, kind="stable")]
-                es = list(es[:1]) + list(es[1:][::-1])
+                # oriented away from the vertex (oid < 0 where it is the head),
+                # in the Evolver's ring order (surface.vertex_rings)
+                from .surface import vertex_edge_rank
+                es, end = np.nonzero(s.E == i)
+                es = es[np.argsort(vertex_edge_rank(s)[es, end], kind="stable")]
+                es = list(dict.fromkeys(es.tolist()))
                 return [I.ElemRef("edge", int(e), 1 if s.E[e, 0] == i else -1) for e in es]
             if kind == "facet":
-                return [I.ElemRef("facet", int(f)) for f in np.nonzero((s.F == i).any(axis=1))[0]]
+                from .surface import vertex_facet_rank
+                fs, corner = np.nonzero(s.F == i)
+                fs = fs[np.argsort(vertex_facet_rank(s)[fs, corner], kind="stable")]
+                return [I.ElemRef("facet", int(f)) for f in dict.fromkeys(fs.tolist())]
         if el.kind == "edge":
             if kind == "vertex":
                 a, b = s.E[i]
@@ -1151,9 +1153,10 @@ class Session(SessionAPI):
                 if isinstance(idx, tuple):
                     raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
                 from .geometry import vertex_normals
+                from .surface import vertex_facet_rank
                 if s.nf == 0:
                     raise UnsupportedError("vertex_normal in the string model")
-                nrm = vertex_normals(s.F, t.facet_N2, s.nv)[i]
+                nrm = vertex_normals(s.F, t.facet_N2, s.nv, vertex_facet_rank(s))[i]
                 if idx is None:
                     return N.array_value(nrm)
                 j = int(idx)
