@@ -401,12 +401,32 @@ class Session(SessionAPI):
             s.vcon = vcon
 
     # -- evaluation ------------------------------------------------------------------
-    def recalc(self, keep_cg=False):
+    def recalc(self, keep_cg=False, reposition=False):
         """Recompute energies, areas and volumes (and reset the CG history,
-        as the Evolver's recalc does, unless ``keep_cg``)."""
+        as the Evolver's recalc does, unless ``keep_cg``).
+
+        ``reposition`` (the ``recalc`` command): first put the vertices on
+        parametric boundaries where their parameters now say (cat.fe's
+        ``rmax := 1; recalc``: REF's energy 14.5547875690274) and project
+        the vertices on level-set constraints onto them (sphere.fe's
+        ``rad := 1.2; recalc``), as evolver-nox-d does after a parameter
+        changed."""
         s = self.surface
         if s is None:
             return
+        if reposition:
+            from .surface import boundary_eval, boundary_groups, project_to_constraints
+            groups = boundary_groups(s) if s.boundaries else []
+            if groups or s.vcon:
+                s.X = s.X.copy()
+                for bid, rows in groups:
+                    s.X[rows], _ = boundary_eval(s, bid, s.vattr["params"][rows])
+                on = np.zeros(s.nv, bool)
+                for m in s.vcon.values():
+                    on |= m
+                if on.any():
+                    project_to_constraints(s, np.nonzero(on)[0])
+                s.__dict__.pop("_lift_cache", None)
         s.gravity_constant = self.variables.get("gravity_constant", s.gravity_constant)
         s.gravity_on = bool(self.toggles.get("gravity", 1))
         s.curvature_mode = ("norm" if self.toggles.get("normal_curvature") else
@@ -1050,8 +1070,12 @@ class Session(SessionAPI):
                 for f in np.nonzero((idx == i).any(axis=1))[0]:
                     g = int(sgn[f][np.nonzero(idx[f] == i)[0][0]]) * el.sign
                     out.append(I.ElemRef("facet", int(f), g))
-                # the facet running along the edge first (REF, two-facet edges)
-                out.sort(key=lambda r: -r.sign * el.sign)
+                # REF's loop order of a two-facet edge: the facet running along
+                # the edge first, unless the loop is known to start with the
+                # other (surface.along_first)
+                from .surface import along_first
+                first = 1 if len(out) != 2 or along_first(s)[i] else -1
+                out.sort(key=lambda r: -r.sign * el.sign * first)
                 return out
         if el.kind == "facet":
             from .geometry import edge_index

@@ -1152,6 +1152,36 @@ def edge_first_facet(s):
     return first
 
 
+def record_along_first(s, along):
+    """Attach to ``s`` which edges have the facet running along them first
+    in their facet loop (``along`` (ne,) bool), valid while its connectivity
+    stays what it is now."""
+    s._along_first = (s.FE.copy(), s.E.copy(), np.asarray(along, bool))
+
+
+def along_first(s):
+    """(ne,) bool: the facet running along the edge comes first in the
+    edge's facet loop (REF's ``ee.facet`` order of a two-facet edge).
+
+    Recorded by ``r`` (:func:`record_along_first`); on a loaded surface from
+    :func:`edge_first_facet`; where neither is known, True (the facet along
+    the edge first, as ``ee.facet`` lists it)."""
+    c = s.__dict__.get("_along_first")
+    if c is not None and c[0].shape == s.FE.shape and c[1].shape == s.E.shape and \
+            np.array_equal(c[0], s.FE) and np.array_equal(c[1], s.E):
+        return c[2].copy()
+    out = np.ones(s.ne, bool)
+    first = edge_first_facet(s)
+    if first is None:
+        return out
+    idx, sgn, _ = s.topology()
+    known = np.nonzero(first >= 0)[0]
+    f = first[known]
+    hit = idx[f] == known[:, None]
+    out[known] = (sgn[f] * hit).sum(axis=1) >= 0
+    return out
+
+
 def record_vertex_rings(s, rank):
     """Attach REF's edge rings to ``s``: ``rank`` (ne, 2) is the position of
     each edge in the ring of its tail (column 0) and head (column 1) vertex

@@ -400,3 +400,28 @@ def test_vertex_rings_and_normals_match_reference(evolver, name, cmds, tmp_path)
     b = np.array([[float(x) for x in l[1:]] for l in pick(mine, "VN")])
     tol = 1e-4 if name == "column.fe" else 1e-12     # column's g 5 differs at 1e-6 (scale)
     assert a.shape == b.shape and np.abs(a - b).max() < tol
+
+
+@pytest.mark.parametrize("name,cmds", [("catbody.fe", "u"), ("catbody.fe", "r\nu"),
+                                       ("column.fe", "r\nu\nr"), ("quad.fe", "r\nr\ng 10\nu"),
+                                       ("cube_irr.fe", "r\ng 3\nu"), ("cat.fe", "r\nu")])
+def test_equiangulation_numbers_as_reference(evolver, name, cmds, tmp_path):
+    """After ``u`` the flipped edges run and the two facets take their
+    triangles as in REF (``list edges``, ``list facets``, ``ee.facet``):
+    which depends on which facet starts the edge's facet loop
+    (surface.along_first: known on load, kept by ``r`` and ``u``)."""
+    text = (cmds + "\nlist edges\nlist facets\n"
+            'foreach edge ee do { printf "EF %d", ee.id; foreach ee.facet ff do '
+            'printf " %d", ff.oid; printf "\\n"; }\n')
+    ref = run_reference(evolver, datafile(name), text, cwd=str(tmp_path))
+    import io
+    out = io.StringIO()
+    s = Session.load(datafile(name), out=out)
+    s.run(text)
+    consistent(s.surface)
+    import re
+    keep = re.compile(r"^\s*-?\d+\s+-?\d+\s+-?\d+|^EF ")
+    a = [l.split("/*")[0].split() for l in ref if keep.match(l)]
+    b = [l.split("/*")[0].split() for l in out.getvalue().splitlines() if keep.match(l)]
+    assert len(a) == s.surface.ne + s.surface.nf + s.surface.ne
+    assert a == b

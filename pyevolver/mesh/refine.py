@@ -211,6 +211,7 @@ def split_edges(s, ref):
             t.eattr["wrap"][eidx] = offset(q[0], q[1], f) - offset(p[0], p[1], f)
 
     _split_rings(s, t, R, half)
+    _split_loops(s, t, R, half)
     new_v = np.arange(nv, nv + k)
     boundary_midpoints(t, s.E[R, 0], s.E[R, 1], new_v)
     if t.vcon:
@@ -223,89 +224,43 @@ def split_edges(s, ref):
     return t
 
 
+def _split_loops(s, t, R, half):
+    """Record which edges of ``t`` have the facet along them first in their
+    facet loop (:func:`surface.along_first`): the tail half of a split edge
+    keeps its edge's order, the head half has the other one, the edges
+    cutting the facets have the facet along them first (measured with
+    ``ee.facet`` after ``r`` on catbody.fe; it decides how ``u`` renumbers)."""
+    from ..surface import along_first, record_along_first
+    out = np.ones(t.ne, bool)
+    old = along_first(s)
+    out[:s.ne] = old
+    out[half[R]] = ~old[R]
+    record_along_first(t, out)
+
+
 def _split_rings(s, t, R, half):
-    """Record REF's edge rings (:func:`surface.vertex_edge_rank`) at the
-    vertices of ``t``: ``s`` with the edges ``R`` split (new head halves
-    ``half[R]``) and its facets cut.
+    """Record REF's edge rings (:mod:`pyevolver.mesh.rings`) at the vertices
+    of ``t``: ``s`` with the edges ``R`` split (new head halves ``half[R]``)
+    and its facets cut.
 
     Measured on catbody.fe and column.fe (``vv.edge`` after ``r``): the
-    edges are split in order; at the old head vertex the old edge leaves the
-    ring, the vertex's first edge becomes the one that followed it, and the
-    new half goes in right after that first edge; a midpoint's ring is the
+    edges are split in order, each one's old head end leaving the ring of
+    its head vertex and the new half joining it; a midpoint's ring is the
     new half (first), then the old edge; then the edges cutting the facets
-    go in (right after the first edge) at both their ends, in id order.
-    The rings are linked lists in arrays, changed in rounds vectorized over
-    the vertices (one change per vertex and round).
+    join the rings at both their ends, in id order.
     """
-    from ..surface import record_vertex_rings, vertex_edge_rank
+    from ..surface import record_vertex_rings
+    from .rings import Rings, rounds
     ne, k = s.ne, len(R)
-    nslot, nv = 2 * t.ne, t.nv
-    nxt = np.arange(nslot)
-    prv = np.arange(nslot)
-    head = np.full(nv, -1, np.int64)
-    # the rings of s as linked lists: slot 2e + end
-    v0 = s.E.ravel()
-    order = np.lexsort((vertex_edge_rank(s).ravel(), v0))
-    vs = v0[order]
-    start = np.searchsorted(vs, np.arange(s.nv))
-    stop = np.searchsorted(vs, np.arange(s.nv), side="right")
-    pos = np.arange(len(order))
-    last = stop[vs] - 1
-    succ = np.where(pos == last, start[vs], pos + 1)
-    nxt[order] = order[succ]
-    prv[order[succ]] = order
-    has = stop > start
-    head[:s.nv][has] = order[start[has]]
-
-    def insert_after_head(vv, y):
-        h = head[vv]
-        empty = h < 0
-        hh = np.where(empty, y, h)
-        s2 = np.where(empty, y, nxt[hh])
-        nxt[hh] = y
-        prv[y] = hh
-        nxt[y] = s2
-        prv[s2] = y
-        head[vv] = hh
-
-    def rounds(vv, items):
-        """Indices into (vv, items) grouped by round: the j-th item per vertex."""
-        o = np.lexsort((items, vv))
-        g = vv[o]
-        first = np.searchsorted(g, g)
-        j = np.arange(len(g)) - first
-        return [o[j == r] for r in range(int(j.max()) + 1 if len(j) else 0)]
-
-    # splits at the old head vertices
+    g = Rings(s, t.ne, t.nv)
     h_all = s.E[R, 1]
     for sel in rounds(h_all, R):
-        hv, x, y = h_all[sel], 2 * R[sel] + 1, 2 * half[R[sel]] + 1
-        p, q = prv[x], nxt[x]
-        alone = q == x
-        nxt[p] = np.where(alone, nxt[p], q)
-        prv[q] = np.where(alone, prv[q], p)
-        head[hv] = np.where(alone, -1, q)
-        insert_after_head(hv, y)
-    # midpoints: the new half, then the old edge
-    mids = t.E[R, 1]
-    a, b = 2 * half[R], 2 * R + 1
-    nxt[a], prv[a], nxt[b], prv[b] = b, b, a, a
-    head[mids] = a
-    # the edges cutting the facets, in id order
+        g.remove(h_all[sel], 2 * R[sel] + 1)
+        g.insert(h_all[sel], 2 * half[R[sel]] + 1)
+    g.set_pair(t.E[R, 1], 2 * half[R], 2 * R + 1)
     inner = np.arange(ne + k, t.ne)
     iv = t.E[inner].ravel()
     islot = 2 * np.repeat(inner, 2) + np.tile([0, 1], len(inner))
     for sel in rounds(iv, islot):
-        insert_after_head(iv[sel], islot[sel])
-    # positions along each ring from its first edge
-    rank = np.zeros(nslot, np.int64)
-    first = head[head >= 0]
-    cur = first.copy()
-    step = 0
-    while len(cur):
-        rank[cur] = step
-        step += 1
-        nx = nxt[cur]
-        keep = nx != first
-        cur, first = nx[keep], first[keep]
-    record_vertex_rings(t, rank.reshape(t.ne, 2))
+        g.insert(iv[sel], islot[sel])
+    record_vertex_rings(t, g.rank())
