@@ -370,6 +370,17 @@ def test_autochop_matches_reference_on_cube(evolver, tmp_path):
         assert abs(a - b) <= 1e-9 * b
 
 
+def _both(evolver, name, text, tmp_path):
+    """Run ``text`` in REF and in pyevolver: (REF's lines, ours, session)."""
+    import io
+    ref = run_reference(evolver, datafile(name), text, cwd=str(tmp_path))
+    out = io.StringIO()
+    s = Session.load(datafile(name), out=out)
+    s.run(text)
+    consistent(s.surface)
+    return ref, out.getvalue().splitlines(), s
+
+
 RING_CASES = [("catbody.fe", "g 5\nr"), ("catbody.fe", "r\nr"), ("column.fe", "g 5\nr"),
               ("cube.fe", "r\nr"), ("quad.fe", "r\nr"), ("sphere.fe", "r\nu")]
 
@@ -387,12 +398,7 @@ def test_vertex_rings_and_normals_match_reference(evolver, name, cmds, tmp_path)
             'printf " %d", ff.id; printf "\\n"; }\n'
             'foreach vertex vv do printf "VN %d %.15f %.15f %.15f\\n", vv.id, '
             'vv.vertex_normal[1], vv.vertex_normal[2], vv.vertex_normal[3]\n')
-    ref = run_reference(evolver, datafile(name), text, cwd=str(tmp_path))
-    import io
-    out = io.StringIO()
-    s = Session.load(datafile(name), out=out)
-    s.run(text)
-    mine = out.getvalue().splitlines()
+    ref, mine, s = _both(evolver, name, text, tmp_path)
     pick = lambda lines, tag: [l.split() for l in lines if l.startswith(tag + " ")]
     assert pick(mine, "VE") == pick(ref, "VE") and len(pick(ref, "VE")) == s.surface.nv
     assert pick(mine, "VF") == pick(ref, "VF")
@@ -413,16 +419,11 @@ def test_equiangulation_numbers_as_reference(evolver, name, cmds, tmp_path):
     text = (cmds + "\nlist edges\nlist facets\n"
             'foreach edge ee do { printf "EF %d", ee.id; foreach ee.facet ff do '
             'printf " %d", ff.oid; printf "\\n"; }\n')
-    ref = run_reference(evolver, datafile(name), text, cwd=str(tmp_path))
-    import io
-    out = io.StringIO()
-    s = Session.load(datafile(name), out=out)
-    s.run(text)
-    consistent(s.surface)
+    ref, mine, s = _both(evolver, name, text, tmp_path)
     import re
     keep = re.compile(r"^\s*-?\d+\s+-?\d+\s+-?\d+|^EF ")
     a = [l.split("/*")[0].split() for l in ref if keep.match(l)]
-    b = [l.split("/*")[0].split() for l in out.getvalue().splitlines() if keep.match(l)]
+    b = [l.split("/*")[0].split() for l in mine if keep.match(l)]
     assert len(a) == s.surface.ne + s.surface.nf + s.surface.ne
     assert a == b
 
@@ -433,13 +434,8 @@ def test_edge_weeding_merges_into_fixed_edges_as_reference(evolver, tmp_path):
     deletions: 0 edges deleted where REF deletes 6 on column.fe)."""
     text = ("g 5\nt 0.1\nlist edges\nlist facets\nlist vertices\n"
             'printf "%.12g %.12g\\n", total_energy, total_area\n')
-    ref = run_reference(evolver, datafile("column.fe"), text, cwd=str(tmp_path))
-    import io
-    out = io.StringIO()
-    s = Session.load(datafile("column.fe"), out=out)
-    s.run(text)
-    consistent(s.surface)
+    ref, mine, _ = _both(evolver, "column.fe", text, tmp_path)
     strip = lambda lines: [l.split("/*")[0].split() for l in lines
                            if l.strip() and "area:" not in l]
     assert "Deleted edges: 6" in ref      # REF's body volume turns negative here: not compared
-    assert strip(ref)[-60:] == strip(out.getvalue().splitlines())[-60:]
+    assert strip(ref)[-60:] == strip(mine)[-60:]
