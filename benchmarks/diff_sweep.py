@@ -123,7 +123,8 @@ def parse(stdout, ref):
         if m:
             g.append(float(m.group(2)))
         elif ln.startswith("DS_E "):
-            energy = float(ln.split()[1])
+            tok = ln.split()[1]
+            energy = float("nan") if "nan" in tok.lower() else float(tok)
         elif ln.startswith("DS_C "):
             counts = [int(t) for t in ln.split()[1:]]
         else:
@@ -163,20 +164,23 @@ def compare(p, r, kind):
     return worst, "; ".join(notes)
 
 
-def one_case(fe, seq, timeout):
+def one_case(fe, seq, timeout, tree=REPO):
     name, cmds, kind = seq
     with tempfile.TemporaryDirectory(prefix="dsweep") as tmp:
         script = os.path.join(tmp, "s.cmd")
         with open(script, "w") as f:
             f.write('printf "DS_BEGIN\\n"\n' + "\n".join(cmds + TAIL) + "\n")
-        env = dict(os.environ, PYTHONPATH=REPO)
+        env = dict(os.environ, PYTHONPATH=tree)
         cwd = os.path.dirname(fe)
         pout, perr, ptime = run([sys.executable, "-m", "pyevolver", "-f", script, fe], cwd,
                                 timeout, env)
         rout, rerr, rtime = run(["evolver-nox-d", "-p1", "-f", script, fe], cwd, timeout)
     p, r = parse(pout, False), parse(rout, True)
+    # warnings (WARNING 1055 and its "Total difference" line) are not errors
+    perr = "\n".join(l for l in perr.splitlines()
+                     if l.strip() and not l.startswith(("WARNING", "Total difference")))
     res = {"file": os.path.relpath(fe, "/"), "seq": name, "worst": None, "note": ""}
-    ref_bad = rtime or r is None or r["error"] or r["energy"] is None
+    ref_bad = rtime or r is None or r["error"] or r["energy"] is None or r["energy"] != r["energy"]
     if "Traceback" in perr:
         res["cls"] = "py-trace"
         res["note"] = perr.strip().split("\n")[-1][:150]
@@ -190,7 +194,7 @@ def one_case(fe, seq, timeout):
         res["cls"] = "both-error" if (perr.strip() or p is None) else "ref-error"
         err = [l for l in rout.split("\n") if "ERROR" in l or "rror" in l]
         res["note"] = ("timeout " if rtime else "") + (err[0][:120] if err else "")
-    elif perr.strip() or p is None or p["energy"] is None:
+    elif perr.strip() or p is None or p["energy"] is None or p["energy"] != p["energy"]:
         res["cls"] = "py-error"
         res["note"] = perr.strip().replace("\n", " | ")[:150]
     else:
@@ -217,6 +221,8 @@ def main():
     ap.add_argument("--all", action="store_true", help="every paper datafile too")
     ap.add_argument("--gogo", action="store_true",
                     help="only the datafiles' own gogo* commands (one case each)")
+    ap.add_argument("--pyevolver", default=REPO,
+                    help="the pyevolver tree to test (PYTHONPATH), this one by default")
     ap.add_argument("--quiet", action="store_true", help="only the non-matching rows")
     a = ap.parse_args()
     files = [f for f in datafiles(a.all) if fnmatch.fnmatch(os.path.basename(f), a.files)]
@@ -224,7 +230,7 @@ def main():
     cases = [(f, s) for f in files for s in (gogo_sequences(f) if a.gogo else seqs)]
     results = []
     with cf.ThreadPoolExecutor(a.jobs) as ex:
-        futs = [ex.submit(one_case, f, s, a.timeout) for f, s in cases]
+        futs = [ex.submit(one_case, f, s, a.timeout, a.pyevolver) for f, s in cases]
         for fut in futs:
             res = fut.result()
             results.append(res)
