@@ -180,7 +180,8 @@ def one_case(fe, seq, timeout, tree=REPO):
     perr = "\n".join(l for l in perr.splitlines()
                      if l.strip() and not l.startswith(("WARNING", "Total difference")))
     res = {"file": os.path.relpath(fe, "/"), "seq": name, "worst": None, "note": ""}
-    ref_bad = rtime or r is None or r["error"] or r["energy"] is None or r["energy"] != r["energy"]
+    ref_bad = (rtime or r is None or r["error"] or "ERROR" in rerr or r["energy"] is None
+               or r["energy"] != r["energy"])
     if "Traceback" in perr:
         res["cls"] = "py-trace"
         res["note"] = perr.strip().split("\n")[-1][:150]
