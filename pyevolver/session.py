@@ -401,12 +401,32 @@ class Session(SessionAPI):
             s.vcon = vcon
 
     # -- evaluation ------------------------------------------------------------------
-    def recalc(self, keep_cg=False):
+    def recalc(self, keep_cg=False, reposition=False):
         """Recompute energies, areas and volumes (and reset the CG history,
-        as the Evolver's recalc does, unless ``keep_cg``)."""
+        as the Evolver's recalc does, unless ``keep_cg``).
+
+        ``reposition`` (the ``recalc`` command): first put the vertices on
+        parametric boundaries where their parameters now say (cat.fe's
+        ``rmax := 1; recalc``: REF's energy 14.5547875690274) and project
+        the vertices on level-set constraints onto them (sphere.fe's
+        ``rad := 1.2; recalc``), as evolver-nox-d does after a parameter
+        changed."""
         s = self.surface
         if s is None:
             return
+        if reposition:
+            from .surface import boundary_eval, boundary_groups, project_to_constraints
+            groups = boundary_groups(s) if s.boundaries else []
+            if groups or s.vcon:
+                s.X = s.X.copy()
+                for bid, rows in groups:
+                    s.X[rows], _ = boundary_eval(s, bid, s.vattr["params"][rows])
+                on = np.zeros(s.nv, bool)
+                for m in s.vcon.values():
+                    on |= m
+                if on.any():
+                    project_to_constraints(s, np.nonzero(on)[0])
+                s.__dict__.pop("_lift_cache", None)
         s.gravity_constant = self.variables.get("gravity_constant", s.gravity_constant)
         s.gravity_on = bool(self.toggles.get("gravity", 1))
         s.curvature_mode = ("norm" if self.toggles.get("normal_curvature") else
@@ -1024,16 +1044,18 @@ class Session(SessionAPI):
                 from .string_model import vertex_edges
                 return [I.ElemRef("edge", e, g) for e, g in vertex_edges(s, i)]
             if kind == "edge":
-                # oriented away from the vertex (oid < 0 where it is the head);
-                # the Evolver's order on a freshly loaded surface: the first
-                # edge, then the others newest first
-                es = np.nonzero((s.E == i).any(axis=1))[0]
-                ids = s.ids("edge")[es]
-                es = es[np.argsort(ids, kind="stable")]
-                es = list(es[:1]) + list(es[1:][::-1])
+                # oriented away from the vertex (oid < 0 where it is the head),
+                # in the Evolver's ring order (surface.vertex_rings)
+                from .surface import vertex_edge_rank
+                es, end = np.nonzero(s.E == i)
+                es = es[np.argsort(vertex_edge_rank(s)[es, end], kind="stable")]
+                es = list(dict.fromkeys(es.tolist()))
                 return [I.ElemRef("edge", int(e), 1 if s.E[e, 0] == i else -1) for e in es]
             if kind == "facet":
-                return [I.ElemRef("facet", int(f)) for f in np.nonzero((s.F == i).any(axis=1))[0]]
+                from .surface import vertex_facet_rank
+                fs, corner = np.nonzero(s.F == i)
+                fs = fs[np.argsort(vertex_facet_rank(s)[fs, corner], kind="stable")]
+                return [I.ElemRef("facet", int(f)) for f in dict.fromkeys(fs.tolist())]
         if el.kind == "edge":
             if kind == "vertex":
                 a, b = s.E[i]
@@ -1048,8 +1070,12 @@ class Session(SessionAPI):
                 for f in np.nonzero((idx == i).any(axis=1))[0]:
                     g = int(sgn[f][np.nonzero(idx[f] == i)[0][0]]) * el.sign
                     out.append(I.ElemRef("facet", int(f), g))
-                # the facet running along the edge first (REF, two-facet edges)
-                out.sort(key=lambda r: -r.sign * el.sign)
+                # REF's loop order of a two-facet edge: the facet running along
+                # the edge first, unless the loop is known to start with the
+                # other (surface.along_first)
+                from .surface import along_first
+                first = 1 if len(out) != 2 or along_first(s)[i] else -1
+                out.sort(key=lambda r: -r.sign * el.sign * first)
                 return out
         if el.kind == "facet":
             from .geometry import edge_index
@@ -1151,9 +1177,10 @@ class Session(SessionAPI):
                 if isinstance(idx, tuple):
                     raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
                 from .geometry import vertex_normals
+                from .surface import vertex_facet_rank
                 if s.nf == 0:
                     raise UnsupportedError("vertex_normal in the string model")
-                nrm = vertex_normals(s.F, t.facet_N2, s.nv)[i]
+                nrm = vertex_normals(s.F, t.facet_N2, s.nv, vertex_facet_rank(s))[i]
                 if idx is None:
                     return N.array_value(nrm)
                 j = int(idx)

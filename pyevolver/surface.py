@@ -1152,6 +1152,87 @@ def edge_first_facet(s):
     return first
 
 
+def record_along_first(s, along):
+    """Attach to ``s`` which edges have the facet running along them first
+    in their facet loop (``along`` (ne,) bool), valid while its connectivity
+    stays what it is now."""
+    s._along_first = (s.FE.copy(), s.E.copy(), np.asarray(along, bool))
+
+
+def along_first(s):
+    """(ne,) bool: the facet running along the edge comes first in the
+    edge's facet loop (REF's ``ee.facet`` order of a two-facet edge).
+
+    Recorded by ``r`` (:func:`record_along_first`); on a loaded surface from
+    :func:`edge_first_facet`; where neither is known, True (the facet along
+    the edge first, as ``ee.facet`` lists it)."""
+    c = s.__dict__.get("_along_first")
+    if c is not None and c[0].shape == s.FE.shape and c[1].shape == s.E.shape and \
+            np.array_equal(c[0], s.FE) and np.array_equal(c[1], s.E):
+        return c[2].copy()
+    out = np.ones(s.ne, bool)
+    first = edge_first_facet(s)
+    if first is None:
+        return out
+    idx, sgn, _ = s.topology()
+    known = np.nonzero(first >= 0)[0]
+    f = first[known]
+    hit = idx[f] == known[:, None]
+    out[known] = (sgn[f] * hit).sum(axis=1) >= 0
+    return out
+
+
+def record_vertex_rings(s, rank):
+    """Attach REF's edge rings to ``s``: ``rank`` (ne, 2) is the position of
+    each edge in the ring of its tail (column 0) and head (column 1) vertex
+    (:func:`vertex_edge_rank`), valid while the edges stay what they are."""
+    s._rings = (s.E.copy(), np.asarray(rank, np.int64))
+
+
+def vertex_edge_rank(s):
+    """(ne, 2) position of each edge in the edge ring of its tail (column 0)
+    and head (column 1) vertex: REF's ``vv.edge`` order.
+
+    The Evolver keeps the edges at a vertex in a cyclic list read from the
+    vertex's first edge; a new edge goes in right after the first.  On a
+    freshly loaded surface edges join in id order, so the list reads: the
+    lowest-numbered edge, then the others newest first (as in the string
+    model, ``string_model.init_rings``).  Rings recorded by an operation
+    that knows how they change (:func:`record_vertex_rings`; ``r``) are used
+    while the edges are unchanged, otherwise the freshly loaded order.
+    """
+    ne, nv = s.ne, s.nv
+    c = s.__dict__.get("_rings")
+    if c is not None and c[0].shape == s.E.shape and np.array_equal(c[0], s.E):
+        return c[1]
+    t = np.empty(ne, np.int64)
+    t[np.argsort(s.ids("edge"), kind="stable")] = np.arange(ne)
+    v = s.E.ravel()
+    key = np.repeat(t, 2)
+    first = np.full(nv, ne, np.int64)
+    np.minimum.at(first, v, key)
+    key = np.where(key == first[v], np.iinfo(np.int64).max, key)
+    order = np.lexsort((-key, v))
+    vs = v[order]
+    start = np.searchsorted(vs, np.arange(nv))
+    pos = np.empty(2 * ne, np.int64)
+    pos[order] = np.arange(2 * ne) - start[vs]
+    return pos.reshape(ne, 2)
+
+
+def vertex_facet_rank(s):
+    """(nf, 3) position of each facet in the facet order of its corner k:
+    REF's ``vv.facet`` order, which its ``vertex_normal`` follows.
+
+    Measured with evolver-nox-d (catbody.fe, column.fe after ``g 5; r``,
+    boundary vertices included): the facets come in the ring order
+    (:func:`vertex_edge_rank`) of the edge along which each leaves the
+    vertex (facet side k leaves corner k).
+    """
+    idx, sgn, _ = s.topology()
+    return vertex_edge_rank(s)[idx, np.where(sgn > 0, 0, 1)]
+
+
 def convex_edges(s):
     """``[(constraint, edge indices)]`` of edges on CONVEX constraints (gap energy)."""
     out = []

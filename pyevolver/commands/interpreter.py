@@ -1555,7 +1555,7 @@ class Interpreter:
             s.note(s.show_vol())
             return
         if name == "recalc":
-            s.recalc()
+            s.recalc(reposition=True)
             return
         if name == "history" and arg is None:
             s.show_history()

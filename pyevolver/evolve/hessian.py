@@ -473,7 +473,9 @@ def lagrangian_hessian(s, cons, lam, grad_fn, basis=None):
 
 
 def vertex_normals(s, t):
-    """(nv, 3) unit vertex normals of hessian_normal (:func:`geometry.vertex_normals`)."""
+    """(nv, 3) unit vertex normals of hessian_normal: the normalized sums of
+    the facet area vectors (:func:`geometry.vertex_normals` without an order;
+    not the ``vertex_normal`` attribute, see there)."""
     return G.vertex_normals(s.F, t.facet_N2, s.nv)
 
 

@@ -9,10 +9,11 @@ eliminated too, it moves to the edge's midpoint (projected back onto the
 edge's constraints), as the Evolver shrinks the edge to zero length;
 otherwise it stays where it is.  The
 facets on ``e`` disappear, and in each of them the side at the eliminated
-vertex merges into the side at the kept one.  A deletion is refused (the
-edge is skipped) when the edge is FIXED, neither endpoint may be
-eliminated, or two sides to be merged carry different constraints,
-boundaries or fixedness.  A common neighbour of the endpoints outside the
+vertex merges into the side at the kept one (the merged edge keeps the
+id and attributes of the side at the eliminated vertex, unless only the
+other is FIXED or constrained).  A deletion is refused (the edge is
+skipped) when the edge is FIXED or neither endpoint may be eliminated.
+A common neighbour of the endpoints outside the
 facets on ``e`` makes two more edges merge; facets left sharing all three
 edges with another ("pillows") are removed in pairs with their then bare
 edges and isolated vertices, as the Evolver does (checked on mound.fe with
@@ -116,22 +117,15 @@ class _Deleter:
             else:
                 ea, eb = sides
             c = [v for v in self.E[eb] if v != elim][0]
-            if (not np.array_equal(self.esig[eb], self.esig[ea])
-                    or self.efixed[eb] != self.efixed[ea]):
-                return False
-            merges.append((f, eb, ea, int(c)))
+            merges.append((f, *self._survivor(eb, ea), int(c)))
         # a common neighbour outside those facets: its two edges become one
         for c in sorted(self.neighbours(keep) & self.neighbours(elim) - {m[3] for m in merges}):
             eb, ea = self._edge_between(elim, c), self._edge_between(keep, c)
-            if (not np.array_equal(self.esig[eb], self.esig[ea])
-                    or self.efixed[eb] != self.efixed[ea]):
-                return False
-            merges.append((None, eb, ea, c))
+            merges.append((None, *self._survivor(eb, ea), c))
         E, FE = self.E, self.FE
         E[E == elim] = keep
         for f, eb, ea, c in merges:
-            # the two sides now join the same vertices; the Evolver keeps the
-            # one that came from the eliminated vertex (eb) and drops ea
+            # the two sides now join the same vertices; eb is kept, ea dropped
             same = tuple(E[ea]) == tuple(E[eb])
             fwd, bwd = FE == ea, FE == ~ea
             FE[fwd] = eb if same else ~eb
@@ -150,6 +144,18 @@ class _Deleter:
         self._drop_pillows(keep)
         self.count += 1
         return True
+
+    def _survivor(self, eb, ea):
+        """``(kept, dropped)`` of two sides that merge: the Evolver keeps the
+        one from the eliminated vertex (``eb``), unless only the other is
+        FIXED or on constraints or a boundary (measured on column.fe,
+        ``g 5; t 0.1``: a free spoke merging into a fixed boundary edge
+        leaves the boundary edge)."""
+        def held(x):
+            return bool(self.efixed[x]) or bool(self.esig[x].any())
+        if held(ea) and not held(eb):
+            return ea, eb
+        return eb, ea
 
     def _edge_between(self, u, v):
         E = self.E

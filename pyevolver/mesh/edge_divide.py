@@ -46,7 +46,16 @@ def long_edges(s, length):
 
 def skinny_edges(s, angle):
     """``K θ``: the longest edge of every facet whose smallest angle is below
-    ``angle`` (radians), as unique edge indices."""
+    ``angle`` (radians), as edge indices.
+
+    As evolver-nox-d does (measured on single triangles, sphere.fe and
+    twointor.fe): facets are taken in id order and a facet one of whose
+    sides was already chosen is passed over (the bisection has cut it); of
+    equally long sides the last is the longest; and a facet with three
+    exactly equal sides counts as skinny whatever ``θ`` (REF finds its
+    smallest angle 0: the symmetric equilateral triangles of sphere.fe and
+    twointor.fe's hexagons are cut by any ``K``).
+    """
     if s.nf == 0:
         return np.zeros(0, np.int64)
     t = s.evaluate()
@@ -59,6 +68,12 @@ def skinny_edges(s, angle):
                         (a * a + b * b - c * c) / (2 * a * b),
                         (b * b + c * c - a * a) / (2 * b * c)], axis=1)
     ang = np.arccos(np.clip(cos, -1.0, 1.0))
-    skinny = np.nanmin(ang, axis=1) < angle
-    longest = idx[np.arange(s.nf), np.argmax(L, axis=1)]
-    return np.unique(longest[skinny])
+    skinny = (np.nanmin(ang, axis=1) < angle) | ((a == b) & (b == c))
+    longest = idx[np.arange(s.nf), 2 - np.argmax(L[:, ::-1], axis=1)]
+    cand = np.nonzero(skinny)[0]
+    cand = cand[np.argsort(s.ids("facet")[cand], kind="stable")]
+    chosen = set()
+    for f in cand.tolist():                     # the skinny facets only
+        if not chosen.intersection(idx[f].tolist()):
+            chosen.add(int(longest[f]))
+    return np.array(sorted(chosen), np.int64)

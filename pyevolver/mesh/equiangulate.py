@@ -46,6 +46,38 @@ def edge_facets(s):
     return ef, ek, val
 
 
+def _flip_rings(s, t, moves):
+    """Record REF's edge rings (:mod:`pyevolver.mesh.rings`) of ``t``, ``s``
+    with edges flipped: ``moves`` lists (edges, old tails, old heads).
+    The pass flips in edge id order; each flip takes the edge out of the
+    rings of its old ends and puts it in those of its new ends (measured
+    with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
+    Runs of flips with no vertex in common are replayed at once."""
+    from ..surface import record_vertex_rings
+    from .rings import Rings
+    g = Rings(s, t.ne, t.nv)
+    I = np.concatenate([m[0] for m in moves])
+    o = np.argsort(I, kind="stable")
+    I = I[o]
+    p = np.concatenate([m[1] for m in moves])[o]
+    q = np.concatenate([m[2] for m in moves])[o]
+    x, y = t.E[I, 0], t.E[I, 1]
+    quads = np.stack([p, q, x, y], 1).tolist()
+    start, used = 0, set()
+    for k in range(len(I) + 1):
+        if k < len(I) and not used.intersection(quads[k]):
+            used.update(quads[k])
+            continue
+        b = slice(start, k)
+        g.remove(p[b], 2 * I[b])
+        g.remove(q[b], 2 * I[b] + 1)
+        g.insert(x[b], 2 * I[b])
+        g.insert(y[b], 2 * I[b] + 1)
+        if k < len(I):
+            start, used = k, set(quads[k])
+    record_vertex_rings(t, g.rank())
+
+
 def _quads(E, FE, ef, edges):
     """For each edge of ``edges`` (two facets of opposite orientations): its
     facets ``fa`` (running along the edge) and ``fb``, the other sides
@@ -133,6 +165,8 @@ def equiangulate(s, threshold=-0.001, only=None):
     E, FE = t.E, t.FE
     wrap = t.eattr.get("wrap")
     ef, ekk, val = edge_facets(t)
+    from ..surface import along_first
+    first = along_first(s)
     wv = t.wrap_shift()
     lengths = np.linalg.norm(G.edge_vectors(t.X, E, wv), axis=1)
     tension = t.fattr["tension"]
@@ -159,6 +193,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     nv = t.nv
     heap = cand
     flips_at_once = 0
+    moves = []              # (edges, old tails, old heads) in the order flipped
     if wrap is None:
         quad = _quads(E, FE, ef, cand)
         if quad is not None:
@@ -173,10 +208,13 @@ def equiangulate(s, threshold=-0.001, only=None):
             if iso.any():
                 I = cand[iso]
                 fa, fb, b1, c1, b2, c2, r, sv = (x[iso] for x in quad)
-                E[I, 0], E[I, 1] = sv, r
-                FE[fa] = np.stack([c1, b2, I], 1)
-                FE[fb] = np.stack([~I, c2, b1], 1)
-                for side, old, new in ((b1, fa, fb), (b2, fb, fa)):
+                moves.append((I, E[I, 0].copy(), E[I, 1].copy()))
+                al = first[I][:, None]
+                E[I, 0], E[I, 1] = np.where(al[:, 0], sv, r), np.where(al[:, 0], r, sv)
+                FE[fa] = np.where(al, np.stack([I, c1, b2], 1), np.stack([I, c2, b1], 1))
+                FE[fb] = np.where(al, np.stack([~I, c2, b1], 1), np.stack([~I, c1, b2], 1))
+                mv1, mv2 = np.where(al[:, 0], b1, c1), np.where(al[:, 0], b2, c2)
+                for side, old, new in ((mv1, fa, fb), (mv2, fb, fa)):
                     i = np.where(side >= 0, side, ~side)
                     two = val[i] == 2
                     i, old, new = i[two], old[two], new[two]
@@ -217,6 +255,7 @@ def equiangulate(s, threshold=-0.001, only=None):
         return x if x >= 0 else ~x
 
     last = -1
+    seq_moves = []
     while heap:
         ed = heapq.heappop(heap)
         if ed == last:              # pops come in increasing order: a repeat is adjacent
@@ -253,19 +292,30 @@ def equiangulate(s, threshold=-0.001, only=None):
         crit = (lb * lb + lc * lc - A * A) / (lb * lc) + (ld * ld + le * le - A * A) / (ld * le)
         if finite and not crit < threshold:
             continue
-        # flip: a was p->q in fa = (a, b1: q->r, c1: r->p), fb = (~a, b2: p->s, c2: s->q)
+        # flip: a was p->q in fa = (a, b1: q->r, c1: r->p), fb = (~a, b2: p->s, c2: s->q).
+        # As REF (list edges / list facets after u): when fa comes first in the
+        # edge's facet loop the new edge runs s->r, fa = (a, c1, b2) and
+        # fb = (~a, c2, b1); when fb does, r->s, fa = (a, c2, b1), fb = (~a, c1, b2)
         p, q = El[2 * ed], El[2 * ed + 1]
+        seq_moves.append((ed, p, q))
         pairs.discard(min(p, q) * nv + max(p, q))
         pairs.add(key)
+        al = bool(first[ed])
         if wrap is not None:
             def w(x):
                 return wrap[x] if x >= 0 else -wrap[~x]
-            wrap[ed] = -w(c1) - w(b2)          # s -> r through p
-        El[2 * ed], El[2 * ed + 1] = sv, r
-        FEl[3 * fa:3 * fa + 3] = (c1, b2, ed)
-        FEl[3 * fb:3 * fb + 3] = (~ed, c2, b1)
-        # b1 moved from fa to fb, b2 from fb to fa
-        for side, old, new in ((b1, fa, fb), (b2, fb, fa)):
+            wrap[ed] = (-1 if al else 1) * (w(c1) + w(b2))       # through p
+        if al:
+            El[2 * ed], El[2 * ed + 1] = sv, r
+            FEl[3 * fa:3 * fa + 3] = (ed, c1, b2)
+            FEl[3 * fb:3 * fb + 3] = (~ed, c2, b1)
+            moved = ((b1, fa, fb), (b2, fb, fa))
+        else:
+            El[2 * ed], El[2 * ed + 1] = r, sv
+            FEl[3 * fa:3 * fa + 3] = (ed, c2, b1)
+            FEl[3 * fb:3 * fb + 3] = (~ed, c1, b2)
+            moved = ((c1, fa, fb), (c2, fb, fa))
+        for side, old, new in moved:
             i = dec(side)
             if vall[i] == 2:
                 if efl[2 * i] == old:
@@ -278,7 +328,7 @@ def equiangulate(s, threshold=-0.001, only=None):
             dz = Xl.item(r, 2) - Xl.item(sv, 2)
             lengths[ed] = math.sqrt(dx * dx + dy * dy + dz * dz)
         else:
-            E[ed] = (sv, r)
+            E[ed] = (El[2 * ed], El[2 * ed + 1])
             lengths[ed] = float(np.linalg.norm(G.edge_vectors(
                 t.X, E[ed:ed + 1], wrap[ed:ed + 1] @ t.periods), axis=1)[0])
         flips += 1
@@ -291,5 +341,12 @@ def equiangulate(s, threshold=-0.001, only=None):
         t.E = np.array(El, dtype=np.int64).reshape(-1, 2)
         t.FE = np.array(FEl, dtype=np.int64).reshape(-1, 3)
     t.__dict__.pop("_topo", None)          # E and FE were changed
+    if flips + flips_at_once:
+        # an edge's facet loop keeps its start through the flips (REF, ee.facet)
+        from ..surface import record_along_first
+        record_along_first(t, first)
+        for ed, p, q in seq_moves:
+            moves.append((np.array([ed]), np.array([p]), np.array([q])))
+        _flip_rings(s, t, moves)
     t.topology_version = getattr(s, "topology_version", 0) + 1
     return t, flips + flips_at_once

@@ -210,6 +210,8 @@ def split_edges(s, ref):
         for eidx, f, p, q in new_edges:
             t.eattr["wrap"][eidx] = offset(q[0], q[1], f) - offset(p[0], p[1], f)
 
+    _split_rings(s, t, R, half)
+    _split_loops(s, t, R, half)
     new_v = np.arange(nv, nv + k)
     boundary_midpoints(t, s.E[R, 0], s.E[R, 1], new_v)
     if t.vcon:
@@ -220,3 +222,45 @@ def split_edges(s, ref):
         if len(sel):
             project_to_constraints(t, sel)
     return t
+
+
+def _split_loops(s, t, R, half):
+    """Record which edges of ``t`` have the facet along them first in their
+    facet loop (:func:`surface.along_first`): the tail half of a split edge
+    keeps its edge's order, the head half has the other one, the edges
+    cutting the facets have the facet along them first (measured with
+    ``ee.facet`` after ``r`` on catbody.fe; it decides how ``u`` renumbers)."""
+    from ..surface import along_first, record_along_first
+    out = np.ones(t.ne, bool)
+    old = along_first(s)
+    out[:s.ne] = old
+    out[half[R]] = ~old[R]
+    record_along_first(t, out)
+
+
+def _split_rings(s, t, R, half):
+    """Record REF's edge rings (:mod:`pyevolver.mesh.rings`) at the vertices
+    of ``t``: ``s`` with the edges ``R`` split (new head halves ``half[R]``)
+    and its facets cut.
+
+    Measured on catbody.fe and column.fe (``vv.edge`` after ``r``): the
+    edges are split in order, each one's old head end leaving the ring of
+    its head vertex and the new half joining it; a midpoint's ring is the
+    new half (first), then the old edge; then the edges cutting the facets
+    join the rings at both their ends, in id order.
+    """
+    from ..surface import record_vertex_rings
+    from .rings import Rings, rounds
+    ne, k = s.ne, len(R)
+    g = Rings(s, t.ne, t.nv)
+    h_all = s.E[R, 1]
+    for sel in rounds(h_all, R):
+        g.remove(h_all[sel], 2 * R[sel] + 1)
+        g.insert(h_all[sel], 2 * half[R[sel]] + 1)
+    g.set_pair(t.E[R, 1], 2 * half[R], 2 * R + 1)
+    inner = np.arange(ne + k, t.ne)
+    iv = t.E[inner].ravel()
+    islot = 2 * np.repeat(inner, 2) + np.tile([0, 1], len(inner))
+    for sel in rounds(iv, islot):
+        g.insert(iv[sel], islot[sel])
+    record_vertex_rings(t, g.rank())

@@ -16,8 +16,10 @@ numerically against ``evolver-nox-d``:
   area weights;
 * fewer than two usable edges: no move;
 * ``D = Σ w_e² (x_e - x_v) / Σ w_e²``;
-* ``V`` only: ``D`` loses its component along the unit vertex normal (the
-  sum of the adjacent facets' area vectors), and on constrained vertices is
+* ``V`` only: ``D`` loses its component along the unit vertex normal
+  (REF's ``vertex_normal``: :func:`geometry.vertex_normals` with the
+  facets in REF's order, the sum of the adjacent facets' area vectors on a
+  smooth star), and on constrained vertices is
   projected onto the constraint tangent space before and after;
 * ``x_v += D / 4``; constrained vertices are projected back.
 """
@@ -28,7 +30,7 @@ import copy
 import numpy as np
 
 from .. import geometry as G
-from ..surface import project_tangent, project_to_constraints
+from ..surface import project_tangent, project_to_constraints, vertex_facet_rank
 
 
 def vertex_average(s, mode="V"):
@@ -92,7 +94,7 @@ def vertex_average(s, mode="V"):
     mv = np.nonzero(movable)[0]
     D[mv] /= W[mv, None]
     if mode == "V":
-        n = G.vertex_normals(s.F, t.facet_N2, nv)
+        n = G.vertex_normals(s.F, t.facet_N2, nv, vertex_facet_rank(s))
         (D,) = project_tangent(s, [D])
         D = D - np.einsum("ij,ij->i", D, n)[:, None] * n
         (D,) = project_tangent(s, [D])
