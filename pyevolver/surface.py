@@ -454,13 +454,14 @@ class _Builder:
         sd = int(sc.values.get("surface_dimension", 1 if s.string else 2))
         if sd not in (1, 2):
             raise self.error(f"not supported in pyevolver: SURFACE_DIMENSION {sd} "
-                             f"(the simplex model)", sc.value_lines.get("surface_dimension"))
+                             f"(the simplex model)", sc.decl_lines.get("surface_dimension"))
         if s.sdim != 3 and not (s.string and s.sdim == 2):
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
                              f"(3, or 2 in the string model)",
-                             sc.value_lines.get("space_dimension"))
+                             sc.decl_lines.get("space_dimension"))
         if s.string and sc.torus and s.sdim != 2:
-            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model")
+            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model",
+                             sc.decl_lines.get("torus", sc.decl_lines.get("torus_filled")))
         s.constraints = dict(sc.constraints)
         s.boundaries = dict(sc.boundaries)
         s.symmetric_content = "symmetric_content" in sc.flags

@@ -117,6 +117,8 @@ def test_errors_once_without_a_line():
     circle = F.read_text(os.path.join(HERE, "data", "string_circle.fe"))
     exc = _load_error("method_instance mi method loop_volume\n" + circle)
     assert exc.line == 1 and "loop_volume" in exc.message
+    exc = _load_error("torus\n" + circle.replace("SPACE_DIMENSION 2", ""))
+    assert exc.line == 1 and "TORUS" in exc.message
 
 
 def test_boundary_declarations():
@@ -181,7 +183,8 @@ TYPE_CONFUSION = [
     # rows of a 2-d array are arrays (main's vector values): not conditions
     'define arr real[3][2]; while arr[1] do break', 'define arr real[3][2]; list vertex where arr[1]',
     'define arr real[3][2]; if arr[2] then print 1', '!999', '!nosuchcommand',
-    'define arr real[3][2]; quiet arr[1]',
+    'define arr real[3][2]; quiet arr[1]', 'define arr real[3][2]; print arr[1] ? 1 : 2',
+    'define arr real[3][2]; printf "%g\\n", arr[1]', 'print sprintf("%d", vertex[1].vertex_normal)',
 ]
 
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 import math
 import re
 
-from ..errors import CommandError
 from .. import limits
+from ..errors import CommandError
 
 _SPEC = re.compile(r"%([-+ #0]*)(\*|\d+)?(?:\.(\*|\d+))?(?:hh|h|ll|l|L|q|j|z|t)?([diouxXeEfFgGcs%])")
 
@@ -32,6 +32,9 @@ def c_format(fmt, args):
             raise CommandError(f"printf: not enough arguments for format {fmt!r}")
         v = args[ai]
         ai += 1
+        if getattr(v, "ndim", 0):               # an array value (vn := vv.vertex_normal)
+            raise CommandError(f"printf: expected a number, got an array of shape "
+                               f"{list(v.shape)}")
         return v
 
     for m in _SPEC.finditer(fmt):
