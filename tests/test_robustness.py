@@ -427,3 +427,15 @@ def test_addload_of_an_attribute_with_another_shape(tmp_path, monkeypatch):
     zz = t.surface.extra[("vertex", "zz")]
     assert zz.shape == (2 * s.surface.nv, 2)
     assert zz[s.surface.nv, 0] == 5.0 and zz[s.surface.nv, 1] == 0.0
+
+
+def test_foreach_over_elements_the_body_deletes():
+    # the element list of foreach is made first; a body that deletes or
+    # refines used to leave stale positions (IndexError)
+    s = _session()
+    with pytest.raises(CommandError, match="no longer exists"):
+        s.run("foreach edge[1].vertex vv do { delete edge where length < 10; print vv.id }")
+    assert s.surface.nv == 14
+    s.run('foreach vertex vv do { if vv.id == 1 then r; printf "%d ", vv.id }')
+    assert s.out.getvalue().split()[-14:] == [str(k) for k in range(1, 15)]
+    s.run('foreach vertex vv where vv.id < 3 do { delete vertex[2].edge[1] }')
