@@ -119,6 +119,11 @@ def test_errors_once_without_a_line():
     assert exc.line == 1 and "loop_volume" in exc.message
     exc = _load_error("torus\n" + circle.replace("SPACE_DIMENSION 2", ""))
     assert exc.line == 1 and "TORUS" in exc.message
+    exc = _load_error("method_instance mi method star_gauss_curvature global\n" + circle)
+    assert exc.line == 1 and "string model" in exc.message        # was AttributeError
+    # a constraint formula that fails while vertices are projected at load
+    exc = _load_error("constraint 2 global formula: z = 0/0\n" + CUBE_TEXT)
+    assert exc.line == 1 and "constraint 2" in exc.message
 
 
 def test_boundary_declarations():
