@@ -82,7 +82,7 @@ class Scene:
     parameters: dict = field(default_factory=dict)     # name -> value (ordered)
     flags: set = field(default_factory=set)
     values: dict = field(default_factory=dict)         # top-section numeric settings
-    value_lines: dict = field(default_factory=dict)    # setting -> source line
+    decl_lines: dict = field(default_factory=dict)     # setting or flag -> source line
     constraints: dict = field(default_factory=dict)    # id -> ConstraintDecl
     boundaries: dict = field(default_factory=dict)     # id -> BoundaryDecl
     quantities: dict = field(default_factory=dict)     # name -> QuantityDecl

@@ -1084,6 +1084,7 @@ class Session(SessionAPI):
         return out
 
     def sub_elements(self, el, kind):
+        self._check_alive(el)
         s = self.surface
         i = el.i
         if s.string and "facet" in (el.kind, kind) and el.kind != "body":
@@ -1161,6 +1162,13 @@ class Session(SessionAPI):
         raise ExpressionError(f"{el.kind} has no {kind}s")
 
     # -- attributes ------------------------------------------------------------------------
+    def _check_alive(self, el):
+        """An element reference kept across a command that removed elements
+        (``foreach ... do { delete ...; print vv.id }``) may point past the
+        end: refused by name."""
+        if el.kind in ("vertex", "edge", "facet", "body") and el.i >= self.count(el.kind):
+            raise ExpressionError(f"the {el.kind} no longer exists (deleted by this command)")
+
     def get_attr(self, base, name, idx):
         if idx is not None:                     # indices are integers (C truncation)
             idx = tuple(I.as_int(j, f"the index of '{name}'") for j in idx) \
@@ -1172,6 +1180,7 @@ class Session(SessionAPI):
         s = self.surface
         t = self.totals
         k, i = base.kind, base.i
+        self._check_alive(base)
         eid = float(s.ids(k)[i]) if k in ("vertex", "edge", "facet") else float(i + 1)
         if name in ("id",):
             return eid
@@ -1388,6 +1397,7 @@ class Session(SessionAPI):
             raise CommandError(f"quantity attribute '{name}' is read-only")
         if not isinstance(base, I.ElemRef):
             raise CommandError(f"'.{name}' needs an element or a quantity")
+        self._check_alive(base)
         k, i = base.kind, base.i
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]

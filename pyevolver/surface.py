@@ -454,13 +454,14 @@ class _Builder:
         sd = int(sc.values.get("surface_dimension", 1 if s.string else 2))
         if sd not in (1, 2):
             raise self.error(f"not supported in pyevolver: SURFACE_DIMENSION {sd} "
-                             f"(the simplex model)", sc.value_lines.get("surface_dimension"))
+                             f"(the simplex model)", sc.decl_lines.get("surface_dimension"))
         if s.sdim != 3 and not (s.string and s.sdim == 2):
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
                              f"(3, or 2 in the string model)",
-                             sc.value_lines.get("space_dimension"))
+                             sc.decl_lines.get("space_dimension"))
         if s.string and sc.torus and s.sdim != 2:
-            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model")
+            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model",
+                             sc.decl_lines.get("torus", sc.decl_lines.get("torus_filled")))
         s.constraints = dict(sc.constraints)
         s.boundaries = dict(sc.boundaries)
         s.symmetric_content = "symmetric_content" in sc.flags
@@ -1073,6 +1074,7 @@ class _Builder:
                     raise self.error(f"method_instance {name}: not supported in pyevolver: method "
                                      f"{m.method} in the string model", m.line)
             self._check_integrand(m, f"method_instance {name}", m.line)
+            self._check_string_method(m, f"method_instance {name}", m.line)
             q = Quantity(name, "instance", line=m.line)
             q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
             s.quantities[name] = q
@@ -1085,12 +1087,8 @@ class _Builder:
                     raise self.error(f"quantity {name}: {exc}", qd.line) from None
                 self._check_integrand(m, f"quantity {name}", qd.line)
                 q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
-            if s.string:
-                from .string_model import STRING_METHODS
-                for m in qd.methods:
-                    if m.method not in STRING_METHODS:
-                        raise self.error(f"quantity {name}: not supported in pyevolver: method "
-                                         f"{m.method} in the string model", qd.line)
+            for m in qd.methods:
+                self._check_string_method(m, f"quantity {name}", qd.line)
             if qd.function is not None:
                 for v in qd.function.names():
                     inst = v[:-len(".value")] if v.endswith(".value") else None
@@ -1109,6 +1107,14 @@ class _Builder:
                 n = {"vertex": s.nv, "edge": s.ne, "facet": s.n_facets,
                      "body": s.bodies.n}[etype]
                 s.extra[(etype, name)] = self._attr_array(etype, name, n, size)
+
+    def _check_string_method(self, m, what, line):
+        """The string model has its own methods (no facets)."""
+        if self.s.string:
+            from .string_model import STRING_METHODS
+            if m.method not in STRING_METHODS:
+                raise self.error(f"{what}: not supported in pyevolver: method {m.method} in "
+                                 f"the string model", line)
 
     def _check_integrand(self, m, what, line):
         """The scalar integral methods need their SCALAR_INTEGRAND."""
@@ -1493,13 +1499,13 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
             grads = []
             for cid in active:
                 c = s.constraints[cid]
-                phi = c.formula.values(env, coords, len(sel))
+                phi = _constraint_formula(c, "values", env, coords, len(sel))
                 if "nonnegative" in c.flags:
                     phi = np.minimum(phi, 0.0)
                 elif "nonpositive" in c.flags:
                     phi = np.maximum(phi, 0.0)
                 phis.append(phi)
-                grads.append(c.formula.gradient(env, coords, len(sel)))
+                grads.append(_constraint_formula(c, "gradient", env, coords, len(sel)))
             phi = np.stack(phis, axis=1)           # (n, k)
             if phi0 is None:
                 phi0 = np.max(np.abs(phi), axis=1)
@@ -1578,4 +1584,25 @@ def build_surface(scene):
         if exc.excerpt is None and exc.line and lines and 0 < exc.line <= len(lines):
             raise DatafileError(exc.message, exc.filename, exc.line, exc.column,
                                 lines[exc.line - 1]) from None
+        raise
+    except PyEvolverError as exc:
+        # an expression that fails while the surface is built (a constraint
+        # formula dividing by zero in the projection): at the declaration
+        # when known
+        line = getattr(exc, "line", None)
+        lines = scene.source_lines
+        raise DatafileError(str(exc), scene.filename, line, None,
+                            lines[line - 1] if line and lines and line <= len(lines)
+                            else None) from None
+
+
+def _constraint_formula(c, what, *args):
+    """``c.formula.values(...)`` or ``.gradient(...)``; an error names the
+    constraint and its line."""
+    try:
+        return getattr(c.formula, what)(*args)
+    except PyEvolverError as exc:
+        if getattr(exc, "line", None) is None:
+            exc.line = getattr(c, "line", None)
+            exc.args = (f"constraint {c.id}: {exc}",)
         raise

@@ -22,6 +22,7 @@ end of the run ("fuzz inputs run").
 import io
 import os
 import random
+import shutil
 
 import numpy as np
 import pytest
@@ -128,8 +129,12 @@ CUBE = os.path.join(F.ROOT, "datafiles", "cube.fe")
 
 
 def _exec_fuzz(target, datafile, nightly=False):
+    """(Run in a temporary directory: ``dump`` without a name writes next
+    to the datafile, so the datafile is a copy there.)"""
     scripts = F.seed_scripts()
     state = {}
+    shutil.copy(datafile, os.path.basename(datafile))
+    datafile = os.path.basename(datafile)
 
     def session():
         s = Session.load(datafile, out=io.StringIO(), err=io.StringIO())

@@ -117,6 +117,13 @@ def test_errors_once_without_a_line():
     circle = F.read_text(os.path.join(HERE, "data", "string_circle.fe"))
     exc = _load_error("method_instance mi method loop_volume\n" + circle)
     assert exc.line == 1 and "loop_volume" in exc.message
+    exc = _load_error("torus\n" + circle.replace("SPACE_DIMENSION 2", ""))
+    assert exc.line == 1 and "TORUS" in exc.message
+    exc = _load_error("method_instance mi method star_gauss_curvature global\n" + circle)
+    assert exc.line == 1 and "string model" in exc.message        # was AttributeError
+    # a constraint formula that fails while vertices are projected at load
+    exc = _load_error("constraint 2 global formula: z = 0/0\n" + CUBE_TEXT)
+    assert exc.line == 1 and "constraint 2" in exc.message
 
 
 def test_boundary_declarations():
@@ -181,7 +188,8 @@ TYPE_CONFUSION = [
     # rows of a 2-d array are arrays (main's vector values): not conditions
     'define arr real[3][2]; while arr[1] do break', 'define arr real[3][2]; list vertex where arr[1]',
     'define arr real[3][2]; if arr[2] then print 1', '!999', '!nosuchcommand',
-    'define arr real[3][2]; quiet arr[1]',
+    'define arr real[3][2]; quiet arr[1]', 'define arr real[3][2]; print arr[1] ? 1 : 2',
+    'define arr real[3][2]; printf "%g\\n", arr[1]', 'print sprintf("%d", vertex[1].vertex_normal)',
 ]
 
 
@@ -424,3 +432,15 @@ def test_addload_of_an_attribute_with_another_shape(tmp_path, monkeypatch):
     zz = t.surface.extra[("vertex", "zz")]
     assert zz.shape == (2 * s.surface.nv, 2)
     assert zz[s.surface.nv, 0] == 5.0 and zz[s.surface.nv, 1] == 0.0
+
+
+def test_foreach_over_elements_the_body_deletes():
+    # the element list of foreach is made first; a body that deletes or
+    # refines used to leave stale positions (IndexError)
+    s = _session()
+    with pytest.raises(CommandError, match="no longer exists"):
+        s.run("foreach edge[1].vertex vv do { delete edge where length < 10; print vv.id }")
+    assert s.surface.nv == 14
+    s.run('foreach vertex vv do { if vv.id == 1 then r; printf "%d ", vv.id }')
+    assert s.out.getvalue().split()[-14:] == [str(k) for k in range(1, 15)]
+    s.run('foreach vertex vv where vv.id < 3 do { delete vertex[2].edge[1] }')

@@ -6,8 +6,8 @@ import numpy as np
 import math
 import re
 
-from ..errors import CommandError
 from .. import limits
+from ..errors import CommandError
 
 _SPEC = re.compile(r"%([-+ #0]*)(\*|\d+)?(?:\.(\*|\d+))?(?:hh|h|ll|l|L|q|j|z|t)?([diouxXeEfFgGcs%])")
 

@@ -1079,7 +1079,21 @@ class Interpreter:
         # visited) but, as in the Evolver, `where` is tested when each element
         # is reached, on the surface the earlier passes left
         gen, body = node[1], node[2]
-        for el in list(self.session._gen_base(gen.base, self.env)):
+        sess = self.session
+        els = list(sess._gen_base(gen.base, self.env))
+        surf0 = sess.surface
+        ids = {k: surf0.ids(k) for k in {el.kind for el in els} if k != "body"}
+        for el in els:
+            if sess.surface is not surf0 and el.kind in ids:
+                # the body changed the topology (r, delete, ...): the element is
+                # found again by its id; one that was deleted is skipped
+                eid = ids[el.kind][el.i]
+                hit = np.nonzero(sess.surface.ids(el.kind) == eid)[0]
+                if not len(hit):
+                    continue
+                el = ElemRef(el.kind, int(hit[0]), el.sign)
+            elif el.kind == "body" and el.i >= sess.count("body"):
+                continue
             with self.env.element(el, gen.var):
                 if gen.where is not None:
                     v = gen.where.ev(self.env)

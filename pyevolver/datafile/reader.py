@@ -475,11 +475,12 @@ class Reader:
             sc.parameters[name] = self._const(expr, self._src(sec, line), f"parameter {name}")
         elif kind == "flag":
             sc.flags.add(d[1])
+            sc.decl_lines[d[1]] = self._src(sec, d[2])
         elif kind == "value":
             _, name, expr, fixed, line = d
             name = VALUE_NAMES.get(name, name)
             sc.values[name] = self._const(expr, self._src(sec, line), name)
-            sc.value_lines[name] = self._src(sec, line)
+            sc.decl_lines[name] = self._src(sec, line)
             if name in ("space_dimension", "surface_dimension") and \
                     sc.values[name] not in (1, 2, 3, 4):
                 raise self.error(f"not supported in pyevolver: {name.upper()} "

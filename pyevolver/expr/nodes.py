@@ -410,6 +410,8 @@ class Cond(Node):
 
     def ev(self, env):
         c = self.c.ev(env)
+        if isinstance(c, ArrayValue) or not (is_number(c) or isinstance(c, str)):
+            raise ExpressionError(f"the condition of '?:' must be a number, got {_what(c)}")
         if isinstance(c, np.ndarray):
             return np.where(c != 0, self.a.ev(env), self.b.ev(env))
         return self.a.ev(env) if c else self.b.ev(env)
