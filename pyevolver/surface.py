@@ -7,6 +7,7 @@ exist only when the datafile declares them.
 """
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -300,11 +301,12 @@ class Totals:
         flat = pts.reshape(-1, pts.shape[-1])
         rep = np.repeat(idx, 2)
         total = np.zeros(n)
-        for k, comp in enumerate(comps):
-            if k >= d.shape[1]:
-                break
-            q = self.eval_points(comp, flat, "edge", rep).reshape(n, 2) @ G.GL2_W
-            total += q * d[:, k]
+        with located(getattr(comps, "what", ""), getattr(comps, "line", None)):
+            for k, comp in enumerate(comps):
+                if k >= d.shape[1]:
+                    break
+                q = self.eval_points(comp, flat, "edge", rep).reshape(n, 2) @ G.GL2_W
+                total += q * d[:, k]
         return total
 
     def _integrals(self):
@@ -586,7 +588,14 @@ class _Builder:
             P = s.vattr["params"][sel]
             env = {f"p{k + 1}": P[:, k] for k in range(b.nparams)}
             for k, f in enumerate(b.coords[:3]):
-                s.X[sel, k] = f.values(s.param_env(), env, len(sel))
+                with located(f"boundary {bid}", b.line):
+                    s.X[sel, k] = f.values(s.param_env(), env, len(sel))
+            bad = ~np.all(np.isfinite(s.X[sel]), axis=1)
+            if bad.any():
+                pos = sel[np.nonzero(bad)[0][0]]
+                blk = self.sc.vertices
+                raise self.error(f"vertex {blk.ids[pos]}: its position on boundary {bid} is "
+                                 f"not finite", blk.lines[pos])
 
     # -- edges ----------------------------------------------------------------
     def _edges(self):
@@ -1208,12 +1217,14 @@ def integral_edges(s, which):
     out = []
     efixed = s.eattr["fixed"]
     for cid, sign in s.econ.items():
-        comps = getattr(s.constraints[cid], which)
+        c = s.constraints[cid]
+        comps = getattr(c, which)
         if comps is None:
             continue
         idx = np.nonzero((sign != 0) & ~efixed)[0]
         if len(idx):
-            out.append((comps, idx, sign[idx].astype(float)))
+            out.append((Integrand(comps, f"constraint {cid} {which}", getattr(c, "line", None)),
+                        idx, sign[idx].astype(float)))
     eb = s.eattr.get("boundary")
     if eb is not None:
         for bid, b in s.boundaries.items():
@@ -1222,8 +1233,33 @@ def integral_edges(s, which):
                 continue
             idx = np.nonzero(eb == bid)[0]
             if len(idx):
-                out.append((comps, idx, np.full(len(idx), -1.0 if which == "content" else 1.0)))
+                out.append((Integrand(comps, f"boundary {bid} {which}", getattr(b, "line", None)),
+                            idx, np.full(len(idx), -1.0 if which == "content" else 1.0)))
     return out
+
+
+class Integrand(tuple):
+    """The components of a constraint's or boundary's ENERGY or CONTENT
+    integrand (a tuple of formulas) with the name and source line of their
+    declaration, for the messages of :func:`located`."""
+
+    def __new__(cls, comps, what, line):
+        self = super().__new__(cls, comps)
+        self.what, self.line = what, line
+        return self
+
+
+@contextlib.contextmanager
+def located(what, line):
+    """Give an error raised in the block without a source line the
+    declaration ``what`` (e.g. ``"constraint 1"``) and its ``line``."""
+    try:
+        yield
+    except PyEvolverError as exc:
+        if getattr(exc, "line", None) is None and line:
+            exc.line = line
+            exc.args = (f"{what}: {exc}",)
+        raise
 
 
 def torus_lift_shifts(s):
@@ -1599,10 +1635,5 @@ def build_surface(scene):
 def _constraint_formula(c, what, *args):
     """``c.formula.values(...)`` or ``.gradient(...)``; an error names the
     constraint and its line."""
-    try:
+    with located(f"constraint {c.id}", getattr(c, "line", None)):
         return getattr(c.formula, what)(*args)
-    except PyEvolverError as exc:
-        if getattr(exc, "line", None) is None:
-            exc.line = getattr(c, "line", None)
-            exc.args = (f"constraint {c.id}: {exc}",)
-        raise

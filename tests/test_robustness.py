@@ -133,6 +133,28 @@ def test_boundary_declarations():
     assert exc.line == 3 and "'y'" in exc.message               # only p1 may appear
 
 
+COLUMN = os.path.join(F.EXAMPLES, "column.fe")
+
+
+def test_boundary_and_constraint_integrands_failing_at_load():
+    """Found by the datafile fuzz: a boundary whose radius is 1e309 (inf)
+    gave non-finite vertices (an invalid surface), and a constraint's
+    ENERGY integrand dividing by zero an error without a line."""
+    if not os.path.isfile(COLUMN):
+        pytest.skip("the Evolver's examples are not installed")
+    column = F.read_text(COLUMN)
+    assert "RAD = 0.05" in column
+    exc = _load_error(column.replace("RAD = 0.05", "RAD = 1e309"), "column.fe")
+    assert "vertex 1" in exc.message and "boundary 1" in exc.message
+    assert exc.excerpt.split()[:2] == ["1", "0.00"]
+    # an integrand that fails only when it is integrated (first evaluation)
+    mound = F.read_text(os.path.join(HERE, "data", "mound_short.fe"))
+    assert "angle*pi/180" in mound
+    exc = _load_error(mound.replace("angle*pi/180", "angle*pi/0.0"), "m.fe")
+    assert exc.message.startswith("constraint 1 energy:") and "Division by zero" in exc.message
+    assert exc.excerpt.lower().startswith("constraint 1")
+
+
 def test_absurd_sizes_are_refused():
     exc = _load_error("define vertex attribute big real[1000000000]\n" + CUBE_TEXT)
     assert exc.line == 1 and "1000000000" in exc.message
