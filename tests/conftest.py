@@ -71,4 +71,53 @@ def pytest_terminal_summary(terminalreporter):
     if fuzzing.COUNTS:
         terminalreporter.write_sep("-", "fuzz inputs run")
         for target, n in sorted(fuzzing.COUNTS.items()):
-            terminalreporter.write_line(f"{target}: {n}")
+            t = fuzzing.TIMES.get(target)
+            terminalreporter.write_line(f"{target}: {n}" + (f" in {t:.1f} s" if t else ""))
+    changed = getattr(terminalreporter.config, "_repo_changes", None)
+    if changed:
+        terminalreporter.write_sep("-", "files the tests wrote into the repository")
+        for path in changed:
+            terminalreporter.write_line(path)
+
+
+# ---------------------------------------------------------------------------
+# the tests write nothing into the repository (no .dmp next to a tracked
+# datafile, no output files): they work on tmp_path copies
+
+REPO = os.path.dirname(os.path.abspath(HERE))
+_IGNORED = {".git", "__pycache__", ".pytest_cache", ".hypothesis", "build"}
+
+
+def _repo_files():
+    """``{path: (size, mtime_ns)}`` of the repository's files (without
+    caches and ignored build output)."""
+    out = {}
+    for root, dirs, files in os.walk(REPO):
+        dirs[:] = [d for d in dirs if d not in _IGNORED and not d.endswith(".egg-info")
+                   and os.path.join(root, d) != os.path.join(REPO, "benchmarks", "data")]
+        for f in files:
+            if f.endswith(".pyc"):
+                continue
+            p = os.path.join(root, f)
+            try:
+                st = os.stat(p)
+            except OSError:
+                continue
+            out[os.path.relpath(p, REPO)] = (st.st_size, st.st_mtime_ns)
+    return out
+
+
+def pytest_sessionstart(session):
+    session.config._repo_before = _repo_files()
+
+
+def pytest_sessionfinish(session, exitstatus):
+    before = getattr(session.config, "_repo_before", None)
+    if before is None:
+        return
+    after = _repo_files()
+    changed = sorted(p for p in after if before.get(p) != after[p])
+    if changed:
+        session.config._repo_changes = changed
+        if session.exitstatus == 0:
+            session.exitstatus = 1

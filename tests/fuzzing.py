@@ -435,6 +435,9 @@ HANG_SECONDS = 10.0
 #: inputs run by each fuzz target in this test session (reported at the end)
 COUNTS = {}
 
+#: seconds each fuzz target ran (hypothesis included)
+TIMES = {}
+
 
 def count(target, n=1):
     COUNTS[target] = COUNTS.get(target, 0) + n

@@ -23,6 +23,7 @@ import io
 import os
 import random
 import shutil
+import time
 
 import numpy as np
 import pytest
@@ -59,7 +60,9 @@ def _fuzz(target, body, nightly=False):
             F.count(target)
 
     before = F.COUNTS.get(target, 0)
+    t0 = time.perf_counter()
     run()
+    F.TIMES[target] = F.TIMES.get(target, 0.0) + time.perf_counter() - t0
     assert F.COUNTS[target] - before >= n
 
 

@@ -84,7 +84,13 @@ def test_long_line_with_odd_numbers():
     ("8  0.0 1.0 1.0", "1000000000000  0.0 1.0 1.0", 12),           # an id of 10^12
     ("3   3 4", "3   3 1e309", 17),                                 # infinity as an id
     ("6  1.0 0.0 1.0", "6  1.0 0.0 -1e400", 10),                    # an infinite coordinate
-])
+    # an id written as a float on a line longer than 2000 characters (the
+    # numeric fast path took '1e308' for an id: ValueError; found by the fuzz)
+    ("1   1 2 3 4 5 6  volume 1", "1e308   1 2 3 4 5 6  volume " + "(" * 1000 + "1" + ")" * 1000,
+     37),
+    ("1   1 2 3 4 5 6  volume 1", "1e400   1 2 3 4 5 6  " + "fixed " * 400, 37),
+], ids=["edge-int64", "face-int64", "id-1e12", "inf-id", "inf-coordinate", "float-id-long",
+        "inf-id-long"])
 def test_huge_ids_and_numbers(old, new, line):
     exc = _load_error(_cube(old, new))
     assert exc.line == line

@@ -82,6 +82,8 @@ def _long_numeric(line):
     head = line[:end]
     if not _NUM_CHARS.fullmatch(head) or (m and end and not line[end - 1].isspace()):
         return None, None
+    if not head.split() or not head.split(None, 1)[0].isdigit():
+        return None, None               # the element id: digits ('1e308' is not one)
     try:
         vals = np.fromstring(head, dtype=float, sep=" ")
     except ValueError:                  # '1-2', '--3': not plain numbers
