@@ -142,3 +142,37 @@ def test_redirect_writes_nothing_when_the_command_fails(tmp_path, monkeypatch):
     s.run('procedure pp() { { print 4; return } >> "kept.txt" }; pp()')
     assert (tmp_path / "kept.txt").read_text().split() == ["1", "4"]
     assert _leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("name", ["cube.vtu", "cube.fe"])
+def test_export_is_atomic(tmp_path, monkeypatch, name):
+    """``export``: a write that dies half way (KeyboardInterrupt inside
+    meshio's writer or the dump) or a failing rename leaves the previous
+    file and no temporary."""
+    import meshio
+
+    import pyevolver.datafile.writer as W
+    s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
+    out = tmp_path / name
+    out.write_text("previous export\n")
+
+    def dies_half_way(path):
+        with open(path, "w") as fh:
+            fh.write("half")
+        raise KeyboardInterrupt
+    monkeypatch.setattr(meshio, "write", lambda path, *a, **k: dies_half_way(path))
+    monkeypatch.setattr(W, "dump", lambda obj, path, *a, **k: dies_half_way(path))
+    with pytest.raises(KeyboardInterrupt):
+        s.export(str(out))
+    assert out.read_text() == "previous export\n" and _leftovers(tmp_path) == []
+    monkeypatch.undo()
+
+    def crash(src, dst):
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(os, "replace", crash)
+    with pytest.raises(CommandError, match="cannot write"):
+        s.run(f'export "{out}"')
+    assert out.read_text() == "previous export\n" and _leftovers(tmp_path) == []
+    monkeypatch.undo()
+    s.run(f'export "{out}"')
+    assert out.read_text() != "previous export\n" and sorted(os.listdir(tmp_path)) == [name]
