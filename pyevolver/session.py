@@ -1440,7 +1440,7 @@ class Session(SessionAPI):
             s.fattr["tension"][i] = value
             return
         if k in ("edge", "facet") and name in ("color", "colour", "frontcolor", "backcolor"):
-            attrs, n = (s.eattr, s.ne) if k == "edge" else (s.fattr, s.nf)
+            attrs, n = (s.eattr, s.ne) if k == "edge" else (s.fattr, self.count(k))
             name = name.replace("colour", "color")
             default = 0 if k == "edge" else 15
             value = I.as_int(value, f"a {name}")

@@ -472,3 +472,14 @@ def test_foreach_over_elements_the_body_deletes():
     s.run('foreach vertex vv do { if vv.id == 1 then r; printf "%d ", vv.id }')
     assert s.out.getvalue().split()[-14:] == [str(k) for k in range(1, 15)]
     s.run('foreach vertex vv where vv.id < 3 do { delete vertex[2].edge[1] }')
+
+
+def test_facet_color_in_the_string_model():
+    # a string model's facets are edge chains (no triangles): setting their
+    # colour indexed an empty array (IndexError; found by the interpreter
+    # fuzz on string_circle.fe)
+    s = _session(os.path.join(HERE, "data", "string_circle.fe"))
+    s.run("set facet color 7.25; print facet[1].color; facet[1].backcolor := 3; "
+          "print facet[1].backcolor; r")
+    assert s.out.getvalue().split()[:2] == ["7", "3"]
+    F.check_surface(s.surface)
