@@ -10,8 +10,9 @@ inputs about as much):
   random bytes, huge numbers, deep nesting), read, built and evaluated;
 * the command parser: windows of the shipped scripts, mutated, and random
   commands (:func:`fuzzing.random_command`), cut into commands and parsed;
-* the interpreter: the same commands run on a cube, each failing command
-  checked to leave the surface arrays as they were.
+* the interpreter: the same commands run on a cube, a string model, a
+  constrained drop and a disc on a parametric boundary, each failing
+  command checked to leave the surface arrays as they were.
 
 CI runs ``FUZZ_INPUTS`` (20,000; ``PYEVOLVER_FUZZ_INPUTS`` overrides) inputs
 per target, on the small seed files; ``pytest --nightly`` (or
@@ -130,17 +131,25 @@ def test_fuzz_command_parser_nightly():
 
 CUBE = os.path.join(F.ROOT, "datafiles", "cube.fe")
 
+#: the interpreter target's surfaces: a body of fixed volume, the string
+#: model, a level-set constraint with gravity and an energy integrand, a
+#: parametric boundary (a fresh session picks one at random)
+INTERPRETER_FILES = [CUBE] + [os.path.join(F.HERE, "data", f) for f in
+                              ("string_circle.fe", "mound_short.fe", "ringdisk.fe")]
 
-def _exec_fuzz(target, datafile, nightly=False):
+
+def _exec_fuzz(target, datafiles, nightly=False):
     """(Run in a temporary directory: ``dump`` without a name writes next
-    to the datafile, so the datafile is a copy there.)"""
+    to the datafile, so the datafiles are copies there.)"""
     scripts = F.seed_scripts()
     state = {}
-    shutil.copy(datafile, os.path.basename(datafile))
-    datafile = os.path.basename(datafile)
+    names = []
+    for path in datafiles:
+        shutil.copy(path, os.path.basename(path))
+        names.append(os.path.basename(path))
 
-    def session():
-        s = Session.load(datafile, out=io.StringIO(), err=io.StringIO())
+    def session(rng):
+        s = Session.load(rng.choice(names), out=io.StringIO(), err=io.StringIO())
         s.time_limit = 0.02
         s.run(F.PRELUDE)
         return s
@@ -148,7 +157,7 @@ def _exec_fuzz(target, datafile, nightly=False):
     def body(rng):
         # a fresh session now and then; in between the state random-walks
         if "s" not in state or rng.random() < 0.1 or state["s"].surface.nf > 1000:
-            state["s"] = session()
+            state["s"] = session(rng)
         if rng.random() < 0.7:
             text = F.random_script(rng)
         else:
@@ -163,7 +172,7 @@ def _exec_fuzz(target, datafile, nightly=False):
 
 
 def test_fuzz_interpreter(small_elements, in_tmp):
-    _exec_fuzz("interpreter", CUBE)
+    _exec_fuzz("interpreter", INTERPRETER_FILES)
 
 
 @pytest.mark.nightly
@@ -172,7 +181,8 @@ def test_fuzz_interpreter_nightly(small_elements, in_tmp, datafile):
     path = os.path.join(F.EXAMPLES, datafile)
     if not os.path.isfile(path):
         pytest.skip("the Evolver's examples are not installed")
-    _exec_fuzz(f"interpreter on {datafile} (nightly)", path, nightly=True)
+    _exec_fuzz(f"interpreter on {datafile} (nightly)", [path] + INTERPRETER_FILES[1:],
+               nightly=True)
 
 
 # ---------------------------------------------------------------------------

@@ -285,7 +285,8 @@ def test_limits_in_commands():
                       ('printf "%100000000d", 3', "width"),
                       ("print " + "sin(" * 300 + "1" + ")" * 300, "nested"),
                       ("{" * 150 + "print 1" + "}" * 150, "nested"),
-                      ("define aa real[0][0x7fffffffffffffff]", "entries")]:
+                      ("define aa real[0][0x7fffffffffffffff]", "entries"),
+                      ("define aa real[0x7fffffffffffffff][0]", "entries")]:   # fuzz
         with pytest.raises(CommandError, match=word):
             s.run(cmd)
     with F.limit("MAX_STRING", 1000):

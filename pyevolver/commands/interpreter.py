@@ -1296,8 +1296,9 @@ class Interpreter:
                 raise CommandError(f"{what}: array sizes must be numbers >= 0")
             shape.append(int(v))
             total *= int(v)
-            if int(v) > MAX_ARRAY_ENTRIES:      # real[0][huge] has no entries but
-                total = max(total, int(v))      # numpy cannot make the dimension
+        # (real[0][huge] and real[huge][0] have no entries, but numpy
+        # cannot make the huge dimension)
+        total = max([total] + shape)
         if total > MAX_ARRAY_ENTRIES:
             raise CommandError(f"{what}: {total} entries is more than the "
                                f"{MAX_ARRAY_ENTRIES} allowed")
