@@ -257,3 +257,50 @@ def test_commands_with_odd_numbers(cmd, v):
     assert np.all(np.isfinite(s.surface.X))
 
 
+
+
+# ---------------------------------------------------------------------------
+# the checks themselves fail on what they are meant to catch (a fuzz target
+# that cannot fail proves nothing)
+
+def test_checks_catch_internal_errors_and_changed_surfaces(monkeypatch):
+    import pyevolver.session as S
+    from pyevolver.errors import CommandError
+    s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
+    F.check_commands(s, "vertex[1].x := 0.25", "ok")        # a working command passes
+    real = S.Session.set_attr
+
+    def buggy(self, *a, **k):
+        raise IndexError("index 0 is out of bounds")      # caught by run_one's last resort
+    monkeypatch.setattr(S.Session, "set_attr", buggy)
+    with pytest.raises(F.FuzzFailure, match="an internal error"):
+        F.check_commands(s, "vertex[1].x := 2", "fuzz")
+
+    def half_done(self, *a, **k):
+        real(self, *a, **k)
+        self.surface.X[0, 0] = 7.0                         # not restored: a bug
+        raise CommandError("fuzz:1: refused")
+    monkeypatch.setattr(S.Session, "_restore", lambda self, snap: None)
+    monkeypatch.setattr(S.Session, "set_attr", half_done)
+    with pytest.raises(F.FuzzFailure, match="changed the surface"):
+        F.check_commands(s, "vertex[1].x := 2", "fuzz")
+
+
+def test_checks_catch_hangs_and_tracebacks(monkeypatch):
+    import pyevolver.session as S
+    from pyevolver.commands import interpreter as I
+    from pyevolver.errors import DatafileError
+    monkeypatch.setattr(F, "HANG_SECONDS", 0.3)
+    s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
+    with pytest.raises(F.FuzzFailure, match="a hang"):
+        F.check_commands(s, "aa := 0; while 1 do aa := aa + 1", "fuzz")
+    monkeypatch.setattr(S, "read_datafile", lambda *a: {}["bug"])
+    with pytest.raises(F.FuzzFailure, match="a traceback"):
+        F.check_datafile("t.fe", _CUBE_TEXT)
+    monkeypatch.setattr(S, "read_datafile",
+                        lambda *a: (_ for _ in ()).throw(DatafileError("bad", "t.fe")))
+    with pytest.raises(F.FuzzFailure, match="unlocated"):
+        F.check_datafile("t.fe", _CUBE_TEXT)
+    monkeypatch.setattr(I, "parse_command", lambda *a: None.x)
+    with pytest.raises(F.FuzzFailure, match="a traceback"):
+        F.check_parse("print 1", "p")
