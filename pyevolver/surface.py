@@ -873,6 +873,14 @@ class _Builder:
                 s.extra[key] = s.extra[key][parent]
         if s.periods is not None and nnew_v:
             self._torus_centers(big, starts, lengths, enc, nface)
+        if nnew_v:
+            # the mean of huge (finite) coordinates or periods can overflow
+            bad = np.nonzero(~np.all(np.isfinite(s.X[nv:]), axis=1))[0]
+            if len(bad):
+                k = cpar[bad[0]]
+                raise self.error(f"face {blk.ids[k]}: the centre of the face is not finite "
+                                 f"(its coordinates or the PERIODS are too large)",
+                                 blk.lines[k])
 
     def _string_faces(self):
         """String model: a facet is a chain of edges, open or closed, kept as

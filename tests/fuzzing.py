@@ -278,7 +278,7 @@ _ATTRS = ["x", "y", "z", "id", "oid", "length", "area", "volume", "target", "pre
           "facet[1]", "zz", "__class__"]
 _FORMATS = ['"%d\\n"', '"%g %s\\n"', '"%*d\\n"', '"%.*f\\n"', '"%c%c\\n"', '"%%%5.2e\\n"',
             '"%x %o\\n"', '"%s\\n"', '"%n\\n"', '"%99999999d"', '"{0.__class__}\\n"', '"%-+ #020.10g"']
-_WORDS = ["g", "r", "u", "V", "t", "w", "l", "K", "n", "j", "m", "U", "G", "v", "q" if False else "v",
+_WORDS = ["g", "r", "u", "V", "t", "w", "l", "K", "n", "j", "m", "U", "G", "v",
           "recalc", "hessian", "hessian_seek", "bfgs", "optimize", "conj_grad", "quiet", "rawv",
           "rawestv", "equiangulate", "check_increase", "autochop", "gravity", "ribiere",
           "show_vol", "linear", "normal_curvature", "effective_area", "autopop", "edgeweed",

@@ -182,6 +182,22 @@ def test_infinite_periods():
     assert "PERIODS" in exc.message
 
 
+def test_face_centres_that_overflow():
+    """Huge but finite numbers whose mean overflows: two 1.7e308 corners of
+    a quadrilateral, a period of 1e308 on a torus (found by the datafile
+    fuzz: the centre vertex was infinite, an invalid surface)."""
+    exc = _load_error(_cube("2  1.0 0.0 0.0", "2  1.7e308 0.0 0.0").replace(
+        "3  1.0 1.0 0.0", "3  1.7e308 1.0 0.0"))
+    assert exc.line == 30 and "face 2" in exc.message
+    phelanc = os.path.join(F.EXAMPLES, "phelanc.fe")
+    if os.path.isfile(phelanc):
+        text = F.read_text(phelanc)
+        assert "0.000000 2.000000 0.000000" in text
+        exc = _load_error(text.replace("0.000000 2.000000 0.000000",
+                                       "0.000000 2.000000 1e308", 1))
+        assert "face 1" in exc.message and "PERIODS" in exc.message
+
+
 def test_singular_constraint_projection_loads():
     # a level set with a zero gradient used to raise LinAlgError (singular matrix)
     text = "constraint 1\nformula: 0*x = 1\n" + _cube("1  0.0 0.0 0.0", "1  0.0 0.0 0.0 constraint 1")
