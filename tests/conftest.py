@@ -72,7 +72,8 @@ def pytest_terminal_summary(terminalreporter):
         terminalreporter.write_sep("-", "fuzz inputs run")
         for target, n in sorted(fuzzing.COUNTS.items()):
             t = fuzzing.TIMES.get(target)
-            terminalreporter.write_line(f"{target}: {n}" + (f" in {t:.1f} s" if t else ""))
+            terminalreporter.write_line(f"{target}: {n}" + (
+                f" in {t[0]:.1f} s ({t[1]:.1f} s CPU)" if t else ""))
     changed = getattr(terminalreporter.config, "_repo_changes", None)
     if changed:
         terminalreporter.write_sep("-", "files the tests wrote into the repository")

@@ -435,7 +435,7 @@ HANG_SECONDS = 10.0
 #: inputs run by each fuzz target in this test session (reported at the end)
 COUNTS = {}
 
-#: seconds each fuzz target ran (hypothesis included)
+#: (wall, CPU) seconds each fuzz target ran (hypothesis included)
 TIMES = {}
 
 

@@ -61,9 +61,10 @@ def _fuzz(target, body, nightly=False):
             F.count(target)
 
     before = F.COUNTS.get(target, 0)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     run()
-    F.TIMES[target] = F.TIMES.get(target, 0.0) + time.perf_counter() - t0
+    wall, cpu = F.TIMES.get(target, (0.0, 0.0))
+    F.TIMES[target] = (wall + time.perf_counter() - t0, cpu + time.process_time() - c0)
     assert F.COUNTS[target] - before >= n
 
 
