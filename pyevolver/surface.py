@@ -1257,6 +1257,22 @@ class Integrand(tuple):
         return self
 
 
+class LocatedFormula:
+    """A formula whose evaluation errors name its declaration ``what`` and
+    source ``line`` (see :func:`located`)."""
+
+    def __init__(self, formula, what, line):
+        self.formula, self.what, self.line = formula, what, line
+
+    def values(self, *args):
+        with located(self.what, self.line):
+            return self.formula.values(*args)
+
+    def gradient(self, *args):
+        with located(self.what, self.line):
+            return self.formula.gradient(*args)
+
+
 @contextlib.contextmanager
 def located(what, line):
     """Give an error raised in the block without a source line the

@@ -159,6 +159,14 @@ def test_boundary_and_constraint_integrands_failing_at_load():
     exc = _load_error(mound.replace("angle*pi/180", "angle*pi/0.0"), "m.fe")
     assert exc.message.startswith("constraint 1 energy:") and "Division by zero" in exc.message
     assert exc.excerpt.lower().startswith("constraint 1")
+    # the same in the string model (integrands at the vertices): an edge
+    # attribute there is an undefined name (the fuzz put STRING on top of
+    # addload_example.fe)
+    probe = F.read_text(os.path.join(HERE, "data", "string_probe.fe"))
+    for old, new, word in [("e1: kk*x", "e1: kk*aa", "energy"), ("c1: 2*x", "c1: 2/0", "content")]:
+        assert old in probe
+        exc = _load_error("define edge attribute aa real\n" + probe.replace(old, new), "p.fe")
+        assert exc.line == 7 and exc.message.startswith(f"constraint 1 {word}:"), exc.message
 
 
 def test_absurd_sizes_are_refused():
