@@ -675,6 +675,10 @@ class Session(SessionAPI):
         from .evolve.hessian import newton_direction
         from .evolve.iterate import StepResult, _Constraints
         self.no_string("hessian")
+        if self.surface is None or self.surface.nv == 0:
+            # (everything deleted; REF: "No vertices" warnings or unrelated errors)
+            raise CommandError(f"{'hessian_seek' if seek else 'hessian'}: the surface has "
+                               f"no vertices")
         it = self.iterator
         s = self.surface
         if not it.pressures_valid and len(_Constraints(s)):

@@ -508,3 +508,20 @@ def test_facet_color_in_the_string_model():
           "print facet[1].backcolor; r")
     assert s.out.getvalue().split()[:2] == ["7", "3"]
     F.check_surface(s.surface)
+
+
+def test_hessian_of_an_empty_surface():
+    # tankex.fe after g and deleting every edge: pressures valid, no vertex
+    # left, the finite-difference Hessian coloured an empty graph
+    # (ValueError; found by the interpreter fuzz on tankex.fe)
+    path = example("tankex.fe")
+    if not os.path.isfile(path):
+        pytest.skip("the Evolver's examples are not installed")
+    s = _session(path)
+    s.run("g 1; delete edge where 1; delete facet where 1")
+    assert s.surface.nv == 0
+    for cmd in ("hessian", "hessian_seek"):
+        before = F.surface_arrays(s)
+        with pytest.raises(CommandError, match=f"{cmd}: the surface has no vertices"):
+            s.run(cmd)
+        assert F.same_arrays(before, F.surface_arrays(s))
