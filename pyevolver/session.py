@@ -647,6 +647,7 @@ class Session(SessionAPI):
         ``callback(result)`` may stop the run, and so does Ctrl-C (after the
         current step)."""
         from .evolve.newton import damped_newton
+        self.no_string("newton")
         s = self.surface
         if s is None or s.nv == 0:
             raise CommandError("newton: no surface loaded")

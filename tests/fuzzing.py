@@ -279,7 +279,8 @@ _ATTRS = ["x", "y", "z", "id", "oid", "length", "area", "volume", "target", "pre
 _FORMATS = ['"%d\\n"', '"%g %s\\n"', '"%*d\\n"', '"%.*f\\n"', '"%c%c\\n"', '"%%%5.2e\\n"',
             '"%x %o\\n"', '"%s\\n"', '"%n\\n"', '"%99999999d"', '"{0.__class__}\\n"', '"%-+ #020.10g"']
 _WORDS = ["g", "r", "u", "V", "t", "w", "l", "K", "n", "j", "m", "U", "G", "v",
-          "recalc", "hessian", "hessian_seek", "bfgs", "optimize", "conj_grad", "quiet", "rawv",
+          "recalc", "hessian", "hessian_seek", "bfgs", "newton", "raw", "rawest", "optimise",
+          "history", "optimize", "conj_grad", "quiet", "rawv",
           "rawestv", "equiangulate", "check_increase", "autochop", "gravity", "ribiere",
           "show_vol", "linear", "normal_curvature", "effective_area", "autopop", "edgeweed",
           "areaweed", "notch", "edge_divide", "zoom", "o", "O", "s", "P", "saddle", "system",
@@ -364,7 +365,8 @@ _SIMPLE = [
     lambda rng, e: f"local aa; aa := {e}",
     lambda rng, e: (f"body[{_num(rng)}].{rng.choice(['target', 'pressure', 'volconst', 'density'])}"
                     f" := {e}"),
-    lambda rng, e: f"{rng.choice(['g', 'r', 'u', 'V', 'hessian'])} {rng.choice(['', '2', _num(rng)])}",
+    lambda rng, e: (f"{rng.choice(['g', 'r', 'u', 'V', 'hessian', 'newton'])} "
+                    f"{rng.choice(['', '2', _num(rng)])}"),
     lambda rng, e: _quantity_command(rng, e),
 ]
 

@@ -525,3 +525,13 @@ def test_hessian_of_an_empty_surface():
         with pytest.raises(CommandError, match=f"{cmd}: the surface has no vertices"):
             s.run(cmd)
         assert F.same_arrays(before, F.surface_arrays(s))
+
+
+def test_newton_in_the_string_model_is_refused():
+    # newton reached the facet Hessian of a string (AttributeError; found
+    # by probing every bare command on the fuzz surfaces)
+    s = _session(os.path.join(HERE, "data", "string_circle.fe"))
+    before = F.surface_arrays(s)
+    with pytest.raises(CommandError, match="not supported in pyevolver: newton in the string"):
+        s.run("newton 2")
+    assert F.same_arrays(before, F.surface_arrays(s))
