@@ -653,6 +653,7 @@ class Session(SessionAPI):
             raise CommandError("newton: no surface loaded")
         with _deferred_sigint() as flag:
             def cb(r):
+                self.interp.tick()
                 if echo and not self.toggles.get("quiet"):
                     self.write("%3d. area: %#17.15g energy: %#17.15g  delta: %#g\n"
                                % (n - r.nit, self.totals.total_area, r.energy, r.delta))
