@@ -2,14 +2,38 @@
 the target only when writing succeeded.
 
 A reader (or a sweep resumed after a crash) therefore sees either the old
-file or the complete new one, never a half-written file; a failed write
-leaves the old file as it was and no temporary file behind.
+file or the complete new one, never a half-written file; a failed or
+interrupted write (an exception, Ctrl-C) leaves the old file as it was and
+no temporary file behind.  Everything pyevolver writes goes through here:
+``dump``, ``export``, ``>>``/``>>>`` redirection, pictures, the sweeps' and
+studies' files.  Devices, pipes and directories are refused
+(:func:`check_regular`): scripts write regular files only.
 """
 from __future__ import annotations
 
 import contextlib
 import os
 import secrets
+import stat
+
+
+class NotRegularFile(OSError):
+    """The path names a device, FIFO, socket or directory."""
+
+
+def check_regular(path, for_writing=True):
+    """Raise :class:`NotRegularFile` when ``path`` exists and is not a
+    regular file (``/dev/zero``, ``/dev/tty``, a FIFO, a directory).  A
+    missing path is fine for writing (FileNotFoundError for reading)."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        if for_writing:
+            return
+        raise
+    if not stat.S_ISREG(st.st_mode):
+        what = "a directory" if stat.S_ISDIR(st.st_mode) else "a device or pipe"
+        raise NotRegularFile(0, f"'{path}' is {what}, not a regular file")
 
 
 @contextlib.contextmanager
@@ -19,20 +43,26 @@ def atomic_path(path, suffix=".tmp"):
     atomic on POSIX and Windows), else removed.
 
     For writers that want a file name (meshio, matplotlib's ``savefig``).
+    A symbolic link is followed: the file it points to is replaced.  The
+    new file keeps the permissions of the one it replaces (a new one gets
+    0666 less the umask, as ``open`` would give it).
     """
     path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
+    check_regular(path)
+    target = os.path.realpath(path)
+    folder = os.path.dirname(target)
     while True:
-        tmp = os.path.join(folder, f".{os.path.basename(path)}.{secrets.token_hex(4)}{suffix}")
+        tmp = os.path.join(folder, f".{os.path.basename(target)}.{secrets.token_hex(4)}{suffix}")
         try:
-            # mode 0666 less the umask, as open() would give the file itself
             os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
             break
         except FileExistsError:
             continue
     try:
         yield tmp
-        os.replace(tmp, path)
+        with contextlib.suppress(FileNotFoundError):
+            os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode))
+        os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):
             os.remove(tmp)
@@ -40,13 +70,39 @@ def atomic_path(path, suffix=".tmp"):
 
 
 @contextlib.contextmanager
-def atomic_write(path, mode="w", **kwargs):
-    """``open(path, mode, **kwargs)`` written atomically: yields the file
-    object of a temporary file that replaces ``path`` when the block ends
-    without an exception (flushed and fsynced first)."""
-    if not mode.startswith("w"):
-        raise ValueError(f"atomic_write: mode must be 'w' or 'wb', not {mode!r}")
-    with atomic_path(path) as tmp, open(tmp, mode, **kwargs) as fh:
+def atomic_write(path, mode="w", *, durable=True, **kwargs):
+    """``open(path, mode, **kwargs)`` written atomically.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    mode : {"w", "wb", "a", "ab"}
+        ``"w"`` replaces the file; ``"a"`` appends, by copying the existing
+        contents into the temporary file first.
+    durable : bool
+        ``fsync`` the file before the rename (survives a power cut, not only
+        a crash; off for the many small appends of ``>>`` in a loop).
+    **kwargs
+        For :func:`open` (``encoding``, ``newline``).
+
+    Yields
+    ------
+    file object
+        Of the temporary file, which replaces ``path`` when the block ends
+        without an exception.
+    """
+    if mode not in ("w", "wb", "a", "ab"):
+        raise ValueError(f"atomic_write: mode must be 'w', 'wb', 'a' or 'ab', not {mode!r}")
+    with atomic_path(path) as tmp, open(tmp, "w" + mode[1:], **kwargs) as fh:
+        if mode.startswith("a") and os.path.exists(path):
+            with open(path, "rb") as old:
+                data = old.read()
+            if "b" in mode:
+                fh.write(data)
+            else:
+                fh.flush()
+                fh.buffer.write(data)
         yield fh
         fh.flush()
-        os.fsync(fh.fileno())
+        if durable:
+            os.fsync(fh.fileno())

@@ -12,9 +12,11 @@ import argparse
 import os
 import sys
 
+import numpy as np
+
 from . import __version__
 from .commands import interpreter as I
-from .errors import PyEvolverError
+from .errors import InternalError, PyEvolverError
 from .session import Session
 
 PROMPT = "Enter command: "
@@ -31,8 +33,22 @@ def build_parser():
     p.add_argument("-f", dest="command_file", help="command file to run after loading")
     p.add_argument("-p", dest="threads", type=int, default=1,
                    help="accepted for compatibility with evolver (ignored)")
+    p.add_argument("--timeout", type=_seconds, default=None, metavar="SECONDS",
+                   help="stop any single command that runs longer than this (the "
+                        "surface is left as it was before it); for unattended runs")
     p.add_argument("--version", action="version", version=f"pyevolver {__version__}")
     return p
+
+
+def _seconds(text):
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") \
+            from None
+    if not v > 0 or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+    return v
 
 
 def _find_datafile(name):
@@ -43,9 +59,17 @@ def _find_datafile(name):
     return None
 
 
+# exit status after Ctrl-C (SIGINT) in batch mode, as a shell reports a
+# process ended by SIGINT
+EXIT_INTERRUPTED = 130
+
+
 def main(argv=None):
     try:
         return _main(argv)
+    except I.Quit as q:                 # `q` in the datafile's read section or a script
+        _flush_quietly()
+        return q.code
     except BrokenPipeError:
         # the reader of our output went away (e.g. `| head`): exit quietly
         try:
@@ -53,6 +77,19 @@ def main(argv=None):
         except OSError:
             pass
         return 0
+    except (KeyboardInterrupt, I.Interrupted):
+        # Ctrl-C outside a command (loading, reading input) or in batch mode:
+        # files are written atomically, so nothing is left half-written
+        _flush_quietly()
+        sys.stderr.write("\nInterrupted.\n")
+        return EXIT_INTERRUPTED
+
+
+def _flush_quietly():
+    try:
+        sys.stdout.flush()
+    except (OSError, ValueError):
+        pass
 
 
 def _main(argv=None):
@@ -62,14 +99,25 @@ def _main(argv=None):
         from .tools import main as tool_main
         return tool_main(argv)
     args = build_parser().parse_args(argv)
+    np.seterr(all="ignore")        # overflows are reported as Evolver warnings, not numpy's
     path = _find_datafile(args.datafile)
     if path is None:
         sys.stderr.write(f"pyevolver: cannot open datafile '{args.datafile}': no such file\n")
         return 1
     try:
-        session = Session.load(path)
+        session = Session(None, None)
+        session.time_limit = args.timeout
+        session.load_file(path)
     except PyEvolverError as exc:
         sys.stderr.write(f"{exc}\n")
+        return 1
+    except MemoryError:
+        sys.stderr.write(f"{path}: out of memory while loading the datafile\n")
+        return 1
+    except (I.Quit, I.Interrupted, KeyboardInterrupt):
+        raise
+    except Exception as exc:            # a bug of pyevolver: a message, not a traceback
+        sys.stderr.write(f"{InternalError.from_exception(exc, path)}\n")
         return 1
     try:
         if args.command_file:
@@ -80,11 +128,23 @@ def _main(argv=None):
                 sys.stderr.write(f"pyevolver: cannot read command file "
                                  f"'{args.command_file}': {exc.strerror}\n")
                 return 1
-            session.run(text, where=args.command_file, stop_on_error=False)
+            try:
+                session.run(text, where=args.command_file, stop_on_error=False)
+            except I.Interrupted as exc:
+                if not _interactive():
+                    raise
+                sys.stdout.write(f"\n{exc}\n")
         return repl(session)
     except I.Quit as q:
         sys.stdout.flush()
         return q.code
+
+
+def _interactive():
+    try:
+        return sys.stdin.isatty()
+    except (AttributeError, ValueError):
+        return False
 
 
 def history_file():
@@ -116,29 +176,37 @@ def repl(session, stdin=None):
         try:
             line = stdin.readline()
         except KeyboardInterrupt:
+            if not interactive:
+                raise               # batch mode: main() exits with status 130
             sys.stdout.write("\n")
             buf = ""
             continue
         if not line:
             if buf.strip():
-                _run(session, buf, lineno)
+                _run(session, buf, lineno, interactive)
             return 0
         lineno += 1
         buf += line
         if not I.needs_more(buf):
             try:
-                _run(session, buf, lineno)
+                _run(session, buf, lineno, interactive)
             finally:
                 buf = ""
 
 
-def _run(session, text, lineno):
+def _run(session, text, lineno, interactive=True):
+    """Run one input command.  Ctrl-C stops it; at a terminal the prompt
+    returns, in batch mode the interruption propagates (exit status 130)."""
     try:
         session.run(text, where="<stdin>", line=max(1, lineno - text.count("\n") + 1),
                     stop_on_error=False)
     except I.Interrupted as exc:
+        if not interactive:
+            raise
         sys.stdout.write(f"\n{exc}\n")
     except KeyboardInterrupt:
+        if not interactive:
+            raise
         sys.stdout.write("\nInterrupted.\n")
     sys.stdout.flush()
 

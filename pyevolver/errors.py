@@ -32,10 +32,26 @@ class DatafileError(PyEvolverError):
                 where += f":{self.column}"
         text = f"{where}: {self.message}"
         if self.excerpt:
-            text += "\n    " + self.excerpt.rstrip("\n")
-            if self.column is not None and self.column >= 1:
-                text += "\n    " + " " * (self.column - 1) + "^"
+            line, col = excerpt_window(self.excerpt.rstrip("\n"), self.column)
+            text += "\n    " + line
+            if col is not None and col >= 1:
+                text += "\n    " + " " * (col - 1) + "^"
         return text
+
+
+def excerpt_window(line, column=None, width=120):
+    """A source line cut to at most ``width`` characters around ``column``
+    (1-based; None: the start), control characters shown as ``?``; returns
+    ``(text, column in text)``."""
+    line = "".join(c if c >= " " or c == "\t" else "?" for c in line)
+    if len(line) <= width:
+        return line, column
+    c = 1 if column is None or column < 1 else min(column, len(line))
+    start = max(0, min(c - 1 - width // 2, len(line) - width))
+    cut = line[start:start + width]
+    pre = "..." if start > 0 else ""
+    post = "..." if start + width < len(line) else ""
+    return pre + cut + post, (None if column is None else c - start + len(pre))
 
 
 class UnsupportedError(PyEvolverError):
@@ -51,6 +67,25 @@ class UnsupportedError(PyEvolverError):
 
 class CommandError(PyEvolverError):
     """A command could not be parsed or executed; the surface is unchanged."""
+
+
+class InternalError(CommandError):
+    """A Python exception inside pyevolver (a bug): reported as a message,
+    never a traceback, and the surface is left as it was.  With the
+    environment variable ``PYEVOLVER_TRACEBACK=1`` the traceback is printed
+    to standard error as well."""
+
+    @classmethod
+    def from_exception(cls, exc, where):
+        import os
+        import sys
+        import traceback
+        if os.environ.get("PYEVOLVER_TRACEBACK"):
+            traceback.print_exception(type(exc), exc, exc.__traceback__, file=sys.stderr)
+        err = cls(f"{where}: internal error ({type(exc).__name__}: {exc}); the surface "
+                  f"is as it was")
+        err.original = exc
+        return err
 
 
 class ExpressionError(PyEvolverError):

@@ -43,6 +43,7 @@ class MethodDecl:
     name: str = ""                   # instance name
     ignore_fixed: bool = False
     ignore_constraints: bool = False
+    line: int | None = None          # source line of a METHOD_INSTANCE declaration
 
 
 @dataclass
@@ -81,6 +82,7 @@ class Scene:
     parameters: dict = field(default_factory=dict)     # name -> value (ordered)
     flags: set = field(default_factory=set)
     values: dict = field(default_factory=dict)         # top-section numeric settings
+    decl_lines: dict = field(default_factory=dict)     # setting or flag -> source line
     constraints: dict = field(default_factory=dict)    # id -> ConstraintDecl
     boundaries: dict = field(default_factory=dict)     # id -> BoundaryDecl
     quantities: dict = field(default_factory=dict)     # name -> QuantityDecl
@@ -94,6 +96,7 @@ class Scene:
     read_text: str | None = None
     read_line: int = 0
     wraps: dict = field(default_factory=dict)          # edge position -> wrap list
+    source_lines: list | None = None                   # the text's lines (error excerpts)
 
     @property
     def space_dimension(self):

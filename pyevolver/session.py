@@ -20,8 +20,10 @@ import numpy as np
 from .api import SessionAPI, progress_bar
 from .commands import interpreter as I
 from .datafile.reader import read_datafile
-from .errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
+from .errors import (CommandError, DatafileError, ExpressionError, InternalError,
+                     PyEvolverError, UnsupportedError)
 from .expr import nodes as N
+from .limits import MAX_NESTING
 from .surface import build_surface, project_to_constraints, restore_state, state
 
 READ_ONLY = {
@@ -94,6 +96,9 @@ class Session(SessionAPI):
         self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
         self.iteration_counter = 0
         self.total_time = 0.0
+        # seconds one top-level command may run (None: no limit); a command
+        # that runs longer stops with an error and leaves the surface as it was
+        self.time_limit = None
         self.history = []                      # (iteration, energy, area) of each g step
         self.command_history = []              # (number, text) of `history`, `!!` (REF: last 100)
         self.command_count = 0
@@ -103,13 +108,15 @@ class Session(SessionAPI):
 
     # -- loading ---------------------------------------------------------------
     @classmethod
-    def load(cls, filename, out=None, err=None, run_read=True):
+    def load(cls, filename, out=None, err=None, run_read=True, text=None):
+        """A session on the datafile ``filename`` (``text``: its contents,
+        when not to be read from disk)."""
         s = cls(out, err)
-        s.load_file(filename, run_read)
+        s.load_file(filename, run_read, text)
         return s
 
-    def load_file(self, filename, run_read=True):
-        scene = read_datafile(filename)
+    def load_file(self, filename, run_read=True, text=None):
+        scene = read_datafile(filename, text)
         surface = build_surface(scene)
         return self._install(filename, scene, surface, run_read)
 
@@ -135,7 +142,18 @@ class Session(SessionAPI):
         self.letters = {}
         self.arrays = {}
         self._init_view_matrix()
-        self.recalc()
+        try:
+            self.recalc()
+        except DatafileError:
+            raise
+        except PyEvolverError as exc:
+            # the first evaluation failed (e.g. a method refused on this
+            # surface): located at the quantity's declaration when known
+            line = getattr(exc, "line", None)
+            lines = scene.source_lines
+            raise DatafileError(str(exc), filename, line, None,
+                                lines[line - 1] if line and lines and line <= len(lines)
+                                else None) from None
         if run_read and scene.read_text:
             self.run(scene.read_text, where=filename, line=scene.read_line + 1,
                      stop_on_error=False)
@@ -167,6 +185,9 @@ class Session(SessionAPI):
     def _read_new(self, cmd, name):
         import os
         if not os.path.isfile(name):
+            if os.path.exists(name):
+                raise CommandError(f"{cmd}: '{name}' is not a regular file (a directory, "
+                                   f"device or pipe)")
             raise CommandError(f"{cmd}: cannot find datafile '{name}'")
         scene = read_datafile(name)
         return scene, build_surface(scene)
@@ -175,8 +196,9 @@ class Session(SessionAPI):
         """``load "file"``: a fresh start on another datafile (variables,
         commands and toggles forgotten; its read section runs)."""
         scene, surface = self._read_new("load", name)
-        out, err = self.out, self.err
+        out, err, limit = self.out, self.err, self.time_limit
         self.__init__(out, err)
+        self.time_limit = limit
         self._install(name, scene, surface, True)
 
     def replace_load(self, name):
@@ -278,7 +300,10 @@ class Session(SessionAPI):
         stripped = text.strip()
         if stripped.startswith("!") and not stripped.startswith("!="):
             # !!, !n, !prefix: a command from the history, echoed (manual)
-            old = self._from_history(stripped[1:].strip())
+            try:
+                old = self._from_history(stripped[1:].strip())
+            except CommandError as exc:
+                raise CommandError(f"{where}:{line}: {exc}") from None
             self.write(old + "\n\n")
             return self.run_one(old, where, line)
         ast = I.parse_command(text, where, line)
@@ -287,8 +312,16 @@ class Session(SessionAPI):
         scopes = self.interp.env.scopes
         depth = len(scopes)
         scopes.append({})
+        interp = self.interp
+        outer = interp.deadline is None         # commands run by `read` share the limit
+        if outer and self.time_limit:
+            interp.deadline = time.monotonic() + self.time_limit
         try:
-            self.interp.execute(ast)
+            interp.execute(ast)
+            if self.surface is not None and not np.all(np.isfinite(self.surface.X)):
+                # e.g. a huge jiggle or a boundary formula out of its domain
+                raise CommandError("the command would make vertex coordinates infinite or "
+                                   "NaN")
         except (I.Quit, I.Interrupted):
             self.refresh()
             raise
@@ -304,14 +337,22 @@ class Session(SessionAPI):
             if isinstance(exc, CommandError) and str(exc).startswith(where):
                 raise
             raise CommandError(f"{where}:{line}: {exc}") from None
-        except (ArithmeticError, ValueError, TypeError, IndexError) as exc:
-            self._restore(snap)
-            raise CommandError(f"{where}:{line}: {type(exc).__name__}: {exc}") from None
         except RecursionError:
             self._restore(snap)
             raise CommandError(f"{where}:{line}: recursion too deep") from None
+        except MemoryError:
+            self._restore(snap)
+            raise CommandError(f"{where}:{line}: out of memory; the command was "
+                               f"abandoned") from None
+        except Exception as exc:
+            # a bug of pyevolver, not of the script: the session goes on, the
+            # surface as it was (PYEVOLVER_TRACEBACK=1 prints the traceback)
+            self._restore(snap)
+            raise InternalError.from_exception(exc, f"{where}:{line}") from None
         finally:
             del scopes[depth:]
+            if outer:
+                interp.deadline = None
             counts, self.pending = self.pending, {"Fixed": 0, "Unfixed": 0}
         for word, n in counts.items():
             if n and word in ("Fixed", "Unfixed"):
@@ -364,20 +405,40 @@ class Session(SessionAPI):
                 dict(self.settings),
                 None if s is None else s.X.copy(),
                 None if b is None or not b.n else (b.target.copy(), b.pressure.copy(),
-                                                    b.volconst.copy(), b.density.copy()),
-                None if s is None else {k: (q.target, q.modulus, q.kind)
+                                                    b.volconst.copy(), b.density.copy(),
+                                                    b.lagrange.copy()),
+                None if s is None else {k: (q.target, q.modulus, q.kind, q.pressure,
+                                            q.tolerance)
                                         for k, q in s.quantities.items()},
                 None if s is None else {k: v.copy() for k, v in s.extra.items()},
                 None if s is None else {k: v.copy() for k, v in s.vattr.items()},
                 None if s is None else {k: v.copy() for k, v in s.eattr.items()},
                 None if s is None else {k: v.copy() for k, v in s.fattr.items()},
                 None if s is None else {k: m.copy() for k, m in s.vcon.items()},
-                s)
+                s, self.totals, self._iterator_state(),
+                None if s is None else ({k: m.copy() for k, m in s.econ.items()},
+                                        {k: m.copy() for k, m in s.fcon.items()},
+                                        s.gravity_constant, s.sq_curvature_modulus),
+                self.filename)
+
+    def _iterator_state(self):
+        it = self._iterator
+        if it is None:
+            return None
+        return (it.cg_history, it.cg_S_old, it.cg_f_old, it.pressures_valid)
 
     def _restore(self, snap):
         (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
-         fattr, vcon, surface) = snap
+         fattr, vcon, surface, totals, it_state, more, filename) = snap
+        self.filename = filename
         self.surface = surface
+        self.totals = totals            # the energies of the restored coordinates
+        if self._iterator is not None:
+            if it_state is None:
+                self._iterator = None
+            else:
+                (self._iterator.cg_history, self._iterator.cg_S_old, self._iterator.cg_f_old,
+                 self._iterator.pressures_valid) = it_state
         self.variables.clear()
         self.variables.update(vars_)
         self.commands = cmds
@@ -390,15 +451,16 @@ class Session(SessionAPI):
             s.X = X
             if bod is not None:
                 b = s.bodies
-                b.target, b.pressure, b.volconst, b.density = bod
-            for k, (t, m, kind) in qs.items():
+                b.target, b.pressure, b.volconst, b.density, b.lagrange = bod
+            for k, (t, m, kind, p, tol) in qs.items():
                 q = s.quantities[k]
-                q.target, q.modulus, q.kind = t, m, kind
+                q.target, q.modulus, q.kind, q.pressure, q.tolerance = t, m, kind, p, tol
             s.extra = extra
             s.vattr = vattr
             s.eattr = eattr
             s.fattr = fattr
             s.vcon = vcon
+            s.econ, s.fcon, s.gravity_constant, s.sq_curvature_modulus = more
 
     # -- evaluation ------------------------------------------------------------------
     def recalc(self, keep_cg=False, reposition=False):
@@ -476,6 +538,7 @@ class Session(SessionAPI):
     def _steps(self, n, callback, echo, results, bar):
         from .evolve.iterate import progress_line
         for k in range(n, 0, -1):
+            self.interp.tick()
             r = self.iterator.step()
             results.append(r)
             self.history.append((self.iteration_counter, r.energy, r.area))
@@ -499,9 +562,10 @@ class Session(SessionAPI):
                     r.warnings.append(f"Autochopped {nch} edges.")
             if echo:
                 for w in r.warnings:
-                    if w.startswith(("WARNING 1055", "Total difference")):
-                        # REF writes these to stderr, the pair followed by a blank line
-                        self.write_err(w + ("\n\n" if w.startswith("Total") else "\n"))
+                    if w.startswith(("WARNING 1055", "Total difference", "WARNING 1864")):
+                        # REF writes these to stderr, the pair (and 1864) followed by a
+                        # blank line
+                        self.write_err(w + ("\n" if w.startswith("WARNING 1055") else "\n\n"))
                     else:
                         self.write(w + "\n")
                 if r.printed and not self.toggles.get("quiet") and not self.toggles.get("quietgo"):
@@ -566,6 +630,7 @@ class Session(SessionAPI):
 
         with _deferred_sigint() as flag:
             def cb(r):
+                self.interp.tick()
                 if echo and not self.toggles.get("quiet"):
                     area = areas.get(id(r.x))
                     if area is None:     # the line search kept an earlier point
@@ -602,11 +667,13 @@ class Session(SessionAPI):
         ``callback(result)`` may stop the run, and so does Ctrl-C (after the
         current step)."""
         from .evolve.newton import damped_newton
+        self.no_string("newton")
         s = self.surface
         if s is None or s.nv == 0:
             raise CommandError("newton: no surface loaded")
         with _deferred_sigint() as flag:
             def cb(r):
+                self.interp.tick()
                 if echo and not self.toggles.get("quiet"):
                     self.write("%3d. area: %#17.15g energy: %#17.15g  delta: %#g\n"
                                % (n - r.nit, self.totals.total_area, r.energy, r.delta))
@@ -630,6 +697,10 @@ class Session(SessionAPI):
         from .evolve.hessian import newton_direction
         from .evolve.iterate import StepResult, _Constraints
         self.no_string("hessian")
+        if self.surface is None or self.surface.nv == 0:
+            # (everything deleted; REF: "No vertices" warnings or unrelated errors)
+            raise CommandError(f"{'hessian_seek' if seek else 'hessian'}: the surface has "
+                               f"no vertices")
         it = self.iterator
         s = self.surface
         if not it.pressures_valid and len(_Constraints(s)):
@@ -835,6 +906,8 @@ class Session(SessionAPI):
         so the numbers differ from the Evolver's)."""
         s = self.surface
         T = self.settings["jiggle_temperature"] if temperature is None else float(temperature)
+        if not math.isfinite(T):
+            raise CommandError(f"j: the temperature must be a finite number, got {T:g}")
         t = self.totals
         sigma = T * (float(np.mean(t.edge_length)) if s.ne else 0.0)
         move = ~s.vattr["fixed"]
@@ -845,7 +918,7 @@ class Session(SessionAPI):
         new.X = s.X.copy()
         idx = np.nonzero(move)[0]
         new.X[idx, :s.sdim] += sigma * self.rng.standard_normal((len(idx), s.sdim))
-        project_to_constraints(new, idx)
+        self._project_or_fail(new, idx)
         self._replace_surface(new)
         if echo:
             self.write("One jiggle done.\n")
@@ -892,10 +965,12 @@ class Session(SessionAPI):
             raise CommandError(f"'{name}' is read-only")
         if name in self.commands:
             del self.commands[name]
+        if name in self.settings or name in ("gravity_constant", "sq_curvature_modulus"):
+            value = I.as_float(value, f"'{name}'")     # settings are numbers
         if name in self.settings:
-            self.settings[name] = value
             if name == "random_seed":
-                self.rng = np.random.default_rng(int(value))
+                self.rng = np.random.default_rng(I.as_int(value, "random_seed") & (2**63 - 1))
+            self.settings[name] = value
             return
         if name == "gravity_constant":
             self.surface.gravity_constant = float(value)
@@ -973,9 +1048,7 @@ class Session(SessionAPI):
         return {"vertex": s.nv, "edge": s.ne, "facet": s.n_facets, "body": s.bodies.n}[kind]
 
     def element(self, kind, index):
-        if isinstance(index, str):
-            raise ExpressionError(f"{kind} index must be a number")
-        k = int(index)
+        k = I.as_int(index, f"a {kind} index")
         n = self.count(kind)
         sign = -1 if k < 0 else 1
         attrs = {"vertex": "vattr", "edge": "eattr", "facet": "fattr"}.get(kind)
@@ -995,10 +1068,12 @@ class Session(SessionAPI):
         if gen.where is None:
             return els
         out = []
+        tick = self.interp.tick
         for el in els:
+            tick()
             with env.element(el, gen.var):
                 v = gen.where.ev(env)
-            if not isinstance(v, str) and v:
+            if I.is_true(v):
                 out.append(el)
         return out
 
@@ -1027,7 +1102,7 @@ class Session(SessionAPI):
         for p in parents:
             subs = self.sub_elements(p, kind)
             if idx is not None:
-                k = int(env.session.interp.value(idx))
+                k = I.as_int(env.session.interp.value(idx), f"a {kind} index")
                 if k < 1 or k > len(subs):
                     raise ExpressionError(f"{p}.{kind}[{k}] does not exist")
                 subs = [subs[k - 1]]
@@ -1035,6 +1110,7 @@ class Session(SessionAPI):
         return out
 
     def sub_elements(self, el, kind):
+        self._check_alive(el)
         s = self.surface
         i = el.i
         if s.string and "facet" in (el.kind, kind) and el.kind != "body":
@@ -1118,7 +1194,17 @@ class Session(SessionAPI):
         raise ExpressionError(f"{el.kind} has no {kind}s")
 
     # -- attributes ------------------------------------------------------------------------
+    def _check_alive(self, el):
+        """An element reference kept across a command that removed elements
+        (``foreach ... do { delete ...; print vv.id }``) may point past the
+        end: refused by name."""
+        if el.kind in ("vertex", "edge", "facet", "body") and el.i >= self.count(el.kind):
+            raise ExpressionError(f"the {el.kind} no longer exists (deleted by this command)")
+
     def get_attr(self, base, name, idx):
+        if idx is not None:                     # indices are integers (C truncation)
+            idx = tuple(I.as_int(j, f"the index of '{name}'") for j in idx) \
+                if isinstance(idx, tuple) else I.as_int(idx, f"the index of '{name}'")
         if isinstance(base, I.QRef):
             return self._quantity_attr(base.name, name)
         if not isinstance(base, I.ElemRef):
@@ -1126,6 +1212,7 @@ class Session(SessionAPI):
         s = self.surface
         t = self.totals
         k, i = base.kind, base.i
+        self._check_alive(base)
         eid = float(s.ids(k)[i]) if k in ("vertex", "edge", "facet") else float(i + 1)
         if name in ("id",):
             return eid
@@ -1320,6 +1407,9 @@ class Session(SessionAPI):
         raise ExpressionError(f"quantity has no attribute '{name}'")
 
     def set_attr(self, base, name, idx, value):
+        if idx is not None:
+            idx = tuple(I.as_int(j, f"the index of '{name}'") for j in idx) \
+                if isinstance(idx, tuple) else I.as_int(idx, f"the index of '{name}'")
         if isinstance(value, str):
             raise CommandError(f"cannot assign a string to '.{name}'")
         s = self.surface
@@ -1331,7 +1421,7 @@ class Session(SessionAPI):
                                    f"'.{name}'")
             arr[base.i] = np.asarray(value)
             return
-        value = float(value)
+        value = I.as_float(value, f"the value of '.{name}'")
         if isinstance(base, I.QRef):
             q = s.quantities[base.name]
             if name in ("target", "modulus", "tolerance"):
@@ -1340,6 +1430,7 @@ class Session(SessionAPI):
             raise CommandError(f"quantity attribute '{name}' is read-only")
         if not isinstance(base, I.ElemRef):
             raise CommandError(f"'.{name}' needs an element or a quantity")
+        self._check_alive(base)
         k, i = base.kind, base.i
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
@@ -1358,6 +1449,8 @@ class Session(SessionAPI):
                 j = int(idx) - 1 if not isinstance(idx, tuple) else -1
                 if j < 0 or j >= s.sdim:
                     raise CommandError(f"vertex x[{j + 1}]: index outside 1..{s.sdim}")
+            if not math.isfinite(value):
+                raise CommandError(f"vertex coordinates must be finite numbers, got {value:g}")
             s.X[i, j] = value
             return
         if k == "body":
@@ -1380,9 +1473,12 @@ class Session(SessionAPI):
             s.fattr["tension"][i] = value
             return
         if k in ("edge", "facet") and name in ("color", "colour", "frontcolor", "backcolor"):
-            attrs, n = (s.eattr, s.ne) if k == "edge" else (s.fattr, s.nf)
+            attrs, n = (s.eattr, s.ne) if k == "edge" else (s.fattr, self.count(k))
             name = name.replace("colour", "color")
             default = 0 if k == "edge" else 15
+            value = I.as_int(value, f"a {name}")
+            if abs(value) > 2**31 - 1:
+                raise CommandError(f"{name} {value} is out of range")
             if "color" not in attrs:
                 attrs["color"] = np.full(n, default, np.int64)
             if name == "color":
@@ -1446,12 +1542,22 @@ class Session(SessionAPI):
         vals = []
         ix = None if idx is None else self.interp.value(idx)
         for el in els:
+            self.interp.tick()
             with env.element(el, gen.var):
                 vals.append(self.interp.value(expr))
         for el, v in zip(els, vals):
             self.set_attr(el, attr, ix, v)
         if gen.kind == "vertex" and attr in ("x", "y", "z"):
-            project_to_constraints(self.surface, np.array([e.i for e in els], np.int64))
+            self._project_or_fail(self.surface, np.array([e.i for e in els], np.int64))
+
+    def _project_or_fail(self, surface, idx):
+        """Project vertices to their constraints; a projection that diverges
+        fails the command (which leaves the surface as it was)."""
+        bad = project_to_constraints(surface, idx)
+        if len(bad):
+            vid = surface.ids("vertex")[bad[0]]
+            raise CommandError(f"the projection of vertex {vid} onto its constraints "
+                               f"diverges")
 
     def set_constraint(self, els, cid):
         """``set gen constraint n``: put the elements on level-set constraint
@@ -1589,11 +1695,14 @@ class Session(SessionAPI):
             for d in os.environ.get("EVOLVERPATH", "").split(os.pathsep):
                 if d:
                     cands.append(os.path.join(d, name))
-        path = next((c for c in cands if os.path.isfile(c)), None)
+        path = next((c for c in cands if os.path.exists(c)), None)
         if path is None:
             raise CommandError(f"read: cannot find file '{name}' (looked in the current "
                                f"directory and EVOLVERPATH)")
-        if len(self.interp.env.scopes) > 200:
+        if not os.path.isfile(path):       # /dev/zero, a FIFO, a directory: never read
+            raise CommandError(f"read: '{path}' is not a regular file (a directory, "
+                               f"device or pipe)")
+        if len(self.interp.env.scopes) > MAX_NESTING:
             raise CommandError(f"read \"{name}\": files read each other too deeply")
         try:
             with open(path, encoding="latin-1") as fh:

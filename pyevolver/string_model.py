@@ -133,11 +133,14 @@ def _edge_gravity(Pt, Ph):
 def _vertex_integrand(s, which):
     """``[(formula, vertex mask)]`` of constraint ENERGY / CONTENT integrands
     (their single component) with the vertices on the constraint."""
+    from .surface import LocatedFormula
     out = []
     for cid, on in s.vcon.items():
-        comps = getattr(s.constraints[cid], which)
+        c = s.constraints[cid]
+        comps = getattr(c, which)
         if comps and on.any():
-            out.append((comps[0], on))
+            out.append((LocatedFormula(comps[0], f"constraint {cid} {which}",
+                                       getattr(c, "line", None)), on))
     return out
 
 

@@ -7,13 +7,15 @@ exist only when the datafile declares them.
 """
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 
 from . import geometry as G
-from .errors import DatafileError, UnsupportedError
+from .errors import DatafileError, PyEvolverError, UnsupportedError
+from .limits import MAX_ARRAY_ENTRIES
 from .expr import nodes as N
 from .methods import method_info
 
@@ -33,6 +35,7 @@ class Quantity:
     # FUNCTION quantities: a Formula of the global values of method instances,
     # ``inst.value``; the instances are quantities of kind "instance"
     function: object = None
+    line: int | None = None        # source line of its declaration
 
 
 @dataclass
@@ -298,11 +301,12 @@ class Totals:
         flat = pts.reshape(-1, pts.shape[-1])
         rep = np.repeat(idx, 2)
         total = np.zeros(n)
-        for k, comp in enumerate(comps):
-            if k >= d.shape[1]:
-                break
-            q = self.eval_points(comp, flat, "edge", rep).reshape(n, 2) @ G.GL2_W
-            total += q * d[:, k]
+        with located(getattr(comps, "what", ""), getattr(comps, "line", None)):
+            for k, comp in enumerate(comps):
+                if k >= d.shape[1]:
+                    break
+                q = self.eval_points(comp, flat, "edge", rep).reshape(n, 2) @ G.GL2_W
+                total += q * d[:, k]
         return total
 
     def _integrals(self):
@@ -388,6 +392,15 @@ class Totals:
         absolute values of its element contributions instead (the scale of
         its restoring tolerance).  A FUNCTION quantity's magnitude is its
         linearization's: Σ_i |∂f/∂v_i| magnitude_i."""
+        try:
+            return self._quantity_value(q, magnitude)
+        except PyEvolverError as exc:
+            if getattr(exc, "line", None) is None:     # say which quantity failed, where
+                exc.line = q.line
+                exc.args = (f"quantity {q.name}: {exc}",)
+            raise
+
+    def _quantity_value(self, q, magnitude=False):
         if q.function is not None:
             s = self.surface
             env = self.instance_values(q)
@@ -443,12 +456,14 @@ class _Builder:
         sd = int(sc.values.get("surface_dimension", 1 if s.string else 2))
         if sd not in (1, 2):
             raise self.error(f"not supported in pyevolver: SURFACE_DIMENSION {sd} "
-                             f"(the simplex model)")
+                             f"(the simplex model)", sc.decl_lines.get("surface_dimension"))
         if s.sdim != 3 and not (s.string and s.sdim == 2):
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
-                             f"(3, or 2 in the string model)")
+                             f"(3, or 2 in the string model)",
+                             sc.decl_lines.get("space_dimension"))
         if s.string and sc.torus and s.sdim != 2:
-            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model")
+            raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model",
+                             sc.decl_lines.get("torus", sc.decl_lines.get("torus_filled")))
         s.constraints = dict(sc.constraints)
         s.boundaries = dict(sc.boundaries)
         s.symmetric_content = "symmetric_content" in sc.flags
@@ -573,7 +588,14 @@ class _Builder:
             P = s.vattr["params"][sel]
             env = {f"p{k + 1}": P[:, k] for k in range(b.nparams)}
             for k, f in enumerate(b.coords[:3]):
-                s.X[sel, k] = f.values(s.param_env(), env, len(sel))
+                with located(f"boundary {bid}", b.line):
+                    s.X[sel, k] = f.values(s.param_env(), env, len(sel))
+            bad = ~np.all(np.isfinite(s.X[sel]), axis=1)
+            if bad.any():
+                pos = sel[np.nonzero(bad)[0][0]]
+                blk = self.sc.vertices
+                raise self.error(f"vertex {blk.ids[pos]}: its position on boundary {bid} is "
+                                 f"not finite", blk.lines[pos])
 
     # -- edges ----------------------------------------------------------------
     def _edges(self):
@@ -810,7 +832,9 @@ class _Builder:
                     s.vcon[cid] = np.concatenate([np.zeros(s.nv - nnew_v, bool), fcon[cid][cpar]])
             if "boundary" in s.vattr:
                 if fbnd[cpar].any():
-                    raise UnsupportedError("BOUNDARY on a face with more than 3 edges")
+                    k = int(cpar[np.nonzero(fbnd[cpar])[0][0]])
+                    raise self.error(f"face {blk.ids[k]}: not supported in pyevolver: BOUNDARY "
+                                     f"on a face with more than 3 edges", blk.lines[k])
                 s.vattr["boundary"] = np.concatenate([s.vattr["boundary"], np.zeros(nnew_v, np.int64)])
                 s.vattr["params"] = np.vstack([s.vattr["params"],
                                                np.zeros((nnew_v, s.vattr["params"].shape[1]))])
@@ -849,6 +873,14 @@ class _Builder:
                 s.extra[key] = s.extra[key][parent]
         if s.periods is not None and nnew_v:
             self._torus_centers(big, starts, lengths, enc, nface)
+        if nnew_v:
+            # the mean of huge (finite) coordinates or periods can overflow
+            bad = np.nonzero(~np.all(np.isfinite(s.X[nv:]), axis=1))[0]
+            if len(bad):
+                k = cpar[bad[0]]
+                raise self.error(f"face {blk.ids[k]}: the centre of the face is not finite "
+                                 f"(its coordinates or the PERIODS are too large)",
+                                 blk.lines[k])
 
     def _string_faces(self):
         """String model: a facet is a chain of edges, open or closed, kept as
@@ -1022,12 +1054,19 @@ class _Builder:
         self.members = getattr(self, "members", {})
         self.members.setdefault((name, etype), []).append((pos, sign))
 
+    def _attr_array(self, etype, name, n, size):
+        """Zeros for an element attribute, refused when absurdly large."""
+        if n * size > MAX_ARRAY_ENTRIES:
+            raise self.error(f"attribute {name}: {n} {etype}s times {size} entries is more "
+                             f"than the {MAX_ARRAY_ENTRIES} allowed")
+        return np.zeros(n if size == 1 else (n, size))
+
     def _attr(self, etype, n, pos, vals):
         name = vals[0]
         atype, size, dims = self.sc.attributes[(etype, name)]
         key = (etype, name)
         if key not in self.s.extra:
-            self.s.extra[key] = np.zeros(n if size == 1 else (n, size))
+            self.s.extra[key] = self._attr_array(etype, name, n, size)
         arr = self.s.extra[key]
         v = vals[1:]
         if size == 1:
@@ -1045,29 +1084,28 @@ class _Builder:
             try:
                 etype, _ = method_info(m.method)
             except UnsupportedError as exc:
-                raise self.error(f"method_instance {name}: {exc}") from None
+                raise self.error(f"method_instance {name}: {exc}", m.line) from None
             if s.string:
                 from .string_model import STRING_METHODS
                 if m.method not in STRING_METHODS:
                     raise self.error(f"method_instance {name}: not supported in pyevolver: method "
-                                     f"{m.method} in the string model", getattr(m, "line", None))
-            q = Quantity(name, "instance")
+                                     f"{m.method} in the string model", m.line)
+            self._check_integrand(m, f"method_instance {name}", m.line)
+            self._check_string_method(m, f"method_instance {name}", m.line)
+            q = Quantity(name, "instance", line=m.line)
             q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
             s.quantities[name] = q
         for name, qd in sc.quantities.items():
-            q = Quantity(name, qd.kind, qd.target, qd.modulus, qd.tolerance)
+            q = Quantity(name, qd.kind, qd.target, qd.modulus, qd.tolerance, line=qd.line)
             for m in qd.methods:
                 try:
                     etype, _ = method_info(m.method)
                 except UnsupportedError as exc:
                     raise self.error(f"quantity {name}: {exc}", qd.line) from None
+                self._check_integrand(m, f"quantity {name}", qd.line)
                 q.methods.append(self._instance(m, etype, members.get((name, etype), [])))
-            if s.string:
-                from .string_model import STRING_METHODS
-                for m in qd.methods:
-                    if m.method not in STRING_METHODS:
-                        raise self.error(f"quantity {name}: not supported in pyevolver: method "
-                                         f"{m.method} in the string model", qd.line)
+            for m in qd.methods:
+                self._check_string_method(m, f"quantity {name}", qd.line)
             if qd.function is not None:
                 for v in qd.function.names():
                     inst = v[:-len(".value")] if v.endswith(".value") else None
@@ -1085,7 +1123,20 @@ class _Builder:
             if (etype, name) not in s.extra:
                 n = {"vertex": s.nv, "edge": s.ne, "facet": s.n_facets,
                      "body": s.bodies.n}[etype]
-                s.extra[(etype, name)] = np.zeros(n if size == 1 else (n, size))
+                s.extra[(etype, name)] = self._attr_array(etype, name, n, size)
+
+    def _check_string_method(self, m, what, line):
+        """The string model has its own methods (no facets)."""
+        if self.s.string:
+            from .string_model import STRING_METHODS
+            if m.method not in STRING_METHODS:
+                raise self.error(f"{what}: not supported in pyevolver: method {m.method} in "
+                                 f"the string model", line)
+
+    def _check_integrand(self, m, what, line):
+        """The scalar integral methods need their SCALAR_INTEGRAND."""
+        if m.method.endswith("_scalar_integral") and m.scalar is None:
+            raise self.error(f"{what}: method {m.method} needs a SCALAR_INTEGRAND", line)
 
     def _instance(self, m, etype, mem):
         s = self.s
@@ -1255,12 +1306,14 @@ def integral_edges(s, which):
     out = []
     efixed = s.eattr["fixed"]
     for cid, sign in s.econ.items():
-        comps = getattr(s.constraints[cid], which)
+        c = s.constraints[cid]
+        comps = getattr(c, which)
         if comps is None:
             continue
         idx = np.nonzero((sign != 0) & ~efixed)[0]
         if len(idx):
-            out.append((comps, idx, sign[idx].astype(float)))
+            out.append((Integrand(comps, f"constraint {cid} {which}", getattr(c, "line", None)),
+                        idx, sign[idx].astype(float)))
     eb = s.eattr.get("boundary")
     if eb is not None:
         for bid, b in s.boundaries.items():
@@ -1269,8 +1322,49 @@ def integral_edges(s, which):
                 continue
             idx = np.nonzero(eb == bid)[0]
             if len(idx):
-                out.append((comps, idx, np.full(len(idx), -1.0 if which == "content" else 1.0)))
+                out.append((Integrand(comps, f"boundary {bid} {which}", getattr(b, "line", None)),
+                            idx, np.full(len(idx), -1.0 if which == "content" else 1.0)))
     return out
+
+
+class Integrand(tuple):
+    """The components of a constraint's or boundary's ENERGY or CONTENT
+    integrand (a tuple of formulas) with the name and source line of their
+    declaration, for the messages of :func:`located`."""
+
+    def __new__(cls, comps, what, line):
+        self = super().__new__(cls, comps)
+        self.what, self.line = what, line
+        return self
+
+
+class LocatedFormula:
+    """A formula whose evaluation errors name its declaration ``what`` and
+    source ``line`` (see :func:`located`)."""
+
+    def __init__(self, formula, what, line):
+        self.formula, self.what, self.line = formula, what, line
+
+    def values(self, *args):
+        with located(self.what, self.line):
+            return self.formula.values(*args)
+
+    def gradient(self, *args):
+        with located(self.what, self.line):
+            return self.formula.gradient(*args)
+
+
+@contextlib.contextmanager
+def located(what, line):
+    """Give an error raised in the block without a source line the
+    declaration ``what`` (e.g. ``"constraint 1"``) and its ``line``."""
+    try:
+        yield
+    except PyEvolverError as exc:
+        if getattr(exc, "line", None) is None and line:
+            exc.line = line
+            exc.args = (f"{what}: {exc}",)
+        raise
 
 
 def torus_lift_shifts(s):
@@ -1406,10 +1500,15 @@ def solve_small(A, b):
     """Batched ``A[n]⁻¹ b[n]`` for small (k, k) systems; a singular system
     (a constraint gradient that vanishes, e.g. x² + y² = 1 at the origin)
     gets the least-squares solution instead of an error."""
-    try:
-        return np.linalg.solve(A, b[..., None])[..., 0]
-    except np.linalg.LinAlgError:
-        return np.einsum("nkl,nl->nk", np.linalg.pinv(A), b)
+    with np.errstate(all="ignore"):
+        try:
+            return np.linalg.solve(A, b[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            # (an infinite or NaN system, from a runaway vertex, would make
+            # the SVD fail: it gets a zero matrix, hence a zero solution)
+            bad = ~np.all(np.isfinite(A), axis=(1, 2))
+            A = np.where(bad[:, None, None], 0.0, A)
+            return np.einsum("nkl,nl->nk", np.linalg.pinv(A), b)
 
 
 def state(s):
@@ -1498,9 +1597,7 @@ def project_tangent(s, vecs):
         for v in out:
             w = v[rr]
             rhs = np.einsum("nik,ni->nk", Gm, w)
-            with np.errstate(all="ignore"):
-                lam = solve_small(GtG, rhs)
-            lam = np.nan_to_num(lam)
+            lam = np.nan_to_num(solve_small(GtG, rhs))
             v[rr] = w - np.einsum("nik,nk->ni", Gm, lam)
     return out
 
@@ -1510,46 +1607,67 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
 
     Uses ``x <- x - G (G^T G)^{-1} phi(x)`` over the vertex's active
     constraints (spec §6.1).  One-sided constraints are projected only when
-    violated.
+    violated.  A vertex whose projection diverges (its coordinates or its
+    constraint values become infinite or NaN, or it ends unconverged
+    farther from its constraints than it started) is put back where it was.
+
+    Returns
+    -------
+    ndarray of int
+        The vertices put back (empty when every projection was finite).
     """
+    failed = np.zeros(0, np.int64)
     if not s.vcon:
-        return
+        return failed
     tol = tol if tol is not None else s.params.get("constraint_tolerance", 1e-12)
     cids = sorted(s.vcon)
     onmat = np.stack([s.vcon[c][idx] for c in cids], axis=1)
     anyon = np.nonzero(onmat.any(axis=1))[0]
     if not len(anyon):
-        return
+        return failed
     ukeys, inv = np.unique(onmat[anyon], axis=0, return_inverse=True)
     inv = inv.ravel()
     env = s.param_env()
     for gi, key in enumerate(ukeys):
         sel = idx[anyon[inv == gi]]
+        start = s.X[sel].copy()
         active = [c for c, on in zip(cids, key) if on]
-        for _ in range(maxit):
+        phi = phi0 = None
+        for _ in range(maxit + 1):
             P = s.X[sel]
             coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
             phis = []
             grads = []
             for cid in active:
                 c = s.constraints[cid]
-                phi = c.formula.values(env, coords, len(sel))
+                phi = _constraint_formula(c, "values", env, coords, len(sel))
                 if "nonnegative" in c.flags:
                     phi = np.minimum(phi, 0.0)
                 elif "nonpositive" in c.flags:
                     phi = np.maximum(phi, 0.0)
                 phis.append(phi)
-                grads.append(c.formula.gradient(env, coords, len(sel)))
+                grads.append(_constraint_formula(c, "gradient", env, coords, len(sel)))
             phi = np.stack(phis, axis=1)           # (n, k)
-            if np.max(np.abs(phi)) < tol:
+            if phi0 is None:
+                phi0 = np.max(np.abs(phi), axis=1)
+            if np.max(np.abs(phi)) < tol or _ == maxit:
                 break
             Gm = np.stack(grads, axis=2)           # (n, 3, k)
             GtG = np.einsum("nik,nil->nkl", Gm, Gm)
+            lam = solve_small(GtG, phi)
             with np.errstate(all="ignore"):
-                lam = solve_small(GtG, phi)
-            step = np.einsum("nik,nk->ni", Gm, lam)
+                step = np.einsum("nik,nk->ni", Gm, lam)
             step = np.where(np.isfinite(step), step, 0.0)
             s.X[sel] = P - step
+        res = np.max(np.abs(phi), axis=1)
+        bad = ~(np.all(np.isfinite(s.X[sel]), axis=1) & np.isfinite(res))
+        # not converged and farther from the constraint than at the start: the
+        # Newton iteration ran away (e.g. atan(z) = 0 from |z| > 1.39)
+        bad |= (res > tol) & (res > phi0)
+        if bad.any():
+            s.X[sel[bad]] = start[bad]
+            failed = np.concatenate([failed, sel[bad]])
+    return failed
 
 
 class _Lazy:
@@ -1603,13 +1721,24 @@ def build_surface(scene):
     try:
         return _Builder(scene).build()
     except DatafileError as exc:
-        if exc.excerpt is None and exc.line:
-            try:
-                with open(scene.filename, encoding="latin-1") as fh:
-                    for k, text in enumerate(fh, 1):
-                        if k == exc.line:
-                            raise DatafileError(exc.message, exc.filename, exc.line,
-                                                exc.column, text) from None
-            except OSError:
-                pass
+        lines = scene.source_lines
+        if exc.excerpt is None and exc.line and lines and 0 < exc.line <= len(lines):
+            raise DatafileError(exc.message, exc.filename, exc.line, exc.column,
+                                lines[exc.line - 1]) from None
         raise
+    except PyEvolverError as exc:
+        # an expression that fails while the surface is built (a constraint
+        # formula dividing by zero in the projection): at the declaration
+        # when known
+        line = getattr(exc, "line", None)
+        lines = scene.source_lines
+        raise DatafileError(str(exc), scene.filename, line, None,
+                            lines[line - 1] if line and lines and line <= len(lines)
+                            else None) from None
+
+
+def _constraint_formula(c, what, *args):
+    """``c.formula.values(...)`` or ``.gradient(...)``; an error names the
+    constraint and its line."""
+    with located(f"constraint {c.id}", getattr(c, "line", None)):
+        return getattr(c.formula, what)(*args)

@@ -33,13 +33,92 @@ def example(name):
     return os.path.join(EXAMPLES, name)
 
 
+# ---------------------------------------------------------------------------
+# nightly-style runs and the fuzz counts
+
+
 def pytest_addoption(parser):
     parser.addoption("--runslow", action="store_true", default=False,
                      help="also run the tests marked slow (long studies); the same as -m ''")
+    parser.addoption("--nightly", action="store_true", default=False,
+                     help="also run the long tests marked 'nightly' (more fuzz inputs)")
 
 
 def pytest_configure(config):
     """pyproject's addopts deselect the ``slow`` tests (``-m 'not slow'``);
-    ``--runslow`` (or ``-m slow`` / ``-m ''`` on the command line) runs them."""
+    ``--runslow`` (or ``-m slow`` / ``-m ''`` on the command line) runs them.
+    ``--nightly`` runs the nightly fuzz sizes."""
     if config.getoption("--runslow"):
         config.option.markexpr = ""
+    if config.getoption("--nightly"):
+        os.environ["PYEVOLVER_NIGHTLY"] = "1"
+
+
+def pytest_collection_modifyitems(config, items):
+    if os.environ.get("PYEVOLVER_NIGHTLY", "") not in ("", "0"):
+        return
+    skip = pytest.mark.skip(reason="nightly: run with --nightly or PYEVOLVER_NIGHTLY=1")
+    for item in items:
+        if "nightly" in item.keywords:
+            item.add_marker(skip)
+
+
+def pytest_terminal_summary(terminalreporter):
+    try:
+        import fuzzing
+    except ImportError:
+        return
+    if fuzzing.COUNTS:
+        terminalreporter.write_sep("-", "fuzz inputs run")
+        for target, n in sorted(fuzzing.COUNTS.items()):
+            t = fuzzing.TIMES.get(target)
+            terminalreporter.write_line(f"{target}: {n}" + (
+                f" in {t[0]:.1f} s ({t[1]:.1f} s CPU)" if t else ""))
+    changed = getattr(terminalreporter.config, "_repo_changes", None)
+    if changed:
+        terminalreporter.write_sep("-", "files the tests wrote into the repository")
+        for path in changed:
+            terminalreporter.write_line(path)
+
+
+# ---------------------------------------------------------------------------
+# the tests write nothing into the repository (no .dmp next to a tracked
+# datafile, no output files): they work on tmp_path copies
+
+REPO = os.path.dirname(os.path.abspath(HERE))
+_IGNORED = {".git", "__pycache__", ".pytest_cache", ".hypothesis", "build"}
+
+
+def _repo_files():
+    """``{path: (size, mtime_ns)}`` of the repository's files (without
+    caches and ignored build output)."""
+    out = {}
+    for root, dirs, files in os.walk(REPO):
+        dirs[:] = [d for d in dirs if d not in _IGNORED and not d.endswith(".egg-info")
+                   and os.path.join(root, d) != os.path.join(REPO, "benchmarks", "data")]
+        for f in files:
+            if f.endswith(".pyc"):
+                continue
+            p = os.path.join(root, f)
+            try:
+                st = os.stat(p)
+            except OSError:
+                continue
+            out[os.path.relpath(p, REPO)] = (st.st_size, st.st_mtime_ns)
+    return out
+
+
+def pytest_sessionstart(session):
+    session.config._repo_before = _repo_files()
+
+
+def pytest_sessionfinish(session, exitstatus):
+    before = getattr(session.config, "_repo_before", None)
+    if before is None:
+        return
+    after = _repo_files()
+    changed = sorted(p for p in after if before.get(p) != after[p])
+    if changed:
+        session.config._repo_changes = changed
+        if session.exitstatus == 0:
+            session.exitstatus = 1

@@ -31,6 +31,14 @@ EXPECTED_LINE = {
     "unterminated_comment.fe": 37,  # the '/*' on the bodies line
     "undefined_parameter.fe": 12,   # vertex 7 'rad 1.0 1.0'
     "unsupported.fe": 5,            # 'METRIC'
+    # resource limits and values that once gave tracebacks (issue 10)
+    "deep_nesting.fe": 8,           # sin(sin(... 300 deep
+    "huge_id.fe": 9,                # vertex id 10^12
+    "macro_bomb.fe": 42,            # #define doubling 39 times
+    "missing_value.fe": 38,         # 'density' at the end of the body line
+    "absurd_attribute.fe": 2,       # real[1000000000] per vertex
+    "infinite_coordinate.fe": 10,   # 1e400
+    "function_arity.fe": 2,         # log(2, 3)
 }
 
 # file -> list of alternatives groups: every group must have at least one
@@ -44,6 +52,13 @@ EXPECTED_WORDS = {
     "unterminated_comment.fe": [("comment",)],
     "undefined_parameter.fe": [("rad",)],
     "unsupported.fe": [("not supported",), ("metric",)],
+    "deep_nesting.fe": [("nested",), ("200",)],
+    "huge_id.fe": [("1000000000000",), ("range",)],
+    "macro_bomb.fe": [("#define",), ("100000",)],
+    "missing_value.fe": [("density",), ("value",)],
+    "absurd_attribute.fe": [("big",), ("1000000000",)],
+    "infinite_coordinate.fe": [("finite",)],
+    "function_arity.fe": [("log",), ("argument",)],
 }
 
 FILES = sorted(EXPECTED_LINE)

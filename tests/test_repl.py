@@ -2,6 +2,7 @@
 multi-line input with the ``more> `` prompt, Tab completion, history kept
 across runs, and Ctrl-C during a long loop."""
 import os
+import signal
 import sys
 import time
 
@@ -21,9 +22,12 @@ def _spawn(tmp_path):
     env["PYEVOLVER_HISTORY"] = str(tmp_path / "history")
     env["TERM"] = "xterm"
     env["PROMPT_TOOLKIT_NO_CPR"] = "1"
+    # preexec_fn: Ctrl-C reaches the child even when this process inherited
+    # SIGINT as ignored (a background job of a shell without job control)
     child = pexpect.spawn(sys.executable, ["-m", "pyevolver", example("cube.fe")], env=env,
                           cwd=str(tmp_path), encoding="utf-8", timeout=30,
-                          dimensions=(40, 200))
+                          dimensions=(40, 200),
+                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     child.expect_exact("Enter command:")
     return child
 
@@ -83,6 +87,43 @@ def test_ctrl_c_in_long_loop_keeps_surface(tmp_path):
     child.sendline('printf "E=%.6f\\n", total_energy')
     child.expect(r"E=(\d\.\d+)")
     assert float(child.match.group(1)) < 6.0     # the iterations done are kept
+    _quit(child)
+
+
+def test_ctrl_c_in_g_returns_within_one_iteration(tmp_path):
+    """``g 100000`` and Ctrl-C: the prompt returns after at most the
+    iteration in progress, and the surface is that of the last complete
+    iteration (its energy is the last one printed, and recalc agrees)."""
+    import re
+    child = _spawn(tmp_path)
+    child.sendline("r; r")
+    child.expect_exact("Enter command:")
+    child.sendline("g 100000")
+    stamps = []
+    energy = None
+    for _ in range(6):
+        child.expect(r"\d+\. area: +\S+ energy: +(\S+)")
+        stamps.append(time.monotonic())
+        energy = child.match.group(1)
+    per_iteration = (stamps[-1] - stamps[0]) / 5
+    t0 = time.monotonic()
+    child.sendintr()
+    child.expect_exact("stopped after a complete iteration")
+    latency = time.monotonic() - t0
+    later = re.findall(r"energy: +(\S+)", child.before)
+    if later:
+        energy = later[-1]
+    child.expect_exact("Enter command:")
+    assert latency < 2.0 + 2 * per_iteration, (latency, per_iteration)
+    child.sendline('printf "E=%.15g\\n", total_energy')
+    child.expect(r"E=(\S+)\r\n")
+    assert float(child.match.group(1)) == pytest.approx(float(energy), rel=1e-14)
+    child.expect_exact("Enter command:")
+    child.sendline('recalc; printf "R=%.15g V=%d\\n", total_energy, vertex_count')
+    child.expect(r"R=(\S+) V=(\d+)\r\n")
+    assert float(child.match.group(1)) == pytest.approx(float(energy), rel=1e-14)
+    assert int(child.match.group(2)) == 194         # the cube (14 vertices) refined twice
+    child.expect_exact("Enter command:")
     _quit(child)
 
 

@@ -6,6 +6,7 @@ import numpy as np
 import math
 import re
 
+from .. import limits
 from ..errors import CommandError
 
 _SPEC = re.compile(r"%([-+ #0]*)(\*|\d+)?(?:\.(\*|\d+))?(?:hh|h|ll|l|L|q|j|z|t)?([diouxXeEfFgGcs%])")
@@ -48,9 +49,17 @@ def c_format(fmt, args):
             out.append("%")
             continue
         if width == "*":
-            width = str(_to_int(take()))
+            w = _to_int(take())
+            if w < 0:                   # C: a negative width means left-justified
+                flags += "-"
+            width = str(abs(w))
         if prec == "*":
-            prec = str(_to_int(take()))
+            p = _to_int(take())
+            prec = None if p < 0 else str(p)      # C: as if the precision were omitted
+        for part in (width, prec):
+            if part is not None and abs(int(part)) > limits.MAX_FORMAT_WIDTH:
+                raise CommandError(f"printf: field width or precision {part} is more than "
+                                   f"the {limits.MAX_FORMAT_WIDTH} allowed")
         spec = "%" + flags + (width or "") + ("." + prec if prec is not None else "")
         v = take()
         if conv in "di":
@@ -71,7 +80,11 @@ def c_format(fmt, args):
                 raise CommandError(f"printf: expected a number for %{conv}, got string {v!r}")
             out.append((spec + conv) % float(v))
     out.append(fmt[pos:])
-    return "".join(out)
+    text = "".join(out)
+    if len(text) > limits.MAX_STRING:
+        raise CommandError(f"printf: the result has {len(text)} characters, more than the "
+                           f"{limits.MAX_STRING} allowed")
+    return text
 
 
 def print_array(a):

@@ -6,15 +6,20 @@ or a shell.
 """
 from __future__ import annotations
 
+import contextlib
 import functools
+import math
 import os
 import re
+import time
 
 import numpy as np
 from lark import Lark, v_args
 from lark.exceptions import UnexpectedInput, VisitError
 
+from ..atomic import atomic_write
 from ..errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
+from ..limits import MAX_ARRAY_ENTRIES, MAX_NESTING, nesting_depth
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
 from .cformat import c_format, print_array, print_value
@@ -154,6 +159,40 @@ def _starts_with_else(chunk):
 
 
 # ---------------------------------------------------------------------------
+# values
+
+
+def as_float(v, what="a value"):
+    """``v`` as a float; strings, elements and quantities are refused."""
+    if isinstance(v, np.ndarray) and v.size == 1:
+        v = v.reshape(())[()]
+    if not N.is_number(v) or isinstance(v, np.ndarray):
+        raise ExpressionError(f"{what} must be a number, got {N._what(v)}")
+    return float(v)
+
+
+def is_true(v, what="a where condition"):
+    """The truth of a ``where`` condition: numbers other than 0 (a string
+    is false, as before); arrays and elements are refused."""
+    if isinstance(v, str):
+        return False
+    if isinstance(v, np.ndarray) and v.size == 1:
+        v = v.reshape(())[()]
+    if not N.is_number(v) or isinstance(v, np.ndarray):
+        raise ExpressionError(f"{what} must be a number, got {N._what(v)}")
+    return bool(v != 0)
+
+
+def as_int(v, what="a count"):
+    """``v`` as an integer (truncated toward zero, as C converts): counts,
+    indices, ids.  Strings, NaN and infinities are refused."""
+    v = as_float(v, what)
+    if not math.isfinite(v):
+        raise ExpressionError(f"{what} must be a finite number, got {v:g}")
+    return int(v)
+
+
+# ---------------------------------------------------------------------------
 # expression nodes of the command language
 
 
@@ -231,9 +270,11 @@ class Aggregate(N.Node):
 
     def ev(self, env):
         vals = []
+        tick = env.session.interp.tick
         for el in env.session.generate(self.gen, env):
+            tick()
             with env.element(el, self.gen.var):
-                vals.append(float(self.expr.ev(env)))
+                vals.append(as_float(self.expr.ev(env), f"the value of {self.op}()"))
         if self.op == "count":
             return float(len(vals))
         if not vals:
@@ -359,6 +400,9 @@ class Proc:
         self.body = body              # statement tuple, None for a prototype
         self.function = function
 
+    def _nested(self):
+        return (self.body,)
+
 
 class Generator:
     """``vertex``, ``vertex[3]``, ``ee.vertex``, ``vertex[2].edge``, with an
@@ -368,6 +412,9 @@ class Generator:
         self.base = base            # ("all", kind) / ("index", kind, expr) / ("sub", base, kind, idx) / ("varsub", name, kind, idx)
         self.var = var
         self.where = where
+
+    def _nested(self):
+        return (self.base, self.where)
 
     @property
     def kind(self):
@@ -736,7 +783,7 @@ def parse_command(text, where="<command>", line=1):
         text = _disambiguate_set(text)
     try:
         tree = command_parser().parse(text)
-        return _TRANSFORMER.transform(tree)
+        ast = _TRANSFORMER.transform(tree)
     except UnexpectedInput as exc:
         ln = (exc.line if exc.line not in (None, -1) else 1) + line - 1
         col = exc.column if exc.column not in (None, -1) else 1
@@ -748,8 +795,15 @@ def parse_command(text, where="<command>", line=1):
                            + " " * (col - 1) + "^") from None
     except VisitError as exc:
         if isinstance(exc.orig_exc, PyEvolverError):
-            raise CommandError(f"{where}:{line}: {exc.orig_exc}") from None
+            ln = getattr(exc.orig_exc, "line", None)
+            col = getattr(exc.orig_exc, "column", None)
+            at = f"{line + ln - 1}:{col}" if ln and col else f"{line}"
+            raise CommandError(f"{where}:{at}: {exc.orig_exc}") from None
         raise
+    if nesting_depth(ast) > MAX_NESTING:
+        raise CommandError(f"{where}:{line}: the command is nested more than {MAX_NESTING} "
+                           f"levels deep (braces, control statements or expressions)")
+    return ast
 
 
 # ---------------------------------------------------------------------------
@@ -769,6 +823,10 @@ class _Continue(Exception):
 class _Return(Exception):
     def __init__(self, value=None):
         self.value = value
+
+
+class TimeLimitExceeded(CommandError):
+    """A command ran past the session's time limit (``--timeout``)."""
 
 
 class Interrupted(Exception):
@@ -836,35 +894,43 @@ class Env:
 def histogram_text(vals, log=False):
     """The ``histogram``/``loghistogram`` report: the Evolver's bins (21 equal
     bins from the least to the greatest value; 20 logarithmic bins over the
-    positive values, with a ``<= 0.0`` line counting the others)."""
-    if not vals:
+    positive values, with a ``<= 0.0`` line counting the others).  NaN
+    values are counted on a last line ``NaN  n``, as REF does; with nothing
+    else, REF's empty bins (from its initial bounds 1e38 and -1e38, which
+    its logarithmic bins print as ``inf``).  Infinities are left out (REF
+    stops on them)."""
+    nan = sum(1 for v in vals if v != v)
+    vals = [v for v in vals if math.isfinite(v)]
+    if not vals and not nan:
         return "No qualifying values.\n"
     out = []
+    tail = ["NaN          %d" % nan] if nan else []
     if log:
         nonpos = sum(1 for v in vals if v <= 0)
         vals = [v for v in vals if v > 0]
         if nonpos:
             out.append("          <= 0.0           %d" % nonpos)
         if not vals:
-            return "\n".join(out) + "\n"
-    lo, hi = min(vals), max(vals)
-    if hi <= lo:
+            if nan:
+                out += ["%10.5g - %10.5g     0" % (math.inf, math.inf)] * 20
+            return "\n".join(out + tail) + "\n"
+    lo, hi = (min(vals), max(vals)) if vals else (1e38, -1e38)
+    if vals and hi <= lo:
         out.append("%10.5g - %10.5g     %d" % (lo, hi, len(vals)))
-        return "\n".join(out) + "\n"
+        return "\n".join(out + tail) + "\n"
     nbins = 20 if log else 21
     if log:
         a, b = np.log(lo), np.log(hi)
-        keys = [(np.log(v) - a) / (b - a) * nbins for v in vals]
         edges = [float(np.exp(a + (b - a) * k / nbins)) for k in range(nbins + 1)]
     else:
-        keys = [(v - lo) / (hi - lo) * nbins for v in vals]
         edges = [lo + (hi - lo) * k / nbins for k in range(nbins + 1)]
-    counts = [0] * nbins
-    for k in keys:
-        counts[min(nbins - 1, max(0, int(k)))] += 1
+    # a value on an edge counts in the bin below it (REF: 6 in 5.4286 - 6
+    # when the values are 2..14)
+    keys = np.searchsorted(np.array(edges[1:]), np.array(vals, dtype=float), side="left")
+    counts = np.bincount(np.minimum(keys, nbins - 1), minlength=nbins).tolist()
     for k in range(nbins):
         out.append("%10.5g - %10.5g     %d" % (edges[k], edges[k + 1], counts[k]))
-    return "\n".join(out) + "\n"
+    return "\n".join(out + tail) + "\n"
 
 
 LETTER_LATER = {
@@ -937,6 +1003,16 @@ class Interpreter:
     def __init__(self, session):
         self.session = session
         self.env = Env(session)
+        self.deadline = None        # time.monotonic() after which the command stops
+
+    def tick(self):
+        """Stop the running command when its time limit (``Session.time_limit``,
+        the CLI's ``--timeout``) has passed; called once per loop pass, call,
+        repetition and iteration, wherever a script could run forever."""
+        if self.deadline is not None and time.monotonic() > self.deadline:
+            raise TimeLimitExceeded(f"the command ran longer than "
+                                    f"{self.session.time_limit:g} s (the time limit) "
+                                    f"and was stopped")
 
     # -- statements -----------------------------------------------------------
     def execute(self, node):
@@ -950,13 +1026,11 @@ class Interpreter:
     def _x_repeat(self, node):
         n = self._count(node[2])
         for _ in range(n):
+            self.tick()
             self.execute(node[1])
 
     def _count(self, expr):
-        v = self.value(expr)
-        if isinstance(v, str):
-            raise CommandError("a repetition count must be a number")
-        return max(0, int(v))
+        return max(0, as_int(self.value(expr), "a repetition count"))
 
     def _x_if(self, node):
         if self.truth(node[1]):
@@ -966,6 +1040,7 @@ class Interpreter:
 
     def _loop(self, body):
         """Run one loop body; returns False to leave the loop."""
+        self.tick()
         try:
             self.execute(body)
         except _Break as b:
@@ -1004,11 +1079,25 @@ class Interpreter:
         # visited) but, as in the Evolver, `where` is tested when each element
         # is reached, on the surface the earlier passes left
         gen, body = node[1], node[2]
-        for el in list(self.session._gen_base(gen.base, self.env)):
+        sess = self.session
+        els = list(sess._gen_base(gen.base, self.env))
+        surf0 = sess.surface
+        ids = {k: surf0.ids(k) for k in {el.kind for el in els} if k != "body"}
+        for el in els:
+            if sess.surface is not surf0 and el.kind in ids:
+                # the body changed the topology (r, delete, ...): the element is
+                # found again by its id; one that was deleted is skipped
+                eid = ids[el.kind][el.i]
+                hit = np.nonzero(sess.surface.ids(el.kind) == eid)[0]
+                if not len(hit):
+                    continue
+                el = ElemRef(el.kind, int(hit[0]), el.sign)
+            elif el.kind == "body" and el.i >= sess.count("body"):
+                continue
             with self.env.element(el, gen.var):
                 if gen.where is not None:
                     v = gen.where.ev(self.env)
-                    if isinstance(v, str) or not v:
+                    if not is_true(v):
                         continue
                 if not self._loop(body):
                     break
@@ -1072,8 +1161,9 @@ class Interpreter:
                                f"'{proc.name}' needs {len(proc.params)} argument"
                                f"{'s' if len(proc.params) != 1 else ''}, the call has "
                                f"{len(args)}")
-        if len(self.env.scopes) > 900:
-            raise CommandError(f"'{proc.name}': calls nested too deeply")
+        self.tick()
+        if len(self.env.scopes) > MAX_NESTING:
+            raise CommandError(f"'{proc.name}': calls nested more than {MAX_NESTING} deep")
         scope = {name: v for (_, name), v in zip(proc.params, args)}
         self.env.scopes.append(scope)
         try:
@@ -1155,12 +1245,7 @@ class Interpreter:
         s = self.session
         if len(name) < 2:
             raise CommandError(f"'{name}' is a single-letter command, not a variable")
-        shape = []
-        for d in dims:
-            v = self.value(d)
-            if isinstance(v, str) or int(v) < 0:
-                raise CommandError(f"define {name}: array sizes must be numbers >= 0")
-            shape.append(int(v))
+        shape = self._sizes(dims, f"define {name}")
         if not shape:                       # `define name real`: a plain variable
             if name not in s.variables:
                 s.set_variable(name, "" if typ == "string" else 0.0)
@@ -1173,7 +1258,8 @@ class Interpreter:
         new = np.zeros(shape, dtype=object if typ == "string" else float)
         if typ == "string":
             new[...] = ""
-        if old is not None and old.ndim == new.ndim:     # redefining keeps the values
+        if old is not None and old.ndim == new.ndim and old.dtype == new.dtype:
+            # redefining keeps the values (of the same type)
             sl = tuple(slice(0, min(a, b)) for a, b in zip(old.shape, new.shape))
             new[sl] = old[sl]
         s.arrays[name] = new
@@ -1193,22 +1279,35 @@ class Interpreter:
                                   f"{'s' if arr.ndim != 1 else ''}, got {len(idx)} indices")
         pos = []
         for k, n in zip(idx, arr.shape):
-            if isinstance(k, str):
-                raise ExpressionError(f"array '{name}': an index must be a number")
-            k = int(k)
+            k = as_int(k, f"an index of array '{name}'")
             if k < 1 or k > n:
                 raise ExpressionError(f"array '{name}': index {k} is outside 1..{n}")
             pos.append(k - 1)
         return arr, tuple(pos)
 
-    def _x_define_attr(self, node):
-        _, kind, name, typ, dims = node
+    def _sizes(self, dims, what, per=1):
+        """Array sizes from ``dims`` expressions: integers >= 0 whose product
+        (times ``per`` elements) stays within :data:`~pyevolver.limits.MAX_ARRAY_ENTRIES`."""
         shape = []
+        total = per
         for d in dims:
             v = self.value(d)
-            if isinstance(v, str) or int(v) < 0:
-                raise CommandError(f"define {kind} attribute {name}: sizes must be numbers >= 0")
+            if isinstance(v, str) or not (0 <= v < float("inf")):
+                raise CommandError(f"{what}: array sizes must be numbers >= 0")
             shape.append(int(v))
+            total *= int(v)
+        # (real[0][huge] and real[huge][0] have no entries, but numpy
+        # cannot make the huge dimension)
+        total = max([total] + shape)
+        if total > MAX_ARRAY_ENTRIES:
+            raise CommandError(f"{what}: {total} entries is more than the "
+                               f"{MAX_ARRAY_ENTRIES} allowed")
+        return shape
+
+    def _x_define_attr(self, node):
+        _, kind, name, typ, dims = node
+        n = self.session.count(kind) if kind != "facetedge" else 1
+        shape = self._sizes(dims, f"define {kind} attribute {name}", per=max(n, 1))
         self.session.define_attribute(kind, name, typ, shape)
 
     def _x_assign(self, node):
@@ -1312,10 +1411,7 @@ class Interpreter:
         def flat(x):
             if isinstance(x, list):
                 return [v for it in x for v in flat(it)]
-            v = self.value(x)
-            if isinstance(v, str):
-                raise CommandError(f"{name}: array values must be numbers")
-            return [float(v)]
+            return [as_float(self.value(x), f"a value of array {name}")]
         vals = flat(items)
         s = self.session
         arr = s.arrays.get(name)
@@ -1400,9 +1496,7 @@ class Interpreter:
         for el in self.session.generate(gen, self.env):
             with self.env.element(el, gen.var):
                 v = self.value(expr)
-            if isinstance(v, str):
-                raise CommandError("histogram needs numbers")
-            vals.append(float(v))
+            vals.append(as_float(v, "a histogram value"))
         self.session.write(histogram_text(vals, log))
 
     # -- files --------------------------------------------------------------------
@@ -1413,17 +1507,27 @@ class Interpreter:
             raise CommandError(f"'{op}' needs a file name in quotes (for example: "
                                f"do_off {op} \"out.off\")")
         s = self.session
-        try:
-            fh = open(name, "w" if op == ">>>" else "a", encoding="latin-1", newline="")
-        except OSError as exc:
-            raise CommandError(f"cannot open '{name}' for output: {exc.strerror}") from None
-        old = s.out
-        s.out = fh
-        try:
-            self.execute(body)
-        finally:
-            s.out = old
-            fh.close()
+        # the file changes only when the command completes (atomic_write): a
+        # failing or interrupted command leaves it as it was
+        with contextlib.ExitStack() as stack:
+            try:
+                fh = stack.enter_context(atomic_write(name, "w" if op == ">>>" else "a",
+                                                      durable=False, encoding="latin-1",
+                                                      newline=""))
+            except OSError as exc:
+                raise CommandError(f"cannot open '{name}' for output: "
+                                   f"{exc.strerror or exc}") from None
+            old = s.out
+            s.out = fh
+            flow = None
+            try:
+                self.execute(body)
+            except (_Break, _Continue, _Return, Loaded, Quit) as exc:
+                flow = exc              # normal control flow: the output is kept
+            finally:
+                s.out = old
+        if flow is not None:
+            raise flow
 
     def _x_pipe(self, node):
         raise UnsupportedError("piping output to a command ('|')",
@@ -1505,15 +1609,16 @@ class Interpreter:
                 el = ElemRef(gen.kind, int(hit[0]))
                 with self.env.element(el, gen.var):
                     v = gen.where.ev(self.env)
-                if not isinstance(v, str) and v:
+                if is_true(v):
                     n += s.delete_elements(gen.kind, [el.i])
         s.report(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted", n)
 
     def _x_break(self, node):
-        raise _Break(1 if node[1] is None else int(self.value(node[1])))
+        raise _Break(1 if node[1] is None else as_int(self.value(node[1]), "break's count"))
 
     def _x_continue(self, node):
-        raise _Continue(1 if node[1] is None else int(self.value(node[1])))
+        raise _Continue(1 if node[1] is None else as_int(self.value(node[1]),
+                                                         "continue's count"))
 
     def _x_return(self, node):
         raise _Return(None if node[1] is None else self.value(node[1]))
@@ -1540,17 +1645,19 @@ class Interpreter:
                 return
             n = 1 if arg is None else self._count(arg)
             for _ in range(n):
+                self.tick()
                 self.run_proc(proc, [])
             return
         if not builtin and raw in s.letters:
             n = 1 if arg is None else self._count(arg)
             for _ in range(n):
+                self.tick()
                 self.run_proc(s.letters[raw], [])
             return
         if name in EXTENSIONS and len(raw) > 1:
             return run_command(s, name, [] if arg is None else [self.value(arg)])
         if raw in ("q",) or name in ("quit", "bye", "exit"):
-            raise Quit(0 if arg is None else int(self.value(arg)))
+            raise Quit(0 if arg is None else as_int(self.value(arg), "the exit status") & 255)
         if raw == "v" or name == "show_vol":
             s.note(s.show_vol())
             return
@@ -1574,28 +1681,29 @@ class Interpreter:
         if raw == "m":
             if arg is None:
                 raise CommandError("m needs a scale value (for example: m 0.1)")
-            v = float(self.value(arg))
+            v = as_float(self.value(arg), f"the argument of {raw}")
             s.settings["scale"] = v
             s.toggles["_fixed_scale"] = 1
             s.note("Scale fixed at %g.\n" % v)
             return
         if name in ("optimize", "optimise"):
             if arg is not None:
-                s.settings["scale_limit"] = float(self.value(arg))
+                s.settings["scale_limit"] = as_float(self.value(arg), f"the argument of {raw}")
             s.toggles["_fixed_scale"] = 0
             s.note("Scale optimizing with bound %g.\n" % s.settings["scale_limit"])
             return
         if raw == "r":
             for _ in range(1 if arg is None else self._count(arg)):
+                self.tick()
                 s.refine()
             return
         if raw == "j":
-            s.jiggle(None if arg is None else float(self.value(arg)))
+            s.jiggle(None if arg is None else as_float(self.value(arg), f"the argument of {raw}"))
             return
         if raw in ("t", "w") or name in ("edgeweed", "areaweed"):
             if arg is None:
                 raise CommandError(f"{raw} needs a value (for example: {raw} 0.01)")
-            v = float(self.value(arg))
+            v = as_float(self.value(arg), f"the argument of {raw}")
             if raw == "t" or name == "edgeweed":
                 s.delete_short_edges(v)
             else:
@@ -1604,7 +1712,7 @@ class Interpreter:
         if raw in ("l", "K", "n") or name in ("edge_divide", "notch"):
             if arg is None:
                 raise CommandError(f"{raw} needs a value (for example: {raw} 0.3)")
-            v = float(self.value(arg))
+            v = as_float(self.value(arg), f"the argument of {raw}")
             if raw == "l" or name == "edge_divide":
                 s.edge_divide_long(v)
             elif raw == "K":
@@ -1629,7 +1737,7 @@ class Interpreter:
             return
         if name in ("hessian", "hessian_seek"):
             if name == "hessian_seek" and arg is not None:
-                s.hessian(seek=True, max_scale=float(self.value(arg)))
+                s.hessian(seek=True, max_scale=as_float(self.value(arg), f"the argument of {raw}"))
             else:
                 s.hessian(seek=name == "hessian_seek")
             return
@@ -1642,7 +1750,7 @@ class Interpreter:
         if raw == "G":
             old_on = s.toggles.get("gravity", 0)
             if arg is not None:
-                s.surface.gravity_constant = float(self.value(arg))
+                s.surface.gravity_constant = as_float(self.value(arg), f"the argument of {raw}")
             g = s.surface.gravity_constant
             s.toggles["gravity"] = int(g != 0)
             was = "on" if old_on else "off"
@@ -1670,7 +1778,7 @@ class Interpreter:
             new = 1 if arg.name == "on" else 0
         else:
             v = self.value(arg)
-            new = 1 if v else 0
+            new = (1 if v else 0) if isinstance(v, str) else int(is_true(v, "a toggle value"))
         old = s.toggles.get(name, TOGGLE_DEFAULTS.get(name, 0))
         if name == "autopop" and new:
             raise UnsupportedError("autopop", "vertex and edge popping (o, O) is not implemented")
@@ -1713,4 +1821,6 @@ class Interpreter:
         v = self.value(expr)
         if isinstance(v, str):
             return bool(v)
+        if isinstance(v, np.ndarray):
+            raise ExpressionError(f"a condition must be a number, got {N._what(v)}")
         return v != 0

@@ -13,6 +13,7 @@ import re
 from dataclasses import dataclass, field
 
 from ..errors import DatafileError
+from ..limits import MAX_EXPANDED_LINE
 
 _COMMENT_RE = re.compile(r'"(?:\\.|[^"\\\n])*"|/\*.*?\*/|//[^\n]*', re.S)
 _SECTION_RE = re.compile(
@@ -156,7 +157,12 @@ def _directives(text, filename, macros, src_lines, depth):
                 src.append(ln)
             continue
         if macros:
-            line = expand_macros(line, macros)
+            try:
+                line = expand_macros(line, macros)
+            except _TooLong:
+                raise DatafileError(f"#define macros expand this line beyond "
+                                    f"{MAX_EXPANDED_LINE} characters", filename, ln, 1,
+                                    line) from None
         out.append(line)
         src.append(ln)
     return "\n".join(out), src
@@ -173,9 +179,17 @@ def _find_include(name, filename):
     return None
 
 
+class _TooLong(Exception):
+    pass
+
+
 def expand_macros(line, macros):
-    """Textual replacement of whole tokens, rescanned (at most 100 passes)."""
+    """Textual replacement of whole tokens, rescanned (at most 100 passes;
+    a line growing beyond :data:`~pyevolver.limits.MAX_EXPANDED_LINE` raises
+    ``_TooLong``: macros that double at each level would exhaust memory)."""
     for _ in range(100):
+        if len(line) > MAX_EXPANDED_LINE:
+            raise _TooLong()
         changed = False
 
         def repl(m):

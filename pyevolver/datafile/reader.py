@@ -7,6 +7,7 @@ only of plain numbers take a fast path that gives the same result.
 from __future__ import annotations
 
 import functools
+import math
 import os
 import re
 
@@ -17,6 +18,7 @@ from lark.exceptions import UnexpectedInput, UnexpectedCharacters, UnexpectedTok
 from ..errors import DatafileError, ExpressionError, PyEvolverError
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
+from ..limits import MAX_ARRAY_ENTRIES, MAX_FACE_EDGES, MAX_ID, MAX_NESTING, nesting_depth
 from ..scene import (Scene, ConstraintDecl, BoundaryDecl, QuantityDecl, MethodDecl)
 from .preprocess import preprocess, read_source
 
@@ -38,6 +40,32 @@ _FIRST_WORD = re.compile(r"[A-CF-Za-cf-z_]|(?<![\d.])[DdEe]")
 _NUM_CHARS = re.compile(r"[ \t\d.eE+-]*")
 
 
+_ELEM_KWS = frozenset(
+    "fixed bare no_refine nodisplay no_display constraint constraints boundary tension "
+    "density volume volconst actual_volume pressure color colour frontcolor frontcolour "
+    "backcolor backcolour wrap orientation original opacity tag phase no_hessian_normal "
+    "hessian_normal_one axial_point triple_point tetra_point lagrange_multiplier".split())
+_WORD = re.compile(r"\S+")
+_PLAIN = re.compile(_NUMBER + r"\Z")
+
+
+def _plain_tail(tail, offset):
+    """The attributes after an element's numbers when they are only keywords
+    of ``fe_elements.lark`` (ELEM_KW) and plain numbers: the items the grammar
+    would give, without parsing (most element lines); else None."""
+    items = []
+    for m in _WORD.finditer(tail):
+        w = m.group(0)
+        lw = w.lower()
+        if lw in _ELEM_KWS:
+            items.append(("kw", lw, offset + m.start() + 1))
+        elif _PLAIN.match(w):
+            items.append(float(w))
+        else:
+            return None
+    return items
+
+
 class _Head:
     def __init__(self, end):
         self._end = end
@@ -54,7 +82,12 @@ def _long_numeric(line):
     head = line[:end]
     if not _NUM_CHARS.fullmatch(head) or (m and end and not line[end - 1].isspace()):
         return None, None
-    vals = np.fromstring(head, dtype=float, sep=" ")
+    if not head.split() or not head.split(None, 1)[0].isdigit():
+        return None, None               # the element id: digits ('1e308' is not one)
+    try:
+        vals = np.fromstring(head, dtype=float, sep=" ")
+    except ValueError:                  # '1-2', '--3': not plain numbers
+        return None, None
     if vals.size != len(head.split()) or not vals.size or vals[0] != int(vals[0]):
         return None, None
     return ("all", None) if m is None else ("head", _Head(len(head.rstrip())))
@@ -276,6 +309,7 @@ class Reader:
         return DatafileError(msg, self.filename, line, col, excerpt)
 
     def read(self):
+        self.scene.source_lines = self.src_lines
         sections, self.macros = preprocess(self.text, self.filename)
         top = sections[0]
         self._top(top)
@@ -336,6 +370,9 @@ class Reader:
                 if len(vals) != limit:
                     line = text.count("\n", 0, m.start()) + 1
                     raise _MatrixError(line, f"PERIODS needs {limit} numbers, found {len(vals)}")
+                if not all(math.isfinite(v) for v in vals):
+                    line = text.count("\n", 0, m.start()) + 1
+                    raise _MatrixError(line, "PERIODS: the numbers must be finite")
                 self.scene.values["_periods"] = vals
         return out
 
@@ -374,8 +411,15 @@ class Reader:
                 raise self.error(f"not supported in pyevolver: {str(kw).upper()}",
                                  srcline, kw.column) from None
             if isinstance(orig, PyEvolverError):
-                raise self.error(str(orig), None) from None
+                line = getattr(orig, "line", None)
+                raise self.error(str(orig), self._src(sec, line) if line else sec.line,
+                                 getattr(orig, "column", None)) from None
             raise
+        for d in decls:
+            if nesting_depth(d) > MAX_NESTING:
+                line = d[-1] if isinstance(d[-1], int) else 1
+                raise self.error(f"expression nested more than {MAX_NESTING} levels deep",
+                                 self._src(sec, line))
         self._fill_scene(decls, sec)
 
     def _src(self, sec, line):
@@ -394,12 +438,15 @@ class Reader:
     def param_env(self):
         return N.MapEnv(self.scene.parameters)
 
-    def _formula(self, expr, text=""):
-        self._check_names(expr)
+    def _formula(self, expr, text="", allowed=None):
+        if allowed is None:
+            self._check_names(expr)
+        else:
+            self._check_names(expr, allowed)
         return N.Formula(expr, text)
 
-    def _check_names(self, expr, allowed=("x", "y", "z", "w", "x1", "x2", "x3", "x4",
-                                           "p1", "p2", "p3", "g")):
+    def _check_names(self, expr, allowed=("x", "y", "z", "w", "x1", "x2", "x3", "x4", "g")):
+        # (boundary parametrizations name p1, p2, ... instead: see _decl)
         for name in expr.names():
             if (name in allowed or name in self.scene.parameters or name in N.CONSTANTS
                     or any(name == a[1] for a in self.scene.attributes)):
@@ -430,10 +477,16 @@ class Reader:
             sc.parameters[name] = self._const(expr, self._src(sec, line), f"parameter {name}")
         elif kind == "flag":
             sc.flags.add(d[1])
+            sc.decl_lines[d[1]] = self._src(sec, d[2])
         elif kind == "value":
             _, name, expr, fixed, line = d
             name = VALUE_NAMES.get(name, name)
             sc.values[name] = self._const(expr, self._src(sec, line), name)
+            sc.decl_lines[name] = self._src(sec, line)
+            if name in ("space_dimension", "surface_dimension") and \
+                    sc.values[name] not in (1, 2, 3, 4):
+                raise self.error(f"not supported in pyevolver: {name.upper()} "
+                                 f"{sc.values[name]:g}", self._src(sec, line))
             if fixed:
                 sc.values[name + "_fixed"] = 1.0
         elif kind == "constraint":
@@ -446,7 +499,12 @@ class Reader:
             sc.constraints[cid] = c
         elif kind == "boundary":
             _, bid, npar, opts, comps, blocks, line = d
-            coords = self._components(comps, "x", sec, line)
+            if not 1 <= npar <= 3:
+                raise self.error(f"boundary {bid}: PARAMETERS must be 1, 2 or 3, got {npar}",
+                                 self._src(sec, line))
+            # a boundary's coordinates are functions of its parameters only
+            coords = self._components(comps, "x", sec, line,
+                                      allowed=tuple(f"p{k + 1}" for k in range(npar)))
             b = BoundaryDecl(bid, npar, coords, set(opts), line=self._src(sec, line))
             for bname, bcomps in blocks:
                 setattr(b, bname, self._components(bcomps, "ec"[bname == "content"], sec, line))
@@ -467,10 +525,14 @@ class Reader:
         elif kind == "method_instance":
             _, name, mname, opts, line = d
             m = self._method(mname, False, opts, sec, line, name)
+            m.line = self._src(sec, line)
             sc.method_instances[name] = m
         elif kind == "attribute":
             _, etype, name, atype, dims, line = d
-            size = int(np.prod(dims)) if dims else 1
+            size = math.prod(dims) if dims else 1
+            if size > MAX_ARRAY_ENTRIES:
+                raise self.error(f"attribute {name}: {size} entries per {etype}; at most "
+                                 f"{MAX_ARRAY_ENTRIES} are allowed", self._src(sec, line))
             sc.attributes[(etype, name)] = (atype, size, dims)
         elif kind == "periods":
             pass    # numbers taken by _extract_matrices
@@ -494,14 +556,14 @@ class Reader:
                 m.ignore_constraints = True
         return m
 
-    def _components(self, comps, letter, sec, line):
+    def _components(self, comps, letter, sec, line, allowed=None):
         out = {}
         for key, expr in comps:
             if key[0] != letter:
                 raise self.error(f"unexpected component '{key.upper()}': expected "
                                  f"{letter.upper()}1, {letter.upper()}2, ...",
                                  self._src(sec, line))
-            out[int(key[1:])] = self._formula(expr)
+            out[int(key[1:])] = self._formula(expr, allowed=allowed)
         n = max(out) if out else 0
         return [out.get(i + 1, N.Formula(N.Num(0.0))) for i in range(n)]
 
@@ -555,9 +617,12 @@ class Reader:
                 if head is not None and kind != "edges" or (head is not None and not torus):
                     nums_ = np.fromstring(line[:head.end()], dtype=float, sep=" ")
                     tail = line[head.end():]
-                    tree = line_parser().parse("0" + " " * (head.end() - 1) + tail, start=start)
-                    _, items = _LINE.transform(tree)
-                    eid = int(nums_[0])
+                    items = _plain_tail(tail, head.end())
+                    if items is None:
+                        tree = line_parser().parse("0" + " " * (head.end() - 1) + tail,
+                                                   start=start)
+                        _, items = _LINE.transform(tree)
+                    eid = int(line[:head.end()].split()[0])
                     items = nums_[1:].tolist() + items
                 else:
                     tree = line_parser().parse(line, start=start)
@@ -570,8 +635,12 @@ class Reader:
                                  col) from None
             except VisitError as exc:
                 if isinstance(exc.orig_exc, PyEvolverError):
-                    raise self.error(str(exc.orig_exc), srcline) from None
+                    raise self.error(str(exc.orig_exc), srcline,
+                                     getattr(exc.orig_exc, "column", None)) from None
                 raise
+            if nesting_depth(items) > MAX_NESTING:
+                raise self.error(f"expression nested more than {MAX_NESTING} levels deep",
+                                 srcline)
             self._element(kind, block, eid, items, srcline)
             entries += 1
         if numeric_txt:
@@ -583,14 +652,35 @@ class Reader:
         vals = np.fromstring(" ".join(texts), dtype=float, sep=" ")
         if vals.size != int(lens.sum()):       # cannot happen for lines that matched
             raise self.error("could not read the numbers of this section", block.lines[positions[0]])
-        if kind != "vertices":
+        starts = np.concatenate([[0], np.cumsum(lens)[:-1]])
+        what = {"vertices": "vertex", "edges": "edge", "faces": "face", "bodies": "body"}[kind]
+
+        def line_of(k):                 # source line of the k-th number
+            return block.lines[positions[int(np.searchsorted(starts, k, side="right")) - 1]]
+        idv = vals[starts]
+        bad = np.nonzero(~((idv >= 1) & (idv <= MAX_ID)))[0]
+        if len(bad):
+            raise self.error(f"{what} id {idv[bad[0]]:.0f} is out of range (ids are 1 to "
+                             f"{MAX_ID})", line_of(starts[bad[0]]), 1)
+        if kind == "vertices":
+            bad = np.nonzero(~np.isfinite(vals))[0]
+            if len(bad):
+                raise self.error(f"vertex coordinate {vals[bad[0]]:g} is not a finite number",
+                                 line_of(bad[0]))
+        else:
             frac = np.nonzero(vals != np.round(vals))[0]
             if len(frac):
-                row = int(np.searchsorted(np.cumsum(lens), frac[0], side="right"))
                 raise self.error(f"expected an integer id, got {vals[frac[0]]:g}",
-                                 block.lines[positions[row]])
+                                 line_of(frac[0]))
+            big = np.nonzero(np.abs(vals) > MAX_ID)[0]
+            if len(big):
+                raise self.error(f"{what}: id {vals[big[0]]:.0f} is out of range (ids are 1 to "
+                                 f"{MAX_ID})", line_of(big[0]))
+            if kind == "faces" and lens.max() - 1 > MAX_FACE_EDGES:
+                k = int(np.argmax(lens))
+                raise self.error(f"face {vals[starts[k]]:.0f} has {lens[k] - 1} edges; at most "
+                                 f"{MAX_FACE_EDGES} are allowed", block.lines[positions[k]])
             vals = vals.astype(np.int64)
-        starts = np.concatenate([[0], np.cumsum(lens)[:-1]])
         ids = vals[starts].astype(np.int64)
         uniform = bool(np.all(lens == lens[0]))
         if uniform and len(positions) == len(block.ids):
@@ -661,10 +751,24 @@ class Reader:
             values = [self._value(e, srcline, f"{etype} {eid}") for e in data]
         except _LocatedName as exc:
             raise self.error(f"undefined parameter '{exc.name}'", srcline, exc.col) from None
-        if kind != "vertices":
+        if not 1 <= eid <= MAX_ID:
+            raise self.error(f"{etype} id {eid} is out of range (ids are 1 to {MAX_ID})",
+                             srcline, 1)
+        if kind == "vertices":
             for v in values:
-                if v != int(v):
+                if not math.isfinite(v):
+                    raise self.error(f"vertex {eid}: coordinate {v:g} is not a finite number",
+                                     srcline)
+        else:
+            for v in values:
+                if not (math.isfinite(v) and v == int(v)):
                     raise self.error(f"expected an integer id in {etype} {eid}, got {v:g}", srcline)
+                if abs(v) > MAX_ID:
+                    raise self.error(f"{etype} {eid}: id {v:.0f} is out of range (ids are 1 to "
+                                     f"{MAX_ID})", srcline)
+            if kind == "faces" and len(values) > MAX_FACE_EDGES:
+                raise self.error(f"face {eid} has {len(values)} edges; at most "
+                                 f"{MAX_FACE_EDGES} are allowed", srcline)
             values = [int(v) for v in values]
         cooked = []
         for kw, args, col in attrs:
@@ -672,25 +776,35 @@ class Reader:
                 cooked.append((kw, args))
                 continue
             vals = []
-            for a in args:
-                if isinstance(a, (N.Node,)):
-                    try:
-                        vals.append(self._value(a, srcline, f"{kw} of {etype} {eid}"))
-                    except _LocatedName as exc:
-                        raise self.error(f"undefined parameter '{exc.name}'", srcline,
-                                         exc.col) from None
-                else:
-                    vals.append(a)
+            for a in (args[1:] if kw == "attribute" else args):
+                what = args[0] if kw == "attribute" else f"{kw} of {etype} {eid}"
+                try:
+                    vals.append(self._value(a, srcline, what))
+                except _LocatedName as exc:
+                    raise self.error(f"undefined parameter '{exc.name}'", srcline,
+                                     exc.col) from None
             if kw == "attribute":
-                cooked.append((kw, [args[0]] + vals[1:] if False else [args[0]] + [
-                    self._value(a, srcline, args[0]) for a in args[1:]]))
+                cooked.append((kw, [args[0]] + vals))
             else:
+                self._check_kw_args(kw, vals, etype, eid, srcline, col)
                 cooked.append((kw, vals))
         block.ids.append(eid)
         block.data.append(values)
         block.lines.append(srcline)
         if cooked:
             block.attrs[len(block.ids) - 1] = cooked
+
+    def _check_kw_args(self, kw, vals, etype, eid, srcline, col):
+        """An attribute keyword's values: present, finite, integers where ids."""
+        if kw in _KW_NEEDS_VALUE and not vals:
+            raise self.error(f"{etype} {eid}: '{kw}' needs a value", srcline, col)
+        for v in vals:
+            if not math.isfinite(v):
+                raise self.error(f"{etype} {eid}: the value of '{kw}' is not a finite number",
+                                 srcline, col)
+            if kw in _KW_INTEGER and (v != int(v) or abs(v) > MAX_ID):
+                raise self.error(f"{etype} {eid}: '{kw}' needs an integer, got {v:g}",
+                                 srcline, col)
 
     def _value(self, expr, line, what):
         if isinstance(expr, float):
@@ -705,6 +819,15 @@ class Reader:
                         col = node.column
                 raise _LocatedName(name, line, col)
         return self._const(expr, line, what)
+
+
+# element keywords that take a value, and those whose values are integers
+_KW_NEEDS_VALUE = {"constraint", "constraints", "boundary", "tension", "density", "volume",
+                   "volconst", "pressure", "color", "colour", "frontcolor", "frontcolour",
+                   "backcolor", "backcolour", "original", "opacity", "phase", "tag",
+                   "orientation", "lagrange_multiplier", "actual_volume"}
+_KW_INTEGER = {"constraint", "constraints", "boundary", "color", "colour", "frontcolor",
+               "frontcolour", "backcolor", "backcolour", "original", "phase", "tag"}
 
 
 class _MatrixError(Exception):

@@ -21,6 +21,7 @@ import re
 import numpy as np
 import scipy.sparse as sp
 
+from ..atomic import atomic_write
 from ..errors import UnsupportedError
 from ..expr import nodes as N
 
@@ -417,7 +418,7 @@ class _FeWriter:
 
 def write_fe(surface, path, session=None):
     text = _FeWriter(surface, session).text()
-    with open(path, "w", encoding="latin-1") as fh:
+    with atomic_write(path, "w", encoding="latin-1") as fh:
         fh.write(text)
 
 

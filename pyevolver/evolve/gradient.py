@@ -124,10 +124,12 @@ def edge_vector_integral_grad(t, comps, idx, sign=None):
     Q = np.zeros((n, 2, 3))
     J = np.zeros((n, 2, 3, 3))                        # J[..., k, j] = dQ_k/dx_j
     env = _Env(t, env_coords, rep)
-    for k, comp in enumerate(comps[:3]):
-        Q[:, :, k] = comp.values(env.params, env.coords, len(flat)).reshape(n, 2)
-        Jk = comp.gradient(env.params, env.coords, len(flat))
-        J[:, :, k, :] = Jk.reshape(n, 2, 3)
+    from ..surface import located
+    with located(getattr(comps, "what", ""), getattr(comps, "line", None)):
+        for k, comp in enumerate(comps[:3]):
+            Q[:, :, k] = comp.values(env.params, env.coords, len(flat)).reshape(n, 2)
+            Jk = comp.gradient(env.params, env.coords, len(flat))
+            J[:, :, k, :] = Jk.reshape(n, 2, 3)
     w = G.GL2_W
     tq = G.GL2_T
     # dI/dx_j at quadrature point q: sum_k J[k, j] d_k

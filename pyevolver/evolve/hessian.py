@@ -293,6 +293,8 @@ def distance2_coloring(s, seed=0):
 def fd_hessian(fun, s, h=None):
     """Sparse Hessian of a gradient function ``fun(X) -> (nv, 3)`` by central
     differences over a distance-2 colouring."""
+    if s.nv == 0:
+        return sp.csr_matrix((0, 0))
     X0 = s.X.copy()
     scale = float(np.max(np.ptp(X0, axis=0))) if len(X0) else 1.0
     h = h if h is not None else 1e-5 * max(scale, 1e-12)

@@ -25,6 +25,13 @@ def _solve(A, d):
         return np.linalg.lstsq(A, d, rcond=None)[0]
 
 
+INFINITE_WARNING = "WARNING 1864: Motion would cause infinite energy. Restoring coordinates."
+
+
+class _Infinite(Exception):
+    """A trial motion reached an infinite or NaN energy."""
+
+
 @dataclass
 class StepResult:
     """What one ``g`` step did (``scipy.optimize``-style result)."""
@@ -112,6 +119,7 @@ class Iterator:
         self.cg_f_old = None
         # the multipliers (pressures) are set by a g step; hessian needs them
         self.pressures_valid = False
+        self._diverged = False        # a constraint projection of the last move diverged
 
     # -- helpers ----------------------------------------------------------------
     @property
@@ -141,6 +149,12 @@ class Iterator:
                 A[i, i] = 1.0
         return gs, us, A
 
+    def _project(self, moved):
+        """Project moved vertices to their constraints; a diverging
+        projection marks the step for undoing."""
+        if len(project_to_constraints(self.surface, moved)):
+            self._diverged = True
+
     # -- one move ------------------------------------------------------------------
     def _move(self, base, vel, scale, cons, us, A, mobile, targets, report, trial=False):
         """Trial move M(scale) from the snapshot ``base`` (:func:`surface.state`):
@@ -149,7 +163,7 @@ class Iterator:
         s = self.surface
         displace(s, base, scale * vel)
         moved = np.nonzero(mobile)[0]
-        project_to_constraints(s, moved)
+        self._project(moved)
         if not len(cons):
             return s.evaluate()
         tol = self.session.settings.get("target_tolerance", 1e-4)
@@ -167,7 +181,7 @@ class Iterator:
             prev = state(s)
             shift = sum(dl * u for dl, u in zip(delta, cur_us))
             displace(s, prev, shift)
-            project_to_constraints(s, moved)
+            self._project(moved)
             t_new = s.evaluate()
             d_new = targets - cons.values(t_new)
             err_new = float(np.sum(np.abs(d_new) / cons.tolerances(t_new, tol)))
@@ -210,7 +224,7 @@ class Iterator:
         # tenth check), then warns with the last difference it checked
         delta = factor * _solve(cur_A, d)
         displace(s, state(s), sum(dl * u for dl, u in zip(delta, cur_us)))
-        project_to_constraints(s, moved)
+        self._project(moved)
         t = s.evaluate()
         if report is not None and not trial:
             # (REF reports this for the actual move only, not for trial moves)
@@ -273,10 +287,17 @@ class Iterator:
         self._carry = (us, A)
 
         def E(scale):
+            self._diverged = False
             t = self._move(X0, vel, scale, cons, us, A, mobile, targets, trial_msgs,
                            trial=True)
-            e = t.energy
+            e = math.nan if self._diverged else t.energy
+            if not math.isfinite(e) and scale > 0 and E.first:
+                # REF: a first trial motion to an infinite (or NaN) energy ends
+                # the step with WARNING 1864 (checked on an overflowing gravity)
+                raise _Infinite()
+            E.first = False
             return e if math.isfinite(e) else math.inf
+        E.first = True
 
         smax = settings["scale_limit"]
         fixed_scale = sess.toggles.get("_fixed_scale", 0)
@@ -284,19 +305,19 @@ class Iterator:
             scale = settings["scale"]
             E0 = None
         else:
-            scale, E0, s1 = self._line_search(E, settings["scale"], smax)
+            try:
+                scale, E0, s1 = self._line_search(E, settings["scale"], smax)
+            except _Infinite:
+                return self._undo(X0, t0, settings["scale"], lam, trial_msgs)
         # actual move (REF prints what the trial moves reported first)
         report = trial_msgs
         self._carry = (us, A)
+        self._diverged = False
         t = self._move(X0, vel, settings.get("scale_scale", 1.0) * scale, cons, us, A,
                        mobile, targets, report)
         e = t.energy
-        if not math.isfinite(e):
-            restore_state(s, X0)
-            sess.recalc()
-            warnings.append("WARNING 1864: energy is not finite; coordinates restored.")
-            return StepResult(t0.energy, t0.total_area, scale, lam, {}, False,
-                              warnings=report + warnings)
+        if not math.isfinite(e) or self._diverged or not np.all(np.isfinite(s.X)):
+            return self._undo(X0, t0, scale, lam, report)
         if E0 is None:
             E0 = t0.energy
         if sess.toggles.get("check_increase", 0) and e > E0:
@@ -310,6 +331,8 @@ class Iterator:
             scale = s1
             t = self._move(X0, vel, scale, cons, *self._carry, mobile, targets, report)
             self.cg_history = None
+            if not math.isfinite(t.energy) or self._diverged or not np.all(np.isfinite(s.X)):
+                return self._undo(X0, t0, scale, lam, report)
         if not fixed_scale:
             settings["scale"] = scale
         # reported pressures: P = -lambda
@@ -332,6 +355,18 @@ class Iterator:
         return StepResult(sess.totals.energy, sess.totals.total_area, scale,
                           b.lagrange.copy() if b.n else np.zeros(0), qp, True,
                           warnings=report + warnings)
+
+    def _undo(self, X0, t0, scale, lam, report):
+        """A motion to an infinite or NaN energy, or a constraint projection
+        that diverged: the coordinates are put back, with the Evolver's
+        warning, and no progress line."""
+        s = self.surface
+        restore_state(s, X0)
+        self.session.recalc()
+        self.cg_history = None
+        return StepResult(t0.energy, t0.total_area, scale, lam, {}, False,
+                          message="infinite",
+                          warnings=report + [INFINITE_WARNING])
 
     def _line_search(self, E, scale, smax):
         """The optimizing-scale search of spec §7.6; returns (s, E0, s1)."""

@@ -117,14 +117,26 @@ def _num(v):
     return v
 
 
+def is_number(v):
+    """True for the values arithmetic accepts: numbers and numpy arrays (not
+    strings, elements or quantities)."""
+    return isinstance(v, (float, int, np.ndarray, np.number))
+
+
 def _mod(a, b):
-    return a - np.floor(a / b) * b
+    if not isinstance(b, np.ndarray) and b == 0:
+        return math.nan * (a if isinstance(a, np.ndarray) else 1.0)  # REF: 5 % 0 is nan
+    with np.errstate(all="ignore"):
+        return a - np.floor(np.true_divide(a, b)) * b
 
 
 def _idiv(a, b):
     a = np.trunc(a)
     b = np.trunc(b)
-    return np.trunc(a / b)
+    if not isinstance(b, np.ndarray) and b == 0:
+        raise ExpressionError("division by zero (idiv)")
+    with np.errstate(all="ignore"):
+        return np.trunc(np.true_divide(a, b))
 
 
 BINOPS = {
@@ -159,6 +171,18 @@ CMPOPS = {
     "<": lambda a, b: a < b, ">": lambda a, b: a > b,
     "<=": lambda a, b: a <= b, ">=": lambda a, b: a >= b,
 }
+
+
+def _what(v):
+    """How a non-number is named in messages."""
+    if isinstance(v, str):
+        return "a string"
+    if isinstance(v, np.ndarray):
+        return f"an array of shape {list(v.shape)}"
+    kind = getattr(v, "kind", None)
+    if isinstance(kind, str):
+        return f"a {kind}"
+    return "a quantity" if hasattr(v, "name") else "something else"
 
 
 def _bool(v):
@@ -253,7 +277,10 @@ class Neg(Node):
         self.a = a
 
     def ev(self, env):
-        return -self.a.ev(env)
+        v = self.a.ev(env)
+        if not is_number(v):
+            raise ExpressionError(f"unary '-' needs a number, got {_what(v)}")
+        return -v
 
     def children(self):
         return (self.a,)
@@ -289,8 +316,9 @@ class Bin(Node):
     def ev(self, env):
         a = self.a.ev(env)
         b = self.b.ev(env)
-        if isinstance(a, str) or isinstance(b, str):
-            raise ExpressionError(f"operator '{self.op}' needs numbers, got a string")
+        if not (is_number(a) and is_number(b)):
+            raise ExpressionError(f"operator '{self.op}' needs numbers, got "
+                                  f"{_what(b if is_number(a) else a)}")
         with np.errstate(all="ignore"):
             if self.op == "/" and not isinstance(b, np.ndarray) and b == 0 \
                     and not isinstance(a, np.ndarray):
@@ -325,6 +353,9 @@ class Cmp(Node):
         b = self.b.ev(env)
         if isinstance(a, str) and isinstance(b, str):
             return _bool(CMPOPS[self.op](a, b))
+        if not (is_number(a) and is_number(b)):
+            raise ExpressionError(f"'{self.op}' compares two numbers or two strings, got "
+                                  f"{_what(a)} and {_what(b)}")
         return _bool(CMPOPS[self.op](a, b))
 
     def children(self):
@@ -379,6 +410,8 @@ class Cond(Node):
 
     def ev(self, env):
         c = self.c.ev(env)
+        if isinstance(c, ArrayValue) or not (is_number(c) or isinstance(c, str)):
+            raise ExpressionError(f"the condition of '?:' must be a number, got {_what(c)}")
         if isinstance(c, np.ndarray):
             return np.where(c != 0, self.a.ev(env), self.b.ev(env))
         return self.a.ev(env) if c else self.b.ev(env)
@@ -397,8 +430,8 @@ class Func(Node):
     def ev(self, env):
         vals = [a.ev(env) for a in self.args]
         for v in vals:
-            if isinstance(v, str):
-                raise ExpressionError(f"{self.name}() needs a number, got a string")
+            if not is_number(v):
+                raise ExpressionError(f"{self.name}() needs a number, got {_what(v)}")
         with np.errstate(all="ignore"):
             if len(vals) == 1:
                 v = vals[0]

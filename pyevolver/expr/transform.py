@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import os
 
-from lark import Transformer, v_args
+from lark import v_args
+from lark.visitors import Transformer_NonRecursive
 
 from ..errors import UnsupportedError, ExpressionError
 from . import nodes as N
@@ -26,8 +27,10 @@ def parse_number(text):
 
 
 @v_args(inline=True)
-class ExprTransformer(Transformer):
-    """Builds :mod:`pyevolver.expr.nodes` trees."""
+class ExprTransformer(Transformer_NonRecursive):
+    """Builds :mod:`pyevolver.expr.nodes` trees (iteratively: a deeply nested
+    expression cannot exhaust Python's recursion; its depth is checked after,
+    see :data:`pyevolver.limits.MAX_NESTING`)."""
 
     def number(self, tok):
         return N.Num(parse_number(str(tok)))
@@ -42,13 +45,14 @@ class ExprTransformer(Transformer):
         nm = str(name).lower()
         args = [a for a in args if a is not None]
         if nm in N.UNSUPPORTED_FUNCS:
-            raise UnsupportedError(f"function {nm}()")
+            raise _at(UnsupportedError(f"function {nm}()"), name)
         if nm in N.FUNC1:
             if len(args) != 1:
-                raise ExpressionError(f"{nm}() takes one argument, got {len(args)}")
+                raise _at(ExpressionError(f"{nm}() takes one argument, got {len(args)}"), name)
         elif nm in N.FUNC2:
             if len(args) != 2:
-                raise ExpressionError(f"{nm}() takes two arguments, got {len(args)}")
+                raise _at(ExpressionError(f"{nm}() takes two arguments, got {len(args)}"),
+                          name)
         else:
             return self.user_call(name, args)
         return N.Func(nm, args)
@@ -82,6 +86,14 @@ class ExprTransformer(Transformer):
 
     def compare(self, a, op, b):
         return N.Cmp(str(op), a, b)
+
+
+def _at(exc, tok):
+    """``exc`` with the position of the token ``tok`` (``line``, ``column``
+    attributes, read by the datafile reader and the command parser)."""
+    exc.line = getattr(tok, "line", None)
+    exc.column = getattr(tok, "column", None)
+    return exc
 
 
 _ESCAPES = {"n": "\n", "r": "\r", "t": "\t", "b": "\b", "q": '"'}

@@ -21,6 +21,16 @@ import numpy as np
 from .. import geometry as G
 
 
+def _div(a, b):
+    """``a / b`` with IEEE results for ``b == 0`` (as the Evolver's C): a
+    zero-length side makes the criterion infinite or NaN, not an error."""
+    if b == 0:
+        if a == 0 or a != a:
+            return math.nan
+        return math.copysign(math.inf, a) * math.copysign(1.0, b)
+    return a / b
+
+
 def edge_facets(s):
     """(ne, 2) the two facets of each edge and their sides, valence (ne,).
 
@@ -289,7 +299,7 @@ def equiangulate(s, threshold=-0.001, only=None):
         lc = lengths[c1 if c1 >= 0 else ~c1]
         ld = lengths[b2 if b2 >= 0 else ~b2]
         le = lengths[c2 if c2 >= 0 else ~c2]
-        crit = (lb * lb + lc * lc - A * A) / (lb * lc) + (ld * ld + le * le - A * A) / (ld * le)
+        crit = _div(lb * lb + lc * lc - A * A, lb * lc) + _div(ld * ld + le * le - A * A, ld * le)
         if finite and not crit < threshold:
             continue
         # flip: a was p->q in fa = (a, b1: q->r, c1: r->p), fb = (~a, b2: p->s, c2: s->q).

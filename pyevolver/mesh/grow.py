@@ -13,6 +13,9 @@ import copy
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import CommandError
+from .. import limits
+
 
 def _zeros_like_rows(arr, n):
     return np.zeros((n,) + arr.shape[1:], dtype=arr.dtype)
@@ -78,6 +81,11 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     ef = np.asarray(e_from_facet, np.int64)
     ff = np.asarray(f_from_facet, np.int64)
     nv_new, ne_new, nf_new = len(ve) + len(vf), len(ee) + len(ef), len(ff)
+    if max(s.nv + nv_new, s.ne + ne_new, s.nf + nf_new) > limits.MAX_ELEMENTS:
+        raise CommandError(f"the surface would grow to {s.nv + nv_new} vertices, "
+                           f"{s.ne + ne_new} edges and {s.nf + nf_new} facets, beyond the "
+                           f"{limits.MAX_ELEMENTS} elements of each kind allowed; the surface is "
+                           f"unchanged")
     t = copy.copy(s)
     for name in ("_lift_cache", "_topo"):
         t.__dict__.pop(name, None)

@@ -29,6 +29,8 @@ def _cat(kind, key, a, b, na, nb):
         return np.full((n,) + ref.shape[1:], fill, dtype=ref.dtype)
 
     a, b = full(a, na), full(b, nb)
+    if a.ndim != b.ndim:                # a scalar attribute in one, an array in the other
+        a, b = (x.reshape(len(x), -1) for x in (a, b))
     if a.ndim == 2 and b.ndim == 2 and a.shape[1] != b.shape[1]:
         w = max(a.shape[1], b.shape[1])
         a = np.pad(a, ((0, 0), (0, w - a.shape[1])))

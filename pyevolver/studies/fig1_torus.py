@@ -35,6 +35,8 @@ import time
 
 import numpy as np
 
+from ..atomic import atomic_write
+
 RUNS = [("HKS", "star_sq_mean_curvature", "g"),
         ("MDSB", "cotan_sq_mean_curvature", "bfgs"),
         ("EffArea", "star_eff_area_sq_mean_curvature", "bfgs"),
@@ -101,7 +103,7 @@ def main(argv=None):
               f"min angle {row['min_angle_deg']:.3g} deg  {row['seconds']:.1f} s", flush=True)
     print(f"2 pi^2 = {2 * math.pi ** 2:.6f}, 4 pi = {4 * math.pi:.6f}")
     csv = os.path.join(a.out, "fig1_torus.csv")
-    with open(csv, "w") as fh:
+    with atomic_write(csv, "w") as fh:
         keys = list(rows[0])
         fh.write(",".join(keys) + "\n")
         for r in rows:
@@ -121,7 +123,8 @@ def main(argv=None):
         ax.set_title(f"{r['label']}: W = {r['W']:.2f}", pad=12)
         ax.set_axis_off()
     fig.tight_layout()
-    fig.savefig(os.path.join(a.out, "fig1_torus.png"), dpi=100)
+    with atomic_write(os.path.join(a.out, "fig1_torus.png"), "wb") as fh:
+        fig.savefig(fh, format="png", dpi=100)
     print("wrote", csv, "and fig1_torus.png")
     return 0
 

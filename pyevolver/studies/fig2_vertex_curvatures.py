@@ -29,6 +29,7 @@ import csv
 
 import numpy as np
 
+from ..atomic import atomic_write
 from ..methods.curvature import _cot_and_grad, _mixed_areas
 
 
@@ -76,7 +77,7 @@ def main(argv=None):
     a = ap.parse_args(argv)
     rows = table(a.n, a.hmax, a.steps)
     names = ["h", "H_HKS", "H_MDSB", "H_EffArea", "H_NormalCur"]
-    with open(a.out + ".csv", "w", newline="") as fh:
+    with atomic_write(a.out + ".csv", "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(names)
         w.writerows(rows.tolist())
@@ -94,7 +95,8 @@ def main(argv=None):
     ax.set_ylabel("discrete mean curvature at the vertex")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(a.out + ".png", dpi=120)
+    with atomic_write(a.out + ".png", "wb") as fh:
+        fig.savefig(fh, format="png", dpi=120)
     print(f"wrote {a.out}.csv and {a.out}.png")
     return 0
 

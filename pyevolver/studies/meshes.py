@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..atomic import atomic_write
+
 
 def _outward(X, F):
     a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
@@ -143,6 +145,6 @@ def fe_text(X, F, header="", face_attrs=""):
 
 def write_fe(path, X, F, header="", face_attrs=""):
     """Write :func:`fe_text` of ``(X, F)`` to ``path``; returns ``path``."""
-    with open(path, "w") as fh:
+    with atomic_write(path, "w") as fh:
         fh.write(fe_text(X, F, header, face_attrs))
     return path
