@@ -19,10 +19,13 @@ from . import gradient as GR
 def _solve(A, d):
     """``A⁻¹ d``, least squares when A is singular (restoring coefficients,
     multipliers)."""
-    try:
+    A = np.asarray(A, dtype=float)
+    if A.size and np.linalg.cond(A) < 1e10:
         return np.linalg.solve(A, d)
-    except np.linalg.LinAlgError:
-        return np.linalg.lstsq(A, d, rcond=None)[0]
+    # dependent constraint gradients (an icosahedron's area and volume
+    # gradients are both radial): the minimum-norm least-squares step
+    # instead of coefficients of 1e13 whose cancellation is round-off
+    return np.linalg.lstsq(A, d, rcond=1e-10)[0]
 
 
 INFINITE_WARNING = "WARNING 1864: Motion would cause infinite energy. Restoring coordinates."
