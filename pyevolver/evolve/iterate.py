@@ -20,12 +20,16 @@ def _solve(A, d):
     """``A⁻¹ d``, least squares when A is singular (restoring coefficients,
     multipliers)."""
     A = np.asarray(A, dtype=float)
-    if A.size and np.linalg.cond(A) < 1e10:
-        return np.linalg.solve(A, d)
-    # dependent constraint gradients (an icosahedron's area and volume
-    # gradients are both radial): the minimum-norm least-squares step
-    # instead of coefficients of 1e13 whose cancellation is round-off
-    return np.linalg.lstsq(A, d, rcond=1e-10)[0]
+    if A.size and np.all(np.isfinite(A)) and np.all(np.isfinite(d)) \
+            and np.linalg.cond(A) >= 1e10:
+        # dependent constraint gradients (an icosahedron's area and volume
+        # gradients are both radial): the minimum-norm least-squares step
+        # instead of coefficients of 1e13 whose cancellation is round-off
+        return np.linalg.lstsq(A, d, rcond=1e-10)[0]
+    try:
+        return np.linalg.solve(A, d)        # non-finite values: the caller restores
+    except np.linalg.LinAlgError:
+        return np.full(len(d), np.nan)
 
 
 INFINITE_WARNING = "WARNING 1864: Motion would cause infinite energy. Restoring coordinates."
