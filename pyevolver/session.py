@@ -24,7 +24,8 @@ from .errors import (CommandError, DatafileError, ExpressionError, InternalError
                      PyEvolverError, UnsupportedError)
 from .expr import nodes as N
 from .limits import MAX_NESTING
-from .surface import build_surface, project_to_constraints, restore_state, state
+from .surface import (build_surface, constrained_vertices, project_to_constraints,
+                      restore_state, state)
 
 READ_ONLY = {
     "total_energy", "total_area", "total_length", "vertex_count", "edge_count",
@@ -477,15 +478,13 @@ class Session(SessionAPI):
         if s is None:
             return
         if reposition:
-            from .surface import boundary_eval, boundary_groups, project_to_constraints
+            from .surface import boundary_eval, boundary_groups
             groups = boundary_groups(s) if s.boundaries else []
             if groups or s.vcon:
                 s.X = s.X.copy()
                 for bid, rows in groups:
                     s.X[rows], _ = boundary_eval(s, bid, s.vattr["params"][rows])
-                on = np.zeros(s.nv, bool)
-                for m in s.vcon.values():
-                    on |= m
+                on = constrained_vertices(s)
                 if on.any():
                     project_to_constraints(s, np.nonzero(on)[0])
                 s.__dict__.pop("_lift_cache", None)
@@ -610,9 +609,7 @@ class Session(SessionAPI):
             raise UnsupportedError("bfgs with fixed volumes or FIXED quantities",
                                    "the restoring of constraints is g's")
         mobile = ~s.vattr["fixed"]
-        on = np.zeros(s.nv, bool)
-        for m in (s.vcon or {}).values():
-            on |= np.asarray(m, bool)
+        on = constrained_vertices(s)
         if "boundary" in s.vattr:
             on |= s.vattr["boundary"] != 0
         if np.any(on & mobile):

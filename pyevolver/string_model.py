@@ -348,7 +348,7 @@ def split_edges(s, R):
     edges in the same order; each facet chain gets the new half next to its
     parent (REF's numbering, ``list facets`` after ``r``)."""
     from .mesh.grow import grow
-    from .surface import project_to_constraints
+    from .surface import constrained_vertices, project_to_constraints
     R = np.asarray(R, np.int64)
     k = len(R)
     t = grow(s, v_from_edge=R, e_from_edge=R)
@@ -387,13 +387,9 @@ def split_edges(s, R):
     t.sf_ptr = np.concatenate([[0], np.cumsum(np.bincount(owner, weights=reps,
                                                            minlength=len(s.sf_ptr) - 1))]
                               ).astype(np.int64)
-    if t.vcon:
-        on = np.zeros(t.nv, bool)
-        for m in t.vcon.values():
-            on |= m
-        sel = mid[on[mid]]
-        if len(sel):
-            project_to_constraints(t, sel)
+    sel = mid[constrained_vertices(t)[mid]]
+    if len(sel):
+        project_to_constraints(t, sel)
     return t
 
 
@@ -490,22 +486,10 @@ class StringTotals(Totals):
         self.sfacet_area = facet_areas(s, self) if len(s.sf_ptr) > 1 else np.zeros(0)
         self.volumes = (b.facet_matrix @ self.sfacet_area + b.volconst) if b.n else \
             np.zeros(0)
-        if b.n:
-            G_ = s.gravity_constant
-            if G_ != 0 and s.gravity_on and np.any(b.density):
-                grav = float(G_ * (b.density @ (b.facet_matrix @ facet_gravity(s, self))))
-                self.terms["gravity"] = grav
-                energy += grav
-            pmask = ~np.isnan(b.pressure)
-            if pmask.any():
-                energy -= float(b.pressure[pmask] @ self.volumes[pmask])
-        self.quantity_values = {}
-        for q in s.quantities.values():
-            v = self.quantity_value(q)
-            self.quantity_values[q.name] = v
-            if q.kind == "energy":
-                energy += v
-        self.energy = energy
+        self.energy = self._finish_energy(energy, self._gravity() if b.n else 0.0)
+
+    def _facet_gravity(self):
+        return facet_gravity(s=self.surface, t=self)
 
     def volume_magnitudes(self):
         s = self.surface

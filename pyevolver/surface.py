@@ -222,12 +222,18 @@ class Totals:
             self.terms["sq_curvature"] = e
             energy += e
         self.volumes = self._volumes()
+        self.energy = self._finish_energy(energy, self._gravity() if s.bodies.n else 0.0)
+
+    def _finish_energy(self, energy, grav):
+        """``energy`` plus gravity ``grav``, the prescribed pressures' −P·V
+        and the energy quantities (whose values are kept); ``self.volumes``
+        must be set."""
+        s = self.surface
         b = s.bodies
+        if grav:
+            self.terms["gravity"] = grav
+            energy += grav
         if b.n:
-            grav = self._gravity()
-            if grav:
-                self.terms["gravity"] = grav
-                energy += grav
             pmask = ~np.isnan(b.pressure)
             if pmask.any():
                 energy -= float(b.pressure[pmask] @ self.volumes[pmask])
@@ -237,7 +243,7 @@ class Totals:
             self.quantity_values[q.name] = v
             if q.kind == "energy":
                 energy += v
-        self.energy = energy
+        return energy
 
     # ---- derived geometry computed on first use -------------------------------
     def __getattr__(self, name):
@@ -378,8 +384,11 @@ class Totals:
         G_ = s.gravity_constant
         if G_ == 0 or not s.gravity_on or not np.any(b.density):
             return 0.0
-        per_facet = G.facet_gravity(self.facet_x0, self.facet_S)
-        return float(G_ * (b.density @ (b.facet_matrix @ per_facet)))
+        return float(G_ * (b.density @ (b.facet_matrix @ self._facet_gravity())))
+
+    def _facet_gravity(self):
+        """(nf,) each facet's gravitational integral (unit density and G)."""
+        return G.facet_gravity(self.facet_x0, self.facet_S)
 
     def instance_values(self, q):
         """``{"inst.value": value}`` of the method instances a FUNCTION reads."""
@@ -677,43 +686,7 @@ class _Builder:
         if s.string:
             return self._string_faces()
         ne0 = s.ne
-        # per-face attributes
-        fixed = np.zeros(nface, bool)
-        tension = np.ones(nface)
-        no_refine = np.zeros(nface, bool)
-        fcon = {}
-        fbnd = np.zeros(nface, np.int64)
-        colors = {}
-        for pos, attrs in blk.attrs.items():
-            for kw, vals in attrs:
-                if kw == "fixed":
-                    fixed[pos] = True
-                elif kw in ("tension", "density"):
-                    tension[pos] = vals[0]
-                elif kw == "no_refine":
-                    no_refine[pos] = True
-                elif kw in ("constraint", "constraints"):
-                    for cid, sign in self._constraint_ids(vals, "face", blk, pos):
-                        fcon.setdefault(cid, np.zeros(nface, bool))[pos] = True
-                elif kw == "boundary":
-                    bid = int(vals[0])
-                    if bid not in sc.boundaries:
-                        raise self.error(f"face {blk.ids[pos]}: boundary {bid} is not defined",
-                                         blk.lines[pos])
-                    fbnd[pos] = bid
-                elif kw in ("color", "colour", "frontcolor", "frontcolour", "backcolor",
-                            "backcolour"):
-                    key = kw.replace("colour", "color")
-                    colors.setdefault(key, np.zeros(nface, np.int64))[pos] = int(vals[0])
-                elif kw == "quantity":
-                    self._member("facet", pos, vals)
-                elif kw == "attribute":
-                    self._attr("facet", nface, pos, vals)
-                elif kw in ("nodisplay", "no_display", "opacity", "original", "phase", "tag"):
-                    pass
-                else:
-                    raise self.error(f"face {blk.ids[pos]}: '{kw}' is not a facet attribute",
-                                     blk.lines[pos])
+        fixed, tension, no_refine, colors, fcon, fbnd = self._face_attributes(blk, nface)
         # validate edge loops
         E = s.E
         table = isinstance(blk.data, np.ndarray)
@@ -882,16 +855,19 @@ class _Builder:
                                  f"(its coordinates or the PERIODS are too large)",
                                  blk.lines[k])
 
-    def _string_faces(self):
-        """String model: a facet is a chain of edges, open or closed, kept as
-        it is (no triangulation)."""
-        sc, s = self.sc, self.s
-        blk = sc.faces
-        nface = len(blk.ids)
+    def _face_attributes(self, blk, nface, string=False):
+        """The faces' attributes: ``(fixed, tension, no_refine, colors,
+        constraints, boundaries)``, arrays over the faces (constraints a dict
+        id → mask; the string model has no facet constraints, boundaries or
+        quantities, and its facets no default tension)."""
+        sc = self.sc
         fixed = np.zeros(nface, bool)
-        tension = np.zeros(nface)
+        tension = np.zeros(nface) if string else np.ones(nface)
         no_refine = np.zeros(nface, bool)
+        fcon = {}
+        fbnd = np.zeros(nface, np.int64)
         colors = {}
+        where = " in the string model" if string else ""
         for pos, attrs in blk.attrs.items():
             for kw, vals in attrs:
                 if kw == "fixed":
@@ -908,12 +884,32 @@ class _Builder:
                     self._attr("facet", nface, pos, vals)
                 elif kw in ("nodisplay", "no_display", "opacity", "original", "phase", "tag"):
                     pass
-                elif kw == "quantity":
+                elif kw == "quantity" and string:
                     raise self.error(f"face {blk.ids[pos]}: not supported in pyevolver: "
                                      f"facet quantities in the string model", blk.lines[pos])
+                elif kw == "quantity":
+                    self._member("facet", pos, vals)
+                elif kw in ("constraint", "constraints") and not string:
+                    for cid, sign in self._constraint_ids(vals, "face", blk, pos):
+                        fcon.setdefault(cid, np.zeros(nface, bool))[pos] = True
+                elif kw == "boundary" and not string:
+                    bid = int(vals[0])
+                    if bid not in sc.boundaries:
+                        raise self.error(f"face {blk.ids[pos]}: boundary {bid} is not defined",
+                                         blk.lines[pos])
+                    fbnd[pos] = bid
                 else:
-                    raise self.error(f"face {blk.ids[pos]}: '{kw}' is not a facet attribute "
-                                     f"in the string model", blk.lines[pos])
+                    raise self.error(f"face {blk.ids[pos]}: '{kw}' is not a facet "
+                                     f"attribute{where}", blk.lines[pos])
+        return fixed, tension, no_refine, colors, fcon, fbnd
+
+    def _string_faces(self):
+        """String model: a facet is a chain of edges, open or closed, kept as
+        it is (no triangulation)."""
+        sc, s = self.sc, self.s
+        blk = sc.faces
+        nface = len(blk.ids)
+        fixed, tension, no_refine, colors, _, _ = self._face_attributes(blk, nface, string=True)
         if isinstance(blk.data, np.ndarray):
             lengths = np.full(nface, blk.data.shape[1], dtype=np.int64)
             flat = blk.data.astype(np.int64).ravel()
@@ -1600,6 +1596,14 @@ def project_tangent(s, vecs):
             lam = np.nan_to_num(solve_small(GtG, rhs))
             v[rr] = w - np.einsum("nik,nk->ni", Gm, lam)
     return out
+
+
+def constrained_vertices(s):
+    """(nv,) bool: the vertices on at least one level-set constraint."""
+    on = np.zeros(s.nv, bool)
+    for m in (s.vcon or {}).values():
+        on |= np.asarray(m, bool)
+    return on
 
 
 def project_to_constraints(s, idx, tol=None, maxit=20):

@@ -24,30 +24,25 @@ def _lines(lines):
     return [l for l in lines if l.strip() and not l.startswith(MEMORY)]
 
 
-def test_procedures_and_queries_match_reference(evolver, tmp_path):
-    """Procedures, functions, locals, recursion, loops with break/continue,
-    :::=, arrays, runtime attributes, fix/unfix, histogram, sprintf,
-    element navigation, colours and show criteria (tests/data/language_procs.cmd)."""
-    with open(os.path.join(HERE, "data", "language_procs.cmd")) as fh:
-        script = fh.read()
-    ref = run_reference(evolver, example("cube.fe"), script, cwd=str(tmp_path))
-    code, out, err = run_pyevolver(example("cube.fe"), script + "q\n", cwd=str(tmp_path))
-    assert err == ""
-    assert _same(_lines(out), _lines(ref)), (out, ref)
+# (datafile, script in tests/data) run in both programs, compared line by line:
+# language_procs.cmd — procedures, functions, locals, recursion, loops with
+#   break/continue, :::=, arrays, runtime attributes, fix/unfix, histogram,
+#   sprintf, element navigation, colours and show criteria;
+# language_more.cmd — history and !!, quiet, REF's toggle wording,
+#   Fixed/Unfixed and refine counts per command, define constraint at run
+#   time, on_constraint by name, defined attributes in list, whole arrays
+#   (vertex_normal, __x, edge_vector, {..} literals, dot products), a single =
+#   in comparisons, a lone printf format, elliptic integrals, `eee length` in
+#   aggregates, set gen.attr, valid_element, frontbody.
+LANGUAGE_SCRIPTS = [("cube.fe", "language_procs.cmd"), ("mound.fe", "language_more.cmd")]
 
 
-def test_more_language_matches_reference(evolver, tmp_path):
-    """history and !!, quiet, REF's toggle wording, Fixed/Unfixed and refine
-    counts per command, define constraint at run time, on_constraint by name,
-    defined attributes in list, whole arrays (vertex_normal, __x,
-    edge_vector, {..} literals, dot products), a single = in comparisons, a
-    lone printf format, elliptic integrals, `eee length` in aggregates, set
-    gen.attr, valid_element, frontbody (tests/data/language_more.cmd on
-    mound.fe)."""
-    with open(os.path.join(HERE, "data", "language_more.cmd")) as fh:
+@pytest.mark.parametrize("datafile,script_name", LANGUAGE_SCRIPTS)
+def test_language_script_matches_reference(evolver, tmp_path, datafile, script_name):
+    with open(os.path.join(HERE, "data", script_name)) as fh:
         script = fh.read()
-    ref = run_reference(evolver, example("mound.fe"), script, cwd=str(tmp_path))
-    code, out, err = run_pyevolver(example("mound.fe"), script + "q\n", cwd=str(tmp_path))
+    ref = run_reference(evolver, example(datafile), script, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(example(datafile), script + "q\n", cwd=str(tmp_path))
     assert err == ""
     assert _same(_lines(out), _lines(ref)), (out, ref)
 

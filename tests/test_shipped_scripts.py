@@ -4,15 +4,14 @@ Each case reads scripts from /usr/share/doc/evolver/examples, runs their
 commands on a datafile in evolver-nox-d and in pyevolver, and compares what
 they print (numbers within 1e-10) and the files they write (byte for byte).
 """
-import glob
 import os
 import shutil
 
 import pytest
 
 from conftest import EXAMPLES, example
-from reference import run_reference
-from test_commands_reference import _same, run_pyevolver
+from test_commands_reference import _same
+from test_language import _run_both
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 MEMORY = ("Element memory", "Total data memory")
@@ -90,15 +89,7 @@ list vertices
 def test_shipped_script(evolver, case, tmp_path):
     name, script, files = CASES[case]
     datafile = name if os.path.isabs(name) else example(name)
-    dirs = {}
-    for who in ("ref", "ours"):
-        d = tmp_path / who
-        d.mkdir()
-        for f in glob.glob(os.path.join(EXAMPLES, "*.cmd")):
-            shutil.copy(f, d)
-        dirs[who] = d
-    ref = run_reference(evolver, datafile, script, cwd=str(dirs["ref"]), timeout=120)
-    code, out, err = run_pyevolver(datafile, script + "q\n", cwd=str(dirs["ours"]))
+    dirs, ref, out, err = _run_both(evolver, datafile, script, tmp_path)
     assert err == ""
     # array attributes print as {a,b,c}: compare their numbers one by one
     ref = [l.translate(BRACES) for l in ref if l.strip() and not l.startswith(MEMORY)]

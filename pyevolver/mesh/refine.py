@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import geometry as G
-from ..surface import project_to_constraints
+from ..surface import constrained_vertices, project_to_constraints
 from .grow import grow
 
 
@@ -214,13 +214,9 @@ def split_edges(s, ref):
     _split_loops(s, t, R, half)
     new_v = np.arange(nv, nv + k)
     boundary_midpoints(t, s.E[R, 0], s.E[R, 1], new_v)
-    if t.vcon:
-        on = np.zeros(t.nv, bool)
-        for m in t.vcon.values():
-            on |= m
-        sel = new_v[on[new_v]]
-        if len(sel):
-            project_to_constraints(t, sel)
+    sel = new_v[constrained_vertices(t)[new_v]]
+    if len(sel):
+        project_to_constraints(t, sel)
     return t
 
 
