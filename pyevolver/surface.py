@@ -459,6 +459,7 @@ class _Builder:
 
     def build(self):
         sc, s = self.sc, self.s
+        self._actual_volume = {}        # body position -> ACTUAL_VOLUME
         s.params = dict(sc.parameters)
         s.sdim = sc.space_dimension
         s.string = sc.string
@@ -488,6 +489,9 @@ class _Builder:
                 P[:sd, :sd] = np.array(vals).reshape(sd, sd)
             s.periods = P
         self._vertices()
+        # the datafile's vertices go onto their constraints before faces are
+        # split, so face centres are means of projected corners (REF)
+        self._project()
         self._edges()
         self._faces()
         self._bodies()
@@ -495,6 +499,11 @@ class _Builder:
         self._project()
         if s.nf:
             record_edge_first_facet(s, first_facets_on_load(s.FE, self.facet_parent, s.ne))
+        if self._actual_volume:
+            # ACTUAL_VOLUME a: volconst is set so that the body's volume is a
+            vols = s.evaluate().volumes
+            for pos, a in self._actual_volume.items():
+                s.bodies.volconst[pos] += a - vols[pos]
         return s
 
     def _constraint_ids(self, vals, what, blk, pos):
@@ -657,6 +666,9 @@ class _Builder:
                     self._attr("edge", n, pos, vals)
                 elif kw in ("bare", "original", "orientation"):
                     pass
+                elif kw == "wrap":
+                    raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: WRAP "
+                                     "(symmetry groups are not implemented)", blk.lines[pos])
                 else:
                     raise self.error(f"edge {blk.ids[pos]}: '{kw}' is not an edge attribute",
                                      blk.lines[pos])
@@ -882,7 +894,11 @@ class _Builder:
                     colors.setdefault(key, np.zeros(nface, np.int64))[pos] = int(vals[0])
                 elif kw == "attribute":
                     self._attr("facet", nface, pos, vals)
-                elif kw in ("nodisplay", "no_display", "opacity", "original", "phase", "tag"):
+                elif kw == "phase":
+                    raise self.error(f"face {blk.ids[pos]}: not supported in pyevolver: PHASE "
+                                     "(phases need a PHASEFILE, which is not implemented)",
+                                     blk.lines[pos])
+                elif kw in ("nodisplay", "no_display", "opacity", "original", "tag"):
                     pass
                 elif kw == "quantity" and string:
                     raise self.error(f"face {blk.ids[pos]}: not supported in pyevolver: "
@@ -1028,10 +1044,16 @@ class _Builder:
                     b.pressure[pos] = v[0]
                 elif kw == "density":
                     b.density[pos] = v[0]
-                elif kw in ("actual_volume", "lagrange_multiplier"):
+                elif kw == "actual_volume":
+                    self._actual_volume[pos] = v[0]
+                elif kw == "lagrange_multiplier":
                     pass
                 elif kw == "attribute":
                     self._attr("body", nb, pos, v)
+                elif kw == "phase":
+                    raise self.error(f"body {blk.ids[pos]}: not supported in pyevolver: PHASE "
+                                     "(phases need a PHASEFILE, which is not implemented)",
+                                     blk.lines[pos])
                 else:
                     raise self.error(f"body {blk.ids[pos]}: '{kw}' is not a body attribute",
                                      blk.lines[pos])
@@ -1544,7 +1566,52 @@ def displace(s, base, dX):
     s.vattr["params"] = P
 
 
-def project_tangent(s, vecs):
+def constraint_activity(s, force=None, tol=1e-9):
+    """Where each level-set constraint restricts motion: ``{cid: (nv,) bool}``.
+
+    An equality constraint acts on every vertex put on it.  A one-sided
+    (NONNEGATIVE / NONPOSITIVE) constraint acts only on the vertices that
+    have hit it (abs(φ) ≤ ``tol``); given the ``force`` (nv, 3), a vertex that
+    the force pulls back into the allowed side is released, as the manual's
+    "One-sided constraints" describes for ``g``.
+
+    Parameters
+    ----------
+    s : Surface
+    force : (nv, 3) array, optional
+    tol : float
+
+    Returns
+    -------
+    dict of int -> (nv,) bool
+    """
+    out = {}
+    env = None
+    for cid, on in (s.vcon or {}).items():
+        c = s.constraints[cid]
+        sign = 1.0 if "nonnegative" in c.flags else -1.0 if "nonpositive" in c.flags else 0.0
+        on = np.asarray(on, bool)
+        if sign == 0.0 or not on.any():
+            out[cid] = on
+            continue
+        if env is None:
+            env = s.param_env()
+        rows = np.nonzero(on)[0]
+        P = s.X[rows]
+        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        phi = np.broadcast_to(_constraint_formula(c, "values", env, coords, len(rows)),
+                              (len(rows),))
+        act = np.abs(phi) <= tol
+        if force is not None and act.any():
+            g = _constraint_formula(c, "gradient", env, coords, len(rows))
+            act &= sign * np.einsum("ni,ni->n", g, force[rows]) <= 0.0
+        m = np.zeros(s.nv, bool)
+        m[rows[act]] = True
+        out[cid] = m
+    return out
+
+
+def project_tangent(s, vecs, active=None):
     """Project vectors onto the tangent spaces of the vertices' level-set
     constraints (all constraints of a vertex at once) and, for vertices on a
     parametric boundary, onto the boundary's tangent space (span of ∂X/∂p).
@@ -1553,6 +1620,9 @@ def project_tangent(s, vecs):
     ----------
     s : Surface
     vecs : list of (nv, 3) arrays
+    active : dict of int -> (nv,) bool, optional
+        Where each constraint acts (:func:`constraint_activity`); by default
+        every vertex on a constraint, one-sided ones where they are hit.
 
     Returns
     -------
@@ -1574,8 +1644,10 @@ def project_tangent(s, vecs):
                 v[rr] = np.einsum("nik,nk->ni", J, np.nan_to_num(c))
     if not s.vcon:
         return vecs
-    cids = sorted(s.vcon)
-    on = np.stack([s.vcon[c] for c in cids], axis=1)
+    if active is None:
+        active = constraint_activity(s)
+    cids = sorted(active)
+    on = np.stack([active[c] for c in cids], axis=1)
     rows = np.nonzero(on.any(axis=1))[0]
     if not len(rows):
         return vecs

@@ -121,6 +121,9 @@ def line_parser():
                 maybe_placeholders=False, cache=True)
 
 
+# ``define edge attribute bbb real function { ... }``: refused by name
+_ATTR_FUNCTION = re.compile(r"\bdefine\s+\w+\s+attribute\s+\w+\s+\w+(?:\s*\[[^\]\n]*\])*"
+                            r"\s+(function)\b", re.I)
 _MATRIX_RE = re.compile(r"\b(torus_periods|periods|view_matrix|view_transforms|"
                         r"view_transform_generators)\b", re.I)
 _NUMTOK_RE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)(?=\s|$)")
@@ -387,6 +390,12 @@ class Reader:
             line = text.count("\n", 0, bad.start()) + 1
             col = bad.start() - (text.rfind("\n", 0, bad.start()) + 1) + 1
             raise self.error(f"malformed number '{bad.group(0)}'", self._src(sec, line), col)
+        fdef = _ATTR_FUNCTION.search(text)
+        if fdef:
+            line = text.count("\n", 0, fdef.start(1)) + 1
+            col = fdef.start(1) - (text.rfind("\n", 0, fdef.start(1)) + 1) + 1
+            raise self.error("not supported in pyevolver: DEFINE ... ATTRIBUTE ... FUNCTION "
+                             "(attributes computed when read)", self._src(sec, line), col)
         try:
             if _MATRIX_RE.search(text):
                 text = self._extract_matrices(text)
