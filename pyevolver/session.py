@@ -19,11 +19,12 @@ import numpy as np
 
 from .api import SessionAPI, progress_bar
 from .commands import interpreter as I
+from .datafile.preprocess import _TooLong as _MacroTooLong, expand_macros
 from .datafile.reader import read_datafile
 from .errors import (CommandError, DatafileError, ExpressionError, InternalError,
                      PyEvolverError, UnsupportedError)
 from .expr import nodes as N
-from .limits import MAX_NESTING
+from .limits import MAX_EXPANDED_LINE, MAX_NESTING
 from .surface import (build_surface, constrained_vertices, project_to_constraints,
                       restore_state, state)
 
@@ -143,6 +144,7 @@ class Session(SessionAPI):
         self.commands = {}
         self.letters = {}
         self.arrays = {}
+        self.macros = dict(scene.macros)       # keep_macros: expanded in commands
         self._init_view_matrix()
         try:
             self.recalc()
@@ -156,9 +158,17 @@ class Session(SessionAPI):
             raise DatafileError(str(exc), filename, line, None,
                                 lines[line - 1] if line and lines and line <= len(lines)
                                 else None) from None
+        for wline, msg in scene.read_warnings:
+            self.err.write(f"{filename}:{wline}: {msg}\n")
         if run_read and scene.read_text:
-            self.run(scene.read_text, where=filename, line=scene.read_line + 1,
-                     stop_on_error=False)
+            # an error abandons the rest of the read section (as in the
+            # Evolver); the surface stays loaded
+            try:
+                self.run(scene.read_text, where=filename, line=scene.read_line + 1)
+            except (I.Quit, I.Interrupted):
+                raise
+            except PyEvolverError as exc:
+                self.write_err(f"{exc}\n")
         return self
 
     def _scene_settings(self, scene):
@@ -308,6 +318,12 @@ class Session(SessionAPI):
                 raise CommandError(f"{where}:{line}: {exc}") from None
             self.write(old + "\n\n")
             return self.run_one(old, where, line)
+        if getattr(self, "macros", None):
+            try:
+                text = expand_macros(text, self.macros)
+            except _MacroTooLong:
+                raise CommandError(f"{where}:{line}: #define macros expand this command "
+                                   f"beyond {MAX_EXPANDED_LINE} characters") from None
         ast = I.parse_command(text, where, line)
         self._remember(stripped)
         snap = self._snapshot()

@@ -489,9 +489,6 @@ class _Builder:
                 P[:sd, :sd] = np.array(vals).reshape(sd, sd)
             s.periods = P
         self._vertices()
-        # the datafile's vertices go onto their constraints before faces are
-        # split, so face centres are means of projected corners (REF)
-        self._project()
         self._edges()
         self._faces()
         self._bodies()
@@ -1566,52 +1563,7 @@ def displace(s, base, dX):
     s.vattr["params"] = P
 
 
-def constraint_activity(s, force=None, tol=1e-9):
-    """Where each level-set constraint restricts motion: ``{cid: (nv,) bool}``.
-
-    An equality constraint acts on every vertex put on it.  A one-sided
-    (NONNEGATIVE / NONPOSITIVE) constraint acts only on the vertices that
-    have hit it (abs(φ) ≤ ``tol``); given the ``force`` (nv, 3), a vertex that
-    the force pulls back into the allowed side is released, as the manual's
-    "One-sided constraints" describes for ``g``.
-
-    Parameters
-    ----------
-    s : Surface
-    force : (nv, 3) array, optional
-    tol : float
-
-    Returns
-    -------
-    dict of int -> (nv,) bool
-    """
-    out = {}
-    env = None
-    for cid, on in (s.vcon or {}).items():
-        c = s.constraints[cid]
-        sign = 1.0 if "nonnegative" in c.flags else -1.0 if "nonpositive" in c.flags else 0.0
-        on = np.asarray(on, bool)
-        if sign == 0.0 or not on.any():
-            out[cid] = on
-            continue
-        if env is None:
-            env = s.param_env()
-        rows = np.nonzero(on)[0]
-        P = s.X[rows]
-        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
-        phi = np.broadcast_to(_constraint_formula(c, "values", env, coords, len(rows)),
-                              (len(rows),))
-        act = np.abs(phi) <= tol
-        if force is not None and act.any():
-            g = _constraint_formula(c, "gradient", env, coords, len(rows))
-            act &= sign * np.einsum("ni,ni->n", g, force[rows]) <= 0.0
-        m = np.zeros(s.nv, bool)
-        m[rows[act]] = True
-        out[cid] = m
-    return out
-
-
-def project_tangent(s, vecs, active=None):
+def project_tangent(s, vecs):
     """Project vectors onto the tangent spaces of the vertices' level-set
     constraints (all constraints of a vertex at once) and, for vertices on a
     parametric boundary, onto the boundary's tangent space (span of ∂X/∂p).
@@ -1620,9 +1572,6 @@ def project_tangent(s, vecs, active=None):
     ----------
     s : Surface
     vecs : list of (nv, 3) arrays
-    active : dict of int -> (nv,) bool, optional
-        Where each constraint acts (:func:`constraint_activity`); by default
-        every vertex on a constraint, one-sided ones where they are hit.
 
     Returns
     -------
@@ -1644,10 +1593,8 @@ def project_tangent(s, vecs, active=None):
                 v[rr] = np.einsum("nik,nk->ni", J, np.nan_to_num(c))
     if not s.vcon:
         return vecs
-    if active is None:
-        active = constraint_activity(s)
-    cids = sorted(active)
-    on = np.stack([active[c] for c in cids], axis=1)
+    cids = sorted(s.vcon)
+    on = np.stack([s.vcon[c] for c in cids], axis=1)
     rows = np.nonzero(on.any(axis=1))[0]
     if not len(rows):
         return vecs

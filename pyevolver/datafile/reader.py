@@ -316,6 +316,8 @@ class Reader:
         sections, self.macros = preprocess(self.text, self.filename)
         top = sections[0]
         self._top(top)
+        if "keep_macros" in self.scene.flags:
+            self.scene.macros = self.macros     # active at run time too (manual)
         seen = []
         for k in range(1, len(sections)):
             sec = sections[k]
@@ -323,6 +325,7 @@ class Reader:
             if sec.kind == "read":
                 self.scene.read_text = sec.text
                 self.scene.read_line = sec.line
+                self.scene.read_warnings = sec.warnings
                 continue
             if sec.kind in seen:
                 raise self.error(f"section '{sec.kind}' appears twice", sec.line, 1)

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..surface import constraint_activity, displace, project_tangent, project_to_constraints, restore_state, state
+from ..surface import displace, project_tangent, project_to_constraints, restore_state, state
 from . import gradient as GR
 
 
@@ -138,9 +138,8 @@ class Iterator:
         return ~s.vattr["fixed"]
 
     def _project_tangent(self, vecs):
-        """Project vectors (list of (nv,3)) onto the constraint tangent spaces
-        (one-sided constraints where this step found them acting)."""
-        return project_tangent(self.surface, vecs, getattr(self, "_active", None))
+        """Project vectors (list of (nv,3)) onto the constraint tangent spaces."""
+        return project_tangent(self.surface, vecs)
 
     def _constrained_dirs(self, t, cons, mobile):
         gs = cons.gradients(t)
@@ -253,7 +252,6 @@ class Iterator:
         f = -GR.energy_gradient(t0)
         f[~mobile] = 0.0
         f_raw = f
-        self._active = constraint_activity(s, f_raw) if s.vcon else None
         (f,) = self._project_tangent([f])
         targets = cons.targets(s)
         lam = np.zeros(len(cons))
