@@ -97,6 +97,10 @@ class Scene:
     read_line: int = 0
     wraps: dict = field(default_factory=dict)          # edge position -> wrap list
     source_lines: list | None = None                   # the text's lines (error excerpts)
+    constraint_names: dict = field(default_factory=dict)  # id -> name (named constraints)
+    boundary_names: dict = field(default_factory=dict)    # id -> name (named boundaries)
+    top_commands: list = field(default_factory=list)      # (text, line): top-section
+                                                          # procedure/function definitions
 
     @property
     def space_dimension(self):

@@ -124,6 +124,10 @@ class Session(SessionAPI):
     def _install(self, filename, scene, surface, run_read):
         self.filename = filename
         self.surface = surface
+        if scene.constraint_names:             # named constraints and boundaries
+            surface.constraint_names = dict(scene.constraint_names)
+        if scene.boundary_names:
+            surface.boundary_names = dict(scene.boundary_names)
         self._iterator = None                  # no CG history, pressures not yet valid
         # REF's gravity flag (reported by G): on when the datafile declares a
         # nonzero gravity_constant or a body has a density (mound.fe: on with
@@ -991,6 +995,9 @@ class Session(SessionAPI):
         for cid, cname in getattr(s, "constraint_names", {}).items():
             if cname == name:
                 return float(cid)
+        for bid, bname in getattr(s, "boundary_names", {}).items():
+            if bname == name:
+                return float(bid)
         if name in self.toggles or name in I.TOGGLES:
             return float(self.toggles.get(name, I.TOGGLE_DEFAULTS.get(name, 0)))
         if s is None:
@@ -1003,6 +1010,8 @@ class Session(SessionAPI):
             "facet_count": lambda: s.n_facets, "body_count": lambda: s.bodies.n,
             "facetedge_count": lambda: self._facetedge_count(),
             "space_dimension": lambda: s.sdim, "surface_dimension": lambda: 1 if s.string else 2,
+            "high_constraint": lambda: max(s.constraints, default=0),
+            "high_boundary": lambda: max(s.boundaries, default=0),
             "torus": lambda: 1 if s.periods is not None else 0,
             "datafilename": lambda: self.filename,
             "gravity_constant": lambda: s.gravity_constant,
@@ -1620,6 +1629,10 @@ class Session(SessionAPI):
         """A constraint's number, or its name when defined at run time."""
         return getattr(self.surface, "constraint_names", {}).get(cid, str(cid))
 
+    def boundary_label(self, bid):
+        """A boundary's number, or its name when declared by name."""
+        return getattr(self.surface, "boundary_names", {}).get(bid, str(bid))
+
     def unset_constraint(self, els, cid):
         s = self.surface
         if cid not in s.vcon and cid not in s.econ and cid not in s.fcon:
@@ -1751,7 +1764,7 @@ class Session(SessionAPI):
             b = s.boundaries[int(bnd[i])]
             par = " ".join(f"{p:17.15g}" for p in s.vattr["params"][i, :b.nparams])
             xyz = "".join(f" {x:17.15g}" for x in s.X[i, :sd])
-            line = f"{vid[i]:3d}  {par}  boundary {int(bnd[i])}  /* ({xyz}) */"
+            line = f"{vid[i]:3d}  {par}  boundary {self.boundary_label(int(bnd[i]))}  /* ({xyz}) */"
         else:
             line = f"{vid[i]:3d}  " + " ".join(f"{x:17.15g}" for x in s.X[i, :sd])
         cons = [c for c in sorted(s.vcon) if s.vcon[c][i]]
@@ -1802,7 +1815,7 @@ class Session(SessionAPI):
                 ("-" if s.econ[c][i] < 0 else "") + self.constraint_label(c) for c in cons) + " "
         eb = s.eattr.get("boundary")
         if eb is not None and eb[i]:
-            line += f"  boundary {int(eb[i])} "
+            line += f"  boundary {self.boundary_label(int(eb[i]))} "
         if s.eattr["fixed"][i]:
             line += "fixed "
         if s.eattr["no_refine"][i]:

@@ -488,6 +488,7 @@ class _Builder:
                 P[:sd, :sd] = np.array(vals).reshape(sd, sd)
             s.periods = P
         self._vertices()
+        self._project()         # REF projects the vertices as read: face centres use them
         self._edges()
         self._faces()
         self._bodies()
@@ -1576,10 +1577,11 @@ def project_tangent(s, vecs):
         return vecs
     cids = sorted(s.vcon)
     on = np.stack([s.vcon[c] for c in cids], axis=1)
+    env = s.param_env()
+    on = _hit_one_sided(s, cids, on, env)
     rows = np.nonzero(on.any(axis=1))[0]
     if not len(rows):
         return vecs
-    env = s.param_env()
     keys, inv = np.unique(on[rows], axis=0, return_inverse=True)
     inv = inv.ravel()
     out = [v.copy() for v in vecs]
@@ -1596,6 +1598,27 @@ def project_tangent(s, vecs):
             lam = np.nan_to_num(solve_small(GtG, rhs))
             v[rr] = w - np.einsum("nik,nk->ni", Gm, lam)
     return out
+
+
+def _hit_one_sided(s, cids, on, env, tol=1e-10):
+    """``on`` with one-sided (NONNEGATIVE / NONPOSITIVE) constraints kept only
+    for the vertices that hit them (value 0 within ``tol``): a vertex inside
+    the allowed region moves freely (REF: the face centres of drop_afm.fe
+    between its two one-sided plates move in z)."""
+    one = [j for j, c in enumerate(cids)
+           if s.constraints[c].flags & {"nonnegative", "nonpositive"}]
+    if not one:
+        return on
+    on = on.copy()
+    for j in one:
+        rr = np.nonzero(on[:, j])[0]
+        if not len(rr):
+            continue
+        P = s.X[rr]
+        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        phi = _constraint_formula(s.constraints[cids[j]], "values", env, coords, len(rr))
+        on[rr, j] = np.abs(phi) <= tol
+    return on
 
 
 def constrained_vertices(s):

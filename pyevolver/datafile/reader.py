@@ -126,6 +126,12 @@ _MATRIX_RE = re.compile(r"\b(torus_periods|periods|view_matrix|view_transforms|"
 _NUMTOK_RE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)(?=\s|$)")
 
 
+def _cid(tok):
+    """A constraint's or boundary's number, or its name (lower case)."""
+    s = str(tok)
+    return int(s) if s.isdigit() else s.lower()
+
+
 @v_args(inline=True)
 class _TopTransformer(ExprTransformer):
     """Top-section declarations -> tuples consumed by :func:`_fill_scene`."""
@@ -164,7 +170,7 @@ class _TopTransformer(ExprTransformer):
                 blocks.append(r)
             else:
                 formula = r
-        return ("constraint", int(cid), opts, formula, blocks, kw.line)
+        return ("constraint", _cid(cid), opts, formula, blocks, kw.line)
 
     def boundary_opt(self, tok):
         return str(tok).lower()
@@ -178,7 +184,7 @@ class _TopTransformer(ExprTransformer):
                 blocks.append(r)
             elif isinstance(r, tuple):
                 comps.append(r)
-        return ("boundary", int(bid), int(nparams), opts, comps, blocks, kw.line)
+        return ("boundary", _cid(bid), int(nparams), opts, comps, blocks, kw.line)
 
     def q_energy(self, _t):
         return ("kind", "energy", None)
@@ -436,7 +442,23 @@ class Reader:
 
     @property
     def param_env(self):
+        named = self._named_ids()
+        if named:
+            return N.MapEnv({**named, **self.scene.parameters})
         return N.MapEnv(self.scene.parameters)
+
+    def _named_ids(self):
+        """Named constraints and boundaries as values (REF: ``print pinned``
+        prints its number; ``constraint 2,pinned`` on an element)."""
+        sc = self.scene
+        if not (sc.constraint_names or sc.boundary_names):
+            return {}
+        key = (tuple(sc.constraint_names.items()), tuple(sc.boundary_names.items()))
+        if getattr(self, "_named_key", None) != key:
+            self._named_key = key
+            self._named = {**{n: float(c) for c, n in sc.boundary_names.items()},
+                           **{n: float(c) for c, n in sc.constraint_names.items()}}
+        return self._named
 
     def _formula(self, expr, text="", allowed=None):
         if allowed is None:
@@ -491,6 +513,8 @@ class Reader:
                 sc.values[name + "_fixed"] = 1.0
         elif kind == "constraint":
             _, cid, opts, formula, blocks, line = d
+            cid = self._number_named(cid, sc.constraints, sc.constraint_names, "constraint",
+                                     self._src(sec, line))
             if cid in sc.constraints:
                 raise self.error(f"constraint {cid} defined twice", self._src(sec, line))
             c = ConstraintDecl(cid, self._formula(formula), set(opts), line=self._src(sec, line))
@@ -499,6 +523,10 @@ class Reader:
             sc.constraints[cid] = c
         elif kind == "boundary":
             _, bid, npar, opts, comps, blocks, line = d
+            bid = self._number_named(bid, sc.boundaries, sc.boundary_names, "boundary",
+                                     self._src(sec, line))
+            if bid in sc.boundaries:
+                raise self.error(f"boundary {bid} defined twice", self._src(sec, line))
             if not 1 <= npar <= 3:
                 raise self.error(f"boundary {bid}: PARAMETERS must be 1, 2 or 3, got {npar}",
                                  self._src(sec, line))
@@ -538,6 +566,30 @@ class Reader:
             pass    # numbers taken by _extract_matrices
         elif kind == "ignored":
             pass
+
+    def _number_named(self, key, table, names, what, line):
+        """The number of a constraint or boundary declared by number or by name.
+
+        A name takes the lowest number not in use; a later declaration by a
+        number a name holds moves the name to the lowest free number (REF:
+        ``constraint aa``, ``constraint bb``, ``constraint 1`` give aa 3, bb 2).
+        """
+        if isinstance(key, int):
+            if key in names:
+                name = names.pop(key)
+                decl = table.pop(key)
+                new = _lowest_free(table, names, also=key)
+                decl.id = new
+                table[new] = decl
+                names[new] = name
+            return key
+        if key in names.values():
+            raise self.error(f"{what} '{key}' defined twice", line)
+        if key in self.scene.parameters:
+            raise self.error(f"{what} name '{key}' is already a parameter", line)
+        new = _lowest_free(table, names)
+        names[new] = key
+        return new
 
     def _method(self, mname, is_global, opts, sec, line, qname):
         m = MethodDecl(mname, is_global, name=qname)
@@ -812,7 +864,8 @@ class Reader:
         if isinstance(expr, N.Num):
             return expr.value
         for name in expr.names():
-            if name not in self.scene.parameters and name not in N.CONSTANTS:
+            if name not in self.scene.parameters and name not in N.CONSTANTS and \
+                    name not in self._named_ids():
                 col = None
                 for node in _walk(expr):
                     if isinstance(node, N.Var) and node.name == name:
@@ -828,6 +881,13 @@ _KW_NEEDS_VALUE = {"constraint", "constraints", "boundary", "tension", "density"
                    "orientation", "lagrange_multiplier", "actual_volume"}
 _KW_INTEGER = {"constraint", "constraints", "boundary", "color", "colour", "frontcolor",
                "frontcolour", "backcolor", "backcolour", "original", "phase", "tag"}
+
+
+def _lowest_free(table, names, also=None):
+    k = 1
+    while k in table or k in names or k == also:
+        k += 1
+    return k
 
 
 class _MatrixError(Exception):
