@@ -128,6 +128,8 @@ class Session(SessionAPI):
             surface.constraint_names = dict(scene.constraint_names)
         if scene.boundary_names:
             surface.boundary_names = dict(scene.boundary_names)
+        if scene.values.get("_period_exprs") is not None and surface.periods is not None:
+            surface.period_exprs = scene.values["_period_exprs"]
         self._iterator = None                  # no CG history, pressures not yet valid
         # REF's gravity flag (reported by G): on when the datafile declares a
         # nonzero gravity_constant or a body has a density (mound.fe: on with
@@ -159,6 +161,8 @@ class Session(SessionAPI):
             raise DatafileError(str(exc), filename, line, None,
                                 lines[line - 1] if line and lines and line <= len(lines)
                                 else None) from None
+        for text, line in scene.top_commands:  # top-section procedures and functions
+            self.run(text, where=filename, line=line, stop_on_error=False)
         if run_read and scene.read_text:
             self.run(scene.read_text, where=filename, line=scene.read_line + 1,
                      stop_on_error=False)
@@ -492,6 +496,8 @@ class Session(SessionAPI):
                 if on.any():
                     project_to_constraints(s, np.nonzero(on)[0])
                 s.__dict__.pop("_lift_cache", None)
+        if getattr(s, "period_exprs", None) is not None:
+            self._eval_periods(s)
         s.gravity_constant = self.variables.get("gravity_constant", s.gravity_constant)
         s.gravity_on = bool(self.toggles.get("gravity", 1))
         s.curvature_mode = ("norm" if self.toggles.get("normal_curvature") else
@@ -501,6 +507,20 @@ class Session(SessionAPI):
         self.totals = t
         if not keep_cg:
             self.reset_cg()
+
+    def _eval_periods(self, s):
+        """PERIODS given by expressions: re-evaluated at each recalc (manual:
+        "give a recalc command whenever you change such a variable")."""
+        env = N.MapEnv(self.variables)
+        vals = [float(e) if isinstance(e, float) else float(e.ev(env)) for e in s.period_exprs]
+        sd = s.sdim
+        P = np.array(vals).reshape(sd, sd)
+        if not np.all(np.isfinite(P)):
+            raise CommandError("PERIODS: the values must be finite")
+        if not np.array_equal(P, s.periods[:sd, :sd]):
+            s.periods = s.periods.copy()
+            s.periods[:sd, :sd] = P
+            s.__dict__.pop("_lift_cache", None)
 
     # -- evolution -------------------------------------------------------------------
     @property

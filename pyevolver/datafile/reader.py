@@ -355,10 +355,47 @@ class Reader:
             return f"unexpected '{tok}': expected {exp}"
         return str(exc).split("\n")[0]
 
+    def _matrix_exprs(self, text, m, count):
+        """The ``count`` values after the PERIODS or VIEW_MATRIX keyword ``m``:
+        expressions separated by white space as on an element line (manual:
+        "PERIODS followed by expressions"; ``1 -2`` is two values, ``1 - 2``
+        one), whole lines at a time.  Returns ``(exprs, end)``."""
+        pos = m.end()
+        vals = []
+        while len(vals) < count and pos < len(text):
+            nl = text.find("\n", pos)
+            nl = len(text) if nl < 0 else nl
+            seg = text[pos:nl]
+            if seg.strip():
+                try:
+                    tree = line_parser().parse("0 " + seg, start="vertex_line")
+                    _, items = _LINE.transform(tree)
+                except (UnexpectedInput, VisitError):
+                    break
+                if any(isinstance(it, tuple) for it in items):
+                    break
+                vals.extend(items)
+            pos = nl + 1 if nl < len(text) else nl
+        return vals, min(pos, len(text))
+
     def _extract_matrices(self, text):
         """Take the numbers of PERIODS / VIEW_* matrices out of the text."""
         out = text
         for m in _MATRIX_RE.finditer(text):
+            key = m.group(1).lower()
+            if key.endswith("periods") or key == "view_matrix":
+                # rows given by expressions (parameters, arithmetic) or numbers
+                sd = self._peek_space_dimension(text[:m.start()])
+                count = sd * sd if key.endswith("periods") else (sd + 1) ** 2
+                vals, pos = self._matrix_exprs(text, m, count)
+                line = text.count("\n", 0, m.start()) + 1
+                if len(vals) != count:
+                    raise _MatrixError(line, f"{key.upper()} needs {count} numbers, "
+                                             f"found {len(vals)}")
+                out = out[:m.end()] + re.sub(r"[^\n]", " ", out[m.end():pos]) + out[pos:]
+                if key.endswith("periods"):
+                    self._period_exprs = vals
+                continue
             pos = m.end()
             vals = []
             limit = None
@@ -386,7 +423,40 @@ class Reader:
         m = re.search(r"\bspace_dimension\s+(\d+)", text, re.I)
         return int(m.group(1)) if m else 3
 
+    def _cut_procedures(self, sec):
+        """Take the stand-alone ``procedure`` and ``function`` declarations and
+        definitions out of the top section (manual, "Functions and
+        procedures": the read-section syntax, allowed in the top section).
+
+        They are kept, with their source lines, in ``scene.top_commands`` (run
+        as commands before the read section) and blanked in the text, so the
+        line and column of everything else are kept.
+        """
+        text = sec.text
+        if not _PROC_START.search(text):
+            return text
+        out = []
+        pos = 0
+        for m in _PROC_START.finditer(text):
+            if m.start() < pos:
+                continue
+            end = _proc_end(text, m.end() - 1)
+            line = text.count("\n", 0, m.start()) + 1
+            if end is None:
+                raise self.error(f"unbalanced parentheses or braces in this "
+                                 f"{m.group(1).lower()} declaration", self._src(sec, line),
+                                 m.start() - text.rfind("\n", 0, m.start()))
+            body = text[m.start():end]
+            self.scene.top_commands.append((body.rstrip().rstrip(";"), self._src(sec, line)))
+            out.append(text[pos:m.start()])
+            out.append(re.sub(r"[^\n]", " ", body))
+            pos = end
+        out.append(text[pos:])
+        return "".join(out)
+
     def _top(self, sec):
+        if _PROC_START.search(sec.text):
+            sec.text = self._cut_procedures(sec)
         text = sec.text.replace(",", " ")
         bad = _BAD_NUMBER.search(text)
         if bad:
@@ -496,6 +566,9 @@ class Reader:
         kind = d[0]
         if kind == "parameter":
             _, name, expr, line = d
+            if isinstance(expr, N.Str):         # a string-valued parameter
+                sc.parameters[name] = expr.value
+                return
             sc.parameters[name] = self._const(expr, self._src(sec, line), f"parameter {name}")
         elif kind == "flag":
             sc.flags.add(d[1])
@@ -563,7 +636,16 @@ class Reader:
                                  f"{MAX_ARRAY_ENTRIES} are allowed", self._src(sec, line))
             sc.attributes[(etype, name)] = (atype, size, dims)
         elif kind == "periods":
-            pass    # numbers taken by _extract_matrices
+            exprs = getattr(self, "_period_exprs", None)
+            if exprs is not None:       # expressions: evaluated here, in order
+                line = self._src(sec, d[2])
+                vals = [self._value(e, line, "PERIODS") for e in exprs]
+                if not all(math.isfinite(v) for v in vals):
+                    raise self.error("PERIODS: the values must be finite", line)
+                sc.values["_periods"] = vals
+                if any(not isinstance(e, (float, N.Num)) for e in exprs):
+                    sc.values["_period_exprs"] = exprs
+            # (plain numbers were taken by _extract_matrices)
         elif kind == "ignored":
             pass
 
@@ -655,6 +737,8 @@ class Reader:
                 entries += 1
                 continue
             line = raw.replace(",", " ").replace(":", " ")
+            if "{" in line:             # array attribute values: ref_coord { 1 0 0 }
+                line = line.replace("{", " ").replace("}", " ")
             bad = _BAD_NUMBER.search(line)
             if bad:
                 raise self.error(f"malformed number '{bad.group(0)}'", srcline, bad.start() + 1)
@@ -881,6 +965,64 @@ _KW_NEEDS_VALUE = {"constraint", "constraints", "boundary", "tension", "density"
                    "orientation", "lagrange_multiplier", "actual_volume"}
 _KW_INTEGER = {"constraint", "constraints", "boundary", "color", "colour", "frontcolor",
                "frontcolour", "backcolor", "backcolour", "original", "phase", "tag"}
+
+
+# a stand-alone procedure or function of the top section: its keyword, (type),
+# name and opening parenthesis
+_PROC_START = re.compile(
+    r"\b(procedure|function)\s+(?:(?:real|integer|string|vertex_type|edge_type|facet_type|"
+    r"body_type|facetedge_type|element_id)\s+)?[A-Za-z_]\w*\s*\(", re.I)
+
+
+def _proc_end(text, k):
+    """The end of a declaration whose parameter list opens at ``text[k]``:
+    after ``)`` and a ``;``, or after the ``{...}`` body (strings skipped);
+    None when the parentheses or braces do not balance."""
+    n = len(text)
+    depth = 0
+    i = k
+    while i < n:
+        c = text[i]
+        if c == "(":
+            depth += 1
+        elif c == ")":
+            depth -= 1
+            if depth == 0:
+                break
+        elif c == '"':
+            i = _skip_string(text, i)
+        i += 1
+    else:
+        return None
+    i += 1
+    while i < n and text[i] in " \t\n":
+        i += 1
+    if i < n and text[i] == ";":
+        return i + 1
+    if i >= n or text[i] != "{":
+        return i                    # a declaration without ';'
+    depth = 0
+    while i < n:
+        c = text[i]
+        if c == "{":
+            depth += 1
+        elif c == "}":
+            depth -= 1
+            if depth == 0:
+                return i + 1
+        elif c == '"':
+            i = _skip_string(text, i)
+        i += 1
+    return None
+
+
+def _skip_string(text, i):
+    j = i + 1
+    while j < len(text) and text[j] != '"':
+        if text[j] == "\\":
+            j += 1
+        j += 1
+    return j
 
 
 def _lowest_free(table, names, also=None):
