@@ -124,6 +124,9 @@ class Session(SessionAPI):
     def _install(self, filename, scene, surface, run_read):
         self.filename = filename
         self.surface = surface
+        for msg, line, col in scene.warnings:  # lines the Evolver warns about
+            where = f"{filename}:{line}:{col}" if col else f"{filename}:{line}"
+            self.write_err(f"{where}: warning: {msg}\n")
         if scene.constraint_names:             # named constraints and boundaries
             surface.constraint_names = dict(scene.constraint_names)
         if scene.boundary_names:

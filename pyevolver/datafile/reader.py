@@ -29,7 +29,9 @@ _BAD_NUMBER = re.compile(r"(?<![\w.])(\d*\.\d*\.[\d.]*|\d+\.?\d*[eEdD][+-]?(?![\
 
 # an element line made of plain numbers (no alternative can match a digit
 # run in two ways, so a failing match cannot backtrack exponentially)
-_NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
+# (a '+' after a space continues the value before it: REF reads "1 2 +3" as
+# the two values 1 and 5; only a '-' after a space starts a new value)
+_NUMBER = r"-?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
 _NUMERIC_LINE = re.compile(r"[ \t]*\d+(?:[ \t]+" + _NUMBER + r")*[ \t]*\Z")
 # the numeric head of a line followed by attributes that start with a letter
 _NUMERIC_HEAD = re.compile(r"[ \t]*\d+(?:[ \t]+" + _NUMBER + r")*(?=[ \t]+[A-Za-z_])")
@@ -82,6 +84,8 @@ def _long_numeric(line):
     head = line[:end]
     if not _NUM_CHARS.fullmatch(head) or (m and end and not line[end - 1].isspace()):
         return None, None
+    if "+" in head and re.search(r"(?:^|[ \t])\+", head):
+        return None, None               # '+3' after a space: an addition
     if not head.split() or not head.split(None, 1)[0].isdigit():
         return None, None               # the element id: digits ('1e308' is not one)
     try:
@@ -736,6 +740,8 @@ class Reader:
                 numeric_txt.append(raw)
                 entries += 1
                 continue
+            if "(" in raw and "-" in raw:
+                raw = _binary_minus_in_parens(raw)
             line = raw.replace(",", " ").replace(":", " ")
             if "{" in line:             # array attribute values: ref_coord { 1 0 0 }
                 line = line.replace("{", " ").replace("}", " ")
@@ -823,10 +829,28 @@ class Reader:
             # the whole section is one table: keep it as arrays
             block.ids = ids
             block.data = vals.reshape(len(texts), int(lens[0]))[:, 1:]
+            if kind == "vertices" and 1 <= block.data.shape[1] < self.scene.space_dimension:
+                block.data = self._pad_coordinates(block.data, ids, block.lines)
             return
+        sd = self.scene.space_dimension
         for p, i, st, n in zip(positions, ids.tolist(), starts.tolist(), lens.tolist()):
             block.ids[p] = i
             block.data[p] = vals[st + 1: st + n]
+            if kind == "vertices" and 2 <= n <= sd:
+                block.data[p] = self._pad_coordinates(block.data[p][None, :], [i],
+                                                      [block.lines[p]])[0]
+
+    def _pad_coordinates(self, data, ids, lines):
+        """Vertices with fewer coordinates than the space dimension: a warning
+        each, the missing ones 0 (REF: WARNING 1127 "Wrong number of
+        coordinates for vertex")."""
+        sd = self.scene.space_dimension
+        for k, vid in enumerate(ids):
+            self.warn(f"wrong number of coordinates for vertex {int(vid)}: "
+                      f"{data.shape[1]} instead of {sd} (the rest are 0)", lines[k])
+        out = np.zeros((data.shape[0], sd))
+        out[:, :data.shape[1]] = data
+        return out
 
     def _strip_wraps(self, line, pos, sdim, srcline):
         toks = line.split()
@@ -835,10 +859,33 @@ class Reader:
             return " ".join(toks[:3] + toks[3 + sdim:])
         return line
 
+    def warn(self, msg, line, col=None):
+        """Record a warning about a line (the Evolver warns and goes on)."""
+        self.scene.warnings.append((msg, line, col))
+
+    def _unknown_words(self, etype, eid, items, qnames, srcline):
+        """Edge, face and body lines: an unknown word is skipped with a warning
+        (REF: WARNING 2110 / 2115 / 2119 "Unexpected token", the rest of the
+        line is read); on a vertex line it is an error (REF: DATAFILE ERROR)."""
+        sc = self.scene
+        named = self._named_ids()
+        keep = []
+        for it in items:
+            if isinstance(it, N.Var) and not (
+                    it.name in sc.parameters or it.name in N.CONSTANTS or it.name in named
+                    or it.name in qnames or (etype, it.name) in sc.attributes):
+                self.warn(f"{etype} {eid}: unexpected word '{it.name}' (ignored)",
+                          srcline, it.column)
+                continue
+            keep.append(it)
+        return keep
+
     def _element(self, kind, block, eid, items, srcline):
         sc = self.scene
         etype = {"vertices": "vertex", "edges": "edge", "faces": "facet", "bodies": "body"}[kind]
         qnames = set(sc.quantities) | set(sc.method_instances)
+        if etype != "vertex" and any(isinstance(it, N.Var) for it in items):
+            items = self._unknown_words(etype, eid, items, qnames, srcline)
         attrs = []
         i = 0
         n = len(items)
@@ -890,6 +937,12 @@ class Reader:
         if not 1 <= eid <= MAX_ID:
             raise self.error(f"{etype} id {eid} is out of range (ids are 1 to {MAX_ID})",
                              srcline, 1)
+        if kind == "vertices" and len(values) < sc.space_dimension and values and \
+                not any(kw == "boundary" for kw, _, _ in attrs):
+            # REF: WARNING 1127 "Wrong number of coordinates", the rest are 0
+            self.warn(f"wrong number of coordinates for vertex {eid}: "
+                      f"{len(values)} instead of {sc.space_dimension} (the rest are 0)", srcline)
+            values = values + [0.0] * (sc.space_dimension - len(values))
         if kind == "vertices":
             for v in values:
                 if not math.isfinite(v):
@@ -1023,6 +1076,27 @@ def _skip_string(text, i):
             j += 1
         j += 1
     return j
+
+
+def _binary_minus_in_parens(line):
+    """Inside parentheses a '-' after a space is a subtraction (REF reads
+    ``1 (2 -3) 4`` as 1, -1, 4), unless a comma or an operator comes before it
+    (``atan2(y, -x)``): the space before such a '-' becomes \\x1a, which the
+    element grammar ignores, so that the '-' is not a new value's sign."""
+    out = list(line)
+    depth = 0
+    for i, c in enumerate(line):
+        if c == "(":
+            depth += 1
+        elif c == ")":
+            depth = max(depth - 1, 0)
+        elif c == "-" and depth and i and line[i - 1] in " \t":
+            j = i - 1
+            while j >= 0 and line[j] in " \t":
+                j -= 1
+            if j >= 0 and (line[j].isalnum() or line[j] in "_.)"):
+                out[i - 1] = "\x1a"
+    return "".join(out)
 
 
 def _lowest_free(table, names, also=None):
