@@ -248,8 +248,8 @@ class _TopTransformer(ExprTransformer):
     def method_instance(self, kw, name, _m, mname, *opts):
         return ("method_instance", str(name).lower(), str(mname).lower(), list(opts), kw.line)
 
-    def dims(self, *ints):
-        return [int(i) for i in ints]
+    def dims(self, *exprs):
+        return list(exprs)          # (expressions: evaluated in order, _decl)
 
     def define_attr(self, kw, etype, _a, name, atype, dims=None):
         return ("attribute", str(etype).lower(), str(name).lower(), str(atype).lower(),
@@ -437,6 +437,12 @@ class Reader:
         line and column of everything else are kept.
         """
         text = sec.text
+        af = _ATTR_FUNCTION.search(text)
+        if af:
+            line = text.count("\n", 0, af.start(1)) + 1
+            raise self.error("not supported in pyevolver: attribute FUNCTION (an extra "
+                             "attribute computed by a procedure)", self._src(sec, line),
+                             af.start(1) - text.rfind("\n", 0, af.start(1)))
         if not _PROC_START.search(text):
             return text
         out = []
@@ -459,7 +465,7 @@ class Reader:
         return "".join(out)
 
     def _top(self, sec):
-        if _PROC_START.search(sec.text):
+        if _PROC_START.search(sec.text) or _ATTR_FUNCTION.search(sec.text):
             sec.text = self._cut_procedures(sec)
         text = sec.text.replace(",", " ")
         bad = _BAD_NUMBER.search(text)
@@ -634,6 +640,7 @@ class Reader:
             sc.method_instances[name] = m
         elif kind == "attribute":
             _, etype, name, atype, dims, line = d
+            dims = [self._dim(e, self._src(sec, line), name) for e in dims]
             size = math.prod(dims) if dims else 1
             if size > MAX_ARRAY_ENTRIES:
                 raise self.error(f"attribute {name}: {size} entries per {etype}; at most "
@@ -652,6 +659,15 @@ class Reader:
             # (plain numbers were taken by _extract_matrices)
         elif kind == "ignored":
             pass
+
+    def _dim(self, expr, line, name):
+        """An attribute's array dimension: a constant expression (REF:
+        ``real[nn+1]``), a positive integer."""
+        v = self._const(expr, line, f"the dimension of attribute {name}")
+        if not (math.isfinite(v) and v == int(v) and v >= 0):
+            raise self.error(f"attribute {name}: the dimension must be a non-negative "
+                             f"integer, got {v:g}", line)
+        return int(v)
 
     def _number_named(self, key, table, names, what, line):
         """The number of a constraint or boundary declared by number or by name.
@@ -1025,6 +1041,11 @@ _KW_INTEGER = {"constraint", "constraints", "boundary", "color", "colour", "fron
 _PROC_START = re.compile(
     r"\b(procedure|function)\s+(?:(?:real|integer|string|vertex_type|edge_type|facet_type|"
     r"body_type|facetedge_type|element_id)\s+)?[A-Za-z_]\w*\s*\(", re.I)
+
+
+# define ... attribute name type [dims] FUNCTION { ... }
+_ATTR_FUNCTION = re.compile(r"\battribute\s+\w+\s+\w+(?:\s*\[[^\]\n]*\])*\s+(function)\s*\{",
+                            re.I)
 
 
 def _proc_end(text, k):
