@@ -111,7 +111,8 @@ def top_parser():
     with open(os.path.join(_HERE, "fe_top.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
     return Lark(grammar, parser="lalr", lexer="contextual", start="start",
-                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse},
+                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse,
+                                                    "UNSUPPORTED2_KW": _refuse},
                 cache=True)
 
 
@@ -143,13 +144,34 @@ class _TopTransformer(ExprTransformer):
     def start(self, *decls):
         return list(decls)
 
-    def parameter(self, kw, name, value):
-        return ("parameter", str(name).lower(), value, kw.line)
+    def parameter(self, kw, name, value, *tail):
+        d = ("parameter", str(name).lower(), value, kw.line)
+        if not tail and not str(kw).lower().startswith("optimi"):
+            return d
+        return d + ({"optimizing": str(kw).lower().startswith("optimi"),
+                     "column": kw.column, **dict(tail)},)
+
+    def p_delta(self, kw, e):
+        return ("pdelta", (e, kw.column))
+
+    def p_scale(self, kw, e):
+        return ("pscale", (e, kw.column))
+
+    def p_on_assign(self, kw, name):
+        return ("on_assign_call", (str(name).lower(), kw.column))
+
+    def value_decl2(self, kw, e):
+        return ("ignored", str(kw).lower().rstrip(":"))
+
+    def merit_factor(self, kw, e=None):
+        return ("ignored", "merit_factor")
 
     def level_expr(self, a, b=None):
         return a if b is None else N.Bin("-", a, b)
 
-    def constraint_opt(self, tok):
+    def constraint_opt(self, tok, n=None):
+        if n is not None:                  # CONTENT_RANK n
+            return ("content_rank", int(n), tok.line, tok.column)
         return str(tok).lower()
 
     def comp(self, kw, e):
@@ -170,6 +192,8 @@ class _TopTransformer(ExprTransformer):
                 opts.append(r)
             elif isinstance(r, Token):
                 continue
+            elif isinstance(r, tuple) and r[0] == "content_rank":
+                opts.append(r)
             elif isinstance(r, tuple):
                 blocks.append(r)
             else:
@@ -339,6 +363,9 @@ class Reader:
             last = len(self.src_lines)
             raise self.error("unexpected end of file: expected a 'vertices' section",
                              last, 1)
+        if self.scene.unsupported:
+            feature, line, col = self.scene.unsupported[0]
+            raise self.error(f"not supported in pyevolver: {feature}", line, col)
         return self.scene
 
     # -- top section --------------------------------------------------------
@@ -401,6 +428,11 @@ class Reader:
                     self._period_exprs = vals
                 continue
             pos = m.end()
+            if key.startswith("view_transform"):
+                # n, then n matrices, each after an optional COLOR c or SWAP_COLORS
+                pos = _skip_transforms(text, pos, self._peek_space_dimension(text[:m.start()]))
+                out = out[:m.end()] + re.sub(r"[^\n]", " ", out[m.end():pos]) + out[pos:]
+                continue
             vals = []
             limit = None
             if m.group(1).lower().endswith("periods"):
@@ -575,7 +607,9 @@ class Reader:
     def _decl(self, d, sc, sec):
         kind = d[0]
         if kind == "parameter":
-            _, name, expr, line = d
+            _, name, expr, line = d[:4]
+            if len(d) > 4:
+                self._parameter_options(name, d[4], self._src(sec, line))
             if isinstance(expr, N.Str):         # a string-valued parameter
                 sc.parameters[name] = expr.value
                 return
@@ -600,6 +634,10 @@ class Reader:
                                      self._src(sec, line))
             if cid in sc.constraints:
                 raise self.error(f"constraint {cid} defined twice", self._src(sec, line))
+            for o in [o for o in opts if isinstance(o, tuple)]:
+                # the content integral's side with several content constraints
+                self._defer("CONTENT_RANK", self._src(sec, o[2]), o[3])
+                opts.remove(o)
             c = ConstraintDecl(cid, self._formula(formula), set(opts), line=self._src(sec, line))
             for bname, comps in blocks:
                 setattr(c, bname, self._components(comps, "ec"[bname == "content"], sec, line))
@@ -659,6 +697,24 @@ class Reader:
             # (plain numbers were taken by _extract_matrices)
         elif kind == "ignored":
             pass
+
+    def _defer(self, feature, line, col=None):
+        """An unsupported feature met while reading: the file is read to the
+        end, then refused by name at the first such feature (located)."""
+        self.scene.unsupported.append((feature, line, col))
+
+    def _parameter_options(self, name, opts, line):
+        """OPTIMIZING_PARAMETER (refused: the Evolver varies it during
+        iteration), PDELTA / PSCALE (used by optimizing parameters only: no
+        number of a plain parameter changes), ON_ASSIGN_CALL (refused)."""
+        if opts.get("optimizing"):
+            self._defer(f"OPTIMIZING_PARAMETER ({name})", line, opts.get("column"))
+        for key in ("pdelta", "pscale"):
+            if key in opts:
+                self._const(opts[key][0], line, f"{key} of parameter {name}")
+        if "on_assign_call" in opts:
+            proc, col = opts["on_assign_call"]
+            self._defer(f"ON_ASSIGN_CALL ({name} calls {proc})", line, col)
 
     def _dim(self, expr, line, name):
         """An attribute's array dimension: a constant expression (REF:
@@ -799,6 +855,7 @@ class Reader:
             if nesting_depth(items) > MAX_NESTING:
                 raise self.error(f"expression nested more than {MAX_NESTING} levels deep",
                                  srcline)
+            self._cur_line = line
             self._element(kind, block, eid, items, srcline)
             entries += 1
         if numeric_txt:
@@ -886,8 +943,11 @@ class Reader:
         sc = self.scene
         named = self._named_ids()
         keep = []
+        text = getattr(self, "_cur_line", "")
         for it in items:
-            if isinstance(it, N.Var) and not (
+            col = getattr(it, "column", None)
+            if isinstance(it, N.Var) and col and col >= 2 and col - 2 < len(text) and \
+                    text[col - 2] in " \t" and not (
                     it.name in sc.parameters or it.name in N.CONSTANTS or it.name in named
                     or it.name in qnames or (etype, it.name) in sc.attributes):
                 self.warn(f"{etype} {eid}: unexpected word '{it.name}' (ignored)",
@@ -1097,6 +1157,30 @@ def _skip_string(text, i):
             j += 1
         j += 1
     return j
+
+
+_COLOR_TOK = re.compile(r"\s*(?:colou?r\s+[A-Za-z_]\w*|colou?r\s+[-+]?\d+|swap_colors)\b", re.I)
+
+
+def _skip_transforms(text, pos, sd):
+    """The end of VIEW_TRANSFORMS / VIEW_TRANSFORM_GENERATORS data from
+    ``pos``: the count, then that many matrices of numbers, each after an
+    optional ``COLOR c`` or ``SWAP_COLORS`` (graphics only)."""
+    mm = _NUMTOK_RE.match(text, pos)
+    if not mm:
+        return pos
+    n = int(float(mm.group(1)))
+    pos = mm.end()
+    for _ in range(max(n, 0)):
+        cm = _COLOR_TOK.match(text, pos)
+        if cm:
+            pos = cm.end()
+        for _ in range((sd + 1) ** 2):
+            mm = _NUMTOK_RE.match(text, pos)
+            if not mm:
+                return pos
+            pos = mm.end()
+    return pos
 
 
 def _binary_minus_in_parens(line):
