@@ -99,6 +99,14 @@ class Scene:
     read_line: int = 0
     wraps: dict = field(default_factory=dict)          # edge position -> wrap list
     source_lines: list | None = None                   # the text's lines (error excerpts)
+    constraint_names: dict = field(default_factory=dict)  # id -> name (named constraints)
+    boundary_names: dict = field(default_factory=dict)    # id -> name (named boundaries)
+    unsupported: list = field(default_factory=list)       # (feature, line, column): refused
+                                                          # once the whole file is read
+    warnings: list = field(default_factory=list)          # (message, line, column): the
+                                                          # lines the Evolver warns about
+    top_commands: list = field(default_factory=list)      # (text, line): top-section
+                                                          # procedure/function definitions
 
     @property
     def space_dimension(self):

@@ -125,6 +125,15 @@ class Session(SessionAPI):
     def _install(self, filename, scene, surface, run_read):
         self.filename = filename
         self.surface = surface
+        for msg, line, col in scene.warnings:  # lines the Evolver warns about
+            where = f"{filename}:{line}:{col}" if col else f"{filename}:{line}"
+            self.write_err(f"{where}: warning: {msg}\n")
+        if scene.constraint_names:             # named constraints and boundaries
+            surface.constraint_names = dict(scene.constraint_names)
+        if scene.boundary_names:
+            surface.boundary_names = dict(scene.boundary_names)
+        if scene.values.get("_period_exprs") is not None and surface.periods is not None:
+            surface.period_exprs = scene.values["_period_exprs"]
         self._iterator = None                  # no CG history, pressures not yet valid
         # REF's gravity flag (reported by G): on when the datafile declares a
         # nonzero gravity_constant or a body has a density (mound.fe: on with
@@ -158,6 +167,8 @@ class Session(SessionAPI):
             raise DatafileError(str(exc), filename, line, None,
                                 lines[line - 1] if line and lines and line <= len(lines)
                                 else None) from None
+        for text, line in scene.top_commands:  # top-section procedures and functions
+            self.run(text, where=filename, line=line, stop_on_error=False)
         for wline, msg in scene.read_warnings:
             self.err.write(f"{filename}:{wline}: {msg}\n")
         if run_read and scene.read_text:
@@ -505,6 +516,8 @@ class Session(SessionAPI):
                 if on.any():
                     project_to_constraints(s, np.nonzero(on)[0])
                 s.__dict__.pop("_lift_cache", None)
+        if getattr(s, "period_exprs", None) is not None:
+            self._eval_periods(s)
         s.gravity_constant = self.variables.get("gravity_constant", s.gravity_constant)
         s.gravity_on = bool(self.toggles.get("gravity", 1))
         s.curvature_mode = ("norm" if self.toggles.get("normal_curvature") else
@@ -514,6 +527,20 @@ class Session(SessionAPI):
         self.totals = t
         if not keep_cg:
             self.reset_cg()
+
+    def _eval_periods(self, s):
+        """PERIODS given by expressions: re-evaluated at each recalc (manual:
+        "give a recalc command whenever you change such a variable")."""
+        env = N.MapEnv(self.variables)
+        vals = [float(e) if isinstance(e, float) else float(e.ev(env)) for e in s.period_exprs]
+        sd = s.sdim
+        P = np.array(vals).reshape(sd, sd)
+        if not np.all(np.isfinite(P)):
+            raise CommandError("PERIODS: the values must be finite")
+        if not np.array_equal(P, s.periods[:sd, :sd]):
+            s.periods = s.periods.copy()
+            s.periods[:sd, :sd] = P
+            s.__dict__.pop("_lift_cache", None)
 
     # -- evolution -------------------------------------------------------------------
     @property
@@ -1008,6 +1035,9 @@ class Session(SessionAPI):
         for cid, cname in getattr(s, "constraint_names", {}).items():
             if cname == name:
                 return float(cid)
+        for bid, bname in getattr(s, "boundary_names", {}).items():
+            if bname == name:
+                return float(bid)
         if name in self.toggles or name in I.TOGGLES:
             return float(self.toggles.get(name, I.TOGGLE_DEFAULTS.get(name, 0)))
         if s is None:
@@ -1020,6 +1050,8 @@ class Session(SessionAPI):
             "facet_count": lambda: s.n_facets, "body_count": lambda: s.bodies.n,
             "facetedge_count": lambda: self._facetedge_count(),
             "space_dimension": lambda: s.sdim, "surface_dimension": lambda: 1 if s.string else 2,
+            "high_constraint": lambda: max(s.constraints, default=0),
+            "high_boundary": lambda: max(s.boundaries, default=0),
             "torus": lambda: 1 if s.periods is not None else 0,
             "datafilename": lambda: self.filename,
             "gravity_constant": lambda: s.gravity_constant,
@@ -1637,6 +1669,10 @@ class Session(SessionAPI):
         """A constraint's number, or its name when defined at run time."""
         return getattr(self.surface, "constraint_names", {}).get(cid, str(cid))
 
+    def boundary_label(self, bid):
+        """A boundary's number, or its name when declared by name."""
+        return getattr(self.surface, "boundary_names", {}).get(bid, str(bid))
+
     def unset_constraint(self, els, cid):
         s = self.surface
         if cid not in s.vcon and cid not in s.econ and cid not in s.fcon:
@@ -1768,7 +1804,7 @@ class Session(SessionAPI):
             b = s.boundaries[int(bnd[i])]
             par = " ".join(f"{p:17.15g}" for p in s.vattr["params"][i, :b.nparams])
             xyz = "".join(f" {x:17.15g}" for x in s.X[i, :sd])
-            line = f"{vid[i]:3d}  {par}  boundary {int(bnd[i])}  /* ({xyz}) */"
+            line = f"{vid[i]:3d}  {par}  boundary {self.boundary_label(int(bnd[i]))}  /* ({xyz}) */"
         else:
             line = f"{vid[i]:3d}  " + " ".join(f"{x:17.15g}" for x in s.X[i, :sd])
         cons = [c for c in sorted(s.vcon) if s.vcon[c][i]]
@@ -1819,7 +1855,7 @@ class Session(SessionAPI):
                 ("-" if s.econ[c][i] < 0 else "") + self.constraint_label(c) for c in cons) + " "
         eb = s.eattr.get("boundary")
         if eb is not None and eb[i]:
-            line += f"  boundary {int(eb[i])} "
+            line += f"  boundary {self.boundary_label(int(eb[i]))} "
         if s.eattr["fixed"][i]:
             line += "fixed "
         if s.eattr["no_refine"][i]:

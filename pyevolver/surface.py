@@ -489,6 +489,7 @@ class _Builder:
                 P[:sd, :sd] = np.array(vals).reshape(sd, sd)
             s.periods = P
         self._vertices()
+        self._project()         # REF projects the vertices as read: face centres use them
         self._edges()
         self._faces()
         self._bodies()
@@ -1595,10 +1596,11 @@ def project_tangent(s, vecs):
         return vecs
     cids = sorted(s.vcon)
     on = np.stack([s.vcon[c] for c in cids], axis=1)
+    env = s.param_env()
+    on = _hit_one_sided(s, cids, on, env)
     rows = np.nonzero(on.any(axis=1))[0]
     if not len(rows):
         return vecs
-    env = s.param_env()
     keys, inv = np.unique(on[rows], axis=0, return_inverse=True)
     inv = inv.ravel()
     out = [v.copy() for v in vecs]
@@ -1617,6 +1619,33 @@ def project_tangent(s, vecs):
     return out
 
 
+def _hit_one_sided(s, cids, on, env, tol=1e-10, rows=None, violated=False):
+    """``on`` with one-sided (NONNEGATIVE / NONPOSITIVE) constraints kept only
+    for the vertices that hit them (value 0 within ``tol``), or, with
+    ``violated``, also those outside the allowed side: a vertex inside the
+    allowed region moves freely (REF: the face centres of drop_afm.fe between
+    its two one-sided plates move in z).  ``rows``: the vertices of the rows
+    of ``on`` (default all)."""
+    one = [j for j, c in enumerate(cids)
+           if s.constraints[c].flags & {"nonnegative", "nonpositive"}]
+    if not one:
+        return on
+    on = on.copy()
+    for j in one:
+        rr = np.nonzero(on[:, j])[0]
+        if not len(rr):
+            continue
+        P = s.X[rr if rows is None else rows[rr]]
+        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        c = s.constraints[cids[j]]
+        phi = np.broadcast_to(_constraint_formula(c, "values", env, coords, len(rr)), (len(rr),))
+        keep = np.abs(phi) <= tol
+        if violated:
+            keep |= (phi < 0) if "nonnegative" in c.flags else (phi > 0)
+        on[rr, j] = keep
+    return on
+
+
 def constrained_vertices(s):
     """(nv,) bool: the vertices on at least one level-set constraint."""
     on = np.zeros(s.nv, bool)
@@ -1625,7 +1654,7 @@ def constrained_vertices(s):
     return on
 
 
-def project_to_constraints(s, idx, tol=None, maxit=20):
+def project_to_constraints(s, idx, tol=None, maxit=20, _again=True):
     """Newton-project the vertices ``idx`` onto their level-set constraints.
 
     Uses ``x <- x - G (G^T G)^{-1} phi(x)`` over the vertex's active
@@ -1645,12 +1674,15 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
     tol = tol if tol is not None else s.params.get("constraint_tolerance", 1e-12)
     cids = sorted(s.vcon)
     onmat = np.stack([s.vcon[c][idx] for c in cids], axis=1)
+    env = s.param_env()
+    full = onmat
+    # one-sided constraints act on the vertices that violate or hit them
+    onmat = _hit_one_sided(s, cids, onmat, env, rows=idx, violated=True)
     anyon = np.nonzero(onmat.any(axis=1))[0]
     if not len(anyon):
         return failed
     ukeys, inv = np.unique(onmat[anyon], axis=0, return_inverse=True)
     inv = inv.ravel()
-    env = s.param_env()
     for gi, key in enumerate(ukeys):
         sel = idx[anyon[inv == gi]]
         start = s.X[sel].copy()
@@ -1690,6 +1722,13 @@ def project_to_constraints(s, idx, tol=None, maxit=20):
         if bad.any():
             s.X[sel[bad]] = start[bad]
             failed = np.concatenate([failed, sel[bad]])
+    if _again and (full != onmat).any():
+        # a one-sided constraint left out may be violated now: once more
+        again = _hit_one_sided(s, cids, full, env, rows=idx, violated=True) & ~onmat
+        redo = np.nonzero(again.any(axis=1))[0]
+        if len(redo):
+            failed = np.concatenate([failed, project_to_constraints(
+                s, idx[redo], tol, maxit, _again=False)])
     return failed
 
 

@@ -17,7 +17,11 @@ from ..limits import MAX_EXPANDED_LINE
 
 _COMMENT_RE = re.compile(r'"(?:\\.|[^"\\\n])*"|/\*.*?\*/|//[^\n]*', re.S)
 _SECTION_RE = re.compile(
-    r"^[ \t]*(vertices|edges|faces|facets|bodies|read)\b[ \t]*:?", re.I | re.M)
+    r"^[ \t]*(vertices|edges|faces|facets|bodies|read"
+    r"|vertex|edge|face|facet|body)\b[ \t]*:?", re.I | re.M)
+# singular section keywords (REF accepts vertex/edge/face/facet/body too)
+_SECTION_KIND = {"vertex": "vertices", "edge": "edges", "face": "faces", "facet": "faces",
+                 "facets": "faces", "body": "bodies"}
 _IDENT_RE = re.compile(r'"(?:\\.|[^"\\\n])*"|[A-Za-z_][A-Za-z0-9_]*')
 _DIRECTIVE_RE = re.compile(r"^[ \t]*#[ \t]*(define|include)\b(.*)$", re.I | re.M)
 
@@ -263,8 +267,7 @@ def _split(text, src_lines):
     ends = [m.start() for m in matches] + [len(text)]
     bodies = [0] + [m.end() for m in matches]
     for kind, s, b, e in zip(kinds, starts, bodies, ends):
-        if kind == "facets":
-            kind = "faces"
+        kind = _SECTION_KIND.get(kind, kind)
         line0 = text.count("\n", 0, s) + 1 if s else 1
         body = text[b:e]
         # the header line's remainder belongs to the section; keep its line

@@ -29,7 +29,9 @@ _BAD_NUMBER = re.compile(r"(?<![\w.])(\d*\.\d*\.[\d.]*|\d+\.?\d*[eEdD][+-]?(?![\
 
 # an element line made of plain numbers (no alternative can match a digit
 # run in two ways, so a failing match cannot backtrack exponentially)
-_NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
+# (a '+' after a space continues the value before it: REF reads "1 2 +3" as
+# the two values 1 and 5; only a '-' after a space starts a new value)
+_NUMBER = r"-?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
 _NUMERIC_LINE = re.compile(r"[ \t]*\d+(?:[ \t]+" + _NUMBER + r")*[ \t]*\Z")
 # the numeric head of a line followed by attributes that start with a letter
 _NUMERIC_HEAD = re.compile(r"[ \t]*\d+(?:[ \t]+" + _NUMBER + r")*(?=[ \t]+[A-Za-z_])")
@@ -82,6 +84,8 @@ def _long_numeric(line):
     head = line[:end]
     if not _NUM_CHARS.fullmatch(head) or (m and end and not line[end - 1].isspace()):
         return None, None
+    if "+" in head and re.search(r"(?:^|[ \t])\+", head):
+        return None, None               # '+3' after a space: an addition
     if not head.split() or not head.split(None, 1)[0].isdigit():
         return None, None               # the element id: digits ('1e308' is not one)
     try:
@@ -107,7 +111,8 @@ def top_parser():
     with open(os.path.join(_HERE, "fe_top.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
     return Lark(grammar, parser="lalr", lexer="contextual", start="start",
-                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse},
+                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse,
+                                                    "UNSUPPORTED2_KW": _refuse},
                 cache=True)
 
 
@@ -129,6 +134,12 @@ _MATRIX_RE = re.compile(r"\b(torus_periods|periods|view_matrix|view_transforms|"
 _NUMTOK_RE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)(?=\s|$)")
 
 
+def _cid(tok):
+    """A constraint's or boundary's number, or its name (lower case)."""
+    s = str(tok)
+    return int(s) if s.isdigit() else s.lower()
+
+
 @v_args(inline=True)
 class _TopTransformer(ExprTransformer):
     """Top-section declarations -> tuples consumed by :func:`_fill_scene`."""
@@ -136,13 +147,34 @@ class _TopTransformer(ExprTransformer):
     def start(self, *decls):
         return list(decls)
 
-    def parameter(self, kw, name, value):
-        return ("parameter", str(name).lower(), value, kw.line)
+    def parameter(self, kw, name, value, *tail):
+        d = ("parameter", str(name).lower(), value, kw.line)
+        if not tail and not str(kw).lower().startswith("optimi"):
+            return d
+        return d + ({"optimizing": str(kw).lower().startswith("optimi"),
+                     "column": kw.column, **dict(tail)},)
+
+    def p_delta(self, kw, e):
+        return ("pdelta", (e, kw.column))
+
+    def p_scale(self, kw, e):
+        return ("pscale", (e, kw.column))
+
+    def p_on_assign(self, kw, name):
+        return ("on_assign_call", (str(name).lower(), kw.column))
+
+    def value_decl2(self, kw, e):
+        return ("ignored", str(kw).lower().rstrip(":"))
+
+    def merit_factor(self, kw, e=None):
+        return ("ignored", "merit_factor")
 
     def level_expr(self, a, b=None):
         return a if b is None else N.Bin("-", a, b)
 
-    def constraint_opt(self, tok):
+    def constraint_opt(self, tok, n=None):
+        if n is not None:                  # CONTENT_RANK n
+            return ("content_rank", int(n), tok.line, tok.column)
         return str(tok).lower()
 
     def comp(self, kw, e):
@@ -163,11 +195,13 @@ class _TopTransformer(ExprTransformer):
                 opts.append(r)
             elif isinstance(r, Token):
                 continue
+            elif isinstance(r, tuple) and r[0] == "content_rank":
+                opts.append(r)
             elif isinstance(r, tuple):
                 blocks.append(r)
             else:
                 formula = r
-        return ("constraint", int(cid), opts, formula, blocks, kw.line)
+        return ("constraint", _cid(cid), opts, formula, blocks, kw.line)
 
     def boundary_opt(self, tok):
         return str(tok).lower()
@@ -181,7 +215,7 @@ class _TopTransformer(ExprTransformer):
                 blocks.append(r)
             elif isinstance(r, tuple):
                 comps.append(r)
-        return ("boundary", int(bid), int(nparams), opts, comps, blocks, kw.line)
+        return ("boundary", _cid(bid), int(nparams), opts, comps, blocks, kw.line)
 
     def q_energy(self, _t):
         return ("kind", "energy", None)
@@ -241,8 +275,8 @@ class _TopTransformer(ExprTransformer):
     def method_instance(self, kw, name, _m, mname, *opts):
         return ("method_instance", str(name).lower(), str(mname).lower(), list(opts), kw.line)
 
-    def dims(self, *ints):
-        return [int(i) for i in ints]
+    def dims(self, *exprs):
+        return list(exprs)          # (expressions: evaluated in order, _decl)
 
     def define_attr(self, kw, etype, _a, name, atype, dims=None):
         return ("attribute", str(etype).lower(), str(name).lower(), str(atype).lower(),
@@ -335,6 +369,9 @@ class Reader:
             last = len(self.src_lines)
             raise self.error("unexpected end of file: expected a 'vertices' section",
                              last, 1)
+        if self.scene.unsupported:
+            feature, line, col = self.scene.unsupported[0]
+            raise self.error(f"not supported in pyevolver: {feature}", line, col)
         return self.scene
 
     # -- top section --------------------------------------------------------
@@ -355,11 +392,53 @@ class Reader:
             return f"unexpected '{tok}': expected {exp}"
         return str(exc).split("\n")[0]
 
+    def _matrix_exprs(self, text, m, count):
+        """The ``count`` values after the PERIODS or VIEW_MATRIX keyword ``m``:
+        expressions separated by white space as on an element line (manual:
+        "PERIODS followed by expressions"; ``1 -2`` is two values, ``1 - 2``
+        one), whole lines at a time.  Returns ``(exprs, end)``."""
+        pos = m.end()
+        vals = []
+        while len(vals) < count and pos < len(text):
+            nl = text.find("\n", pos)
+            nl = len(text) if nl < 0 else nl
+            seg = text[pos:nl]
+            if seg.strip():
+                try:
+                    tree = line_parser().parse("0 " + seg, start="vertex_line")
+                    _, items = _LINE.transform(tree)
+                except (UnexpectedInput, VisitError):
+                    break
+                if any(isinstance(it, tuple) for it in items):
+                    break
+                vals.extend(items)
+            pos = nl + 1 if nl < len(text) else nl
+        return vals, min(pos, len(text))
+
     def _extract_matrices(self, text):
         """Take the numbers of PERIODS / VIEW_* matrices out of the text."""
         out = text
         for m in _MATRIX_RE.finditer(text):
+            key = m.group(1).lower()
+            if key.endswith("periods") or key == "view_matrix":
+                # rows given by expressions (parameters, arithmetic) or numbers
+                sd = self._peek_space_dimension(text[:m.start()])
+                count = sd * sd if key.endswith("periods") else (sd + 1) ** 2
+                vals, pos = self._matrix_exprs(text, m, count)
+                line = text.count("\n", 0, m.start()) + 1
+                if len(vals) != count:
+                    raise _MatrixError(line, f"{key.upper()} needs {count} numbers, "
+                                             f"found {len(vals)}")
+                out = out[:m.end()] + re.sub(r"[^\n]", " ", out[m.end():pos]) + out[pos:]
+                if key.endswith("periods"):
+                    self._period_exprs = vals
+                continue
             pos = m.end()
+            if key.startswith("view_transform"):
+                # n, then n matrices, each after an optional COLOR c or SWAP_COLORS
+                pos = _skip_transforms(text, pos, self._peek_space_dimension(text[:m.start()]))
+                out = out[:m.end()] + re.sub(r"[^\n]", " ", out[m.end():pos]) + out[pos:]
+                continue
             vals = []
             limit = None
             if m.group(1).lower().endswith("periods"):
@@ -386,7 +465,46 @@ class Reader:
         m = re.search(r"\bspace_dimension\s+(\d+)", text, re.I)
         return int(m.group(1)) if m else 3
 
+    def _cut_procedures(self, sec):
+        """Take the stand-alone ``procedure`` and ``function`` declarations and
+        definitions out of the top section (manual, "Functions and
+        procedures": the read-section syntax, allowed in the top section).
+
+        They are kept, with their source lines, in ``scene.top_commands`` (run
+        as commands before the read section) and blanked in the text, so the
+        line and column of everything else are kept.
+        """
+        text = sec.text
+        af = _ATTR_FUNCTION.search(text)
+        if af:
+            line = text.count("\n", 0, af.start(1)) + 1
+            raise self.error("not supported in pyevolver: attribute FUNCTION (an extra "
+                             "attribute computed by a procedure)", self._src(sec, line),
+                             af.start(1) - text.rfind("\n", 0, af.start(1)))
+        if not _PROC_START.search(text):
+            return text
+        out = []
+        pos = 0
+        for m in _PROC_START.finditer(text):
+            if m.start() < pos:
+                continue
+            end = _proc_end(text, m.end() - 1)
+            line = text.count("\n", 0, m.start()) + 1
+            if end is None:
+                raise self.error(f"unbalanced parentheses or braces in this "
+                                 f"{m.group(1).lower()} declaration", self._src(sec, line),
+                                 m.start() - text.rfind("\n", 0, m.start()))
+            body = text[m.start():end]
+            self.scene.top_commands.append((body.rstrip().rstrip(";"), self._src(sec, line)))
+            out.append(text[pos:m.start()])
+            out.append(re.sub(r"[^\n]", " ", body))
+            pos = end
+        out.append(text[pos:])
+        return "".join(out)
+
     def _top(self, sec):
+        if _PROC_START.search(sec.text) or _ATTR_FUNCTION.search(sec.text):
+            sec.text = self._cut_procedures(sec)
         text = sec.text.replace(",", " ")
         bad = _BAD_NUMBER.search(text)
         if bad:
@@ -448,7 +566,23 @@ class Reader:
 
     @property
     def param_env(self):
+        named = self._named_ids()
+        if named:
+            return N.MapEnv({**named, **self.scene.parameters})
         return N.MapEnv(self.scene.parameters)
+
+    def _named_ids(self):
+        """Named constraints and boundaries as values (REF: ``print pinned``
+        prints its number; ``constraint 2,pinned`` on an element)."""
+        sc = self.scene
+        if not (sc.constraint_names or sc.boundary_names):
+            return {}
+        key = (tuple(sc.constraint_names.items()), tuple(sc.boundary_names.items()))
+        if getattr(self, "_named_key", None) != key:
+            self._named_key = key
+            self._named = {**{n: float(c) for c, n in sc.boundary_names.items()},
+                           **{n: float(c) for c, n in sc.constraint_names.items()}}
+        return self._named
 
     def _formula(self, expr, text="", allowed=None):
         if allowed is None:
@@ -485,7 +619,12 @@ class Reader:
     def _decl(self, d, sc, sec):
         kind = d[0]
         if kind == "parameter":
-            _, name, expr, line = d
+            _, name, expr, line = d[:4]
+            if len(d) > 4:
+                self._parameter_options(name, d[4], self._src(sec, line))
+            if isinstance(expr, N.Str):         # a string-valued parameter
+                sc.parameters[name] = expr.value
+                return
             sc.parameters[name] = self._const(expr, self._src(sec, line), f"parameter {name}")
         elif kind == "flag":
             sc.flags.add(d[1])
@@ -503,14 +642,24 @@ class Reader:
                 sc.values[name + "_fixed"] = 1.0
         elif kind == "constraint":
             _, cid, opts, formula, blocks, line = d
+            cid = self._number_named(cid, sc.constraints, sc.constraint_names, "constraint",
+                                     self._src(sec, line))
             if cid in sc.constraints:
                 raise self.error(f"constraint {cid} defined twice", self._src(sec, line))
+            for o in [o for o in opts if isinstance(o, tuple)]:
+                # the content integral's side with several content constraints
+                self._defer("CONTENT_RANK", self._src(sec, o[2]), o[3])
+                opts.remove(o)
             c = ConstraintDecl(cid, self._formula(formula), set(opts), line=self._src(sec, line))
             for bname, comps in blocks:
                 setattr(c, bname, self._components(comps, "ec"[bname == "content"], sec, line))
             sc.constraints[cid] = c
         elif kind == "boundary":
             _, bid, npar, opts, comps, blocks, line = d
+            bid = self._number_named(bid, sc.boundaries, sc.boundary_names, "boundary",
+                                     self._src(sec, line))
+            if bid in sc.boundaries:
+                raise self.error(f"boundary {bid} defined twice", self._src(sec, line))
             if not 1 <= npar <= 3:
                 raise self.error(f"boundary {bid}: PARAMETERS must be 1, 2 or 3, got {npar}",
                                  self._src(sec, line))
@@ -541,15 +690,76 @@ class Reader:
             sc.method_instances[name] = m
         elif kind == "attribute":
             _, etype, name, atype, dims, line = d
+            dims = [self._dim(e, self._src(sec, line), name) for e in dims]
             size = math.prod(dims) if dims else 1
             if size > MAX_ARRAY_ENTRIES:
                 raise self.error(f"attribute {name}: {size} entries per {etype}; at most "
                                  f"{MAX_ARRAY_ENTRIES} are allowed", self._src(sec, line))
             sc.attributes[(etype, name)] = (atype, size, dims)
         elif kind == "periods":
-            pass    # numbers taken by _extract_matrices
+            exprs = getattr(self, "_period_exprs", None)
+            if exprs is not None:       # expressions: evaluated here, in order
+                line = self._src(sec, d[2])
+                vals = [self._value(e, line, "PERIODS") for e in exprs]
+                if not all(math.isfinite(v) for v in vals):
+                    raise self.error("PERIODS: the values must be finite", line)
+                sc.values["_periods"] = vals
+                if any(not isinstance(e, (float, N.Num)) for e in exprs):
+                    sc.values["_period_exprs"] = exprs
+            # (plain numbers were taken by _extract_matrices)
         elif kind == "ignored":
             pass
+
+    def _defer(self, feature, line, col=None):
+        """An unsupported feature met while reading: the file is read to the
+        end, then refused by name at the first such feature (located)."""
+        self.scene.unsupported.append((feature, line, col))
+
+    def _parameter_options(self, name, opts, line):
+        """OPTIMIZING_PARAMETER (refused: the Evolver varies it during
+        iteration), PDELTA / PSCALE (used by optimizing parameters only: no
+        number of a plain parameter changes), ON_ASSIGN_CALL (refused)."""
+        if opts.get("optimizing"):
+            self._defer(f"OPTIMIZING_PARAMETER ({name})", line, opts.get("column"))
+        for key in ("pdelta", "pscale"):
+            if key in opts:
+                self._const(opts[key][0], line, f"{key} of parameter {name}")
+        if "on_assign_call" in opts:
+            proc, col = opts["on_assign_call"]
+            self._defer(f"ON_ASSIGN_CALL ({name} calls {proc})", line, col)
+
+    def _dim(self, expr, line, name):
+        """An attribute's array dimension: a constant expression (REF:
+        ``real[nn+1]``), a positive integer."""
+        v = self._const(expr, line, f"the dimension of attribute {name}")
+        if not (math.isfinite(v) and v == int(v) and v >= 0):
+            raise self.error(f"attribute {name}: the dimension must be a non-negative "
+                             f"integer, got {v:g}", line)
+        return int(v)
+
+    def _number_named(self, key, table, names, what, line):
+        """The number of a constraint or boundary declared by number or by name.
+
+        A name takes the lowest number not in use; a later declaration by a
+        number a name holds moves the name to the lowest free number (REF:
+        ``constraint aa``, ``constraint bb``, ``constraint 1`` give aa 3, bb 2).
+        """
+        if isinstance(key, int):
+            if key in names:
+                name = names.pop(key)
+                decl = table.pop(key)
+                new = _lowest_free(table, names, also=key)
+                decl.id = new
+                table[new] = decl
+                names[new] = name
+            return key
+        if key in names.values():
+            raise self.error(f"{what} '{key}' defined twice", line)
+        if key in self.scene.parameters:
+            raise self.error(f"{what} name '{key}' is already a parameter", line)
+        new = _lowest_free(table, names)
+        names[new] = key
+        return new
 
     def _method(self, mname, is_global, opts, sec, line, qname):
         m = MethodDecl(mname, is_global, name=qname)
@@ -614,7 +824,11 @@ class Reader:
                 numeric_txt.append(raw)
                 entries += 1
                 continue
+            if "(" in raw and "-" in raw:
+                raw = _binary_minus_in_parens(raw)
             line = raw.replace(",", " ").replace(":", " ")
+            if "{" in line:             # array attribute values: ref_coord { 1 0 0 }
+                line = line.replace("{", " ").replace("}", " ")
             bad = _BAD_NUMBER.search(line)
             if bad:
                 raise self.error(f"malformed number '{bad.group(0)}'", srcline, bad.start() + 1)
@@ -653,6 +867,7 @@ class Reader:
             if nesting_depth(items) > MAX_NESTING:
                 raise self.error(f"expression nested more than {MAX_NESTING} levels deep",
                                  srcline)
+            self._cur_line = line
             self._element(kind, block, eid, items, srcline)
             entries += 1
         if numeric_txt:
@@ -699,10 +914,28 @@ class Reader:
             # the whole section is one table: keep it as arrays
             block.ids = ids
             block.data = vals.reshape(len(texts), int(lens[0]))[:, 1:]
+            if kind == "vertices" and 1 <= block.data.shape[1] < self.scene.space_dimension:
+                block.data = self._pad_coordinates(block.data, ids, block.lines)
             return
+        sd = self.scene.space_dimension
         for p, i, st, n in zip(positions, ids.tolist(), starts.tolist(), lens.tolist()):
             block.ids[p] = i
             block.data[p] = vals[st + 1: st + n]
+            if kind == "vertices" and 2 <= n <= sd:
+                block.data[p] = self._pad_coordinates(block.data[p][None, :], [i],
+                                                      [block.lines[p]])[0]
+
+    def _pad_coordinates(self, data, ids, lines):
+        """Vertices with fewer coordinates than the space dimension: a warning
+        each, the missing ones 0 (REF: WARNING 1127 "Wrong number of
+        coordinates for vertex")."""
+        sd = self.scene.space_dimension
+        for k, vid in enumerate(ids):
+            self.warn(f"wrong number of coordinates for vertex {int(vid)}: "
+                      f"{data.shape[1]} instead of {sd} (the rest are 0)", lines[k])
+        out = np.zeros((data.shape[0], sd))
+        out[:, :data.shape[1]] = data
+        return out
 
     def _strip_wraps(self, line, pos, sdim, srcline):
         toks = line.split()
@@ -711,10 +944,36 @@ class Reader:
             return " ".join(toks[:3] + toks[3 + sdim:])
         return line
 
+    def warn(self, msg, line, col=None):
+        """Record a warning about a line (the Evolver warns and goes on)."""
+        self.scene.warnings.append((msg, line, col))
+
+    def _unknown_words(self, etype, eid, items, qnames, srcline):
+        """Edge, face and body lines: an unknown word is skipped with a warning
+        (REF: WARNING 2110 / 2115 / 2119 "Unexpected token", the rest of the
+        line is read); on a vertex line it is an error (REF: DATAFILE ERROR)."""
+        sc = self.scene
+        named = self._named_ids()
+        keep = []
+        text = getattr(self, "_cur_line", "")
+        for it in items:
+            col = getattr(it, "column", None)
+            if isinstance(it, N.Var) and col and col >= 2 and col - 2 < len(text) and \
+                    text[col - 2] in " \t" and not (
+                    it.name in sc.parameters or it.name in N.CONSTANTS or it.name in named
+                    or it.name in qnames or (etype, it.name) in sc.attributes):
+                self.warn(f"{etype} {eid}: unexpected word '{it.name}' (ignored)",
+                          srcline, it.column)
+                continue
+            keep.append(it)
+        return keep
+
     def _element(self, kind, block, eid, items, srcline):
         sc = self.scene
         etype = {"vertices": "vertex", "edges": "edge", "faces": "facet", "bodies": "body"}[kind]
         qnames = set(sc.quantities) | set(sc.method_instances)
+        if etype != "vertex" and any(isinstance(it, N.Var) for it in items):
+            items = self._unknown_words(etype, eid, items, qnames, srcline)
         attrs = []
         i = 0
         n = len(items)
@@ -766,6 +1025,12 @@ class Reader:
         if not 1 <= eid <= MAX_ID:
             raise self.error(f"{etype} id {eid} is out of range (ids are 1 to {MAX_ID})",
                              srcline, 1)
+        if kind == "vertices" and len(values) < sc.space_dimension and values and \
+                not any(kw == "boundary" for kw, _, _ in attrs):
+            # REF: WARNING 1127 "Wrong number of coordinates", the rest are 0
+            self.warn(f"wrong number of coordinates for vertex {eid}: "
+                      f"{len(values)} instead of {sc.space_dimension} (the rest are 0)", srcline)
+            values = values + [0.0] * (sc.space_dimension - len(values))
         if kind == "vertices":
             for v in values:
                 if not math.isfinite(v):
@@ -824,7 +1089,8 @@ class Reader:
         if isinstance(expr, N.Num):
             return expr.value
         for name in expr.names():
-            if name not in self.scene.parameters and name not in N.CONSTANTS:
+            if name not in self.scene.parameters and name not in N.CONSTANTS and \
+                    name not in self._named_ids():
                 col = None
                 for node in _walk(expr):
                     if isinstance(node, N.Var) and node.name == name:
@@ -840,6 +1106,121 @@ _KW_NEEDS_VALUE = {"constraint", "constraints", "boundary", "tension", "density"
                    "orientation", "lagrange_multiplier", "actual_volume"}
 _KW_INTEGER = {"constraint", "constraints", "boundary", "color", "colour", "frontcolor",
                "frontcolour", "backcolor", "backcolour", "original", "phase", "tag"}
+
+
+# a stand-alone procedure or function of the top section: its keyword, (type),
+# name and opening parenthesis
+_PROC_START = re.compile(
+    r"\b(procedure|function)\s+(?:(?:real|integer|string|vertex_type|edge_type|facet_type|"
+    r"body_type|facetedge_type|element_id)\s+)?[A-Za-z_]\w*\s*\(", re.I)
+
+
+# define ... attribute name type [dims] FUNCTION { ... }
+_ATTR_FUNCTION = re.compile(r"\battribute\s+\w+\s+\w+(?:\s*\[[^\]\n]*\])*\s+(function)\s*\{",
+                            re.I)
+
+
+def _proc_end(text, k):
+    """The end of a declaration whose parameter list opens at ``text[k]``:
+    after ``)`` and a ``;``, or after the ``{...}`` body (strings skipped);
+    None when the parentheses or braces do not balance."""
+    n = len(text)
+    depth = 0
+    i = k
+    while i < n:
+        c = text[i]
+        if c == "(":
+            depth += 1
+        elif c == ")":
+            depth -= 1
+            if depth == 0:
+                break
+        elif c == '"':
+            i = _skip_string(text, i)
+        i += 1
+    else:
+        return None
+    i += 1
+    while i < n and text[i] in " \t\n":
+        i += 1
+    if i < n and text[i] == ";":
+        return i + 1
+    if i >= n or text[i] != "{":
+        return i                    # a declaration without ';'
+    depth = 0
+    while i < n:
+        c = text[i]
+        if c == "{":
+            depth += 1
+        elif c == "}":
+            depth -= 1
+            if depth == 0:
+                return i + 1
+        elif c == '"':
+            i = _skip_string(text, i)
+        i += 1
+    return None
+
+
+def _skip_string(text, i):
+    j = i + 1
+    while j < len(text) and text[j] != '"':
+        if text[j] == "\\":
+            j += 1
+        j += 1
+    return j
+
+
+_COLOR_TOK = re.compile(r"\s*(?:colou?r\s+[A-Za-z_]\w*|colou?r\s+[-+]?\d+|swap_colors)\b", re.I)
+
+
+def _skip_transforms(text, pos, sd):
+    """The end of VIEW_TRANSFORMS / VIEW_TRANSFORM_GENERATORS data from
+    ``pos``: the count, then that many matrices of numbers, each after an
+    optional ``COLOR c`` or ``SWAP_COLORS`` (graphics only)."""
+    mm = _NUMTOK_RE.match(text, pos)
+    if not mm:
+        return pos
+    n = int(float(mm.group(1)))
+    pos = mm.end()
+    for _ in range(max(n, 0)):
+        cm = _COLOR_TOK.match(text, pos)
+        if cm:
+            pos = cm.end()
+        for _ in range((sd + 1) ** 2):
+            mm = _NUMTOK_RE.match(text, pos)
+            if not mm:
+                return pos
+            pos = mm.end()
+    return pos
+
+
+def _binary_minus_in_parens(line):
+    """Inside parentheses a '-' after a space is a subtraction (REF reads
+    ``1 (2 -3) 4`` as 1, -1, 4), unless a comma or an operator comes before it
+    (``atan2(y, -x)``): the space before such a '-' becomes \\x1a, which the
+    element grammar ignores, so that the '-' is not a new value's sign."""
+    out = list(line)
+    depth = 0
+    for i, c in enumerate(line):
+        if c == "(":
+            depth += 1
+        elif c == ")":
+            depth = max(depth - 1, 0)
+        elif c == "-" and depth and i and line[i - 1] in " \t":
+            j = i - 1
+            while j >= 0 and line[j] in " \t":
+                j -= 1
+            if j >= 0 and (line[j].isalnum() or line[j] in "_.)"):
+                out[i - 1] = "\x1a"
+    return "".join(out)
+
+
+def _lowest_free(table, names, also=None):
+    k = 1
+    while k in table or k in names or k == also:
+        k += 1
+    return k
 
 
 class _MatrixError(Exception):
