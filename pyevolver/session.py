@@ -173,13 +173,18 @@ class Session(SessionAPI):
             self.err.write(f"{filename}:{wline}: {msg}\n")
         if run_read and scene.read_text:
             # an error abandons the rest of the read section (as in the
-            # Evolver); the surface stays loaded
-            try:
-                self.run(scene.read_text, where=filename, line=scene.read_line + 1)
-            except (I.Quit, I.Interrupted):
-                raise
-            except PyEvolverError as exc:
-                self.write_err(f"{exc}\n")
+            # Evolver); the surface stays loaded.  A command refused by name
+            # (a feature pyevolver lacks, which the Evolver would run) is
+            # reported and the section goes on.
+            for chunk, ln in I.split_commands(scene.read_text):
+                try:
+                    self.run_one(chunk, filename, scene.read_line + ln)
+                except (I.Quit, I.Interrupted):
+                    raise
+                except PyEvolverError as exc:
+                    self.write_err(f"{exc}\n")
+                    if "not supported in pyevolver" not in str(exc):
+                        break
         return self
 
     def _scene_settings(self, scene):
