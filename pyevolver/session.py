@@ -1199,6 +1199,11 @@ class Session(SessionAPI):
             raise ExpressionError(f"the {el.kind} no longer exists (deleted by this command)")
 
     def get_attr(self, base, name, idx):
+        from .commands import attributes as A
+        if isinstance(base, A.ConstraintAt):
+            return A.constraint_attr(self, base, name, idx)
+        if name in ("on_quantity", "on_method_instance"):
+            return A.on_quantity(self, base, name, idx)
         if idx is not None:                     # indices are integers (C truncation)
             idx = tuple(I.as_int(j, f"the index of '{name}'") for j in idx) \
                 if isinstance(idx, tuple) else I.as_int(idx, f"the index of '{name}'")
@@ -1232,6 +1237,10 @@ class Session(SessionAPI):
             if k == "edge":
                 return float(bool(s.eattr["fixed"][i]) or
                              len(self.sub_elements(base, "facet")) != 2)
+        from .commands import attributes as A
+        v = A.element_attr(self, base, name, idx)
+        if v is not A.MISSING:
+            return v
         if s.sdim == 2 and name in ("z", "x3") and k in ("vertex", "edge", "facet"):
             raise ExpressionError("Coordinate dimension exceeds space dimension.")  # REF 2475
         if k == "vertex":
@@ -1368,8 +1377,8 @@ class Session(SessionAPI):
                 raise ExpressionError(f"{base}.{kind}[{j}] does not exist ({k} {int(eid)} has "
                                       f"{len(subs)} {kind}{'s' if len(subs) != 1 else ''})")
             return subs[j - 1]
-        if name in s.quantities:
-            raise UnsupportedError(f"per-element quantity values ({k}.{name})")
+        if name in s.quantities and k in ("vertex", "edge", "facet"):
+            return A.element_quantity_value(self, base, name)
         raise ExpressionError(f"{k} has no attribute '{name}'")
 
     @staticmethod
@@ -1429,6 +1438,9 @@ class Session(SessionAPI):
             raise CommandError(f"'.{name}' needs an element or a quantity")
         self._check_alive(base)
         k, i = base.kind, base.i
+        from .commands import attributes as A
+        if (k, name) not in s.extra and A.set_element_attr(self, base, name, idx, value):
+            return
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
             if self.attr_types.get((k, name)) == "integer":
@@ -1449,6 +1461,7 @@ class Session(SessionAPI):
             if not math.isfinite(value):
                 raise CommandError(f"vertex coordinates must be finite numbers, got {value:g}")
             s.X[i, j] = value
+            A.cache(self).touch()           # attributes read the live coordinates
             return
         if k == "body":
             b = s.bodies
@@ -1503,7 +1516,12 @@ class Session(SessionAPI):
         raise CommandError(f"cannot assign to {k} attribute '{name}'")
 
     def set_elements(self, gen, attr, expr, env, unset, idx=None):
+        from .commands import attributes as A
         els = self.generate(gen, env)
+        if A.is_flag(gen.kind, attr) and (expr is None or unset):
+            for el in els:         # boolean attributes: set = 1, unset = 0
+                self.set_attr(el, attr, None, 0.0 if unset else 1.0)
+            return
         if attr in ("fixed", "no_refine") and (expr is None or unset):
             if gen.kind == "body":
                 raise CommandError(f"bodies cannot be {'un' if unset else ''}set {attr}; "

@@ -248,6 +248,8 @@ class Attr(N.Node):
         base = self.base.ev(env)
         if self.index is None:
             idx = None
+        elif self.name in ("on_quantity", "on_method_instance"):
+            idx = _quantity_arg(self.index, env)
         elif isinstance(self.index, list):
             idx = tuple(i.ev(env) for i in self.index)
         else:
@@ -299,7 +301,18 @@ class OnTest(N.Node):
         el = env.current()
         if el is None:
             raise ExpressionError(f"{self.what} needs an element (use it in a where clause)")
+        if self.what in ("on_quantity", "on_method_instance"):
+            return env.session.get_attr(el, self.what, _quantity_arg(self.arg, env))
         return env.session.get_attr(el, self.what, self.arg.ev(env))
+
+
+def _quantity_arg(node, env):
+    """The quantity named after ``on_quantity`` (a name that inside an
+    element loop would otherwise read the element's own quantity value)."""
+    s = env.session.surface
+    if isinstance(node, N.Var) and s is not None and node.name.lower() in s.quantities:
+        return QRef(node.name.lower())
+    return node.ev(env)
 
 
 class ArrayLit(N.Node):

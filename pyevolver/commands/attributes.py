@@ -1,0 +1,381 @@
+"""Element attributes of the manual's list that the session's basic table
+(:meth:`pyevolver.session.Session.get_attr`) does not hold: geometric ones
+computed on whole arrays (:mod:`pyevolver.geometry_attrs`), graphics-only
+ones (kept, without effect), and the internal ones refused by name.
+
+:func:`element_attr` returns :data:`MISSING` for names it does not know;
+:data:`ATTRIBUTES` lists what is supported and refused, for
+docs/supported.md.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import geometry_attrs as GA
+from ..errors import ExpressionError, UnsupportedError
+from ..expr import nodes as N
+
+MISSING = object()
+
+# graphics-only attributes: read-write, no number depends on them; values set
+# at run time are kept per element (element index), the defaults otherwise
+GRAPHICS = {
+    ("facet", "opacity"): 1.0,
+    ("facet", "no_display"): 0.0,
+    ("facet", "nodisplay"): 0.0,
+    ("facet", "no_transform"): 0.0,
+    ("edge", "no_transform"): 0.0,
+    ("body", "centerofmass"): 1.0,
+}
+_GRAPHICS_ALIAS = {"nodisplay": "no_display"}
+
+# read-write flags that change numbers elsewhere in the Evolver: read as
+# their default (pyevolver never sets them), setting them is refused by name
+FLAGS_DEFAULT = {
+    ("vertex", "mid_edge"): 0.0, ("vertex", "mid_facet"): 0.0,
+    ("vertex", "axial_point"): 0.0, ("vertex", "triple_point"): 0.0,
+    ("vertex", "tetra_point"): 0.0, ("vertex", "no_hessian_normal"): 0.0,
+    ("edge", "noncontent"): 0.0, ("facet", "noncontent"): 0.0,
+    ("facet", "orientation"): 1.0,
+    ("facet", "phase"): 0.0, ("body", "phase"): 0.0,
+}
+SET_REFUSED = {
+    "axial_point": "symmetry groups are not supported",
+    "triple_point": "it changes effective_area motion, which pyevolver does not run",
+    "tetra_point": "it changes effective_area motion, which pyevolver does not run",
+    "no_hessian_normal": "per-vertex exemptions from hessian_normal",
+    "noncontent": "elements left out of volumes",
+    "orientation": "reversed signs of oriented integrals",
+    "phase": "phasefiles are not supported",
+    "mid_edge": "read-only", "mid_facet": "read-only",
+}
+
+# internal lists of the Evolver's data structure: refused by name
+INTERNAL = {
+    "v_constraint_list", "e_constraint_list", "f_constraint_list", "v_method_list",
+    "e_method_list", "f_method_list", "f_body_list", "f_next_bfacet", "f_next_vfacet",
+    "raw_velocity", "v_boundary", "e_boundary", "f_boundary", "wrap_list",
+}
+
+# motion vectors of the last `g` step: not kept by pyevolver's iterator
+MOTION = {"v_force", "v_velocity", "v_oldx"}
+
+# documentation table: (kinds, name, status)
+ATTRIBUTES = [
+    ("vertex", "mean_curvature", "supported: 3 F·N/(2 N·N), F the area gradient and N the "
+     "area-vector sum of the star, both projected onto the vertex's constraints and "
+     "boundary (REF's values; torus refused by name)"),
+    ("vertex", "sqcurve", "supported: h² of `sq_mean_curvature` (of "
+     "`normal_sq_mean_curvature` with `normal_curvature` on), 0 at FIXED and boundary "
+     "vertices, as REF"),
+    ("vertex", "dihedral", "string model: 2 asin(|F|/2) with unit tensions, clamped to π "
+     "(REF); soapfilm model: REF's error \"Dihedral only for edges\""),
+    ("edge", "dihedral", "supported: angle between the two facets' normals, 0 unless "
+     "exactly two facets"),
+    ("vertex", "value_of_constraint n", "supported: the constraint's formula at the vertex"),
+    ("vertex", "constraint[n].normal", "supported: the constraint's unit normal at the "
+     "vertex (vector, or one component with [i])"),
+    ("facet", "facet_normal, x, y, z, x1..x3, x[i]", "supported (length = facet area)"),
+    ("edge", "edge_vector, x, y, z, x1..x3, x[i]", "supported"),
+    ("edge, facet", "length, area", "supported, from the live coordinates (a `set` of "
+     "coordinates earlier in the same command counts, as in REF)"),
+    ("body", "volfixed", "supported"),
+    ("quantity", "value, target, modulus, pressure, tolerance, fixed, energy, info_only, "
+     "conserved", "supported (`target`, `modulus`, `tolerance` assignable)"),
+    ("facet, edge, body", "opacity, no_display / nodisplay, no_transform, centerofmass",
+     "graphics only: read and set, no effect"),
+    ("vertex, edge, facet, body", "mid_edge, mid_facet, axial_point, triple_point, "
+     "tetra_point, no_hessian_normal, noncontent, orientation (facet), phase",
+     "read as their defaults (0; orientation 1); setting refused by name (they change "
+     "numbers: effective_area, hessian_normal, volumes, phases)"),
+    ("vertex, edge", "bare", "read and set (bare on datafile lines is not kept by the "
+     "reader: reads 0)"),
+    ("vertex", "v_force, v_velocity, v_oldx", "refused by name (the iterator keeps no "
+     "per-vertex motion of the last step)"),
+    ("vertex, edge, facet", "v_/e_/f_constraint_list, v_/e_/f_method_list, f_body_list, "
+     "f_next_bfacet, wrap_list, raw_velocity", "refused by name (the Evolver's internal "
+     "data structure)"),
+    ("edge", "midv", "REF's error: only in the quadratic model"),
+    ("edge", "frontbody, backbody", "string model only (REF's error in the soapfilm model)"),
+    ("facet", "bare", "REF's error: no bareness for facets or bodies"),
+    ("vertex, edge, facet", "named quantity as attribute (`ff.qname`)", "refused by name"),
+]
+
+
+def _session_store(session):
+    st = session.__dict__.get("_attr_store")
+    if st is None:
+        st = session._attr_store = {}
+    return st
+
+
+def cache(session):
+    """The session's :class:`~pyevolver.geometry_attrs.AttrCache`."""
+    c = session.__dict__.get("_attr_cache")
+    if c is None:
+        c = session._attr_cache = GA.AttrCache()
+    return c
+
+
+def geometry(session):
+    """Totals of the live coordinates (see :class:`AttrCache`)."""
+    return cache(session).geometry(session)
+
+
+def _component(vec, idx, name):
+    if idx is None:
+        return N.array_value(np.asarray(vec, float))
+    if isinstance(idx, tuple):
+        raise ExpressionError(f"{name} takes one index")
+    j = int(idx)
+    if j < 1 or j > len(vec):
+        raise ExpressionError(f"{name}[{j}]: index outside 1..{len(vec)}")
+    return float(vec[j - 1])
+
+
+def _constraint_id(session, idx, what):
+    s = session.surface
+    if idx is None or isinstance(idx, tuple):
+        raise ExpressionError(f"{what} needs a constraint number or name "
+                              f"(for example: vv.{what} 1)")
+    cid = int(idx)
+    if cid not in s.constraints:
+        raise ExpressionError(f"{what}: constraint {cid} is not defined")
+    return cid
+
+
+def constraint_value(session, i, cid):
+    """Value of constraint ``cid``'s formula at vertex ``i``."""
+    s = session.surface
+    c = s.constraints[cid]
+    P = s.X[i:i + 1]
+    coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+    return float(np.asarray(c.formula.values(s.param_env(), coords, 1)).ravel()[0])
+
+
+def constraint_normal(session, i, cid):
+    """Unit normal (3,) of constraint ``cid`` at vertex ``i``."""
+    s = session.surface
+    c = s.constraints[cid]
+    P = s.X[i:i + 1]
+    coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+    g = np.asarray(c.formula.gradient(s.param_env(), coords, 1), float).reshape(-1)[:s.sdim]
+    n = np.linalg.norm(g)
+    return g / n if n > 0 else g
+
+
+def element_attr(session, base, name, idx):
+    """Value of attribute ``name`` of element ``base`` (an ElemRef), or
+    :data:`MISSING` when the name is not one of this module's."""
+    s = session.surface
+    k, i = base.kind, base.i
+    if name in INTERNAL:
+        raise UnsupportedError(f"the internal attribute {name}",
+                               "the Evolver's own data structure")
+    if (k, name) in GRAPHICS:
+        key = (k, _GRAPHICS_ALIAS.get(name, name))
+        return float(_session_store(session).get(key, {}).get(i, GRAPHICS[(k, name)]))
+    if (k, name) in FLAGS_DEFAULT:
+        return FLAGS_DEFAULT[(k, name)]
+    if name == "bare":
+        if k in ("facet", "body"):
+            raise ExpressionError("No bareness for facets or bodies.")
+        return float(_session_store(session).get((k, "bare"), {}).get(i, 0.0))
+    if k == "vertex":
+        if name in MOTION:
+            raise UnsupportedError(f"vertex {name}", "the motion of the last g step is not "
+                                   "kept per vertex")
+        if name == "mean_curvature":
+            _no_string(s, name)
+            return float(cache(session).get(session, name, GA.vertex_mean_curvature)[i])
+        if name == "sqcurve":
+            _no_string(s, name)
+            nc = bool(session.toggles.get("normal_curvature", 0))
+            arr = cache(session).get(session, f"sqcurve{int(nc)}",
+                                     lambda ss, tt: GA.vertex_sqcurve(ss, tt, nc))
+            return float(arr[i])
+        if name == "dihedral":
+            if not s.string:
+                raise ExpressionError("Dihedral only for edges.")
+            return float(cache(session).get(session, "vdihedral",
+                                            GA.string_vertex_dihedral)[i])
+        if name == "value_of_constraint":
+            return constraint_value(session, i, _constraint_id(session, idx, name))
+        if name == "constraint" and idx is not None:
+            return ConstraintAt(i, _constraint_id(session, idx, "constraint[n]"))
+    elif k == "edge":
+        if name == "dihedral":
+            if s.string:
+                return 0.0
+            return float(cache(session).get(session, "edihedral", GA.edge_dihedral)[i])
+        if name in ("x", "y", "z", "x1", "x2", "x3", "edge_vector"):
+            vec = geometry(session).edge_vec[i, :s.sdim] * base.sign
+            if name == "edge_vector" or (name == "x" and idx is not None):
+                return _component(vec, idx, name)
+            return _component(vec, _coord_index(name, s), name)
+        if name == "length":
+            return float(geometry(session).edge_length[i])
+        if name == "midv":
+            raise ExpressionError("Cannot do MIDV except in QUADRATIC model.")
+        if name in ("frontbody", "backbody") and not s.string:
+            raise ExpressionError("Frontbody or backbody only for facets, or string model "
+                                  "edges.")
+        if name == "wrap":
+            return float(_torus_wrap(s, i))
+    elif k == "facet":
+        if s.string:
+            return MISSING
+        if name in ("x", "y", "z", "x1", "x2", "x3", "facet_normal"):
+            vec = _facet_normal(session, i) * base.sign
+            if name == "facet_normal" or (name == "x" and idx is not None):
+                return _component(vec, idx, name)
+            return _component(vec, _coord_index(name, s), name)
+        if name == "area":
+            return float(geometry(session).facet_area[i])
+    elif k == "body":
+        if name == "volfixed":
+            return float(not np.isnan(s.bodies.target[i]))
+        if name in ("actual_volume",):
+            raise ExpressionError(f"\"{name}\" is not an attribute name (it is read from "
+                                  f"the datafile only)")
+    return MISSING
+
+
+def _no_string(s, name):
+    if s.string:
+        raise UnsupportedError(f"vertex {name} in the string model")
+
+
+def _coord_index(name, s):
+    j = {"x": 1, "y": 2, "z": 3, "x1": 1, "x2": 2, "x3": 3}[name]
+    if j > s.sdim:
+        raise ExpressionError("Coordinate dimension exceeds space dimension.")
+    return j
+
+
+def _facet_normal(session, i):
+    s = session.surface
+    if s.periods is None and s.sdim == 3:
+        a, b, c = s.X[s.F[i]]                  # (side 1) x (side 2), REF's order
+        return 0.5 * np.cross(b - a, c - b)
+    return 0.5 * geometry(session).facet_N2[i, :s.sdim]
+
+
+def _torus_wrap(s, i):
+    """The Evolver's torus wrap code of edge ``i``: +x 1, -x 31, +y 64,
+    -y 1984, +z 4096, -z 127040, summed."""
+    w = s.eattr.get("wrap")
+    if w is None or s.periods is None:
+        return 0
+    row = np.asarray(w[i]).ravel()
+    plus = (1, 64, 4096)
+    minus = (31, 1984, 127040)
+    code = 0
+    for d, v in enumerate(row[:3]):
+        v = int(v)
+        if v > 0:
+            code += plus[d] * v
+        elif v < 0:
+            code += minus[d] * (-v)
+    return code
+
+
+def set_element_attr(session, base, name, idx, value):
+    """Assign a graphics-only attribute or ``bare``; refuse the flags that
+    would change numbers.  Returns True when handled."""
+    k, i = base.kind, base.i
+    if (k, name) in GRAPHICS:
+        key = (k, _GRAPHICS_ALIAS.get(name, name))
+        _session_store(session).setdefault(key, {})[i] = float(value)
+        return True
+    if name == "bare" and k in ("vertex", "edge"):
+        _session_store(session).setdefault((k, "bare"), {})[i] = float(bool(value))
+        return True
+    if name in SET_REFUSED and (k, name) in FLAGS_DEFAULT or name in SET_REFUSED:
+        if float(value) == FLAGS_DEFAULT.get((k, name), np.nan):
+            return True                           # setting the default changes nothing
+        raise UnsupportedError(f"set {k} {name}", SET_REFUSED[name])
+    if name in INTERNAL or name in MOTION or name in ("mean_curvature", "sqcurve",
+                                                      "dihedral", "volfixed", "valence",
+                                                      "facet_normal", "value_of_constraint"):
+        raise ExpressionError(f"{k} attribute '{name}' is read-only")
+    return False
+
+
+def is_flag(kind, name):
+    """Whether ``set gen name`` / ``unset gen name`` (no value) sets or
+    clears a boolean attribute of this module."""
+    return ((kind, name) in GRAPHICS and GRAPHICS[(kind, name)] in (0.0, 1.0)
+            and name != "opacity") or (kind, name) in FLAGS_DEFAULT and \
+        name not in ("orientation", "phase") or (name == "bare" and kind in ("vertex", "edge"))
+
+
+class ConstraintAt:
+    """``vv.constraint[n]``: constraint n seen from a vertex (its ``normal``)."""
+
+    __slots__ = ("i", "cid")
+
+    def __init__(self, i, cid):
+        self.i = i
+        self.cid = cid
+
+
+def constraint_attr(session, base, name, idx):
+    """``vertex[i].constraint[n].normal`` (vector or one component)."""
+    if name != "normal":
+        raise ExpressionError(f"constraint[{base.cid}] has no attribute '{name}' "
+                              f"(only .normal)")
+    if idx is not None and not isinstance(idx, tuple):
+        from .interpreter import as_int
+        idx = as_int(idx, "the index of 'normal'")
+    return _component(constraint_normal(session, base.i, base.cid), idx, "normal")
+
+
+def on_quantity(session, base, name, arg):
+    """``on_quantity q`` / ``on_method_instance m``: whether the element
+    contributes to the quantity (to one of its method instances)."""
+    from .interpreter import ElemRef, QRef
+    if not isinstance(base, ElemRef):
+        raise ExpressionError(f"'{name}' needs an element")
+    s = session.surface
+    if not isinstance(arg, QRef):
+        raise ExpressionError(f"{name} needs a quantity or method instance name "
+                              f"(for example: ff.{name} myquant)")
+    q = s.quantities[arg.name]
+    if name == "on_method_instance" and q.kind != "instance":
+        raise ExpressionError(f"'{arg.name}' is a quantity, not a method instance")
+    if name == "on_quantity" and q.kind == "instance":
+        raise ExpressionError(f"'{arg.name}' is a method instance, not a quantity")
+    for m, etype, idx, _sign in q.methods:
+        if m.is_global:            # REF: global methods mark no elements
+            continue
+        if etype == base.kind and base.i in np.asarray(idx).tolist():
+            return 1.0
+    return 0.0
+
+
+def element_quantity_value(session, base, qname):
+    """``ff.qname``: the element's contribution to a named quantity (or
+    method instance): Σ over the quantity's methods on elements of this kind
+    of modulus × value (× orientation), times the quantity's modulus."""
+    from ..methods import method_info
+    s = session.surface
+    q = s.quantities[qname]
+    if q.function is not None:
+        raise UnsupportedError(f"per-element values of the FUNCTION quantity {qname}")
+    kind = base.kind
+
+    def values(ss, tt):
+        out = np.zeros(session.count(kind))
+        for m, etype, idx, sign in q.methods:
+            if etype != kind:
+                continue
+            _, fn = method_info(m.method)
+            idx = np.asarray(idx, np.int64)
+            vals = np.asarray(fn(tt, m, idx), float)
+            if sign is not None:
+                vals = vals * sign
+            np.add.at(out, idx, m.modulus * vals)
+        return q.modulus * out
+
+    return float(cache(session).get(session, f"quantity:{qname}:{kind}", values)[base.i])
