@@ -13,12 +13,12 @@ and what evolver-nox-d prints (checked in tests/test_attributes.py):
 * vertex ``mean_curvature``: ``h = 3 F·N / (2 N·N)`` with ``F`` the area
   gradient at the vertex and ``N`` the sum of its facets' area vectors
   (``N = Σ ½ N_f``), both projected onto the tangent space of the vertex's
-  level-set constraints and parametric boundary; signed (positive where the
+  level-set constraints (not of a parametric boundary); signed (positive where the
   surface curves towards its normals); every vertex, FIXED ones included.
 * vertex ``sqcurve``: ``h²`` with the ``sq_mean_curvature`` method's
-  estimate ``h = 3|F| / (2A)`` (``A`` the star area; the
-  ``normal_sq_mean_curvature`` estimate ``h = 3 F·F / (2 F·N)`` when the
-  ``normal_curvature`` toggle is on), zero at FIXED vertices and vertices
+  estimate ``h = 3|F| / (2A)`` (``A`` the star area; ``3|F| / (2|N|)``
+  with the ``effective_area`` toggle on, the ``normal_sq_mean_curvature``
+  estimate ``h = 3 F·F / (2 F·N)`` with ``normal_curvature`` on), zero at FIXED vertices and vertices
   on parametric boundaries, as that method.
 * edge ``dihedral``: the angle between the unit normals of the edge's two
   facets, oriented alike across the edge; 0 unless there are exactly two.
@@ -54,8 +54,20 @@ def star_sums_projected(s, t):
         raise UnsupportedError("curvature attributes (mean_curvature, sqcurve) in the "
                                "torus model")
     A, F, N = star_sums(t)
-    F, N = project_tangent(s, [F, N])
+    if s.vcon:                  # level-set constraints only (REF: not boundaries)
+        F, N = project_tangent(_WithoutBoundaries(s), [F, N])
     return A, F, N
+
+
+class _WithoutBoundaries:
+    """A view of a surface whose vertices are on no parametric boundary."""
+
+    def __init__(self, s):
+        self._s = s
+        self.vattr = {k: v for k, v in s.vattr.items() if k != "boundary"}
+
+    def __getattr__(self, name):
+        return getattr(self._s, name)
 
 
 def vertex_mean_curvature(s, t):
@@ -68,17 +80,22 @@ def vertex_mean_curvature(s, t):
     return np.nan_to_num(h)
 
 
-def vertex_sqcurve(s, t, normal_curvature=False):
+def vertex_sqcurve(s, t, mode="plain"):
     """(nv,) the ``sqcurve`` attribute: the squared mean curvature estimate
-    of ``sq_mean_curvature`` (``normal_sq_mean_curvature`` when
-    ``normal_curvature``), zero at FIXED and boundary vertices."""
+    of ``sq_mean_curvature`` (``mode`` "plain"), of
+    ``eff_area_sq_mean_curvature`` ("eff", the ``effective_area`` toggle) or
+    of ``normal_sq_mean_curvature`` ("norm", the ``normal_curvature``
+    toggle), zero at FIXED and boundary vertices."""
     A, F, N = star_sums_projected(s, t)
     FF = np.einsum("ij,ij->i", F, F)
     with np.errstate(all="ignore"):
-        if normal_curvature:
+        if mode == "norm":
             FN = np.einsum("ij,ij->i", F, N)
             h = np.where(FN != 0, 1.5 * FF / FN, 0.0)
             h2 = h * h
+        elif mode == "eff":
+            NN = np.einsum("ij,ij->i", N, N)
+            h2 = np.where(NN > 0, 2.25 * FF / NN, 0.0)
         else:
             h2 = np.where(A > 0, 2.25 * FF / (A * A), 0.0)
     h2 = np.nan_to_num(h2)
@@ -102,8 +119,8 @@ def edge_dihedral(s, t):
     if not len(e):
         return out
     fa, fb = ef[e, 0], ef[e, 1]
-    sa = np.sign(s.FE[fa, ek[e, 0]])
-    sb = np.sign(s.FE[fb, ek[e, 1]])
+    sa = np.where(s.FE[fa, ek[e, 0]] >= 0, 1.0, -1.0)      # ~e encodes a reversed edge
+    sb = np.where(s.FE[fb, ek[e, 1]] >= 0, 1.0, -1.0)
     Na = t.facet_N2[fa]
     Nb = t.facet_N2[fb] * (-sa * sb)[:, None]        # opposite senses: consistent
     with np.errstate(all="ignore"):

@@ -71,7 +71,10 @@ ATTRIBUTES = [
     ("vertex", "dihedral", "string model: 2 asin(|F|/2) with unit tensions, clamped to π "
      "(REF); soapfilm model: REF's error \"Dihedral only for edges\""),
     ("edge", "dihedral", "supported: angle between the two facets' normals, 0 unless "
-     "exactly two facets"),
+     "exactly two facets (REF's error in the string model); coplanar facets give 0 where "
+     "REF's round-off gives up to 3e-8"),
+    ("vertex", "mean_curvature, sqcurve (string model)", "refused by name (REF's string "
+     "formula was not reproduced)"),
     ("vertex", "value_of_constraint n", "supported: the constraint's formula at the vertex"),
     ("vertex", "constraint[n].normal", "supported: the constraint's unit normal at the "
      "vertex (vector, or one component with [i])"),
@@ -190,9 +193,11 @@ def element_attr(session, base, name, idx):
             return float(cache(session).get(session, name, GA.vertex_mean_curvature)[i])
         if name == "sqcurve":
             _no_string(s, name)
-            nc = bool(session.toggles.get("normal_curvature", 0))
-            arr = cache(session).get(session, f"sqcurve{int(nc)}",
-                                     lambda ss, tt: GA.vertex_sqcurve(ss, tt, nc))
+            tg = session.toggles
+            mode = ("norm" if tg.get("normal_curvature") else
+                    "eff" if tg.get("effective_area") else "plain")
+            arr = cache(session).get(session, f"sqcurve_{mode}",
+                                     lambda ss, tt: GA.vertex_sqcurve(ss, tt, mode))
             return float(arr[i])
         if name == "dihedral":
             if not s.string:
@@ -206,7 +211,7 @@ def element_attr(session, base, name, idx):
     elif k == "edge":
         if name == "dihedral":
             if s.string:
-                return 0.0
+                raise ExpressionError("Dihedral only for vertices.")
             return float(cache(session).get(session, "edihedral", GA.edge_dihedral)[i])
         if name in ("x", "y", "z", "x1", "x2", "x3", "edge_vector"):
             vec = geometry(session).edge_vec[i, :s.sdim] * base.sign
@@ -217,9 +222,11 @@ def element_attr(session, base, name, idx):
             return float(geometry(session).edge_length[i])
         if name == "midv":
             raise ExpressionError("Cannot do MIDV except in QUADRATIC model.")
-        if name in ("frontbody", "backbody") and not s.string:
-            raise ExpressionError("Frontbody or backbody only for facets, or string model "
-                                  "edges.")
+        if name in ("frontbody", "backbody"):
+            if not s.string:
+                raise ExpressionError("Frontbody or backbody only for facets, or string "
+                                      "model edges.")
+            return float(_string_edge_body(session, base, name))
         if name == "wrap":
             return float(_torus_wrap(s, i))
     elif k == "facet":
@@ -239,6 +246,20 @@ def element_attr(session, base, name, idx):
             raise ExpressionError(f"\"{name}\" is not an attribute name (it is read from "
                                   f"the datafile only)")
     return MISSING
+
+
+def _string_edge_body(session, base, name):
+    """String model: the body of the facet running along the edge
+    (``frontbody``) or against it (``backbody``); 0 when there is none."""
+    from ..string_model import facets_of_edge
+    s = session.surface
+    want = (1 if name == "frontbody" else -1) * base.sign
+    for f, g in facets_of_edge(s, base.i):
+        if g == want:
+            col = s.bodies.facet_matrix[:, f].tocoo()
+            for b, v in zip(col.row, col.data):
+                return int(b) + 1
+    return 0
 
 
 def _no_string(s, name):
