@@ -1400,6 +1400,9 @@ class Session(SessionAPI):
 
     def _quantity_attr(self, qname, name):
         q = self.surface.quantities[qname]
+        if q.kind == "instance" and name not in ("value", "modulus"):
+            raise ExpressionError(f"method instance {qname} has no attribute '{name}' "
+                                  f"(possible method instance attributes: value, modulus)")
         if name == "value":
             return float(self.totals.quantity_values[qname])
         if name == "target":
@@ -1410,7 +1413,8 @@ class Session(SessionAPI):
             return float(q.pressure)
         if name == "tolerance":
             return float(q.tolerance)
-        raise ExpressionError(f"quantity has no attribute '{name}'")
+        from .commands import attributes as A
+        return A.quantity_attr(self, q, name)
 
     def set_attr(self, base, name, idx, value):
         if idx is not None:

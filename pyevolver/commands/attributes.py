@@ -400,3 +400,53 @@ def element_quantity_value(session, base, qname):
         return q.modulus * out
 
     return float(cache(session).get(session, f"quantity:{qname}:{kind}", values)[base.i])
+
+
+QUANTITY_KINDS = ("fixed", "energy", "info_only", "conserved")
+
+
+def quantity_attr(session, q, name):
+    """Quantity attributes beyond value/target/modulus/pressure/tolerance:
+    the kind flags ``fixed``, ``energy``, ``info_only``, ``conserved`` (0/1)
+    and ``volconst`` (0: pyevolver's quantities have none)."""
+    if name in QUANTITY_KINDS:
+        return float(q.kind == name)
+    if name == "volconst":
+        return 0.0
+    if name in ("parameter_1", "element_modulus"):
+        raise UnsupportedError(f"quantity attribute {name} in commands",
+                               "method parameters are read from the datafile only")
+    what = "method instance" if q.kind == "instance" else "quantity"
+    raise ExpressionError(f"{what} {q.name} has no attribute '{name}' (expected value, "
+                          f"target, modulus, pressure, tolerance, fixed, energy, info_only, "
+                          f"conserved)")
+
+
+def set_quantity(session, qname, attr, value):
+    """``set q target|modulus|tolerance value`` and ``set q
+    fixed|energy|info_only|conserved`` (the manual's SET quantityname forms);
+    a method instance takes only ``modulus``."""
+    from .interpreter import as_float
+    s = session.surface
+    q = s.quantities[qname]
+    if q.kind == "instance":
+        if attr != "modulus":
+            raise ExpressionError(f"set {qname}: a method instance has only a settable "
+                                  f"modulus")
+    if attr in QUANTITY_KINDS:
+        if value is not None:
+            raise ExpressionError(f"set {qname} {attr} takes no value")
+        if q.kind == "instance":
+            raise ExpressionError(f"set {qname} {attr}: {qname} is a method instance")
+        q.kind = attr
+        return
+    if attr in ("target", "modulus", "tolerance"):
+        if value is None:
+            raise ExpressionError(f"set {qname} {attr} needs a value")
+        setattr(q, attr, as_float(value, f"{qname}.{attr}"))
+        return
+    if attr == "volconst":
+        raise UnsupportedError("quantity volconst")
+    raise ExpressionError(f"set {qname}: '{attr}' is not a settable quantity attribute "
+                          f"(expected target, modulus, tolerance, fixed, energy, info_only "
+                          f"or conserved)")

@@ -580,6 +580,10 @@ class _CmdTransformer(ExprTransformer):
     def array_ref(self, name, *idx):
         return ArrayRef(str(name), list(idx))
 
+    def string_concat(self, *parts):
+        # "a" "b": adjacent literals are one string, as in C and the Evolver
+        return N.Str("".join(p.value for p in parts))
+
     def sprintf_expr(self, _s, *args):
         return Sprintf(list(args))
 
@@ -1483,8 +1487,24 @@ class Interpreter:
                                f"list vertex[3] or list facets where area > 0.1)")
         self.session.list_elements(node[1], self.env)
 
+    def _quantity_gen(self, gen):
+        """The quantity or method instance a ``set``/``unset`` names, if any."""
+        s = self.session.surface
+        if gen.base[0] == "var" and s is not None and gen.base[1] in s.quantities \
+                and self._var_elem(gen.base[1]) is None:
+            return gen.base[1]
+        return None
+
     def _x_set(self, node):
         idx = node[4] if len(node) > 4 else None
+        qname = self._quantity_gen(node[1])
+        if qname is not None:
+            from .attributes import set_quantity
+            if node[1].where is not None or node[1].var is not None or idx is not None:
+                raise CommandError(f"set {qname}: expected set {qname} attribute [value]")
+            value = None if node[3] is None else self.value(node[3])
+            set_quantity(self.session, qname, node[2], value)
+            return
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=False, idx=idx)
 
     def _x_fix(self, node):
@@ -1581,6 +1601,10 @@ class Interpreter:
         raise CommandError("Command aborted (abort).")
 
     def _x_unset(self, node):
+        qname = self._quantity_gen(node[1])
+        if qname is not None:
+            raise CommandError(f"unset {qname}: a quantity is not an element (REF: syntax "
+                               f"error); use unfix {qname} or set {qname} info_only")
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=True)
 
     def _x_refine(self, node):
