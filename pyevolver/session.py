@@ -1356,13 +1356,14 @@ class Session(SessionAPI):
             if name == "volume":
                 return float(t.volumes[i])
             if name == "target":
-                return float(b.target[i]) if not math.isnan(b.target[i]) else 0.0
+                return float(b.target[i]) if not math.isnan(b.target[i]) else \
+                    A.unset_value(self, i, "target", 0.0)
             if name == "volconst":
                 return float(b.volconst[i])
             if name == "pressure":
                 if not math.isnan(b.pressure[i]):
                     return float(b.pressure[i])
-                return float(b.lagrange[i])
+                return A.unset_value(self, i, "pressure", float(b.lagrange[i]))
             if name == "density":
                 return float(b.density[i])
             if name == "fixed":
@@ -1500,6 +1501,8 @@ class Session(SessionAPI):
                     if key in attrs:
                         attrs[key][i] = int(value)
             elif name == "frontcolor":
+                if k == "facet" and "backcolor" not in attrs:    # the back keeps its colour
+                    attrs["backcolor"] = attrs["color"].copy()
                 for key in ("color", "frontcolor"):
                     if key in attrs:
                         attrs[key][i] = int(value)
@@ -1534,18 +1537,18 @@ class Session(SessionAPI):
                 self.set_attr(el, attr, None, 0.0 if unset else 1.0)
             return
         if unset:
+            if attr == "boundary" and expr is not None:
+                A.unset_boundary(self, els, self.interp.value(expr))
+                return
             if attr in ("constraint",) and expr is not None:
                 self.unset_constraint(els, int(self.interp.value(expr)))
                 return
-            if attr == "target" and gen.kind == "body":
+            if attr in ("target", "pressure") and gen.kind == "body":
                 b = self.surface.bodies
-                for el in els:
-                    b.target[el.i] = np.nan
-                return
-            if attr == "pressure" and gen.kind == "body":
-                b = self.surface.bodies
-                for el in els:
-                    b.pressure[el.i] = np.nan
+                arr = getattr(b, attr)
+                for el in els:      # REF still prints the old value (volfixed 0)
+                    A.remember_unset(self, el.i, attr, arr[el.i])
+                    arr[el.i] = np.nan
                 return
             if (gen.kind, attr) in self.surface.extra:
                 for el in els:

@@ -309,6 +309,12 @@ def set_element_attr(session, base, name, idx, value):
         key = (k, _GRAPHICS_ALIAS.get(name, name))
         _session_store(session).setdefault(key, {})[i] = float(value)
         return True
+    if k == "vertex" and name in ("p1", "p2", "p3", "p4") or (k == "vertex" and name == "p"
+                                                            and idx is not None):
+        return _set_parameter(session, i, name, idx, value)
+    if name == "boundary":
+        raise UnsupportedError(f"set {k} boundary", "putting elements on a parametric "
+                               "boundary at run time")
     if name == "bare" and k in ("vertex", "edge"):
         _session_store(session).setdefault((k, "bare"), {})[i] = float(bool(value))
         return True
@@ -450,3 +456,61 @@ def set_quantity(session, qname, attr, value):
     raise ExpressionError(f"set {qname}: '{attr}' is not a settable quantity attribute "
                           f"(expected target, modulus, tolerance, fixed, energy, info_only "
                           f"or conserved)")
+
+
+def _set_parameter(session, i, name, idx, value):
+    """``set vertex p1 expr``: a boundary vertex's parameter; the vertex
+    moves to its new place on the boundary at once (REF)."""
+    from ..surface import boundary_eval
+    s = session.surface
+    bnd = s.vattr.get("boundary")
+    if bnd is None or not bnd[i]:
+        raise ExpressionError(f"vertex {int(s.ids('vertex')[i])} is on no parametric "
+                              f"boundary: it has no parameter {name}")
+    j = int(idx) if name == "p" else int(name[1])
+    b = s.boundaries[int(bnd[i])]
+    if j < 1 or j > b.nparams:
+        raise ExpressionError(f"boundary {b.id} has {b.nparams} parameter(s), not p{j}")
+    if not np.isfinite(value):
+        raise ExpressionError(f"boundary parameters must be finite numbers, got {value:g}")
+    P = s.vattr["params"]
+    P[i, j - 1] = float(value)
+    X, _ = boundary_eval(s, int(bnd[i]), P[i:i + 1])
+    if not np.all(np.isfinite(X)):
+        raise ExpressionError(f"boundary {b.id} at p{j} = {value:g} is not a finite point")
+    s.X[i, :X.shape[1]] = X[0]
+    cache(session).touch()
+    return True
+
+
+def unset_boundary(session, els, bid):
+    """``unset vertex|edge|facet boundary n``: the elements leave boundary n
+    (vertices keep their place and become free)."""
+    s = session.surface
+    from .interpreter import as_int
+    bid = as_int(bid, "a boundary number")
+    if bid not in s.boundaries:
+        raise ExpressionError(f"unset ... boundary {bid}: boundary {bid} is not defined")
+    for el in els:
+        attrs = {"vertex": s.vattr, "edge": s.eattr, "facet": s.fattr}.get(el.kind)
+        if attrs is None:
+            raise ExpressionError("unset boundary applies to vertices, edges and facets")
+        b = attrs.get("boundary")
+        if b is not None and b[el.i] == bid:
+            b[el.i] = 0
+
+
+def remember_unset(session, i, attr, value):
+    """``unset body target|pressure``: REF keeps printing the value it had."""
+    if not np.isnan(value):
+        _session_store(session).setdefault(("body", attr + "_unset"), {})[i] = \
+            (session.surface, float(value))
+
+
+def unset_value(session, i, attr, default):
+    """The value a body's unset target or pressure still reads as (REF), or
+    ``default``."""
+    hit = _session_store(session).get(("body", attr + "_unset"), {}).get(i)
+    if hit is None or hit[0] is not session.surface:
+        return default
+    return hit[1]

@@ -708,6 +708,10 @@ class _CmdTransformer(ExprTransformer):
     def bare_arg(self, name, expr):
         return ("bare", str(name), expr)
 
+    def set_background(self, _s, _b, expr):
+        # the graphics window's background colour: no effect without graphics
+        return ("seq", [])
+
     def graphics(self, tok):
         return ("seq", [])
 
