@@ -167,16 +167,22 @@ class AttrCache:
         self._geo = None
         self._born = None
 
-    def touch(self):
-        """Coordinates changed: forget every array."""
+    def touch(self, session):
+        """Coordinates changed: forget every array (and note that the
+        session's totals no longer describe the coordinates)."""
+        self._note_born(session)
         self.version += 1
+
+    def _note_born(self, session):
+        t = session.totals
+        if self._born is None or self._born[0] is not t:
+            self._born = (t, self.version)
 
     def geometry(self, session):
         """A :class:`Totals` of the current coordinates: the session's own
         when no coordinate changed since it was made, else a fresh one."""
         t = session.totals
-        if self._born is None or self._born[0] is not t:
-            self._born = (t, self.version)
+        self._note_born(session)
         if self._born[1] == self.version:
             return t
         s = session.surface

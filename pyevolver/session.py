@@ -1466,7 +1466,7 @@ class Session(SessionAPI):
             if not math.isfinite(value):
                 raise CommandError(f"vertex coordinates must be finite numbers, got {value:g}")
             s.X[i, j] = value
-            A.cache(self).touch()           # attributes read the live coordinates
+            A.cache(self).touch(self)           # attributes read the live coordinates
             return
         if k == "body":
             b = s.bodies

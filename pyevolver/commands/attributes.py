@@ -63,45 +63,62 @@ MOTION = {"v_force", "v_velocity", "v_oldx"}
 # documentation table: (kinds, name, status)
 ATTRIBUTES = [
     ("vertex", "mean_curvature", "supported: 3 F·N/(2 N·N), F the area gradient and N the "
-     "area-vector sum of the star, both projected onto the vertex's constraints and "
-     "boundary (REF's values; torus refused by name)"),
+     "area-vector sum of the star, both projected onto the vertex's level-set constraints "
+     "(not onto parametric boundaries), FIXED vertices included (REF's values; the torus "
+     "model refused by name)"),
     ("vertex", "sqcurve", "supported: h² of `sq_mean_curvature` (of "
-     "`normal_sq_mean_curvature` with `normal_curvature` on), 0 at FIXED and boundary "
-     "vertices, as REF"),
-    ("vertex", "dihedral", "string model: 2 asin(|F|/2) with unit tensions, clamped to π "
-     "(REF); soapfilm model: REF's error \"Dihedral only for edges\""),
+     "`eff_area_sq_mean_curvature` with `effective_area` on, of `normal_sq_mean_curvature` "
+     "with `normal_curvature` on), 0 at FIXED and boundary vertices, as REF"),
+    ("vertex", "mean_curvature, sqcurve (string model)", "refused by name (REF's string "
+     "formula was not reproduced)"),
+    ("vertex", "dihedral", "string model: 2 asin(F/2), F the length of the sum of the unit "
+     "edge vectors, clamped to π (REF); soapfilm model: REF's error \"Dihedral only for "
+     "edges\""),
     ("edge", "dihedral", "supported: angle between the two facets' normals, 0 unless "
      "exactly two facets (REF's error in the string model); coplanar facets give 0 where "
      "REF's round-off gives up to 3e-8"),
-    ("vertex", "mean_curvature, sqcurve (string model)", "refused by name (REF's string "
-     "formula was not reproduced)"),
     ("vertex", "value_of_constraint n", "supported: the constraint's formula at the vertex"),
     ("vertex", "constraint[n].normal", "supported: the constraint's unit normal at the "
      "vertex (vector, or one component with [i])"),
+    ("vertex", "p1, p2", "read and set: setting moves the vertex on its boundary at once "
+     "(REF); `set vertex boundary n` refused by name, `unset vertex/edge/facet boundary n` "
+     "supported"),
     ("facet", "facet_normal, x, y, z, x1..x3, x[i]", "supported (length = facet area)"),
     ("edge", "edge_vector, x, y, z, x1..x3, x[i]", "supported"),
     ("edge, facet", "length, area", "supported, from the live coordinates (a `set` of "
      "coordinates earlier in the same command counts, as in REF)"),
-    ("body", "volfixed", "supported"),
+    ("edge", "wrap", "supported (REF's torus code: +x 1, -x 31, +y 64, -y 1984, +z 4096, "
+     "-z 127040)"),
+    ("body", "volfixed", "supported; after `unset body target` (or `pressure`) the body "
+     "still prints its old target (pressure), as REF"),
+    ("vertex, edge, facet", "on_quantity q, on_method_instance m", "supported (global "
+     "methods mark no elements, as REF)"),
+    ("vertex, edge, facet", "named quantity or method instance as attribute (`ff.qname`)",
+     "supported: the element's contribution (0 on elements the quantity does not cover); "
+     "FUNCTION quantities refused by name"),
     ("quantity", "value, target, modulus, pressure, tolerance, fixed, energy, info_only, "
-     "conserved", "supported (`target`, `modulus`, `tolerance` assignable)"),
+     "conserved", "supported; `target`, `modulus`, `tolerance` assignable (`q.target := 2`, "
+     "`set q target 2`), `set q fixed|energy|info_only|conserved`; `volconst` reads 0, "
+     "setting it is refused by name; `parameter_1`, `element_modulus` refused by name"),
+    ("method instance", "value, modulus", "supported (`set inst modulus 2`); other "
+     "attributes rejected as REF"),
     ("facet, edge, body", "opacity, no_display / nodisplay, no_transform, centerofmass",
      "graphics only: read and set, no effect"),
     ("vertex, edge, facet, body", "mid_edge, mid_facet, axial_point, triple_point, "
      "tetra_point, no_hessian_normal, noncontent, orientation (facet), phase",
-     "read as their defaults (0; orientation 1); setting refused by name (they change "
-     "numbers: effective_area, hessian_normal, volumes, phases)"),
+     "read as their defaults (0; orientation 1); setting another value refused by name "
+     "(they change numbers: effective_area, hessian_normal, volumes, phases)"),
     ("vertex, edge", "bare", "read and set (bare on datafile lines is not kept by the "
-     "reader: reads 0)"),
+     "datafile reader: it reads 0)"),
     ("vertex", "v_force, v_velocity, v_oldx", "refused by name (the iterator keeps no "
      "per-vertex motion of the last step)"),
     ("vertex, edge, facet", "v_/e_/f_constraint_list, v_/e_/f_method_list, f_body_list, "
      "f_next_bfacet, wrap_list, raw_velocity", "refused by name (the Evolver's internal "
      "data structure)"),
     ("edge", "midv", "REF's error: only in the quadratic model"),
-    ("edge", "frontbody, backbody", "string model only (REF's error in the soapfilm model)"),
+    ("edge", "frontbody, backbody", "string model: the bodies of the facets along and "
+     "against the edge; soapfilm model: REF's error"),
     ("facet", "bare", "REF's error: no bareness for facets or bodies"),
-    ("vertex, edge, facet", "named quantity as attribute (`ff.qname`)", "refused by name"),
 ]
 
 
@@ -479,7 +496,7 @@ def _set_parameter(session, i, name, idx, value):
     if not np.all(np.isfinite(X)):
         raise ExpressionError(f"boundary {b.id} at p{j} = {value:g} is not a finite point")
     s.X[i, :X.shape[1]] = X[0]
-    cache(session).touch()
+    cache(session).touch(session)
     return True
 
 
