@@ -1483,6 +1483,8 @@ class Session(SessionAPI):
                 return
             if name == "density":
                 b.density[i] = value
+                if value:           # REF: a body density switches gravity on
+                    self.toggles["gravity"] = 1
                 return
         if k == "facet" and name in ("tension", "density"):
             s.fattr["tension"][i] = value

@@ -256,6 +256,9 @@ def element_attr(session, base, name, idx):
             return _component(vec, _coord_index(name, s), name)
         if name == "area":
             return float(geometry(session).facet_area[i])
+        if name == "no_refine":
+            nr = s.fattr.get("no_refine")
+            return float(bool(nr[i])) if nr is not None else 0.0
     elif k == "body":
         if name == "volfixed":
             return float(not np.isnan(s.bodies.target[i]))

@@ -279,8 +279,8 @@ class Aggregate(N.Node):
                 vals.append(as_float(self.expr.ev(env), f"the value of {self.op}()"))
         if self.op == "count":
             return float(len(vals))
-        if not vals:
-            return 0.0
+        if not vals:                # REF: max -1e38, min 1e38 over no elements
+            return {"max": -1e38, "min": 1e38}.get(self.op, 0.0)
         if self.op == "sum":
             return float(sum(vals))
         if self.op == "avg":
