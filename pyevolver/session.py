@@ -420,7 +420,8 @@ class Session(SessionAPI):
                 None if s is None else ({k: m.copy() for k, m in s.econ.items()},
                                         {k: m.copy() for k, m in s.fcon.items()},
                                         s.gravity_constant, s.sq_curvature_modulus),
-                self.filename)
+                self.filename,
+                {k: dict(v) for k, v in self.__dict__.get("_attr_store", {}).items()})
 
     def _iterator_state(self):
         it = self._iterator
@@ -430,8 +431,9 @@ class Session(SessionAPI):
 
     def _restore(self, snap):
         (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
-         fattr, vcon, surface, totals, it_state, more, filename) = snap
+         fattr, vcon, surface, totals, it_state, more, filename, attr_store) = snap
         self.filename = filename
+        self._attr_store = attr_store          # graphics-only attributes (commands.attributes)
         self.surface = surface
         self.totals = totals            # the energies of the restored coordinates
         if self._iterator is not None:

@@ -133,7 +133,12 @@ REJECTED = [
     ("qmound.fe", "print facet[1].bare", "No bareness"),
     ("qmound.fe", "print facet[1].normal", "facet has no attribute 'normal'"),
     ("qmound.fe", "print vertex[1].star_area", "vertex has no attribute 'star_area'"),
-    ("qmound.fe", "print vertex[1].area", "vertex has no attribute 'area'"),
+    ("qmound.fe", "print vertex[1].area", "Area only for facets"),
+    ("qmound.fe", "print edge[1].area", "Area only for facets"),
+    ("qmound.fe", "print vertex[1].length", "Length only for edges"),
+    ("qmound.fe", "print facet[1].volume", "Volume only for bodies"),
+    ("qmound.fe", "print edge[1].sqcurve", "Square mean curvature only for vertices"),
+    ("qmound.fe", "print facet[1].mean_curvature", "Mean_curvature only for vertices"),
     ("qmound.fe", "print body[1].actual_volume", "actual_volume"),
     ("slidestr.fe", "print edge[1].dihedral", "Dihedral only for vertices"),
 ]

@@ -122,6 +122,20 @@ ATTRIBUTES = [
 ]
 
 
+# attributes of one kind of element: REF's messages for the others
+_ONLY = {
+    "area": (("facet",), "Area only for facets."),
+    "length": (("edge",), "Length only for edges."),
+    "volume": (("body",), "Volume only for bodies."),
+    "sqcurve": (("vertex",), "Square mean curvature only for vertices."),
+    "mean_curvature": (("vertex",), "Mean_curvature only for vertices."),
+    "facet_normal": (("facet",), "\"facet_normal\" is a facet attribute."),
+    "edge_vector": (("edge",), "\"edge_vector\" is an edge attribute."),
+    "volfixed": (("body",), "\"volfixed\" is a body attribute."),
+    "value_of_constraint": (("vertex",), "\"value_of_constraint\" is a vertex attribute."),
+}
+
+
 def _session_store(session):
     st = session.__dict__.get("_attr_store")
     if st is None:
@@ -197,6 +211,9 @@ def element_attr(session, base, name, idx):
         return float(_session_store(session).get(key, {}).get(i, GRAPHICS[(k, name)]))
     if (k, name) in FLAGS_DEFAULT:
         return FLAGS_DEFAULT[(k, name)]
+    only = _ONLY.get(name)
+    if only is not None and k not in only[0] and (k, name) not in s.extra:
+        raise ExpressionError(only[1])
     if name == "bare":
         if k in ("facet", "body"):
             raise ExpressionError("No bareness for facets or bodies.")
