@@ -409,7 +409,7 @@ class Session(SessionAPI):
                                                     b.volconst.copy(), b.density.copy(),
                                                     b.lagrange.copy()),
                 None if s is None else {k: (q.target, q.modulus, q.kind, q.pressure,
-                                            q.tolerance)
+                                            q.tolerance, list(q.methods))
                                         for k, q in s.quantities.items()},
                 None if s is None else {k: v.copy() for k, v in s.extra.items()},
                 None if s is None else {k: v.copy() for k, v in s.vattr.items()},
@@ -455,9 +455,10 @@ class Session(SessionAPI):
             if bod is not None:
                 b = s.bodies
                 b.target, b.pressure, b.volconst, b.density, b.lagrange = bod
-            for k, (t, m, kind, p, tol) in qs.items():
+            for k, (t, m, kind, p, tol, methods) in qs.items():
                 q = s.quantities[k]
                 q.target, q.modulus, q.kind, q.pressure, q.tolerance = t, m, kind, p, tol
+                q.methods[:] = methods          # set/unset element membership
             s.extra = extra
             s.vattr = vattr
             s.eattr = eattr
@@ -1529,6 +1530,10 @@ class Session(SessionAPI):
     def set_elements(self, gen, attr, expr, env, unset, idx=None):
         from .commands import attributes as A
         els = self.generate(gen, env)
+        qname = A.membership_name(self, gen.kind, attr, expr)
+        if qname is not None:
+            A.set_membership(self, gen.kind, els, qname, not unset)
+            return
         if A.is_flag(gen.kind, attr) and (expr is None or unset):
             for el in els:         # boolean attributes: set = 1, unset = 0
                 self.set_attr(el, attr, None, 0.0 if unset else 1.0)

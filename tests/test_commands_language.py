@@ -193,6 +193,24 @@ print edge[1].ll
 print edge[1].on_method_instance ll
 print count(facet where on_method_instance aa, 1)
 print mix.info_only
+set aa modulus 1
+unset facet aa where id == 1
+recalc
+print aa.value
+print facet[1].aa
+set facet[1] aa
+recalc
+print aa.value
+set facet method_instance aa where id == 5
+recalc
+print aa.value
+print facet[5].on_method_instance aa
+unset facet ll
+unset edge ll where id == 1
+set edge ll where id == 1
+recalc
+print ll.value
+print mix.value
 """
 
 BOUNDARIES = """g 2
@@ -275,3 +293,19 @@ def test_rejected_by_the_reference_too(evolver, tmp_path):
         proc = subprocess.run([evolver, "-p1", example("qmound.fe")], input=cmd + "\nq\nq\n",
                               capture_output=True, text=True, timeout=60, cwd=str(tmp_path))
         assert "error" in (proc.stdout + proc.stderr).lower(), cmd
+
+
+def test_set_quantity_on_elements_it_cannot_apply_to_warns_as_reference(evolver, tmp_path):
+    """``set vertex quantity vol`` (a facet quantity): REF's WARNING 1569 once
+    per element, nothing changed."""
+    import subprocess
+    cmd = "set vertex quantity vol where id < 4\nprint vol.value\n"
+    proc = subprocess.run([evolver, "-p1", example("qmound.fe")], input=cmd + "q\nq\n",
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          timeout=60, cwd=str(tmp_path))
+    n_ref = proc.stdout.count("WARNING 1569")
+    code, out, err = run_pyevolver(example("qmound.fe"), cmd + "q\n", cwd=str(tmp_path))
+    assert n_ref == 3 and err.count("WARNING 1569: Quantity 'vol' has no methods applying "
+                                    "to this type element.") == n_ref
+    ref = run_reference(evolver, example("qmound.fe"), cmd, cwd=str(tmp_path))
+    assert _same(out, [l for l in ref if l.strip() and "WARNING" not in l])

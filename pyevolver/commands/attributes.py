@@ -96,6 +96,10 @@ ATTRIBUTES = [
     ("vertex, edge, facet", "named quantity or method instance as attribute (`ff.qname`)",
      "supported: the element's contribution (0 on elements the quantity does not cover); "
      "FUNCTION quantities refused by name"),
+    ("vertex, edge, facet", "set gen quantity q, set gen method_instance m, set gen q, "
+     "unset gen q", "supported: the elements join or leave the non-global methods of that "
+     "element kind (global ones unchanged, as REF); REF's WARNING 1569 per element when the "
+     "quantity has no method for that kind"),
     ("quantity", "value, target, modulus, pressure, tolerance, fixed, energy, info_only, "
      "conserved", "supported; `target`, `modulus`, `tolerance` assignable (`q.target := 2`, "
      "`set q target 2`), `set q fixed|energy|info_only|conserved`; `volconst` reads 0, "
@@ -551,3 +555,52 @@ def unset_value(session, i, attr, default):
     if hit is None or hit[0] is not session.surface:
         return default
     return hit[1]
+
+
+def membership_name(session, kind, attr, expr):
+    """The quantity or method instance a ``set gen [quantity] name`` /
+    ``unset gen name`` adds elements to or removes them from, or None."""
+    s = session.surface
+    if s is None or kind not in ("vertex", "edge", "facet") or (kind, attr) in s.extra:
+        return None
+    if attr in ("quantity", "method_instance", "method") and isinstance(expr, N.Var) \
+            and expr.name in s.quantities:
+        return expr.name
+    if attr in s.quantities and expr is None:
+        return attr
+    return None
+
+
+def set_membership(session, kind, els, qname, on):
+    """Put elements on a named quantity / method instance (``on``) or take
+    them off: its non-global methods of this element kind get or lose the
+    elements (orientation +1 for new ones); global methods are left as they
+    are, as REF does."""
+    s = session.surface
+    q = s.quantities[qname]
+    if q.function is not None:
+        raise UnsupportedError(f"set/unset elements on the FUNCTION quantity {qname}",
+                               "put them on its method instances")
+    which = [j for j, (m, etype, _idx, _sgn) in enumerate(q.methods) if etype == kind]
+    if not which:
+        if not on:
+            return
+        for _ in els:           # REF warns once per element
+            session.write_err(f"WARNING 1569: Quantity '{qname}' has no methods applying "
+                              f"to this type element.\n")
+        return
+    ids = np.array(sorted({el.i for el in els}), np.int64)
+    for j in which:
+        m, etype, idx, sgn = q.methods[j]
+        if m.is_global:         # on every element already; REF ignores unset
+            continue
+        idx = np.asarray(idx, np.int64)
+        sgn = np.ones(len(idx)) if sgn is None else np.asarray(sgn, float)
+        if on:
+            new = ids[~np.isin(ids, idx)]
+            idx = np.concatenate([idx, new])
+            sgn = np.concatenate([sgn, np.ones(len(new))])
+        else:
+            keep = ~np.isin(idx, ids)
+            idx, sgn = idx[keep], sgn[keep]
+        q.methods[j] = (m, etype, idx, sgn)
