@@ -30,13 +30,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import UnsupportedError
 
 
 def star_sums_projected(s, t):
     """Per-vertex star area ``A`` (nv,), area gradient ``F`` (nv, 3) and
     area-vector sum ``N`` (nv, 3), with ``F`` and ``N`` projected onto the
-    tangent spaces of the vertices' constraints and boundaries.
+    tangent spaces of the vertices' level-set constraints.
+
+    The facets' corners come from their first vertex and side vectors, so
+    facets that wrap round a torus are taken whole.
 
     Parameters
     ----------
@@ -48,12 +50,28 @@ def star_sums_projected(s, t):
     -------
     A, F, N : ndarray
     """
-    from .methods.curvature import star_sums
     from .surface import project_tangent
-    if s.periods is not None:
-        raise UnsupportedError("curvature attributes (mean_curvature, sqcurve) in the "
-                               "torus model")
-    A, F, N = star_sums(t)
+    nv = s.nv
+    A = np.zeros(nv)
+    F = np.zeros((nv, 3))
+    N = np.zeros((nv, 3))
+    if s.nf:
+        S = t.facet_S
+        P0 = t.facet_x0
+        P = [P0, P0 + S[:, 0], P0 + S[:, 1]]
+        N2 = t.facet_N2
+        L = np.linalg.norm(N2, axis=1)
+        with np.errstate(all="ignore"):
+            n = np.nan_to_num(N2 / L[:, None])
+        Fc = s.F
+        for c in range(3):
+            v = Fc[:, c]
+            e = P[(c + 2) % 3] - P[(c + 1) % 3]            # the side opposite corner c
+            g = 0.5 * np.cross(n, e)
+            A += np.bincount(v, weights=0.5 * L, minlength=nv)
+            for k in range(3):
+                F[:, k] += np.bincount(v, weights=g[:, k], minlength=nv)
+                N[:, k] += np.bincount(v, weights=0.5 * N2[:, k], minlength=nv)
     if s.vcon:                  # level-set constraints only (REF: not boundaries)
         F, N = project_tangent(_WithoutBoundaries(s), [F, N])
     return A, F, N

@@ -35,6 +35,7 @@ SURFACES = [
     ("qmound.fe", "r\ng 4"),
     ("sphere.fe", "g 3"),
     ("cat.fe", "g 3"),                      # vertices on parametric boundaries
+    ("twointor.fe", "g 3"),                 # the torus model: facets wrap round
 ]
 
 
@@ -102,6 +103,10 @@ PRINTS = {
         # live coordinates: a set earlier in the same command counts (REF)
         "set vertex[5] x 0.3; print edge[5].length; print facet[1].area; "
         "print vertex[5].mean_curvature",
+    ]),
+    "twointor.fe": ("g 2", [      # torus wrap codes
+        'foreach edge ee where ee.wrap != 0 do printf "%d %d\\n", ee.id, ee.wrap',
+        "print facet[1].facet_normal", "print edge[1].x",
     ]),
     "slidestr.fe": ("g 3", [      # the string model
         "print vertex[3].dihedral", "print vertex[2].dihedral",

@@ -64,8 +64,8 @@ MOTION = {"v_force", "v_velocity", "v_oldx"}
 ATTRIBUTES = [
     ("vertex", "mean_curvature", "supported: 3 F·N/(2 N·N), F the area gradient and N the "
      "area-vector sum of the star, both projected onto the vertex's level-set constraints "
-     "(not onto parametric boundaries), FIXED vertices included (REF's values; the torus "
-     "model refused by name)"),
+     "(not onto parametric boundaries), FIXED vertices included (REF's values, the torus "
+     "model too)"),
     ("vertex", "sqcurve", "supported: h² of `sq_mean_curvature` (of "
      "`eff_area_sq_mean_curvature` with `effective_area` on, of `normal_sq_mean_curvature` "
      "with `normal_curvature` on), 0 at FIXED and boundary vertices, as REF"),
@@ -87,8 +87,9 @@ ATTRIBUTES = [
     ("edge", "edge_vector, x, y, z, x1..x3, x[i]", "supported"),
     ("edge, facet", "length, area", "supported, from the live coordinates (a `set` of "
      "coordinates earlier in the same command counts, as in REF)"),
-    ("edge", "wrap", "supported (REF's torus code: +x 1, -x 31, +y 64, -y 1984, +z 4096, "
-     "-z 127040)"),
+    ("edge", "wrap", "supported (REF's torus code, a 6-bit field per period: +x 1, -x 31, "
+     "+y 64, -y 1984, +z 4096, -z 126976; the manual says 127040 for -z, REF prints "
+     "126976)"),
     ("body", "volfixed", "supported; after `unset body target` (or `pressure`) the body "
      "still prints its old target (pressure), as REF"),
     ("vertex, edge, facet", "on_quantity q, on_method_instance m", "supported (global "
@@ -324,22 +325,14 @@ def _facet_normal(session, i):
 
 
 def _torus_wrap(s, i):
-    """The Evolver's torus wrap code of edge ``i``: +x 1, -x 31, +y 64,
-    -y 1984, +z 4096, -z 127040, summed."""
+    """The Evolver's torus wrap code of edge ``i``: per period a 6-bit field
+    holding the wrap mod 32 (+x 1, -x 31, +y 64, -y 1984, +z 4096,
+    -z 126976; the manual's 127040 for -z is not what REF prints)."""
     w = s.eattr.get("wrap")
     if w is None or s.periods is None:
         return 0
     row = np.asarray(w[i]).ravel()
-    plus = (1, 64, 4096)
-    minus = (31, 1984, 127040)
-    code = 0
-    for d, v in enumerate(row[:3]):
-        v = int(v)
-        if v > 0:
-            code += plus[d] * v
-        elif v < 0:
-            code += minus[d] * (-v)
-    return code
+    return sum((int(v) & 31) << (6 * d) for d, v in enumerate(row[:3]))
 
 
 def set_element_attr(session, base, name, idx, value):
