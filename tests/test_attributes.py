@@ -104,6 +104,14 @@ PRINTS = {
         "set vertex[5] x 0.3; print edge[5].length; print facet[1].area; "
         "print vertex[5].mean_curvature",
     ]),
+    "catbody.fe": ("print vertex[1].v_force\nprint vertex[1].v_oldx\ng 3", [
+        "print vertex[1].v_force", "print vertex[1].v_oldx", "print vertex[9].v_force",
+        "print vertex[14].v_force", "print vertex[14].v_oldx[3]",
+    ]),
+    "mound.fe": ("g 4", [          # v_force is not projected onto the constraint
+        "print vertex[1].v_force", "print vertex[1].v_force[3]", "print vertex[1].v_oldx",
+        "print vertex[12].v_force", "print vertex[9].v_force",
+    ]),
     "twointor.fe": ("g 2", [      # torus wrap codes
         'foreach edge ee where ee.wrap != 0 do printf "%d %d\\n", ee.id, ee.wrap',
         "print facet[1].facet_normal", "print edge[1].x",
@@ -161,7 +169,6 @@ def test_rejected_attributes(evolver, datafile, cmd, text):
 
 # refused by name (no number of pyevolver's can stand for them)
 REFUSED = [
-    ("print vertex[1].v_force", "not supported in pyevolver: vertex v_force"),
     ("print vertex[1].v_velocity", "not supported in pyevolver: vertex v_velocity"),
     ("print vertex[1].v_constraint_list", "the internal attribute v_constraint_list"),
     ("print facet[1].f_body_list", "the internal attribute f_body_list"),
