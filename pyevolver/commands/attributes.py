@@ -48,6 +48,9 @@ SET_REFUSED = {
     "orientation": "reversed signs of oriented integrals",
     "phase": "phasefiles are not supported",
     "mid_edge": "read-only", "mid_facet": "read-only",
+    "frontbody": "changing a body's facets at run time",
+    "backbody": "changing a body's facets at run time",
+    "wrap": "changing torus wraps by hand",
 }
 
 # internal lists of the Evolver's data structure: refused by name
@@ -130,6 +133,8 @@ ATTRIBUTES = [
     ("edge", "midv", "REF's error: only in the quadratic model"),
     ("edge", "frontbody, backbody", "string model: the bodies of the facets along and "
      "against the edge; soapfilm model: REF's error"),
+    ("facet, edge", "set frontbody / backbody / wrap, unset frontbody / backbody / bodies",
+     "refused by name (changing bodies' facets or torus wraps at run time)"),
     ("facet", "bare", "REF's error: no bareness for facets or bodies"),
 ]
 
