@@ -426,12 +426,16 @@ def on_quantity(session, base, name, arg):
         raise ExpressionError(f"'{arg.name}' is a quantity, not a method instance")
     if name == "on_quantity" and q.kind == "instance":
         raise ExpressionError(f"'{arg.name}' is a method instance, not a quantity")
-    for m, etype, idx, _sign in q.methods:
-        if m.is_global:            # REF: global methods mark no elements
-            continue
-        if etype == base.kind and base.i in np.asarray(idx).tolist():
-            return 1.0
-    return 0.0
+    kind = base.kind
+
+    def members(ss, tt):
+        mask = np.zeros(session.count(kind), bool)
+        for m, etype, idx, _sign in q.methods:
+            if etype == kind and not m.is_global:     # REF: global methods mark none
+                mask[np.asarray(idx, np.int64)] = True
+        return mask
+
+    return float(cache(session).get(session, f"on:{arg.name}:{kind}", members)[base.i])
 
 
 def element_quantity_value(session, base, qname):
@@ -616,3 +620,4 @@ def set_membership(session, kind, els, qname, on):
             keep = ~np.isin(idx, ids)
             idx, sgn = idx[keep], sgn[keep]
         q.methods[j] = (m, etype, idx, sgn)
+    cache(session).touch(session)           # memberships and values cached per surface
