@@ -110,7 +110,12 @@ PRINTS = {
     ]),
     "mound.fe": ("g 4", [          # v_force is not projected onto the constraint
         "print vertex[1].v_force", "print vertex[1].v_force[3]", "print vertex[1].v_oldx",
-        "print vertex[12].v_force", "print vertex[9].v_force",
+        "print vertex[12].v_force", "print vertex[9].v_force", "print vertex[1].v_velocity",
+        "print vertex[5].v_velocity", "print vertex[9].v_velocity",
+    ]),
+    "cube.fe": ("print vertex[1].v_velocity\ng", [
+        "print vertex[1].v_velocity", "g", "print vertex[1].v_velocity",
+        "print vertex[3].v_velocity[2]", "U", "g", "print vertex[5].v_velocity",
     ]),
     "twointor.fe": ("g 2", [      # torus wrap codes
         'foreach edge ee where ee.wrap != 0 do printf "%d %d\\n", ee.id, ee.wrap',
@@ -169,7 +174,6 @@ def test_rejected_attributes(evolver, datafile, cmd, text):
 
 # refused by name (no number of pyevolver's can stand for them)
 REFUSED = [
-    ("print vertex[1].v_velocity", "not supported in pyevolver: vertex v_velocity"),
     ("print vertex[1].v_constraint_list", "the internal attribute v_constraint_list"),
     ("print facet[1].f_body_list", "the internal attribute f_body_list"),
     ("set vertex triple_point where id == 5", "set vertex triple_point"),

@@ -60,10 +60,7 @@ INTERNAL = {
     "raw_velocity", "v_boundary", "e_boundary", "f_boundary", "wrap_list",
 }
 
-# REF's velocity of the last `g` step (after its restoring steps): not reproduced
-MOTION = {"v_velocity"}
-
-READ_ONLY = {"mean_curvature", "sqcurve", "v_force", "v_oldx", "dihedral", "volfixed",
+READ_ONLY = {"mean_curvature", "sqcurve", "v_force", "v_oldx", "v_velocity", "dihedral", "volfixed",
              "valence", "facet_normal", "value_of_constraint"}
 
 # documentation table: (kinds, name, status)
@@ -121,12 +118,10 @@ ATTRIBUTES = [
      "(they change numbers: effective_area, hessian_normal, volumes, phases)"),
     ("vertex, edge", "bare", "read and set (bare on datafile lines is not kept by the "
      "datafile reader: it reads 0)"),
-    ("vertex", "v_force, v_oldx", "supported: the force (minus the energy gradient, FIXED "
-     "vertices included, not projected onto constraints) and the coordinates of the moving "
-     "vertices (0 for FIXED ones) at the start of the last `g` step; zeros before any, as "
-     "REF"),
-    ("vertex", "v_velocity", "refused by name (REF's velocity after the restoring steps of "
-     "`g` is not reproduced)"),
+    ("vertex", "v_force, v_velocity, v_oldx", "supported: the force (minus the energy "
+     "gradient, FIXED vertices included, not projected onto constraints), the motion "
+     "direction (projected, after conjugate gradients) and the coordinates of the moving "
+     "vertices (0 for FIXED ones) of the last `g` step; zeros before any, as REF"),
     ("vertex, edge, facet", "v_/e_/f_constraint_list, v_/e_/f_method_list, f_body_list, "
      "f_next_bfacet, wrap_list, raw_velocity", "refused by name (the Evolver's internal "
      "data structure)"),
@@ -236,18 +231,16 @@ def element_attr(session, base, name, idx):
             raise ExpressionError("No bareness for facets or bodies.")
         return float(_session_store(session).get((k, "bare"), {}).get(i, 0.0))
     if k == "vertex":
-        if name in ("v_force", "v_oldx"):
+        if name in ("v_force", "v_oldx", "v_velocity"):
             last = session.__dict__.get("_last_motion")
-            if last is None or last[0] is not s or len(last[1]) != s.nv:
+            k = {"v_force": 1, "v_oldx": 2, "v_velocity": 3}[name]
+            if last is None or last[0] is not s or len(last) <= k or len(last[k]) != s.nv:
                 vec = np.zeros(s.sdim)          # REF: zeros before any g
             else:
-                vec = (last[1] if name == "v_force" else last[2])[i, :s.sdim]
+                vec = last[k][i, :s.sdim] + 0.0
             if isinstance(idx, tuple):
                 raise ExpressionError(f"{name} takes one index")
             return _component(vec, idx, name)
-        if name in MOTION:
-            raise UnsupportedError(f"vertex {name}", "REF's velocity after the restoring "
-                                   "steps of g is not reproduced")
         if name == "mean_curvature":
             _no_string(s, name)
             return float(cache(session).get(session, name, GA.vertex_mean_curvature)[i])
@@ -377,7 +370,7 @@ def set_element_attr(session, base, name, idx, value):
         if float(value) == FLAGS_DEFAULT.get((k, name), np.nan):
             return True                           # setting the default changes nothing
         raise UnsupportedError(f"set {k} {name}", SET_REFUSED[name])
-    if name in INTERNAL or name in MOTION or name in READ_ONLY:
+    if name in INTERNAL or name in READ_ONLY:
         raise ExpressionError(f"{k} attribute '{name}' is read-only")
     return False
 

@@ -290,6 +290,7 @@ class Iterator:
             self.cg_f_old = f_raw      # the Evolver keeps the unprojected force
             vel = h
         X0 = state(s)
+        sess._last_motion += (vel,)             # v_velocity: the motion direction
         warnings = []
         trial_msgs = []
         # Trial moves start from the directions at X0 (REF resets them after
