@@ -18,8 +18,8 @@ and what evolver-nox-d prints (checked in tests/test_attributes.py):
 * vertex ``sqcurve``: ``h²`` with the ``sq_mean_curvature`` method's
   estimate ``h = 3|F| / (2A)`` (``A`` the star area; ``3|F| / (2|N|)``
   with the ``effective_area`` toggle on, the ``normal_sq_mean_curvature``
-  estimate ``h = 3 F·F / (2 F·N)`` with ``normal_curvature`` on), zero at FIXED vertices and vertices
-  on parametric boundaries, as that method.
+  estimate ``h = 3 F·F / (2 F·N)`` with ``normal_curvature`` on), zero
+  at FIXED vertices and vertices on parametric boundaries, as that method.
 * edge ``dihedral``: the angle between the unit normals of the edge's two
   facets, oriented alike across the edge; 0 unless there are exactly two.
 * vertex ``dihedral`` (string model): ``2 asin(|F|/2)``, ``F`` the sum of

@@ -60,8 +60,8 @@ INTERNAL = {
     "raw_velocity", "v_boundary", "e_boundary", "f_boundary", "wrap_list",
 }
 
-READ_ONLY = {"mean_curvature", "sqcurve", "v_force", "v_oldx", "v_velocity", "dihedral", "volfixed",
-             "valence", "facet_normal", "value_of_constraint"}
+READ_ONLY = {"mean_curvature", "sqcurve", "v_force", "v_oldx", "v_velocity", "dihedral",
+             "volfixed", "valence", "facet_normal", "value_of_constraint"}
 
 # documentation table: (kinds, name, status)
 ATTRIBUTES = [
@@ -232,12 +232,13 @@ def element_attr(session, base, name, idx):
         return float(_session_store(session).get((k, "bare"), {}).get(i, 0.0))
     if k == "vertex":
         if name in ("v_force", "v_oldx", "v_velocity"):
-            last = session.__dict__.get("_last_motion")
-            k = {"v_force": 1, "v_oldx": 2, "v_velocity": 3}[name]
-            if last is None or last[0] is not s or len(last) <= k or len(last[k]) != s.nv:
+            last = session.__dict__.get("_last_motion")      # set by Iterator.step
+            slot = {"v_force": 1, "v_oldx": 2, "v_velocity": 3}[name]
+            if last is None or last[0] is not s or len(last) <= slot or \
+                    len(last[slot]) != s.nv:
                 vec = np.zeros(s.sdim)          # REF: zeros before any g
             else:
-                vec = last[k][i, :s.sdim] + 0.0
+                vec = last[slot][i, :s.sdim] + 0.0
             if isinstance(idx, tuple):
                 raise ExpressionError(f"{name} takes one index")
             return _component(vec, idx, name)
@@ -313,8 +314,8 @@ def _string_edge_body(session, base, name):
     for f, g in facets_of_edge(s, base.i):
         if g == want:
             col = s.bodies.facet_matrix[:, f].tocoo()
-            for b, v in zip(col.row, col.data):
-                return int(b) + 1
+            if len(col.row):
+                return int(col.row[0]) + 1
     return 0
 
 
