@@ -228,3 +228,22 @@ def test_attribute_table_in_docs():
         text = fh.read()
     for _kind, names, _status in ATTRIBUTES:
         assert names in text, names
+
+
+def test_hit_constraint_of_one_sided_constraints(evolver, tmp_path):
+    """mound.fe with its table a NONNEGATIVE constraint: a vertex lifted off
+    the plane is still on the constraint but no longer hits it (REF)."""
+    with open(example("mound.fe")) as fh:
+        src = fh.read()
+    src = src.replace("constraint 1   /* the table top */",
+                      "constraint 1 nonnegative  /* the table top */")
+    path = tmp_path / "moundn.fe"
+    path.write_text(src)
+    cmds = ("print vertex[1].hit_constraint 1\nprint vertex[5].hit_constraint 1\n"
+            "set vertex[1] z 0.1\nprint vertex[1].hit_constraint 1\n"
+            "print vertex[1].on_constraint 1\nprint vertex[1].value_of_constraint 1\n"
+            "print count(vertex where hit_constraint 1, 1)\n")
+    ref = run_reference(evolver, str(path), cmds)
+    code, out, err = run_pyevolver(str(path), cmds + "q\n")
+    assert err == ""
+    assert _same(out, [l for l in ref if l.strip()])

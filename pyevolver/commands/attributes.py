@@ -81,6 +81,9 @@ ATTRIBUTES = [
      "exactly two facets (REF's error in the string model); coplanar facets give 0 where "
      "REF's round-off gives up to 3e-8"),
     ("vertex", "value_of_constraint n", "supported: the constraint's formula at the vertex"),
+    ("vertex", "hit_constraint n", "supported: on the constraint and, for a one-sided "
+     "(NONNEGATIVE / NONPOSITIVE) constraint, at its boundary within "
+     "`constraint_tolerance` (REF: 0 after `set vertex z 0.1` off the plane)"),
     ("vertex", "constraint[n].normal", "supported: the constraint's unit normal at the "
      "vertex (vector, or one component with [i])"),
     ("vertex", "p1, p2", "read and set: setting moves the vertex on its boundary at once "
@@ -258,6 +261,17 @@ def element_attr(session, base, name, idx):
                 raise ExpressionError("Dihedral only for edges.")
             return float(cache(session).get(session, "vdihedral",
                                             GA.string_vertex_dihedral)[i])
+        if name == "hit_constraint" and idx is not None:
+            cid = _constraint_id(session, idx, name)
+            on = s.vcon.get(cid)
+            if on is None or not on[i]:
+                return 0.0
+            flags = s.constraints[cid].flags
+            if "nonnegative" not in flags and "nonpositive" not in flags:
+                return 1.0
+            # a one-sided constraint is hit where the vertex is on its boundary
+            tol = float(session.settings.get("constraint_tolerance", 1e-12))
+            return float(abs(constraint_value(session, i, cid)) <= tol)
         if name == "value_of_constraint":
             return constraint_value(session, i, _constraint_id(session, idx, name))
         if name == "constraint" and idx is not None:
