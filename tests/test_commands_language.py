@@ -214,6 +214,11 @@ print mix.value
 """
 
 BOUNDARIES = """g 2
+print vertex[2].p[1]
+print vertex[2].p
+print vertex[13].p
+set vertex[3] p[1] 2.2
+print vertex[3].x
 set vertex p1 p1+0.1 where id == 2
 print vertex[2].x
 print vertex[2].y

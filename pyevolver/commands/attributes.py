@@ -86,7 +86,8 @@ ATTRIBUTES = [
      "`constraint_tolerance` (REF: 0 after `set vertex z 0.1` off the plane)"),
     ("vertex", "constraint[n].normal", "supported: the constraint's unit normal at the "
      "vertex (vector, or one component with [i])"),
-    ("vertex", "p1, p2", "read and set: setting moves the vertex on its boundary at once "
+    ("vertex", "p1, p2, p[i], p", "read and set: setting moves the vertex on its boundary "
+     "at once "
      "(REF); `set vertex boundary n` refused by name, `unset vertex/edge/facet boundary n` "
      "supported"),
     ("facet", "facet_normal, x, y, z, x1..x3, x[i]", "supported (length = facet area)"),
@@ -261,6 +262,13 @@ def element_attr(session, base, name, idx):
                 raise ExpressionError("Dihedral only for edges.")
             return float(cache(session).get(session, "vdihedral",
                                             GA.string_vertex_dihedral)[i])
+        if name == "p":                 # the boundary parameters as an array
+            bnd = s.vattr.get("boundary")
+            if bnd is None or not bnd[i]:
+                vec = np.zeros(0)
+            else:
+                vec = s.vattr["params"][i, :s.boundaries[int(bnd[i])].nparams]
+            return _component(vec, idx, name)
         if name == "hit_constraint" and idx is not None:
             cid = _constraint_id(session, idx, name)
             on = s.vcon.get(cid)
