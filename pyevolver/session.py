@@ -442,7 +442,7 @@ class Session(SessionAPI):
                                                     b.volconst.copy(), b.density.copy(),
                                                     b.lagrange.copy()),
                 None if s is None else {k: (q.target, q.modulus, q.kind, q.pressure,
-                                            q.tolerance)
+                                            q.tolerance, list(q.methods))
                                         for k, q in s.quantities.items()},
                 None if s is None else {k: v.copy() for k, v in s.extra.items()},
                 None if s is None else {k: v.copy() for k, v in s.vattr.items()},
@@ -453,7 +453,8 @@ class Session(SessionAPI):
                 None if s is None else ({k: m.copy() for k, m in s.econ.items()},
                                         {k: m.copy() for k, m in s.fcon.items()},
                                         s.gravity_constant, s.sq_curvature_modulus),
-                self.filename)
+                self.filename,
+                {k: dict(v) for k, v in self.__dict__.get("_attr_store", {}).items()})
 
     def _iterator_state(self):
         it = self._iterator
@@ -463,8 +464,9 @@ class Session(SessionAPI):
 
     def _restore(self, snap):
         (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
-         fattr, vcon, surface, totals, it_state, more, filename) = snap
+         fattr, vcon, surface, totals, it_state, more, filename, attr_store) = snap
         self.filename = filename
+        self._attr_store = attr_store          # graphics-only attributes (commands.attributes)
         self.surface = surface
         self.totals = totals            # the energies of the restored coordinates
         if self._iterator is not None:
@@ -486,9 +488,10 @@ class Session(SessionAPI):
             if bod is not None:
                 b = s.bodies
                 b.target, b.pressure, b.volconst, b.density, b.lagrange = bod
-            for k, (t, m, kind, p, tol) in qs.items():
+            for k, (t, m, kind, p, tol, methods) in qs.items():
                 q = s.quantities[k]
                 q.target, q.modulus, q.kind, q.pressure, q.tolerance = t, m, kind, p, tol
+                q.methods[:] = methods          # set/unset element membership
             s.extra = extra
             s.vattr = vattr
             s.eattr = eattr
@@ -1253,6 +1256,11 @@ class Session(SessionAPI):
             raise ExpressionError(f"the {el.kind} no longer exists (deleted by this command)")
 
     def get_attr(self, base, name, idx):
+        from .commands import attributes as A
+        if isinstance(base, A.ConstraintAt):
+            return A.constraint_attr(self, base, name, idx)
+        if name in ("on_quantity", "on_method_instance"):
+            return A.on_quantity(self, base, name, idx)
         if idx is not None:                     # indices are integers (C truncation)
             idx = tuple(I.as_int(j, f"the index of '{name}'") for j in idx) \
                 if isinstance(idx, tuple) else I.as_int(idx, f"the index of '{name}'")
@@ -1286,6 +1294,10 @@ class Session(SessionAPI):
             if k == "edge":
                 return float(bool(s.eattr["fixed"][i]) or
                              len(self.sub_elements(base, "facet")) != 2)
+        from .commands import attributes as A
+        v = A.element_attr(self, base, name, idx)
+        if v is not A.MISSING:
+            return v
         if s.sdim == 2 and name in ("z", "x3") and k in ("vertex", "edge", "facet"):
             raise ExpressionError("Coordinate dimension exceeds space dimension.")  # REF 2475
         if k == "vertex":
@@ -1401,13 +1413,14 @@ class Session(SessionAPI):
             if name == "volume":
                 return float(t.volumes[i])
             if name == "target":
-                return float(b.target[i]) if not math.isnan(b.target[i]) else 0.0
+                return float(b.target[i]) if not math.isnan(b.target[i]) else \
+                    A.unset_value(self, i, "target", 0.0)
             if name == "volconst":
                 return float(b.volconst[i])
             if name == "pressure":
                 if not math.isnan(b.pressure[i]):
                     return float(b.pressure[i])
-                return float(b.lagrange[i])
+                return A.unset_value(self, i, "pressure", float(b.lagrange[i]))
             if name == "density":
                 return float(b.density[i])
             if name == "fixed":
@@ -1422,8 +1435,8 @@ class Session(SessionAPI):
                 raise ExpressionError(f"{base}.{kind}[{j}] does not exist ({k} {int(eid)} has "
                                       f"{len(subs)} {kind}{'s' if len(subs) != 1 else ''})")
             return subs[j - 1]
-        if name in s.quantities:
-            raise UnsupportedError(f"per-element quantity values ({k}.{name})")
+        if name in s.quantities and k in ("vertex", "edge", "facet"):
+            return A.element_quantity_value(self, base, name)
         raise ExpressionError(f"{k} has no attribute '{name}'")
 
     @staticmethod
@@ -1445,6 +1458,9 @@ class Session(SessionAPI):
 
     def _quantity_attr(self, qname, name):
         q = self.surface.quantities[qname]
+        if q.kind == "instance" and name not in ("value", "modulus"):
+            raise ExpressionError(f"method instance {qname} has no attribute '{name}' "
+                                  f"(possible method instance attributes: value, modulus)")
         if name == "value":
             return float(self.totals.quantity_values[qname])
         if name == "target":
@@ -1455,7 +1471,8 @@ class Session(SessionAPI):
             return float(q.pressure)
         if name == "tolerance":
             return float(q.tolerance)
-        raise ExpressionError(f"quantity has no attribute '{name}'")
+        from .commands import attributes as A
+        return A.quantity_attr(self, q, name)
 
     def set_attr(self, base, name, idx, value):
         if idx is not None:
@@ -1483,6 +1500,9 @@ class Session(SessionAPI):
             raise CommandError(f"'.{name}' needs an element or a quantity")
         self._check_alive(base)
         k, i = base.kind, base.i
+        from .commands import attributes as A
+        if (k, name) not in s.extra and A.set_element_attr(self, base, name, idx, value):
+            return
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
             if self.attr_types.get((k, name)) == "integer":
@@ -1503,6 +1523,7 @@ class Session(SessionAPI):
             if not math.isfinite(value):
                 raise CommandError(f"vertex coordinates must be finite numbers, got {value:g}")
             s.X[i, j] = value
+            A.cache(self).touch(self)           # attributes read the live coordinates
             return
         if k == "body":
             b = s.bodies
@@ -1519,6 +1540,8 @@ class Session(SessionAPI):
                 return
             if name == "density":
                 b.density[i] = value
+                if value:           # REF: a body density switches gravity on
+                    self.toggles["gravity"] = 1
                 return
         if k == "facet" and name in ("tension", "density"):
             s.fattr["tension"][i] = value
@@ -1537,6 +1560,8 @@ class Session(SessionAPI):
                     if key in attrs:
                         attrs[key][i] = int(value)
             elif name == "frontcolor":
+                if k == "facet" and "backcolor" not in attrs:    # the back keeps its colour
+                    attrs["backcolor"] = attrs["color"].copy()
                 for key in ("color", "frontcolor"):
                     if key in attrs:
                         attrs[key][i] = int(value)
@@ -1557,7 +1582,16 @@ class Session(SessionAPI):
         raise CommandError(f"cannot assign to {k} attribute '{name}'")
 
     def set_elements(self, gen, attr, expr, env, unset, idx=None):
+        from .commands import attributes as A
         els = self.generate(gen, env)
+        qname = A.membership_name(self, gen.kind, attr, expr)
+        if qname is not None:
+            A.set_membership(self, gen.kind, els, qname, not unset)
+            return
+        if A.is_flag(gen.kind, attr) and (expr is None or unset):
+            for el in els:         # boolean attributes: set = 1, unset = 0
+                self.set_attr(el, attr, None, 0.0 if unset else 1.0)
+            return
         if attr in ("fixed", "no_refine") and (expr is None or unset):
             if gen.kind == "body":
                 raise CommandError(f"bodies cannot be {'un' if unset else ''}set {attr}; "
@@ -1566,18 +1600,18 @@ class Session(SessionAPI):
                 self.set_attr(el, attr, None, 0.0 if unset else 1.0)
             return
         if unset:
+            if attr == "boundary" and expr is not None:
+                A.unset_boundary(self, els, self.interp.value(expr))
+                return
             if attr in ("constraint",) and expr is not None:
                 self.unset_constraint(els, int(self.interp.value(expr)))
                 return
-            if attr == "target" and gen.kind == "body":
+            if attr in ("target", "pressure") and gen.kind == "body":
                 b = self.surface.bodies
-                for el in els:
-                    b.target[el.i] = np.nan
-                return
-            if attr == "pressure" and gen.kind == "body":
-                b = self.surface.bodies
-                for el in els:
-                    b.pressure[el.i] = np.nan
+                arr = getattr(b, attr)
+                for el in els:      # REF still prints the old value (volfixed 0)
+                    A.remember_unset(self, el.i, attr, arr[el.i])
+                    arr[el.i] = np.nan
                 return
             if (gen.kind, attr) in self.surface.extra:
                 for el in els:

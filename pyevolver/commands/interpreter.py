@@ -248,6 +248,8 @@ class Attr(N.Node):
         base = self.base.ev(env)
         if self.index is None:
             idx = None
+        elif self.name in ("on_quantity", "on_method_instance"):
+            idx = _quantity_arg(self.index, env)
         elif isinstance(self.index, list):
             idx = tuple(i.ev(env) for i in self.index)
         else:
@@ -277,8 +279,8 @@ class Aggregate(N.Node):
                 vals.append(as_float(self.expr.ev(env), f"the value of {self.op}()"))
         if self.op == "count":
             return float(len(vals))
-        if not vals:
-            return 0.0
+        if not vals:                # REF: max -1e38, min 1e38 over no elements
+            return {"max": -1e38, "min": 1e38}.get(self.op, 0.0)
         if self.op == "sum":
             return float(sum(vals))
         if self.op == "avg":
@@ -299,7 +301,18 @@ class OnTest(N.Node):
         el = env.current()
         if el is None:
             raise ExpressionError(f"{self.what} needs an element (use it in a where clause)")
+        if self.what in ("on_quantity", "on_method_instance"):
+            return env.session.get_attr(el, self.what, _quantity_arg(self.arg, env))
         return env.session.get_attr(el, self.what, self.arg.ev(env))
+
+
+def _quantity_arg(node, env):
+    """The quantity named after ``on_quantity`` (a name that inside an
+    element loop would otherwise read the element's own quantity value)."""
+    s = env.session.surface
+    if isinstance(node, N.Var) and s is not None and node.name.lower() in s.quantities:
+        return QRef(node.name.lower())
+    return node.ev(env)
 
 
 class ArrayLit(N.Node):
@@ -567,6 +580,10 @@ class _CmdTransformer(ExprTransformer):
     def array_ref(self, name, *idx):
         return ArrayRef(str(name), list(idx))
 
+    def string_concat(self, *parts):
+        # "a" "b": adjacent literals are one string, as in C and the Evolver
+        return N.Str("".join(p.value for p in parts))
+
     def sprintf_expr(self, _s, *args):
         return Sprintf(list(args))
 
@@ -690,6 +707,10 @@ class _CmdTransformer(ExprTransformer):
 
     def bare_arg(self, name, expr):
         return ("bare", str(name), expr)
+
+    def set_background(self, _s, _b, expr):
+        # the graphics window's background colour: no effect without graphics
+        return ("seq", [])
 
     def graphics(self, tok):
         return ("seq", [])
@@ -1470,8 +1491,24 @@ class Interpreter:
                                f"list vertex[3] or list facets where area > 0.1)")
         self.session.list_elements(node[1], self.env)
 
+    def _quantity_gen(self, gen):
+        """The quantity or method instance a ``set``/``unset`` names, if any."""
+        s = self.session.surface
+        if gen.base[0] == "var" and s is not None and gen.base[1] in s.quantities \
+                and self._var_elem(gen.base[1]) is None:
+            return gen.base[1]
+        return None
+
     def _x_set(self, node):
         idx = node[4] if len(node) > 4 else None
+        qname = self._quantity_gen(node[1])
+        if qname is not None:
+            from .attributes import set_quantity
+            if node[1].where is not None or node[1].var is not None or idx is not None:
+                raise CommandError(f"set {qname}: expected set {qname} attribute [value]")
+            value = None if node[3] is None else self.value(node[3])
+            set_quantity(self.session, qname, node[2], value)
+            return
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=False, idx=idx)
 
     def _x_fix(self, node):
@@ -1568,6 +1605,10 @@ class Interpreter:
         raise CommandError("Command aborted (abort).")
 
     def _x_unset(self, node):
+        qname = self._quantity_gen(node[1])
+        if qname is not None:
+            raise CommandError(f"unset {qname}: a quantity is not an element (REF: syntax "
+                               f"error); use unfix {qname} or set {qname} info_only")
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=True)
 
     def _x_refine(self, node):
