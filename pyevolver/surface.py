@@ -1028,8 +1028,8 @@ class _Builder:
                     b.pressure[pos] = v[0]
                 elif kw == "density":
                     b.density[pos] = v[0]
-                elif kw in ("actual_volume", "lagrange_multiplier"):
-                    pass
+                elif kw in ("actual_volume", "lagrange_multiplier", "centerofmass"):
+                    pass        # recomputed; centerofmass is a display flag
                 elif kw == "attribute":
                     self._attr("body", nb, pos, v)
                 else:

@@ -44,7 +44,8 @@ _ELEM_KWS = frozenset(
     "fixed bare no_refine nodisplay no_display constraint constraints boundary tension "
     "density volume volconst actual_volume pressure color colour frontcolor frontcolour "
     "backcolor backcolour wrap orientation original opacity tag phase no_hessian_normal "
-    "hessian_normal_one axial_point triple_point tetra_point lagrange_multiplier".split())
+    "hessian_normal_one axial_point triple_point tetra_point lagrange_multiplier "
+    "centerofmass".split())
 _WORD = re.compile(r"\S+")
 _PLAIN = re.compile(_NUMBER + r"\Z")
 
@@ -263,11 +264,27 @@ class _TopTransformer(ExprTransformer):
     def unsupported(self, kw):
         raise _Unsupported(kw)
 
+    # -- what the Evolver's dump writes --
+    def slice_coeff(self, kw, _nums):
+        return ("ignored", "slice_coeff")       # the slicing plane of the graphics
+
+    def quantity_forward(self, kw, name):
+        return ("quantity_forward", str(name).lower(), kw.line)
+
 
 @v_args(inline=True)
 class _LineTransformer(ExprTransformer):
     def _line(self, idtok, *items):
-        return (int(idtok), list(items))
+        flat = []
+        for it in items:
+            if isinstance(it, list):        # braced array values
+                flat.extend(it)
+            else:
+                flat.append(it)
+        return (int(idtok), flat)
+
+    def braced(self, *exprs):
+        return list(exprs)
 
     vertex_line = edge_line = face_line = body_line = _line
 
@@ -461,6 +478,7 @@ class Reader:
 
     def _fill_scene(self, decls, sec):
         sc = self.scene
+        self._forward = {}
         for d in decls:
             kind = d[0]
             try:
@@ -469,6 +487,9 @@ class Reader:
                 raise self.error(f"undefined parameter '{exc.name}'",
                                  self._src(sec, exc.line) if exc.line else None,
                                  exc.col) from None
+        for name, line in self._forward.items():
+            if name not in sc.quantities:
+                raise self.error(f"quantity {name} is declared but never defined", line)
 
     def _decl(self, d, sc, sec):
         kind = d[0]
@@ -529,11 +550,19 @@ class Reader:
             sc.method_instances[name] = m
         elif kind == "attribute":
             _, etype, name, atype, dims, line = d
+            if atype in _INT_ATTR_TYPES:
+                atype = "integer"        # the Evolver's integer types; stored as numbers
+            elif atype != "real":
+                raise self.error(f"not supported in pyevolver: {atype.upper()} element "
+                                 f"attributes (attribute {name})", self._src(sec, line))
             size = math.prod(dims) if dims else 1
             if size > MAX_ARRAY_ENTRIES:
                 raise self.error(f"attribute {name}: {size} entries per {etype}; at most "
                                  f"{MAX_ARRAY_ENTRIES} are allowed", self._src(sec, line))
             sc.attributes[(etype, name)] = (atype, size, dims)
+        elif kind == "quantity_forward":
+            # ``quantity name;``: declared now, defined later in the top section
+            self._forward.setdefault(d[1], self._src(sec, d[2]))
         elif kind == "periods":
             pass    # numbers taken by _extract_matrices
         elif kind == "ignored":
@@ -828,6 +857,11 @@ _KW_NEEDS_VALUE = {"constraint", "constraints", "boundary", "tension", "density"
                    "orientation", "lagrange_multiplier", "actual_volume"}
 _KW_INTEGER = {"constraint", "constraints", "boundary", "color", "colour", "frontcolor",
                "frontcolour", "backcolor", "backcolour", "original", "phase", "tag"}
+
+
+# the integer types of ``define ... attribute`` (the Evolver's dump writes them)
+_INT_ATTR_TYPES = {"integer", "uchar", "char", "uint", "ulong_int", "short_int", "ushort_int",
+                   "long_int"}
 
 
 class _MatrixError(Exception):
