@@ -133,7 +133,7 @@ class Session(SessionAPI):
                                       bool(b.n and np.any(b.density)))
         self.variables = surface.params        # parameters and variables share one namespace
         self._scene_settings(scene)
-        for flag in ("area_normalization", "autopop", "conj_grad"):
+        for flag in ("area_normalization", "autopop", "conj_grad", "torus_filled"):
             if flag in scene.flags:             # top-section toggles (100grain.fe)
                 self.toggles[flag] = 1
         if scene.values.get("autochop"):

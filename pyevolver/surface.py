@@ -573,7 +573,7 @@ class _Builder:
                 s.vcon[cid] = np.ones(n, bool)
         s.X = X
         s.vattr["fixed"] = fixed
-        s.vattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.vattr["original"] = self._originals(blk)
         if bnd is not None:
             s.vattr["boundary"] = bnd
             s.vattr["params"] = params
@@ -663,7 +663,7 @@ class _Builder:
         s.E = E
         s.eattr["fixed"] = fixed
         s.eattr["no_refine"] = no_refine
-        s.eattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.eattr["original"] = self._originals(blk)
         if tension is not None:
             s.eattr["tension"] = tension
         if bnd is not None:
@@ -779,7 +779,7 @@ class _Builder:
         s.fattr["fixed"] = fixed[parent]
         s.fattr["tension"] = tension[parent]
         s.fattr["no_refine"] = no_refine[parent]
-        s.fattr["original"] = np.asarray(blk.ids, dtype=np.int64)[parent] if nface else \
+        s.fattr["original"] = self._originals(blk)[parent] if nface else \
             np.zeros(0, np.int64)
         for key, arr in colors.items():
             s.fattr[key] = arr[parent]
@@ -947,12 +947,24 @@ class _Builder:
         s.fattr["fixed"] = fixed
         s.fattr["tension"] = tension
         s.fattr["no_refine"] = no_refine
-        s.fattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.fattr["original"] = self._originals(blk)
         for key, arr in colors.items():
             s.fattr[key] = arr
 
     def children(self, pos):
         return self.split_children.get(pos, [pos])
+
+    @staticmethod
+    def _originals(blk):
+        """The ``original`` attribute of a section's elements: the datafile
+        id, or the value of an ``original N`` keyword (the Evolver's dump
+        writes it for elements made by refining element N)."""
+        orig = np.asarray(blk.ids, dtype=np.int64).copy()
+        for pos, attrs in blk.attrs.items():
+            for kw, vals in attrs:
+                if kw == "original" and vals:
+                    orig[pos] = int(vals[0])
+        return orig
 
     def _face_center(self, rim):
         return self.s.X[rim].mean(axis=0)
@@ -994,7 +1006,7 @@ class _Builder:
         b.pressure = np.full(nb, np.nan)
         b.density = np.zeros(nb)
         b.lagrange = np.zeros(nb)
-        b.original = np.asarray(blk.ids, dtype=np.int64)
+        b.original = self._originals(blk)
         lens = [len(d) for d in blk.data]
         flat = np.concatenate([np.asarray(d, dtype=np.int64) for d in blk.data]) if nb else \
             np.zeros(0, np.int64)
@@ -1028,8 +1040,8 @@ class _Builder:
                     b.pressure[pos] = v[0]
                 elif kw == "density":
                     b.density[pos] = v[0]
-                elif kw in ("actual_volume", "lagrange_multiplier", "centerofmass"):
-                    pass        # recomputed; centerofmass is a display flag
+                elif kw in ("actual_volume", "lagrange_multiplier", "centerofmass", "original"):
+                    pass        # recomputed; centerofmass is a display flag; original above
                 elif kw == "attribute":
                     self._attr("body", nb, pos, v)
                 else:
