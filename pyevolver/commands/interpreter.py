@@ -118,9 +118,13 @@ def _scan(text):
             continue                # blank and comment lines neither start nor end one
         if start is None:
             start = lineno
+        spliced = not in_str and code.rstrip().endswith("\\")
+        if spliced:                 # backslash-newline: the line goes on (REF's dump writes it)
+            k = code.rstrip().rfind("\\")
+            code = code[:k] + " " + code[k + 1:]
         buf.append(code)
         tail = code.rstrip()
-        if depth > 0 or in_str or in_comment or tail.endswith(_CONT_END) or \
+        if depth > 0 or in_str or in_comment or spliced or tail.endswith(_CONT_END) or \
                 _ends_with_keyword(tail):
             continue
         if not opened and not tail.endswith(";") and _PROC_START.match("\n".join(buf)):

@@ -346,7 +346,42 @@ class Reader:
             last = len(self.src_lines)
             raise self.error("unexpected end of file: expected a 'vertices' section",
                              last, 1)
+        if "keep_originals" in self.scene.flags:
+            self._keep_originals()
         return self.scene
+
+    def _keep_originals(self):
+        """KEEP_ORIGINALS: the elements keep their datafile ids (the Evolver
+        otherwise numbers them in reading order).  pyevolver numbers elements
+        1..n by position, so a section whose ids are 1..n in another order
+        (the Evolver's dump after refining) is put in id order; ids with gaps
+        cannot be kept and are refused."""
+        sc = self.scene
+        for kind, what in (("vertices", "vertex"), ("edges", "edge"), ("faces", "face"),
+                           ("bodies", "body")):
+            blk = getattr(sc, kind)
+            ids = np.asarray(blk.ids, dtype=np.int64)
+            n = len(ids)
+            if not n or np.array_equal(ids, np.arange(1, n + 1)):
+                continue
+            order = np.argsort(ids, kind="stable")
+            if not np.array_equal(ids[order], np.arange(1, n + 1)):
+                missing = int(np.setdiff1d(np.arange(1, n + 1), ids)[0])
+                line = sc.decl_lines.get("keep_originals")
+                raise self.error(f"not supported in pyevolver: KEEP_ORIGINALS with {what} ids "
+                                 f"that are not 1 to {n} ({what} {missing} is missing); "
+                                 f"elements are numbered 1..n", line)
+            inv = np.empty(n, np.int64)
+            inv[order] = np.arange(n)
+            blk.ids = ids[order] if isinstance(blk.ids, np.ndarray) else ids[order].tolist()
+            if isinstance(blk.data, np.ndarray):
+                blk.data = blk.data[order]
+            else:
+                blk.data = [blk.data[k] for k in order.tolist()]
+            blk.lines = type(blk.lines)("l", [blk.lines[k] for k in order.tolist()])
+            blk.attrs = {int(inv[pos]): a for pos, a in blk.attrs.items()}
+            if kind == "edges" and sc.wraps:
+                sc.wraps = {int(inv[pos]): w for pos, w in sc.wraps.items()}
 
     # -- top section --------------------------------------------------------
     def _describe(self, exc, text):
