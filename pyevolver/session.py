@@ -164,6 +164,8 @@ class Session(SessionAPI):
         for k in ("scale_limit", "constraint_tolerance"):
             if k in scene.values:
                 self.settings[k] = scene.values[k]
+        if "total_time" in scene.values:        # TOTAL_TIME: a dump goes on with its clock
+            self.total_time = float(scene.values["total_time"])
         if "scale" in scene.values:
             self.settings["scale"] = scene.values["scale"]
             if scene.values.get("scale_fixed"):

@@ -1040,7 +1040,9 @@ class _Builder:
                     b.pressure[pos] = v[0]
                 elif kw == "density":
                     b.density[pos] = v[0]
-                elif kw in ("actual_volume", "lagrange_multiplier", "centerofmass", "original"):
+                elif kw == "lagrange_multiplier":
+                    b.lagrange[pos] = v[0]      # the pressure REF reports until the next step
+                elif kw in ("actual_volume", "centerofmass", "original"):
                     pass        # recomputed; centerofmass is a display flag; original above
                 elif kw == "attribute":
                     self._attr("body", nb, pos, v)
@@ -1105,6 +1107,7 @@ class _Builder:
             s.quantities[name] = q
         for name, qd in sc.quantities.items():
             q = Quantity(name, qd.kind, qd.target, qd.modulus, qd.tolerance, line=qd.line)
+            q.pressure = qd.lagrange_multiplier      # a dump's multiplier, until the next step
             for m in qd.methods:
                 try:
                     etype, _ = method_info(m.method)
