@@ -1056,9 +1056,9 @@ TOGGLE_MESSAGES = {
                         "Autopop quartic mode OFF.\n (was {was})\n"),
     "immediate_autopop": ("Immediate autopop mode ON.\n (was {was})\n",
                           "Immediate autopop mode OFF.\n (was {was})\n"),
-    "debug": ("YACC debugging was {WAS_}.\nNow ON.\n", "YACC debugging was {WAS_}.Now OFF.\n"),
-    "itdebug": ("Iteration debugging was {WAS_}.\nNow ON.\n",
-                "Iteration debugging was {WAS_}.Now OFF.\n"),
+    "debug": ("YACC debugging was {WAS_}Now ON.\n", "YACC debugging was {WAS_}Now OFF.\n"),
+    "itdebug": ("Iteration debugging was {WAS_}Now ON.\n",
+                "Iteration debugging was {WAS_}Now OFF.\n"),
     "ysmp": ("Using YSMP. (was {alg})\n", "Using alternate minimal degree. (was {alg})\n"),
     "interp_bdry_param": ("interpolation of boundary parameters  ON. (was {was})\n",
                           "interpolation of boundary parameters OFF (using extrapolation). "
@@ -1973,7 +1973,10 @@ class Interpreter:
         elif key in TOGGLE_MESSAGES:
             fmt = TOGGLE_MESSAGES[key][0 if new else 1]
             zc = s.variables.get("zener_coeff")
-            s.note(fmt.format(was=was, WAS=was.upper(), WAS_=was.upper(),
+            if key == "ysmp" and new == old:      # REF says nothing then
+                fmt = ""
+            s.note(fmt.format(was=was, WAS=was.upper(),
+                              WAS_="OFF.\n" if old == 0 else was.upper() + ".",
                               alg="YSMP" if old else "alt min deg",
                               zener="zener_coeff not set" if zc is None else
                               f"zener_coeff: {zc:g}" if isinstance(zc, (int, float))
@@ -1981,10 +1984,11 @@ class Interpreter:
         else:
             word = TOGGLE_WORDS.get(key, key)
             s.note(f"{word} {now}. (was {was})\n")
-        if key == "sparse_constraints" and not new:     # REF switches this one off too
+        if key == "sparse_constraints" and not new:     # REF settles an unset one too
             old_aug = s.toggles.get("augmented_hessian", TOGGLE_DEFAULTS["augmented_hessian"])
-            s.toggles["augmented_hessian"] = 0
-            s.note(f"augmented Hessian OFF. (was {({1: 'on', 0: 'off'}).get(old_aug, 'unset')})\n")
+            if old_aug == -1:
+                s.toggles["augmented_hessian"] = 0
+                s.note("augmented Hessian OFF. (was unset)\n")
         if key == "gravity":
             s.recalc()
 
