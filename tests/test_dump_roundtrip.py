@@ -55,10 +55,18 @@ def _pick(lines):
 
 
 def _ours(path):
-    s = Session.load(path, out=io.StringIO(), err=io.StringIO())
-    s.out = io.StringIO()
+    """Our output of loading ``path`` (its read section) and of SCRIPT."""
+    out = io.StringIO()
+    s = Session.load(path, out=out, err=io.StringIO())
+    s.out = out
     s.run(SCRIPT)
-    return s.out.getvalue().split("\n")
+    return out.getvalue().split("\n")
+
+
+def _messages(lines):
+    """What loading printed (the read section's toggles), before SCRIPT's."""
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("R "))
+    return [ln for ln in lines[:k] if ln.strip() and not ln.startswith("more>")]
 
 
 def _agree(ref, ours):
@@ -83,7 +91,9 @@ def _ref_dump(evolver, name, pre, tmp_path):
 @pytest.mark.parametrize("name", SUPPORTED)
 def test_reference_dump_goes_on_alike(evolver, name, pre, tmp_path):
     dmp = _ref_dump(evolver, name, pre, tmp_path)
-    _agree(run_reference(evolver, dmp, SCRIPT, cwd=str(tmp_path)), _ours(dmp))
+    ref, ours = run_reference(evolver, dmp, SCRIPT, cwd=str(tmp_path)), _ours(dmp)
+    _agree(ref, ours)
+    assert _messages(ours) == _messages(ref)
 
 
 def _refusal(path, cmds="g 1"):

@@ -1805,7 +1805,10 @@ class Interpreter:
             # REF's dump writes it in the read section of files that used
             # named-quantity energies; pyevolver computes the same numbers
             # either way, so only the message is kept
-            if s.toggles.get("_all_quantities"):
+            # REF converts at load a surface whose boundaries carry integrals
+            bnd = getattr(s.surface, "boundaries", None) or {}
+            if s.toggles.get("_all_quantities") or any(
+                    b.energy or b.content for b in bnd.values()):
                 s.note("Everything already quantities.\n")
             else:
                 s.toggles["_all_quantities"] = 1
@@ -1918,7 +1921,10 @@ class Interpreter:
             new = (1 if v else 0) if isinstance(v, str) else int(is_true(v, "a toggle value"))
         key = TOGGLE_ALIASES.get(name, name)
         names = [key] + [a for a, k in TOGGLE_ALIASES.items() if k == key]
-        old = s.toggles.get(key, TOGGLE_DEFAULTS.get(key, 0))
+        default = TOGGLE_DEFAULTS.get(key, 0)
+        if key == "show_all_edges" and s.surface is not None and s.surface.string:
+            default = 0                         # REF: off in the string model
+        old = s.toggles.get(key, default)
         if name == "autopop" and new:
             raise UnsupportedError("autopop", "vertex and edge popping (o, O) is not implemented")
         if key in TOGGLE_REFUSED and new:
