@@ -176,7 +176,6 @@ class Session(SessionAPI):
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
         from .datafile.writer import dump
-        self.no_string("dump")
         if name is None:
             name = (self.filename or "pyevolver") + ".dmp"
         self.write(f"Dumping to {name}.\n")

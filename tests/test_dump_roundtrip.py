@@ -30,7 +30,6 @@ SUPPORTED = ["addload_example", "cat", "catbody", "catman", "column", "cube", "m
 REFUSED = [("100grain", "g 3"), ("100grain", "r; g 3"), ("knotty", "g 3"), ("knotty", "r; g 3"),
            ("metric", "g 3"), ("mylarcube", "g 3"), ("mylarcube", "r; g 3"), ("quadm", "g 3"),
            ("relaxed", "g 3"), ("symtest", "g 3"), ("simplex3", "r; g 3")]
-STRING = {"popstr", "slidestr"}       # pyevolver's dump refuses the string model
 PRE = ["g 3", "r; g 3"]
 
 SCRIPT = ('printf "R %.17g %.17g %d %d %d %d\\n", total_energy, total_area, vertex_count, '
@@ -120,7 +119,7 @@ def test_reference_dump_refused_like_its_datafile(evolver, name, pre, tmp_path):
 
 
 @pytest.mark.parametrize("pre", PRE)
-@pytest.mark.parametrize("name", [n for n in SUPPORTED if n not in STRING])
+@pytest.mark.parametrize("name", SUPPORTED)
 def test_our_dump_goes_on_alike_in_reference(evolver, name, pre, tmp_path):
     out = str(tmp_path / f"our_{name}.dmp")
     s = Session.load(example(name + ".fe"), out=io.StringIO(), err=io.StringIO())
@@ -131,11 +130,26 @@ def test_our_dump_goes_on_alike_in_reference(evolver, name, pre, tmp_path):
     _agree(run_reference(evolver, out, SCRIPT, cwd=str(tmp_path)), s.out.getvalue().split("\n"))
 
 
-@pytest.mark.parametrize("name", sorted(STRING))
-def test_string_dump_refused_by_name(name, tmp_path):
-    s = Session.load(example(name + ".fe"), out=io.StringIO(), err=io.StringIO())
-    with pytest.raises(PyEvolverError, match="not supported in pyevolver: dump in the string"):
-        s.run(f'dump "{tmp_path / "x.dmp"}"')
+@pytest.mark.parametrize("name", ["string_circle", "string_ten", "100grain"])
+def test_our_string_dump_loads_in_reference(evolver, name, tmp_path):
+    """The string model's dump: chains as faces, 2-d coordinates, the 2x2
+    torus periods and 100grain's motion toggles in the read section."""
+    path = example(name + ".fe") if name == "100grain" else os.path.join(
+        os.path.dirname(__file__), "data", name + ".fe")
+    s = Session.load(path, out=io.StringIO(), err=io.StringIO())
+    s.run("r")
+    out = str(tmp_path / "our.dmp")
+    s.run(f'dump "{out}"')
+    s.out = io.StringIO()
+    s.run(SCRIPT.replace("g 5\n", ""))
+    ref = run_reference(evolver, out, SCRIPT.replace("g 5\n", ""), cwd=str(tmp_path))
+    (rr, rv, _), (orr, ov, _) = _pick(ref), _pick(s.out.getvalue().split("\n"))
+    assert all(_rel(a, b) <= 1e-9 for a, b in zip(rr[:2], orr[:2])) and rr[2:] == orr[2:]
+    assert len(rv) == len(ov) and all(_rel(a, b) <= 1e-9 for a, b in zip(rv, ov))
+    if name == "100grain":
+        text = open(out).read()
+        for line in ("AUTOCHOP 0.0149", "autochop on", "area_normalization on", "autopop on"):
+            assert line in text
 
 
 # ---------------------------------------------------------------------------
