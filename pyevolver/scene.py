@@ -96,6 +96,7 @@ class Scene:
     read_text: str | None = None
     read_line: int = 0
     wraps: dict = field(default_factory=dict)          # edge position -> wrap list
+    arrays: dict = field(default_factory=dict)         # global arrays: name -> (type, ndarray)
     source_lines: list | None = None                   # the text's lines (error excerpts)
 
     @property

@@ -143,6 +143,9 @@ class Session(SessionAPI):
         self.letters = {}
         self.arrays = {}
         self._init_view_matrix()
+        for name, (typ, arr) in scene.arrays.items():     # a dump's global arrays
+            self.arrays[name] = arr.copy()
+            self.array_types[name] = typ
         try:
             self.recalc()
         except DatafileError:

@@ -446,3 +446,65 @@ def test_transforms_in_a_procedure(tmp_path):
     s.run("few; print transforms")
     assert s.out.getvalue().split("\n")[:2] == ["Transform showing OFF. (was on)",
                                                 "                   0"]
+
+
+def test_method_instance_forward_declaration(tmp_path):
+    top = """// Forward declarations
+quantity qf;
+method_instance ma;
+// End forward declarations
+METHOD_INSTANCE ma METHOD facet_area global
+QUANTITY qf INFO_ONLY  function 2*ma.value
+"""
+    s, _, _ = _load(tmp_path, top)
+    assert s.surface.evaluate().quantity_values["qf"] == pytest.approx(12.0)
+    with pytest.raises(DatafileError, match=r"t2\.fe:1: method_instance mb is declared but "
+                                            r"never defined"):
+        _load(tmp_path, "method_instance mb;\n", name="t2.fe")
+
+
+def test_global_arrays_of_a_dump(tmp_path):
+    top = """define a2 real[2][3] =
+{{ 0, 0, 0},
+ { 0, 0,-1.5e-07}}
+define ia integer[2] =
+{7,0}
+define sa string[2] =
+{"x y",""}
+define emp real[0] =
+{}
+"""
+    s, _, _ = _load(tmp_path, top)
+    np.testing.assert_array_equal(s.arrays["a2"], [[0, 0, 0], [0, 0, -1.5e-7]])
+    assert s.arrays["ia"].tolist() == [7, 0] and s.array_types["ia"] == "integer"
+    assert s.arrays["sa"].tolist() == ["x y", ""] and s.array_types["sa"] == "string"
+    assert s.arrays["emp"].shape == (0,)
+    with pytest.raises(DatafileError, match=r"t2\.fe:2: array bad: expected 3 numbers"):
+        _load(tmp_path, "define bad real[3] =\n{1, 2}\n", name="t2.fe")
+
+
+def test_run_time_state_of_a_reference_dump(evolver, tmp_path):
+    """What REF's dump keeps of a session: global arrays and parameters at the
+    top, string variables in the read section, defined attributes with
+    their (array) values, method instances and FUNCTION quantities."""
+    path = tmp_path / "mi.fe"
+    path.write_text("method_instance ma method facet_area\n"
+                    "quantity qf info_only function ma.value\n" + CUBE_ELEMENTS.replace(
+                        "1 1 10 -5 -9\n", "1 1 10 -5 -9 ma\n"))
+    cmds = ('define arr real[3]\narr[2] := 5\nss := "hello"\nnn := 3.5\n'
+            'define vertex attribute va real\nset vertex va x+1\n'
+            'define edge attribute ea integer[2]\nset edge ea[1] 4\nr\ng 2\n'
+            f'dump "{tmp_path / "rt.dmp"}"')
+    run_reference(evolver, str(path), cmds, cwd=str(tmp_path))
+    dmp = str(tmp_path / "rt.dmp")
+    ref, ours = run_reference(evolver, dmp, SCRIPT, cwd=str(tmp_path)), _ours(dmp)
+    _agree(ref, ours)
+    s = Session.load(dmp, out=io.StringIO(), err=io.StringIO())
+    s.out = io.StringIO()
+    show = ('printf "S %g %s %g %g %g %.15g\\n", arr[2], ss, nn, vertex[3].va, edge[2].ea[1], '
+            'qf.value')
+    s.run(show)
+    got = s.out.getvalue().split()
+    want = next(ln for ln in run_reference(evolver, dmp, show, cwd=str(tmp_path))
+                if ln.startswith("S ")).split()
+    assert got[:6] == want[:6] and _rel(got[6], want[6]) <= 1e-12, (got, want)

@@ -271,6 +271,14 @@ class _TopTransformer(ExprTransformer):
     def quantity_forward(self, kw, name):
         return ("quantity_forward", str(name).lower(), kw.line)
 
+    def instance_forward(self, kw, name):
+        return ("instance_forward", str(name).lower(), kw.line)
+
+    def global_array(self, kw, name, atype, dims, init):
+        # ``define arr real[2][3] = {{...},{...}}``: a global array with its values
+        return ("global_array", str(name).lower(), str(atype).lower(), dims, str(init),
+                kw.line, init.line)
+
 
 @v_args(inline=True)
 class _LineTransformer(ExprTransformer):
@@ -522,9 +530,11 @@ class Reader:
                 raise self.error(f"undefined parameter '{exc.name}'",
                                  self._src(sec, exc.line) if exc.line else None,
                                  exc.col) from None
-        for name, line in self._forward.items():
-            if name not in sc.quantities:
-                raise self.error(f"quantity {name} is declared but never defined", line)
+        for name, (kind, line) in self._forward.items():
+            known = sc.quantities if kind == "quantity_forward" else sc.method_instances
+            if name not in known:
+                what = "quantity" if kind == "quantity_forward" else "method_instance"
+                raise self.error(f"{what} {name} is declared but never defined", line)
 
     def _decl(self, d, sc, sec):
         kind = d[0]
@@ -595,13 +605,49 @@ class Reader:
                 raise self.error(f"attribute {name}: {size} entries per {etype}; at most "
                                  f"{MAX_ARRAY_ENTRIES} are allowed", self._src(sec, line))
             sc.attributes[(etype, name)] = (atype, size, dims)
-        elif kind == "quantity_forward":
-            # ``quantity name;``: declared now, defined later in the top section
-            self._forward.setdefault(d[1], self._src(sec, d[2]))
+        elif kind == "global_array":
+            self._global_array(d, sc, sec)
+        elif kind in ("quantity_forward", "instance_forward"):
+            # ``quantity name;``, ``method_instance name;``: declared now, defined
+            # later in the top section
+            self._forward.setdefault(d[1], (kind, self._src(sec, d[2])))
         elif kind == "periods":
             pass    # numbers taken by _extract_matrices
         elif kind == "ignored":
             pass
+
+    def _global_array(self, d, sc, sec):
+        _, name, atype, dims, init, line, iline = d
+        where = self._src(sec, line)
+        if atype not in ("real", "string") and atype not in _INT_ATTR_TYPES:
+            raise self.error(f"not supported in pyevolver: {atype.upper()} arrays "
+                             f"(array {name})", where)
+        size = math.prod(dims) if dims else 1
+        if size > MAX_ARRAY_ENTRIES:
+            raise self.error(f"array {name}: {size} entries; at most {MAX_ARRAY_ENTRIES} are "
+                             f"allowed", where)
+        # the values in braces, row by row: numbers or strings
+        depth, shape_ok, vals = 0, True, []
+        for m in _ARRAY_TOKEN.finditer(init):
+            tok = m.group(0)
+            if tok == "{":
+                depth += 1
+                shape_ok = shape_ok and depth <= len(dims)
+            elif tok == "}":
+                depth -= 1
+            elif tok.startswith('"'):
+                vals.append(tok[1:-1].encode("latin-1").decode("unicode_escape"))
+            else:
+                vals.append(float(tok.replace("d", "e").replace("D", "e")))
+        strings = atype == "string"
+        if not shape_ok or len(vals) != size or any(isinstance(v, str) != strings
+                                                     for v in vals):
+            raise self.error(f"array {name}: expected {size} "
+                             f"{'strings' if strings else 'numbers'} in "
+                             f"{len(dims)} levels of braces for {atype}"
+                             + "".join(f"[{k}]" for k in dims), self._src(sec, iline))
+        arr = np.array(vals, dtype=object if strings else float).reshape(dims)
+        sc.arrays[name] = ("integer" if atype in _INT_ATTR_TYPES else atype, arr)
 
     def _method(self, mname, is_global, opts, sec, line, qname):
         m = MethodDecl(mname, is_global, name=qname)
@@ -897,6 +943,9 @@ _KW_INTEGER = {"constraint", "constraints", "boundary", "color", "colour", "fron
 # the integer types of ``define ... attribute`` (the Evolver's dump writes them)
 _INT_ATTR_TYPES = {"integer", "uchar", "char", "uint", "ulong_int", "short_int", "ushort_int",
                    "long_int"}
+
+
+_ARRAY_TOKEN = re.compile(r'[{}]|"(?:\\.|[^"\\\n])*"|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?')
 
 
 class _MatrixError(Exception):
