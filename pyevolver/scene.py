@@ -98,6 +98,7 @@ class Scene:
     read_text: str | None = None
     read_line: int = 0
     wraps: dict = field(default_factory=dict)          # edge position -> wrap list
+    arrays: dict = field(default_factory=dict)         # global arrays: name -> (type, ndarray)
     source_lines: list | None = None                   # the text's lines (error excerpts)
     constraint_names: dict = field(default_factory=dict)  # id -> name (named constraints)
     boundary_names: dict = field(default_factory=dict)    # id -> name (named boundaries)

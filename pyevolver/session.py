@@ -143,8 +143,8 @@ class Session(SessionAPI):
                                       bool(b.n and np.any(b.density)))
         self.variables = surface.params        # parameters and variables share one namespace
         self._scene_settings(scene)
-        for flag in ("area_normalization", "autopop", "conj_grad", "effective_area",
-                     "normal_curvature", "approximate_curvature", "jiggle"):
+        for flag in ("area_normalization", "autopop", "conj_grad", "torus_filled",
+                     "effective_area", "normal_curvature", "approximate_curvature", "jiggle"):
             if flag in scene.flags:             # top-section toggles (100grain.fe)
                 self.toggles[flag] = 1
         if scene.values.get("autochop"):
@@ -155,6 +155,9 @@ class Session(SessionAPI):
         self.arrays = {}
         self.macros = dict(scene.macros)       # keep_macros: expanded in commands
         self._init_view_matrix()
+        for name, (typ, arr) in scene.arrays.items():     # a dump's global arrays
+            self.arrays[name] = arr.copy()
+            self.array_types[name] = typ
         try:
             self.recalc()
         except DatafileError:
@@ -191,6 +194,8 @@ class Session(SessionAPI):
         for k in ("scale_limit", "constraint_tolerance"):
             if k in scene.values:
                 self.settings[k] = scene.values[k]
+        if "total_time" in scene.values:        # TOTAL_TIME: a dump goes on with its clock
+            self.total_time = float(scene.values["total_time"])
         if "scale" in scene.values:
             self.settings["scale"] = scene.values["scale"]
             if scene.values.get("scale_fixed"):
@@ -201,7 +206,6 @@ class Session(SessionAPI):
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
         from .datafile.writer import dump
-        self.no_string("dump")
         if name is None:
             name = (self.filename or "pyevolver") + ".dmp"
         self.write(f"Dumping to {name}.\n")

@@ -580,7 +580,7 @@ class _Builder:
                 s.vcon[cid] = np.ones(n, bool)
         s.X = X
         s.vattr["fixed"] = fixed
-        s.vattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.vattr["original"] = self._originals(blk)
         if bnd is not None:
             s.vattr["boundary"] = bnd
             s.vattr["params"] = params
@@ -673,7 +673,7 @@ class _Builder:
         s.E = E
         s.eattr["fixed"] = fixed
         s.eattr["no_refine"] = no_refine
-        s.eattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.eattr["original"] = self._originals(blk)
         if tension is not None:
             s.eattr["tension"] = tension
         if bnd is not None:
@@ -789,7 +789,7 @@ class _Builder:
         s.fattr["fixed"] = fixed[parent]
         s.fattr["tension"] = tension[parent]
         s.fattr["no_refine"] = no_refine[parent]
-        s.fattr["original"] = np.asarray(blk.ids, dtype=np.int64)[parent] if nface else \
+        s.fattr["original"] = self._originals(blk)[parent] if nface else \
             np.zeros(0, np.int64)
         for key, arr in colors.items():
             s.fattr[key] = arr[parent]
@@ -961,12 +961,24 @@ class _Builder:
         s.fattr["fixed"] = fixed
         s.fattr["tension"] = tension
         s.fattr["no_refine"] = no_refine
-        s.fattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.fattr["original"] = self._originals(blk)
         for key, arr in colors.items():
             s.fattr[key] = arr
 
     def children(self, pos):
         return self.split_children.get(pos, [pos])
+
+    @staticmethod
+    def _originals(blk):
+        """The ``original`` attribute of a section's elements: the datafile
+        id, or the value of an ``original N`` keyword (the Evolver's dump
+        writes it for elements made by refining element N)."""
+        orig = np.asarray(blk.ids, dtype=np.int64).copy()
+        for pos, attrs in blk.attrs.items():
+            for kw, vals in attrs:
+                if kw == "original" and vals:
+                    orig[pos] = int(vals[0])
+        return orig
 
     def _face_center(self, rim):
         return self.s.X[rim].mean(axis=0)
@@ -1008,7 +1020,7 @@ class _Builder:
         b.pressure = np.full(nb, np.nan)
         b.density = np.zeros(nb)
         b.lagrange = np.zeros(nb)
-        b.original = np.asarray(blk.ids, dtype=np.int64)
+        b.original = self._originals(blk)
         lens = [len(d) for d in blk.data]
         flat = np.concatenate([np.asarray(d, dtype=np.int64) for d in blk.data]) if nb else \
             np.zeros(0, np.int64)
@@ -1045,7 +1057,9 @@ class _Builder:
                 elif kw == "actual_volume":
                     self._actual_volume[pos] = v[0]
                 elif kw == "lagrange_multiplier":
-                    pass
+                    b.lagrange[pos] = v[0]      # the pressure REF reports until the next step
+                elif kw in ("centerofmass", "original"):
+                    pass        # centerofmass is a display flag; original above
                 elif kw == "attribute":
                     self._attr("body", nb, pos, v)
                 elif kw == "phase":
@@ -1113,6 +1127,7 @@ class _Builder:
             s.quantities[name] = q
         for name, qd in sc.quantities.items():
             q = Quantity(name, qd.kind, qd.target, qd.modulus, qd.tolerance, line=qd.line)
+            q.pressure = qd.lagrange_multiplier      # a dump's multiplier, until the next step
             for m in qd.methods:
                 try:
                     etype, _ = method_info(m.method)
