@@ -291,6 +291,7 @@ def test_settings_that_change_no_number(evolver, tmp_path, top):
     ("constraint 1 content_rank 2\nformula: z = 0", "CONTENT_RANK", 1),
     ("square_gaussian_curvature 1", "SQUARE_GAUSSIAN_CURVATURE", 1),
     ("define vertex attribute kk real function { self.kk := 1 }", "FUNCTION", 1),
+    ("function real sq(real xx) { return xx*xx }\nparameter pp = sq(3)", "sq", 2),
 ])
 def test_unsupported_settings_refused_by_name(tmp_path, top, word, line):
     path = write(tmp_path, tetra(top + "\n"))
