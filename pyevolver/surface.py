@@ -1634,7 +1634,7 @@ def project_tangent(s, vecs):
     return out
 
 
-def _hit_one_sided(s, cids, on, env, tol=1e-10, rows=None, violated=False):
+def _hit_one_sided(s, cids, on, env, tol=1e-10, rows=None, violated=False, hold=None):
     """``on`` with one-sided (NONNEGATIVE / NONPOSITIVE) constraints kept only
     for the vertices that hit them (value 0 within ``tol``), or, with
     ``violated``, also those outside the allowed side: a vertex inside the
@@ -1655,10 +1655,48 @@ def _hit_one_sided(s, cids, on, env, tol=1e-10, rows=None, violated=False):
         c = s.constraints[cids[j]]
         phi = np.broadcast_to(_constraint_formula(c, "values", env, coords, len(rr)), (len(rr),))
         keep = np.abs(phi) <= tol
+        rel = getattr(s, "_one_sided_released", None)
+        if rel and cids[j] in rel:      # hit, but leaving it this step
+            keep &= ~np.isin(rr if rows is None else rows[rr], rel[cids[j]])
         if violated:
             keep |= (phi < 0) if "nonnegative" in c.flags else (phi > 0)
+        if hold and cids[j] in hold:    # held on the constraint (see project_to_constraints)
+            keep |= np.isin(rr if rows is None else rows[rr], hold[cids[j]])
         on[rr, j] = keep
     return on
+
+
+def release_one_sided(s, force):
+    """At the start of a step: the vertices that hit a one-sided constraint
+    and whose force ``force`` (nv, 3) points into its allowed side leave it
+    for this step (manual: "The 'g' iteration step will check for a vertex
+    wanting to leave a one-sided constraint it has hit"); recorded in
+    ``s._one_sided_released``."""
+    s._one_sided_released = None
+    if not s.vcon:
+        return
+    env = s.param_env()
+    out = {}
+    for c, mask in s.vcon.items():
+        con = s.constraints[c]
+        if not con.flags & {"nonnegative", "nonpositive"}:
+            continue
+        rr = np.nonzero(mask)[0]
+        if not len(rr):
+            continue
+        P = s.X[rr]
+        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        phi = np.broadcast_to(_constraint_formula(con, "values", env, coords, len(rr)),
+                              (len(rr),))
+        g = np.broadcast_to(_constraint_formula(con, "gradient", env, coords, len(rr)),
+                            (len(rr), 3))
+        into = np.einsum("ij,ij->i", np.asarray(force)[rr], g)
+        if "nonpositive" in con.flags:
+            into = -into
+        leave = (np.abs(phi) <= 1e-10) & (into > 0)
+        if leave.any():
+            out[c] = rr[leave]
+    s._one_sided_released = out or None
 
 
 def constrained_vertices(s):
@@ -1669,12 +1707,13 @@ def constrained_vertices(s):
     return on
 
 
-def project_to_constraints(s, idx, tol=None, maxit=20, _again=True):
+def project_to_constraints(s, idx, tol=None, maxit=20, _again=True, hold=None):
     """Newton-project the vertices ``idx`` onto their level-set constraints.
 
     Uses ``x <- x - G (G^T G)^{-1} phi(x)`` over the vertex's active
     constraints (spec §6.1).  One-sided constraints are projected only when
-    violated.  A vertex whose projection diverges (its coordinates or its
+    violated (or hit, or held: ``hold`` maps a constraint to vertices kept on
+    it; the constraints a call enforced are left in ``s._one_sided_hits``).  A vertex whose projection diverges (its coordinates or its
     constraint values become infinite or NaN, or it ends unconverged
     farther from its constraints than it started) is put back where it was.
 
@@ -1692,7 +1731,11 @@ def project_to_constraints(s, idx, tol=None, maxit=20, _again=True):
     env = s.param_env()
     full = onmat
     # one-sided constraints act on the vertices that violate or hit them
-    onmat = _hit_one_sided(s, cids, onmat, env, rows=idx, violated=True)
+    onmat = _hit_one_sided(s, cids, onmat, env, rows=idx, violated=True, hold=hold)
+    if _again:                      # the one-sided constraints this projection enforces
+        s._one_sided_hits = {c: idx[onmat[:, j]] for j, c in enumerate(cids)
+                             if s.constraints[c].flags & {"nonnegative", "nonpositive"}
+                             and onmat[:, j].any()}
     anyon = np.nonzero(onmat.any(axis=1))[0]
     if not len(anyon):
         return failed
@@ -1710,11 +1753,8 @@ def project_to_constraints(s, idx, tol=None, maxit=20, _again=True):
             grads = []
             for cid in active:
                 c = s.constraints[cid]
+                # (a one-sided constraint here is violated, hit or held: an equality)
                 phi = _constraint_formula(c, "values", env, coords, len(sel))
-                if "nonnegative" in c.flags:
-                    phi = np.minimum(phi, 0.0)
-                elif "nonpositive" in c.flags:
-                    phi = np.maximum(phi, 0.0)
                 phis.append(phi)
                 grads.append(_constraint_formula(c, "gradient", env, coords, len(sel)))
             phi = np.stack(phis, axis=1)           # (n, k)

@@ -535,6 +535,7 @@ class Reader:
         line and column of everything else are kept.
         """
         text = sec.text
+        self._functions = set()
         af = _ATTR_FUNCTION.search(text)
         if af:
             line = text.count("\n", 0, af.start(1)) + 1
@@ -556,11 +557,25 @@ class Reader:
                                  m.start() - text.rfind("\n", 0, m.start()))
             body = text[m.start():end]
             self.scene.top_commands.append((body.rstrip().rstrip(";"), self._src(sec, line)))
+            if m.group(1).lower() == "function":
+                self._functions.add(re.match(r"\w+\s+(?:\w+\s+)?(\w+)", body).group(1).lower())
             out.append(text[pos:m.start()])
             out.append(re.sub(r"[^\n]", " ", body))
             pos = end
         out.append(text[pos:])
-        return "".join(out)
+        text = "".join(out)
+        if self._functions:
+            # a user function called in a top-section expression (REF evaluates
+            # it with its command interpreter; pyevolver's datafile reader has none)
+            call = re.search(r"\b(" + "|".join(map(re.escape, sorted(self._functions))) +
+                             r")\s*\(", text, re.I)
+            if call:
+                line = text.count("\n", 0, call.start()) + 1
+                raise self.error(f"not supported in pyevolver: calling the user function "
+                                 f"{call.group(1)} in the top section of a datafile",
+                                 self._src(sec, line),
+                                 call.start() - text.rfind("\n", 0, call.start()))
+        return text
 
     def _top(self, sec):
         if _PROC_START.search(sec.text) or _ATTR_FUNCTION.search(sec.text):
@@ -1220,9 +1235,12 @@ _KW_INTEGER = {"constraint", "constraints", "boundary", "color", "colour", "fron
 
 # a stand-alone procedure or function of the top section: its keyword, (type),
 # name and opening parenthesis
+# (a stand-alone function has a return type: "function qwerty^3" and
+# "function sin(x)" are quantity FUNCTION expressions)
 _PROC_START = re.compile(
-    r"\b(procedure|function)\s+(?:(?:real|integer|string|vertex_type|edge_type|facet_type|"
-    r"body_type|facetedge_type|element_id)\s+)?[A-Za-z_]\w*\s*\(", re.I)
+    r"\b(procedure(?=\s+[A-Za-z_]\w*\s*\()|function(?=\s+(?:real|integer|string|"
+    r"vertex_type|edge_type|facet_type|body_type|facetedge_type|element_id)\s+"
+    r"[A-Za-z_]\w*\s*\())\s+(?:\w+\s+)?[A-Za-z_]\w*\s*\(", re.I)
 
 
 # define ... attribute name type [dims] FUNCTION { ... }

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..surface import displace, project_tangent, project_to_constraints, restore_state, state
+from ..surface import (displace, project_tangent, project_to_constraints, release_one_sided,
+                       restore_state, state)
 from . import gradient as GR
 
 
@@ -162,6 +163,20 @@ class Iterator:
         if len(project_to_constraints(self.surface, moved)):
             self._diverged = True
 
+    def _hold_one_sided(self, t):
+        """After the actual move: the vertices its first projection put on a
+        one-sided constraint, and that the restoring moved off it, are
+        projected back onto it (REF: drop_afm.fe's defect vertex ends the
+        step exactly on its NONNEGATIVE plane; trial moves do not do this)."""
+        hold = getattr(self, "_move_hits", None)
+        self._move_hits = None
+        if not hold:
+            return t
+        s = self.surface
+        idx = np.unique(np.concatenate(list(hold.values())))
+        project_to_constraints(s, idx, hold=hold)
+        return s.evaluate()
+
     # -- one move ------------------------------------------------------------------
     def _move(self, base, vel, scale, cons, us, A, mobile, targets, report, trial=False):
         """Trial move M(scale) from the snapshot ``base`` (:func:`surface.state`):
@@ -170,7 +185,9 @@ class Iterator:
         s = self.surface
         displace(s, base, scale * vel)
         moved = np.nonzero(mobile)[0]
+        s._one_sided_hits = None
         self._project(moved)
+        self._move_hits = None if trial else s._one_sided_hits
         if not len(cons):
             return s.evaluate()
         tol = self.session.settings.get("target_tolerance", 1e-4)
@@ -257,17 +274,26 @@ class Iterator:
         sess._last_motion = (s, f + 0.0, np.where(mobile[:, None], s.X, 0.0))
         f[~mobile] = 0.0
         f_raw = f
-        (f,) = self._project_tangent([f])
+        s._one_sided_released = None
         targets = cons.targets(s)
-        lam = np.zeros(len(cons))
-        if len(cons):
-            gs, us, A = self._constrained_dirs(t0, cons, mobile)
-            b = np.array([float(np.sum(f * g)) for g in gs])
-            lam = _solve(A, b)
-            vel = f - sum(l * u for l, u in zip(lam, us))
-        else:
-            us, A = [], np.zeros((0, 0))
-            vel = f
+        for _pass in range(2):
+            (f,) = self._project_tangent([f_raw])
+            lam = np.zeros(len(cons))
+            if len(cons):
+                gs, us, A = self._constrained_dirs(t0, cons, mobile)
+                b = np.array([float(np.sum(f * g)) for g in gs])
+                lam = _solve(A, b)
+                vel = f - sum(l * u for l, u in zip(lam, us))
+            else:
+                gs, us, A = [], [], np.zeros((0, 0))
+                vel = f
+            if _pass:
+                break
+            # hit one-sided constraints that the force (with the constraints'
+            # multipliers) takes a vertex off, for this step
+            release_one_sided(s, f_raw - sum(l * g for l, g in zip(lam, gs)))
+            if not getattr(s, "_one_sided_released", None):
+                break
         # conjugate gradient
         if sess.toggles.get("conj_grad", 0):
             # Fletcher-Reeves: gamma = S/S_old with S = sum vel.f; Polak-Ribiere
@@ -328,6 +354,7 @@ class Iterator:
         self._diverged = False
         t = self._move(X0, vel, settings.get("scale_scale", 1.0) * scale, cons, us, A,
                        mobile, targets, report)
+        t = self._hold_one_sided(t)
         e = t.energy
         if not math.isfinite(e) or self._diverged or not np.all(np.isfinite(s.X)):
             return self._undo(X0, t0, scale, lam, report)
