@@ -264,8 +264,9 @@ def element_attr(session, base, name, idx):
                                             GA.string_vertex_dihedral)[i])
         if name == "p":                 # the boundary parameters as an array
             bnd = s.vattr.get("boundary")
-            if bnd is None or not bnd[i]:
-                vec = np.zeros(0)
+            if bnd is None or not bnd[i]:       # REF: as many zeros as the widest boundary
+                par = s.vattr.get("params")
+                vec = np.zeros(0 if par is None else par.shape[1])
             else:
                 vec = s.vattr["params"][i, :s.boundaries[int(bnd[i])].nparams]
             return _component(vec, idx, name)
