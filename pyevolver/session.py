@@ -1568,6 +1568,7 @@ class Session(SessionAPI):
             raise UnsupportedError(f"set {gen.kind} {attr} (without a value)")
         if attr == "constraint":
             self.set_constraint(els, self.interp.value(expr))
+            A.cache(self).touch(self)           # projected vertices moved
             return
         # compute every value first, then assign (like the Evolver's set)
         vals = []
@@ -1580,6 +1581,7 @@ class Session(SessionAPI):
             self.set_attr(el, attr, ix, v)
         if gen.kind == "vertex" and attr in ("x", "y", "z"):
             self._project_or_fail(self.surface, np.array([e.i for e in els], np.int64))
+            A.cache(self).touch(self)
 
     def _project_or_fail(self, surface, idx):
         """Project vertices to their constraints; a projection that diverges
