@@ -110,7 +110,7 @@ ATTRIBUTES = [
      "quantity has no method for that kind"),
     ("quantity", "value, target, modulus, pressure, tolerance, fixed, energy, info_only, "
      "conserved", "supported; `target`, `modulus`, `tolerance` assignable (`q.target := 2`, "
-     "`set q target 2`), `set q fixed|energy|info_only|conserved`; `volconst` reads 0, "
+     "`set q target 2`), `set q fixed` (`energy`, `info_only`, `conserved`); `volconst` reads 0, "
      "setting it is refused by name; `parameter_1`, `element_modulus` refused by name"),
     ("method instance", "value, modulus", "supported (`set inst modulus 2`); other "
      "attributes rejected as REF"),
