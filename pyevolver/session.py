@@ -1552,6 +1552,8 @@ class Session(SessionAPI):
             if attr in ("constraint",) and expr is not None:
                 self.unset_constraint(els, int(self.interp.value(expr)))
                 return
+            if attr == "density" and gen.kind == "body":
+                return      # REF: neither the printed density nor the energy changes
             if attr in ("target", "pressure") and gen.kind == "body":
                 b = self.surface.bodies
                 arr = getattr(b, attr)
