@@ -273,7 +273,7 @@ def test_language_matches_reference(evolver, tmp_path, datafile, script):
 # commands REF rejects; pyevolver rejects them with a located message and
 # leaves the surface, the quantities and the variables as they were
 REJECTED = [
-    ("set quantity vol target 3", "undefined name 'quantity'"),
+    ("set quantity vol target 3", "write set NAME target value"),
     ("unset vol fixed", "unset vol: a quantity is not an element"),
     ("unset facet color", "not supported in pyevolver: unset facet color"),
     ("set vol volconst 0.5", "not supported in pyevolver: quantity volconst"),
