@@ -1610,6 +1610,8 @@ class Session(SessionAPI):
             if attr in ("constraint",) and expr is not None:
                 self.unset_constraint(els, int(self.interp.value(expr)))
                 return
+            if attr == "density" and gen.kind == "body":
+                return      # REF: neither the printed density nor the energy changes
             if attr in ("target", "pressure") and gen.kind == "body":
                 b = self.surface.bodies
                 arr = getattr(b, attr)
@@ -1626,6 +1628,7 @@ class Session(SessionAPI):
             raise UnsupportedError(f"set {gen.kind} {attr} (without a value)")
         if attr == "constraint":
             self.set_constraint(els, self.interp.value(expr))
+            A.cache(self).touch(self)           # projected vertices moved
             return
         # compute every value first, then assign (like the Evolver's set)
         vals = []
@@ -1638,6 +1641,7 @@ class Session(SessionAPI):
             self.set_attr(el, attr, ix, v)
         if gen.kind == "vertex" and attr in ("x", "y", "z"):
             self._project_or_fail(self.surface, np.array([e.i for e in els], np.int64))
+            A.cache(self).touch(self)
 
     def _project_or_fail(self, surface, idx):
         """Project vertices to their constraints; a projection that diverges

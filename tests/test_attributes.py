@@ -112,6 +112,12 @@ PRINTS = {
         "print vertex[1].v_force", "print vertex[1].v_force[3]", "print vertex[1].v_oldx",
         "print vertex[12].v_force", "print vertex[9].v_force", "print vertex[1].v_velocity",
         "print vertex[5].v_velocity", "print vertex[9].v_velocity",
+        "print vertex[1].v_constraint_list", "print vertex[5].v_constraint_list",
+        "print vertex[1].v_constraint_list[2] imod 0x100000",
+        "set vertex[5] constraint 1; print vertex[5].v_constraint_list",
+        "print edge[1].e_constraint_list", "print edge[5].e_constraint_list",
+        "print facet[1].f_constraint_list",
+        "foreach vertex vs where vs.v_constraint_list[1] == 1 do print vs.id",
     ]),
     "cube.fe": ("print vertex[1].v_velocity\ng", [
         "print vertex[1].v_velocity", "g", "print vertex[1].v_velocity",
@@ -174,7 +180,7 @@ def test_rejected_attributes(evolver, datafile, cmd, text):
 
 # refused by name (no number of pyevolver's can stand for them)
 REFUSED = [
-    ("print vertex[1].v_constraint_list", "the internal attribute v_constraint_list"),
+    ("print vertex[1].e_constraint_list", "is a edge attribute, not vertex"),
     ("print facet[1].f_body_list", "the internal attribute f_body_list"),
     ("set vertex triple_point where id == 5", "set vertex triple_point"),
     ("set facet orientation -1 where id == 1", "set facet orientation"),

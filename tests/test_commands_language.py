@@ -213,6 +213,16 @@ print ll.value
 print mix.value
 """
 
+DENSITY = """gravity_constant := 2
+recalc
+print total_energy
+unset body density
+print body[1].density
+recalc
+print total_energy
+g 2
+"""
+
 BOUNDARIES = """g 2
 print vertex[2].p[1]
 print vertex[2].p
@@ -250,8 +260,8 @@ def _instance_file(tmp_path):
 
 @pytest.mark.parametrize("datafile,script", [
     ("cube.fe", AGGREGATES), ("cube.fe", SETS), ("qmound.fe", QUANTITIES),
-    ("instances", INSTANCES), ("cat.fe", BOUNDARIES)],
-    ids=["aggregates", "sets", "quantities", "instances", "boundaries"])
+    ("instances", INSTANCES), ("cat.fe", BOUNDARIES), ("mound.fe", DENSITY)],
+    ids=["aggregates", "sets", "quantities", "instances", "boundaries", "density"])
 def test_language_matches_reference(evolver, tmp_path, datafile, script):
     path = _instance_file(tmp_path) if datafile == "instances" else example(datafile)
     ref = run_reference(evolver, path, script, cwd=str(tmp_path))
@@ -263,7 +273,7 @@ def test_language_matches_reference(evolver, tmp_path, datafile, script):
 # commands REF rejects; pyevolver rejects them with a located message and
 # leaves the surface, the quantities and the variables as they were
 REJECTED = [
-    ("set quantity vol target 3", "undefined name 'quantity'"),
+    ("set quantity vol target 3", "write set NAME target value"),
     ("unset vol fixed", "unset vol: a quantity is not an element"),
     ("unset facet color", "not supported in pyevolver: unset facet color"),
     ("set vol volconst 0.5", "not supported in pyevolver: quantity volconst"),

@@ -55,7 +55,7 @@ SET_REFUSED = {
 
 # internal lists of the Evolver's data structure: refused by name
 INTERNAL = {
-    "v_constraint_list", "e_constraint_list", "f_constraint_list", "v_method_list",
+    "v_method_list",
     "e_method_list", "f_method_list", "f_body_list", "f_next_bfacet", "f_next_vfacet",
     "raw_velocity", "v_boundary", "e_boundary", "f_boundary", "wrap_list",
 }
@@ -110,7 +110,7 @@ ATTRIBUTES = [
      "quantity has no method for that kind"),
     ("quantity", "value, target, modulus, pressure, tolerance, fixed, energy, info_only, "
      "conserved", "supported; `target`, `modulus`, `tolerance` assignable (`q.target := 2`, "
-     "`set q target 2`), `set q fixed|energy|info_only|conserved`; `volconst` reads 0, "
+     "`set q target 2`), `set q fixed` (`energy`, `info_only`, `conserved`); `volconst` reads 0, "
      "setting it is refused by name; `parameter_1`, `element_modulus` refused by name"),
     ("method instance", "value, modulus", "supported (`set inst modulus 2`); other "
      "attributes rejected as REF"),
@@ -126,9 +126,12 @@ ATTRIBUTES = [
      "gradient, FIXED vertices included, not projected onto constraints), the motion "
      "direction (projected, after conjugate gradients) and the coordinates of the moving "
      "vertices (0 for FIXED ones) of the last `g` step; zeros before any, as REF"),
-    ("vertex, edge, facet", "v_/e_/f_constraint_list, v_/e_/f_method_list, f_body_list, "
-     "f_next_bfacet, wrap_list, raw_velocity", "refused by name (the Evolver's internal "
-     "data structure)"),
+    ("vertex, edge, facet", "v_constraint_list, e_constraint_list, f_constraint_list",
+     "supported as REF prints them: count, then the constraint numbers (a vertex's with bit "
+     "31 set where it hits the constraint, so scripts mask with `imod 0x100000`), zero-padded "
+     "to 4 entries; empty when no element of the kind is on a constraint"),
+    ("vertex, edge, facet", "v_/e_/f_method_list, f_body_list, f_next_bfacet, wrap_list, "
+     "raw_velocity", "refused by name (the Evolver's internal data structure)"),
     ("edge", "midv", "REF's error: only in the quadratic model"),
     ("edge", "frontbody, backbody", "string model: the bodies of the facets along and "
      "against the edge; soapfilm model: REF's error"),
@@ -174,6 +177,8 @@ def geometry(session):
 
 def _component(vec, idx, name):
     if idx is None:
+        if np.issubdtype(np.asarray(vec).dtype, np.integer):    # printed with %d
+            return np.asarray(vec, np.int64).view(N.ArrayValue)
         return N.array_value(np.asarray(vec, float))
     if isinstance(idx, tuple):
         raise ExpressionError(f"{name} takes one index")
@@ -222,6 +227,11 @@ def element_attr(session, base, name, idx):
     if name in INTERNAL:
         raise UnsupportedError(f"the internal attribute {name}",
                                "the Evolver's own data structure")
+    if name in _CONSTRAINT_LISTS:
+        if k != _CONSTRAINT_LISTS[name]:
+            raise ExpressionError(f"\"{name}\" is a {_CONSTRAINT_LISTS[name]} attribute, "
+                                  f"not {k}.")
+        return _component(constraint_list(session, k, i), idx, name)
     if (k, name) in GRAPHICS:
         key = (k, _GRAPHICS_ALIAS.get(name, name))
         return float(_session_store(session).get(key, {}).get(i, GRAPHICS[(k, name)]))
@@ -264,8 +274,9 @@ def element_attr(session, base, name, idx):
                                             GA.string_vertex_dihedral)[i])
         if name == "p":                 # the boundary parameters as an array
             bnd = s.vattr.get("boundary")
-            if bnd is None or not bnd[i]:
-                vec = np.zeros(0)
+            if bnd is None or not bnd[i]:       # REF: as many zeros as the widest boundary
+                par = s.vattr.get("params")
+                vec = np.zeros(0 if par is None else par.shape[1])
             else:
                 vec = s.vattr["params"][i, :s.boundaries[int(bnd[i])].nparams]
             return _component(vec, idx, name)
@@ -325,6 +336,41 @@ def element_attr(session, base, name, idx):
             raise ExpressionError(f"\"{name}\" is not an attribute name (it is read from "
                                   f"the datafile only)")
     return MISSING
+
+
+_CONSTRAINT_LISTS = {"v_constraint_list": "vertex", "e_constraint_list": "edge",
+                     "f_constraint_list": "facet"}
+
+
+def constraint_list(session, kind, i):
+    """REF's ``v_constraint_list`` (``e_``, ``f_``): the number of
+    constraints, then their numbers (a vertex's with bit 31 set where it hits
+    the constraint, read as a signed 32-bit integer, so ``imod 0x100000``
+    gives the number back), zero-padded to at least 4 entries; empty when no
+    element of the kind is on a constraint."""
+    s = session.surface
+    masks = {"vertex": s.vcon, "edge": s.econ, "facet": s.fcon}[kind] or {}
+    if not any(np.any(m) for m in masks.values()):
+        return np.zeros(0, np.int64)
+    cids = [c for c in sorted(masks) if masks[c][i]]
+    out = [len(cids)]
+    for c in cids:
+        v = int(c)
+        if kind == "vertex" and element_attr(session, _Ref(kind, i), "hit_constraint", c):
+            v -= 2 ** 31                    # (c | 0x80000000) as a signed int
+        out.append(v)
+    return np.array(out + [0] * (4 - len(out)), np.int64)
+
+
+class _Ref:
+    """A plain element reference (kind, index) for internal attribute reads."""
+
+    __slots__ = ("kind", "i", "sign")
+
+    def __init__(self, kind, i):
+        self.kind = kind
+        self.i = i
+        self.sign = 1
 
 
 def _string_edge_body(session, base, name):

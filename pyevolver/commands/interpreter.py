@@ -1628,6 +1628,9 @@ class Interpreter:
 
     def _x_set(self, node):
         idx = node[4] if len(node) > 4 else None
+        if node[1].base == ("var", "quantity") and self._var_elem("quantity") is None:
+            raise CommandError("set quantity NAME ...: write set NAME target value (the "
+                               "Evolver reads 'set quantity' as a syntax error)")
         qname = self._quantity_gen(node[1])
         if qname is not None:
             from .attributes import set_quantity
