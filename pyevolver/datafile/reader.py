@@ -856,6 +856,7 @@ class Reader:
     def _global_array(self, d, sc, sec):
         _, name, atype, dims, init, line, iline = d
         where = self._src(sec, line)
+        dims = [self._dim(e, where, name) for e in dims]
         if atype not in ("real", "string") and atype not in _INT_ATTR_TYPES:
             raise self.error(f"not supported in pyevolver: {atype.upper()} arrays "
                              f"(array {name})", where)
