@@ -461,6 +461,12 @@ class ConstraintAt:
         self.i = i
         self.cid = cid
 
+    def __float__(self):                    # printed or computed with on its own
+        raise ExpressionError(f"constraint[{self.cid}] of a vertex is not a value; use "
+                              f"vertex[i].constraint[{self.cid}].normal")
+
+    __bool__ = __float__
+
 
 def constraint_attr(session, base, name, idx):
     """``vertex[i].constraint[n].normal`` (vector or one component)."""
