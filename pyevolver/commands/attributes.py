@@ -68,7 +68,8 @@ ATTRIBUTES = [
     ("vertex", "mean_curvature", "supported: 3 F·N/(2 N·N), F the area gradient and N the "
      "area-vector sum of the star, both projected onto the vertex's level-set constraints "
      "(not onto parametric boundaries), FIXED vertices included (REF's values, the torus "
-     "model too)"),
+     "model too; the manual's text, the area gradient over a third of the star area, is "
+     "not what REF computes)"),
     ("vertex", "sqcurve", "supported: h² of `sq_mean_curvature` (of "
      "`eff_area_sq_mean_curvature` with `effective_area` on, of `normal_sq_mean_curvature` "
      "with `normal_curvature` on), 0 at FIXED and boundary vertices, as REF"),
