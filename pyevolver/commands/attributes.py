@@ -436,7 +436,7 @@ def set_element_attr(session, base, name, idx, value):
     if name == "bare" and k in ("vertex", "edge"):
         _session_store(session).setdefault((k, "bare"), {})[i] = float(bool(value))
         return True
-    if name in SET_REFUSED and (k, name) in FLAGS_DEFAULT or name in SET_REFUSED:
+    if name in SET_REFUSED:
         if float(value) == FLAGS_DEFAULT.get((k, name), np.nan):
             return True                           # setting the default changes nothing
         raise UnsupportedError(f"set {k} {name}", SET_REFUSED[name])
