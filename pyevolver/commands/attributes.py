@@ -68,7 +68,8 @@ ATTRIBUTES = [
     ("vertex", "mean_curvature", "supported: 3 F·N/(2 N·N), F the area gradient and N the "
      "area-vector sum of the star, both projected onto the vertex's level-set constraints "
      "(not onto parametric boundaries), FIXED vertices included (REF's values, the torus "
-     "model too)"),
+     "model too; the manual's text, the area gradient over a third of the star area, is "
+     "not what REF computes)"),
     ("vertex", "sqcurve", "supported: h² of `sq_mean_curvature` (of "
      "`eff_area_sq_mean_curvature` with `effective_area` on, of `normal_sq_mean_curvature` "
      "with `normal_curvature` on), 0 at FIXED and boundary vertices, as REF"),
@@ -435,7 +436,7 @@ def set_element_attr(session, base, name, idx, value):
     if name == "bare" and k in ("vertex", "edge"):
         _session_store(session).setdefault((k, "bare"), {})[i] = float(bool(value))
         return True
-    if name in SET_REFUSED and (k, name) in FLAGS_DEFAULT or name in SET_REFUSED:
+    if name in SET_REFUSED:
         if float(value) == FLAGS_DEFAULT.get((k, name), np.nan):
             return True                           # setting the default changes nothing
         raise UnsupportedError(f"set {k} {name}", SET_REFUSED[name])
@@ -460,6 +461,12 @@ class ConstraintAt:
     def __init__(self, i, cid):
         self.i = i
         self.cid = cid
+
+    def __float__(self):                    # printed or computed with on its own
+        raise ExpressionError(f"constraint[{self.cid}] of a vertex is not a value; use "
+                              f"vertex[i].constraint[{self.cid}].normal")
+
+    __bool__ = __float__
 
 
 def constraint_attr(session, base, name, idx):
