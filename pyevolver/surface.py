@@ -662,6 +662,10 @@ class _Builder:
                     self._member("edge", pos, vals)
                 elif kw == "attribute":
                     self._attr("edge", n, pos, vals)
+                elif kw == "orientation" and vals and vals[0] < 0:
+                    raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: "
+                                     "ORIENTATION -1 (an edge's oriented integrals reversed)",
+                                     blk.lines[pos])
                 elif kw in ("bare", "original", "orientation"):
                     pass
                 elif kw == "wrap":
