@@ -1947,6 +1947,8 @@ class Interpreter:
                                    "coordinates is not implemented")
         for n in names:
             s.toggles[n] = new
+        if key == "effective_area":          # the command also changes REF's motion
+            s.toggles["_effective_area_motion"] = new
         if key in TOGGLE_CELLS:                  # one display mode of three
             for other in TOGGLE_CELLS:
                 if other != key:

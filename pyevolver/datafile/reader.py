@@ -102,13 +102,21 @@ def _refuse(tok):
     raise _Unsupported(tok)
 
 
+def _parameter_kw(tok):
+    # OPTIMIZING_PARAMETER makes g and hessian move the parameter: not implemented
+    if str(tok).lower().startswith("optimi"):
+        raise _Unsupported(tok)
+    return tok
+
+
 @functools.lru_cache(maxsize=1)
 def top_parser():
     """LALR parser of the top section (``fe_top.lark`` + ``expr.lark``)."""
     with open(os.path.join(_HERE, "fe_top.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
     return Lark(grammar, parser="lalr", lexer="contextual", start="start",
-                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse},
+                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse,
+                                                           "PARAMETER_KW": _parameter_kw},
                 cache=True)
 
 
@@ -270,6 +278,9 @@ class _TopTransformer(ExprTransformer):
 
     def quantity_forward(self, kw, name):
         return ("quantity_forward", str(name).lower(), kw.line)
+
+    def dump_flag(self, kw):
+        return ("flag", str(kw).lower(), kw.line)
 
     def instance_forward(self, kw, name):
         return ("instance_forward", str(name).lower(), kw.line)
@@ -555,6 +566,14 @@ class Reader:
                                  f"{sc.values[name]:g}", self._src(sec, line))
             if fixed:
                 sc.values[name + "_fixed"] = 1.0
+            # the quadrature orders: pyevolver has REF's default rules only
+            default = {"integral_order_1d": 3.0, "integral_order_2d": 6.0}.get(name)
+            if name == "integral_order" or (default is not None and
+                                            sc.values[name] != default):
+                raise self.error(f"not supported in pyevolver: {name.upper()} "
+                                 f"{sc.values[name]:g} (edge integrals use order 3 and facet "
+                                 f"integrals order 6, the Evolver's defaults)",
+                                 self._src(sec, line))
         elif kind == "constraint":
             _, cid, opts, formula, blocks, line = d
             if cid in sc.constraints:
