@@ -1049,7 +1049,8 @@ TOGGLE_WORDS.update({
     "ps_labelflag": "ps_labelflag", "ps_colorflag": "ps_colorflag",
 })
 # REF's message when the generic "WORD ON. (was off)" does not fit: (on, off)
-# formats with {was} ("on", "off" or "unset") and {WAS} (upper case)
+# formats with {was} ("on", "off" or "unset"), {WAS} (upper case), {WAS_}
+# ("OFF." and a line break, or "ON."), {alg} (ysmp) and {zener} (zener_coeff)
 TOGGLE_MESSAGES = {
     "autopop": ("Autopopping ON.\n (was {was})\n", "Autopopping OFF.\n (was {was})\n"),
     "autopop_quartic": ("Autopop quartic mode ON.\n (was {was})\n",

@@ -989,6 +989,8 @@ _TERMINAL_NAMES = {
     "NUMBER": "a number", "NAME": "a name", "INT": "an integer", "MINUS": "'-'",
     "PLUS": "'+'", "LPAR": "'('", "RPAR": "')'", "FORMULA_KW": "FORMULA",
     "COMPKW": "a component such as E1: or X1:", "EQUAL": "'='",
+    "BRACED_NUMBERS": "numbers in braces { ... }", "ARRAY_INIT": "values in braces { ... }",
+    "DUMP_FLAG_KW": "RUNGE_KUTTA", "SLICE_COEFF_KW": "slice_coeff",
 }
 
 
