@@ -148,6 +148,8 @@ class Session(SessionAPI):
         for name, (typ, arr) in scene.arrays.items():     # a dump's global arrays
             self.arrays[name] = arr.copy()
             self.array_types[name] = typ
+        for key, (typ, _size, _dims) in scene.attributes.items():   # define ... attribute
+            self.attr_types[key] = typ
         try:
             self.recalc()
         except DatafileError:

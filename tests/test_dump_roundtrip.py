@@ -549,3 +549,16 @@ def test_runge_kutta_keyword(tmp_path):
     assert s.toggles["runge_kutta"] == 1
     with pytest.raises(PyEvolverError, match="g with runge_kutta on"):
         s.run("g 1")
+
+
+def test_integer_attribute_of_a_datafile(evolver, tmp_path):
+    """An attribute declared integer in the datafile (as REF's dumps declare
+    them) keeps integers when set, as in REF, and is dumped as integer."""
+    s, _, _ = _load(tmp_path, "define vertex attribute ia integer\n")
+    cmds = "set vertex ia 2.7\nprint vertex[1].ia\nset vertex ia -2.7\nprint vertex[1].ia"
+    s.out = io.StringIO()
+    s.run(cmds)
+    ref = run_reference(evolver, str(tmp_path / "t.fe"), cmds, cwd=str(tmp_path))
+    assert s.out.getvalue().split() == [ln.strip() for ln in ref if ln.strip()] == ["2", "-2"]
+    s.run(f'dump "{tmp_path / "o.dmp"}"')
+    assert "define vertex attribute ia integer" in (tmp_path / "o.dmp").read_text()
