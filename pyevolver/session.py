@@ -144,7 +144,8 @@ class Session(SessionAPI):
         self.variables = surface.params        # parameters and variables share one namespace
         self._scene_settings(scene)
         for flag in ("area_normalization", "autopop", "conj_grad", "torus_filled",
-                     "effective_area", "normal_curvature", "approximate_curvature", "jiggle"):
+                     "effective_area", "normal_curvature", "approximate_curvature",
+                     "runge_kutta", "jiggle"):
             if flag in scene.flags:             # top-section toggles (100grain.fe)
                 self.toggles[flag] = 1
         if scene.values.get("autochop"):
@@ -158,6 +159,8 @@ class Session(SessionAPI):
         for name, (typ, arr) in scene.arrays.items():     # a dump's global arrays
             self.arrays[name] = arr.copy()
             self.array_types[name] = typ
+        for key, (typ, _size, _dims) in scene.attributes.items():   # define ... attribute
+            self.attr_types[key] = typ
         try:
             self.recalc()
         except DatafileError:
@@ -578,6 +581,11 @@ class Session(SessionAPI):
             if self.toggles.get(name):
                 raise UnsupportedError(f"g with {name} on", "only the plain gradient motion "
                                        "is implemented")
+        if self.toggles.get("_effective_area_motion"):
+            # REF's effective_area command also changes the motion (the top-section
+            # keyword EFFECTIVE_AREA changes only the squared curvature)
+            raise UnsupportedError("g with effective_area on", "the effective-area motion "
+                                   "is not implemented")
         results = []
         if self.surface.nv == 0:                # e.g. after `t` removed everything (REF)
             self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")

@@ -186,7 +186,7 @@ faces
 5 5 6 7 8
 6 -4 -3 -2 -1
 bodies
-1 -1 -2 -3 -4 -5 -6 volume 1
+1 1 2 3 4 5 6 volume 1
 """
 
 
@@ -312,8 +312,8 @@ def test_braced_array_values(tmp_path):
 
 def test_body_line_of_a_dump(tmp_path):
     elements = CUBE_ELEMENTS.replace(
-        "1 -1 -2 -3 -4 -5 -6 volume 1",
-        "1 -1 -2 -3 -4 -5 -6  volume 1  /*actual: 1*/ lagrange_multiplier 3.25  "
+        "1 1 2 3 4 5 6 volume 1",
+        "1 1 2 3 4 5 6  volume 1  /*actual: 1*/ lagrange_multiplier 3.25  "
         "centerofmass   density 0")
     s, out, _ = _load(tmp_path, "", elements)
     assert s.surface.bodies.lagrange[0] == 3.25          # REF reports it until the next step
@@ -508,3 +508,57 @@ def test_run_time_state_of_a_reference_dump(evolver, tmp_path):
     want = next(ln for ln in run_reference(evolver, dmp, show, cwd=str(tmp_path))
                 if ln.startswith("S ")).split()
     assert got[:6] == want[:6] and _rel(got[6], want[6]) <= 1e-12, (got, want)
+
+
+@pytest.mark.parametrize("top,word", [
+    ("optimizing_parameter op = 0.5 pdelta = 0.001 pscale =  2\n", "OPTIMIZING_PARAMETER"),
+    ("INTEGRAL_ORDER_1D: 5\n", "INTEGRAL_ORDER_1D 5"),
+    ("INTEGRAL_ORDER_2D: 8\n", "INTEGRAL_ORDER_2D 8"),
+])
+def test_number_changing_top_lines_refused(tmp_path, top, word):
+    with pytest.raises(DatafileError, match=rf"t\.fe:1:(1:)? not supported in pyevolver: {word}"):
+        _load(tmp_path, top)
+
+
+def test_default_integral_orders_accepted(tmp_path):
+    s, _, _ = _load(tmp_path, "INTEGRAL_ORDER_1D: 3\nINTEGRAL_ORDER_2D: 6\n")
+    assert s.surface.evaluate().energy == pytest.approx(6.0)
+
+
+def test_effective_area_keyword_and_command(evolver, tmp_path):
+    """The top-section keyword EFFECTIVE_AREA changes the legacy squared
+    curvature (REF's g lines); the command ``effective_area`` also changes
+    REF's motion, which pyevolver refuses by name in g."""
+    top = "effective_area\nsquared_curvature 0.1\n"
+    s, _, _ = _load(tmp_path, top)
+    s.out = io.StringIO()
+    s.run("g 2")
+    ours = [ln for ln in s.out.getvalue().split("\n") if LINE.match(ln)]
+    ref = [ln for ln in run_reference(evolver, str(tmp_path / "t.fe"), "g 2",
+                                      cwd=str(tmp_path)) if LINE.match(ln)]
+    assert len(ours) == len(ref) == 2
+    for a, b in zip(ours, ref):
+        assert _rel(a.split()[4], b.split()[4]) <= 1e-9, (ours, ref)
+    s.run("effective_area on")
+    with pytest.raises(PyEvolverError, match="not supported in pyevolver: g with effective_area"):
+        s.run("g 1")
+
+
+def test_runge_kutta_keyword(tmp_path):
+    s, _, _ = _load(tmp_path, "RUNGE_KUTTA\n")
+    assert s.toggles["runge_kutta"] == 1
+    with pytest.raises(PyEvolverError, match="g with runge_kutta on"):
+        s.run("g 1")
+
+
+def test_integer_attribute_of_a_datafile(evolver, tmp_path):
+    """An attribute declared integer in the datafile (as REF's dumps declare
+    them) keeps integers when set, as in REF, and is dumped as integer."""
+    s, _, _ = _load(tmp_path, "define vertex attribute ia integer\n")
+    cmds = "set vertex ia 2.7\nprint vertex[1].ia\nset vertex ia -2.7\nprint vertex[1].ia"
+    s.out = io.StringIO()
+    s.run(cmds)
+    ref = run_reference(evolver, str(tmp_path / "t.fe"), cmds, cwd=str(tmp_path))
+    assert s.out.getvalue().split() == [ln.strip() for ln in ref if ln.strip()] == ["2", "-2"]
+    s.run(f'dump "{tmp_path / "o.dmp"}"')
+    assert "define vertex attribute ia integer" in (tmp_path / "o.dmp").read_text()

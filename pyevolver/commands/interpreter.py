@@ -1070,7 +1070,8 @@ TOGGLE_WORDS.update({
     "ps_labelflag": "ps_labelflag", "ps_colorflag": "ps_colorflag",
 })
 # REF's message when the generic "WORD ON. (was off)" does not fit: (on, off)
-# formats with {was} ("on", "off" or "unset") and {WAS} (upper case)
+# formats with {was} ("on", "off" or "unset"), {WAS} (upper case), {WAS_}
+# ("OFF." and a line break, or "ON."), {alg} (ysmp) and {zener} (zener_coeff)
 TOGGLE_MESSAGES = {
     "autopop": ("Autopopping ON.\n (was {was})\n", "Autopopping OFF.\n (was {was})\n"),
     "autopop_quartic": ("Autopop quartic mode ON.\n (was {was})\n",
@@ -1991,6 +1992,8 @@ class Interpreter:
                                    "coordinates is not implemented")
         for n in names:
             s.toggles[n] = new
+        if key == "effective_area":          # the command also changes REF's motion
+            s.toggles["_effective_area_motion"] = new
         if key in TOGGLE_CELLS:                  # one display mode of three
             for other in TOGGLE_CELLS:
                 if other != key:

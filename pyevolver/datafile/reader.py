@@ -308,6 +308,9 @@ class _TopTransformer(ExprTransformer):
     def quantity_forward(self, kw, name):
         return ("quantity_forward", str(name).lower(), kw.line)
 
+    def dump_flag(self, kw):
+        return ("flag", str(kw).lower(), kw.line)
+
     def instance_forward(self, kw, name):
         return ("instance_forward", str(name).lower(), kw.line)
 
@@ -721,6 +724,14 @@ class Reader:
                                  f"{sc.values[name]:g}", self._src(sec, line))
             if fixed:
                 sc.values[name + "_fixed"] = 1.0
+            # the quadrature orders: pyevolver has REF's default rules only
+            default = {"integral_order_1d": 3.0, "integral_order_2d": 6.0}.get(name)
+            if name == "integral_order" or (default is not None and
+                                            sc.values[name] != default):
+                raise self.error(f"not supported in pyevolver: {name.upper()} "
+                                 f"{sc.values[name]:g} (edge integrals use order 3 and facet "
+                                 f"integrals order 6, the Evolver's defaults)",
+                                 self._src(sec, line))
         elif kind == "constraint":
             _, cid, opts, formula, blocks, line = d
             cid = self._number_named(cid, sc.constraints, sc.constraint_names, "constraint",
@@ -1380,6 +1391,8 @@ _TERMINAL_NAMES = {
     "NUMBER": "a number", "NAME": "a name", "INT": "an integer", "MINUS": "'-'",
     "PLUS": "'+'", "LPAR": "'('", "RPAR": "')'", "FORMULA_KW": "FORMULA",
     "COMPKW": "a component such as E1: or X1:", "EQUAL": "'='",
+    "BRACED_NUMBERS": "numbers in braces { ... }", "ARRAY_INIT": "values in braces { ... }",
+    "DUMP_FLAG_KW": "RUNGE_KUTTA", "SLICE_COEFF_KW": "slice_coeff",
 }
 
 
