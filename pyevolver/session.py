@@ -127,6 +127,7 @@ class Session(SessionAPI):
         for msg, line, col in scene.warnings:  # lines the Evolver warns about
             where = f"{filename}:{line}:{col}" if col else f"{filename}:{line}"
             self.write_err(f"{where}: warning: {msg}\n")
+        self._warn_bare_edges(filename, scene, surface)
         if scene.constraint_names:             # named constraints and boundaries
             surface.constraint_names = dict(scene.constraint_names)
         if scene.boundary_names:
@@ -170,6 +171,23 @@ class Session(SessionAPI):
             self.run(scene.read_text, where=filename, line=scene.read_line + 1,
                      stop_on_error=False)
         return self
+
+    def _warn_bare_edges(self, filename, scene, s):
+        """REF warns at load about each edge of a soapfilm surface that is on
+        no facet and not marked BARE ("Edge 19 has no facets, and is not
+        marked "bare".")."""
+        if s.string or not s.nf or not s.ne or len(scene.edges.ids) > s.ne:
+            return
+        FE = np.asarray(s.FE)
+        used = np.zeros(s.ne, bool)
+        used[np.where(FE >= 0, FE, ~FE).ravel()] = True
+        blk = scene.edges
+        for i in np.nonzero(~used[:len(blk.ids)])[0].tolist():
+            attrs = blk.attrs.get(i, ())
+            if any(kw == "bare" for kw, _ in attrs):
+                continue
+            self.write_err(f"{filename}:{blk.lines[i]}: warning: edge {blk.ids[i]} has no "
+                           f"facets and is not marked bare\n")
 
     def _scene_settings(self, scene):
         for k in ("scale_limit", "constraint_tolerance"):
