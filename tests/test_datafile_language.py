@@ -326,3 +326,13 @@ def test_too_few_coordinates_warns(evolver, tmp_path):
     path = write(tmp_path, text)
     err = compare(evolver, path, ["vertex[4].z", "total_area"])
     assert "t.fe:6" in err and "coordinates" in err
+
+
+def test_user_function_on_an_element_line_refused_by_name(tmp_path):
+    # REF evaluates it with its command interpreter (vertex x = 4 here)
+    top = "function real sq(real xx) { return xx*xx }\n"
+    path = write(tmp_path, tetra(top).replace("2 1 0 0 \n", "2 sq(1) 0 0\n"))
+    with pytest.raises(DatafileError) as info:
+        Session.load(path)
+    assert "not supported in pyevolver" in str(info.value) and "sq" in str(info.value)
+    assert info.value.line == 5

@@ -860,6 +860,12 @@ class Reader:
                 col = exc.column if exc.column not in (None, -1) else None
                 what = {"vertices": "vertex", "edges": "edge", "faces": "face",
                         "bodies": "body"}[kind]
+                for fn in getattr(self, "_functions", ()):
+                    call = re.search(r"\b" + re.escape(fn) + r"\s*\(", line, re.I)
+                    if call:
+                        raise self.error(f"not supported in pyevolver: calling the user "
+                                         f"function {fn} in a datafile element line",
+                                         srcline, call.start() + 1) from None
                 raise self.error(self._describe(exc, line) + f" in {what} line", srcline,
                                  col) from None
             except VisitError as exc:
@@ -947,6 +953,12 @@ class Reader:
             return " ".join(toks[:3] + toks[3 + sdim:])
         return line
 
+    def _undefined(self, exc, srcline):
+        if exc.name in getattr(self, "_functions", ()):
+            return self.error(f"not supported in pyevolver: calling the user function "
+                              f"{exc.name} in a datafile element line", srcline, exc.col)
+        return self.error(f"undefined parameter '{exc.name}'", srcline, exc.col)
+
     def warn(self, msg, line, col=None):
         """Record a warning about a line (the Evolver warns and goes on)."""
         self.scene.warnings.append((msg, line, col))
@@ -1024,7 +1036,7 @@ class Reader:
         try:
             values = [self._value(e, srcline, f"{etype} {eid}") for e in data]
         except _LocatedName as exc:
-            raise self.error(f"undefined parameter '{exc.name}'", srcline, exc.col) from None
+            raise self._undefined(exc, srcline) from None
         if not 1 <= eid <= MAX_ID:
             raise self.error(f"{etype} id {eid} is out of range (ids are 1 to {MAX_ID})",
                              srcline, 1)
@@ -1061,8 +1073,7 @@ class Reader:
                 try:
                     vals.append(self._value(a, srcline, what))
                 except _LocatedName as exc:
-                    raise self.error(f"undefined parameter '{exc.name}'", srcline,
-                                     exc.col) from None
+                    raise self._undefined(exc, srcline) from None
             if kw == "attribute":
                 cooked.append((kw, [args[0]] + vals))
             else:
