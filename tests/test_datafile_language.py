@@ -336,3 +336,12 @@ def test_user_function_on_an_element_line_refused_by_name(tmp_path):
         Session.load(path)
     assert "not supported in pyevolver" in str(info.value) and "sq" in str(info.value)
     assert info.value.line == 5
+
+
+def test_forward_declared_names(evolver, tmp_path):
+    # REF's dumps declare named constraints ahead: "constraint pinned;"
+    top = ("constraint bb;\nconstraint aa;\nconstraint 1\nformula: z = 0\n"
+           "constraint aa\nformula: x = 0.5\nconstraint bb\nformula: y = 0.25\n")
+    path = write(tmp_path, tetra(top, v2="constraint aa", v3="constraint 1,bb"))
+    compare(evolver, path, ["aa", "bb", "high_constraint", "vertex[2].x", "vertex[3].y",
+                            "total_area"])

@@ -160,6 +160,12 @@ class _TopTransformer(ExprTransformer):
     def p_on_assign(self, kw, name):
         return ("on_assign_call", (str(name).lower(), kw.column))
 
+    def constraint_forward(self, kw, name):
+        return ("forward", "constraint", str(name).lower(), kw.line)
+
+    def boundary_forward(self, kw, name):
+        return ("forward", "boundary", str(name).lower(), kw.line)
+
     def value_decl2(self, kw, e):
         return ("ignored", str(kw).lower().rstrip(":"))
 
@@ -330,6 +336,7 @@ class Reader:
         self.text = read_source(filename) if text is None else text
         self.scene = Scene(filename=filename)
         self._src_lines = None
+        self._forward = set()           # names declared ahead ("constraint pinned;")
 
     @property
     def src_lines(self):
@@ -699,6 +706,13 @@ class Reader:
                 raise self.error(f"attribute {name}: {size} entries per {etype}; at most "
                                  f"{MAX_ARRAY_ENTRIES} are allowed", self._src(sec, line))
             sc.attributes[(etype, name)] = (atype, size, dims)
+        elif kind == "forward":          # constraint NAME;  boundary NAME;
+            _, what, name, line = d
+            table, names = ((sc.constraints, sc.constraint_names) if what == "constraint"
+                            else (sc.boundaries, sc.boundary_names))
+            if name not in names.values():
+                self._number_named(name, table, names, what, self._src(sec, line))
+                self._forward.add((what, name))
         elif kind == "periods":
             exprs = getattr(self, "_period_exprs", None)
             if exprs is not None:       # expressions: evaluated here, in order
@@ -750,13 +764,17 @@ class Reader:
         if isinstance(key, int):
             if key in names:
                 name = names.pop(key)
-                decl = table.pop(key)
+                decl = table.pop(key, None)     # (None: only declared ahead so far)
                 new = _lowest_free(table, names, also=key)
-                decl.id = new
-                table[new] = decl
+                if decl is not None:
+                    decl.id = new
+                    table[new] = decl
                 names[new] = name
             return key
         if key in names.values():
+            if (what, key) in self._forward:     # declared ahead, defined now
+                self._forward.discard((what, key))
+                return next(c for c, n in names.items() if n == key)
             raise self.error(f"{what} '{key}' defined twice", line)
         if key in self.scene.parameters:
             raise self.error(f"{what} name '{key}' is already a parameter", line)
