@@ -128,6 +128,7 @@ class Session(SessionAPI):
             where = f"{filename}:{line}:{col}" if col else f"{filename}:{line}"
             self.write_err(f"{where}: warning: {msg}\n")
         self._warn_bare_edges(filename, scene, surface)
+        self._record_order(scene, surface)     # constraints in datafile order
         if scene.constraint_names:             # named constraints and boundaries
             surface.constraint_names = dict(scene.constraint_names)
         if scene.boundary_names:
@@ -1616,7 +1617,14 @@ class Session(SessionAPI):
                                f"is not defined")
         cid = int(cid)
         moved = []
+        order = getattr(s, "con_order", None)
         for el in els:
+            if order is not None and el.kind in ("vertex", "edge"):
+                # REF lists a constraint set later after the element's others
+                table = s.vcon if el.kind == "vertex" else s.econ
+                had = [c for c in sorted(table) if table[c][el.i] and c != cid]
+                seq = [c for c in order.get((el.kind, el.i), had) if c in had]
+                order[(el.kind, el.i)] = seq + [c for c in had if c not in seq] + [cid]
             if el.kind == "vertex":
                 m = s.vcon.setdefault(cid, np.zeros(s.nv, bool))
                 m[el.i] = True
@@ -1669,6 +1677,30 @@ class Session(SessionAPI):
     def constraint_label(self, cid):
         """A constraint's number, or its name when defined at run time."""
         return getattr(self.surface, "constraint_names", {}).get(cid, str(cid))
+
+    def _in_order(self, kind, i, cons):
+        """An element's constraints in the order REF lists them: as the
+        datafile line gave them, then those set later, in turn (``cons``:
+        the constraints it is on, by number)."""
+        order = getattr(self.surface, "con_order", None)
+        seq = order.get((kind, i)) if order else None
+        if not seq or len(cons) < 2:
+            return cons
+        first = [c for c in seq if c in cons]
+        return first + [c for c in cons if c not in first]
+
+    def _record_order(self, scene, surface):
+        """The datafile order of the constraints of vertices and edges named
+        with several (see :meth:`_in_order`)."""
+        order = {}
+        for kind, blk, n in (("vertex", scene.vertices, surface.nv),
+                             ("edge", scene.edges, surface.ne)):
+            for pos, attrs in blk.attrs.items():
+                cids = [int(abs(v)) for kw, vals in attrs
+                        if kw in ("constraint", "constraints") for v in vals]
+                if len(cids) > 1 and cids != sorted(cids) and pos < n:
+                    order[(kind, pos)] = cids
+        surface.con_order = order
 
     def boundary_label(self, bid):
         """A boundary's number, or its name when declared by name."""
@@ -1808,7 +1840,7 @@ class Session(SessionAPI):
             line = f"{vid[i]:3d}  {par}  boundary {self.boundary_label(int(bnd[i]))}  /* ({xyz}) */"
         else:
             line = f"{vid[i]:3d}  " + " ".join(f"{x:17.15g}" for x in s.X[i, :sd])
-        cons = [c for c in sorted(s.vcon) if s.vcon[c][i]]
+        cons = self._in_order("vertex", i, [c for c in sorted(s.vcon) if s.vcon[c][i]])
         if cons:
             line += "  constraints " + " ".join(map(self.constraint_label, cons)) + " "
         if s.vattr["fixed"][i]:
@@ -1850,7 +1882,7 @@ class Session(SessionAPI):
         ten = s.edge_tension[i]
         if ten != (1.0 if s.string else 0.0):
             line += f"  density {ten:g} "
-        cons = [c for c in sorted(s.econ) if s.econ[c][i]]
+        cons = self._in_order("edge", i, [c for c in sorted(s.econ) if s.econ[c][i]])
         if cons:
             line += "  constraints " + " ".join(
                 ("-" if s.econ[c][i] < 0 else "") + self.constraint_label(c) for c in cons) + " "
@@ -1887,7 +1919,7 @@ class Session(SessionAPI):
         attrs = ""
         cons = [c for c in sorted(s.fcon) if s.fcon[c][i]]
         if cons:
-            attrs += " constraints " + " ".join(map(str, cons)) + "  "
+            attrs += " constraints " + " ".join(map(self.constraint_label, cons)) + "  "
         if not s.string and s.facet_tension[i] != 1.0:
             attrs += f" density {s.facet_tension[i]:g} "
         if s.fattr["fixed"][i]:

@@ -345,3 +345,18 @@ def test_forward_declared_names(evolver, tmp_path):
     path = write(tmp_path, tetra(top, v2="constraint aa", v3="constraint 1,bb"))
     compare(evolver, path, ["aa", "bb", "high_constraint", "vertex[2].x", "vertex[3].y",
                             "total_area"])
+
+
+def test_list_keeps_the_order_of_constraints(evolver, tmp_path):
+    # REF lists an element's constraints as its datafile line gave them, then
+    # those set later (named ones have small numbers: aa is 3 here)
+    path = write(tmp_path, tetra(NAMED, v2="constraint 1,aa", v3="constraints bb 1",
+                                 e1="constraint aa 1"))
+    cmds = "list vertex\nlist edge[1]\nset vertex[4] constraint bb\nlist vertex[4]\n"
+    ref = [l for l in run_reference(evolver, path, cmds) if "constraints" in l]
+    out = io.StringIO()
+    Session.load(path, out=out).run(cmds)
+    mine = [l for l in out.getvalue().splitlines() if "constraints" in l]
+    assert len(ref) == 4
+    assert [l.split("constraints")[1].split("/*")[0].split() for l in mine] == \
+        [l.split("constraints")[1].split("/*")[0].split() for l in ref]
