@@ -360,3 +360,9 @@ def test_list_keeps_the_order_of_constraints(evolver, tmp_path):
     assert len(ref) == 4
     assert [l.split("constraints")[1].split("/*")[0].split() for l in mine] == \
         [l.split("constraints")[1].split("/*")[0].split() for l in ref]
+
+
+@pytest.mark.parametrize("etype", ["facet", "facets", "face", "faces"])
+def test_define_takes_plural_and_face(evolver, tmp_path, etype):
+    path = write(tmp_path, tetra(f"define {etype} attribute kk real\n", f1="kk 2.5"))
+    compare(evolver, path, ["facet[1].kk", "facet[2].kk", "total_area"])

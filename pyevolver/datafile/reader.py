@@ -282,7 +282,9 @@ class _TopTransformer(ExprTransformer):
         return list(exprs)          # (expressions: evaluated in order, _decl)
 
     def define_attr(self, kw, etype, _a, name, atype, dims=None):
-        return ("attribute", str(etype).lower(), str(name).lower(), str(atype).lower(),
+        # (REF also takes the plural and 'face' forms: define faces attribute ...)
+        etype = _ETYPE.get(str(etype).lower(), str(etype).lower())
+        return ("attribute", etype, str(name).lower(), str(atype).lower(),
                 dims or [], kw.line)
 
     def flag_decl(self, kw):
@@ -1228,6 +1230,10 @@ def _skip_transforms(text, pos, sd):
                 return pos
             pos = mm.end()
     return pos
+
+
+_ETYPE = {"vertices": "vertex", "edges": "edge", "facets": "facet", "face": "facet",
+          "faces": "facet", "bodies": "body"}
 
 
 def _binary_minus_in_parens(line):
