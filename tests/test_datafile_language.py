@@ -366,3 +366,19 @@ def test_list_keeps_the_order_of_constraints(evolver, tmp_path):
 def test_define_takes_plural_and_face(evolver, tmp_path, etype):
     path = write(tmp_path, tetra(f"define {etype} attribute kk real\n", f1="kk 2.5"))
     compare(evolver, path, ["facet[1].kk", "facet[2].kk", "total_area"])
+
+
+def test_dump_keeps_the_names(evolver, tmp_path):
+    # a dump writes named constraints and boundaries by name (declared ahead,
+    # as REF's dumps do) and loads back with the same geometry
+    path = write(tmp_path, tetra(NAMED, v2="constraint aa", v3="constraint 1,bb",
+                                 e1="constraint aa"))
+    out = io.StringIO()
+    ses = Session.load(path, out=out)
+    ses.run(f'dump "{tmp_path / "d.dmp"}"')
+    text = (tmp_path / "d.dmp").read_text()
+    assert "constraint aa;" in text and "CONSTRAINT aa" in text
+    again, _ = ours(str(tmp_path / "d.dmp"), ["vertex[2].on_constraint aa", "total_area",
+                                              "edge[1].on_constraint aa"])
+    same(again, ref_numbers(evolver, path, ["vertex[2].on_constraint aa", "total_area",
+                                            "edge[1].on_constraint aa"]))

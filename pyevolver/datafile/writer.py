@@ -187,9 +187,21 @@ class _FeWriter:
             dims = "".join(f"[{d}]" for d in arr.shape[1:])
             self.w(f"define {etype} attribute {aname} {typ}{dims}")
         self.w()
+        cnames = getattr(s, "constraint_names", {})
+        bnames = getattr(s, "boundary_names", {})
+        if cnames or bnames:
+            # named constraints and boundaries are written by name, declared
+            # ahead as in REF's dumps ("constraint pinned;")
+            for cid in sorted(cnames):
+                if cid in s.constraints:
+                    self.w(f"constraint {cnames[cid]};")
+            for bid in sorted(bnames):
+                if bid in s.boundaries:
+                    self.w(f"boundary {bnames[bid]};")
+            self.w()
         for cid, c in sorted(s.constraints.items()):
             opts = "".join(f" {f.upper()}" for f in sorted(c.flags) if f in _CON_FLAGS)
-            self.w(f"CONSTRAINT {cid}{opts}")
+            self.w(f"CONSTRAINT {cnames.get(cid, cid)}{opts}")
             self.w(f"FORMULA: {expr_text(c.formula)} = 0")
             if c.energy:
                 self.w("ENERGY:\n" + _comps("e", c.energy))
@@ -198,7 +210,7 @@ class _FeWriter:
             self.w()
         for bid, b in sorted(s.boundaries.items()):
             opts = " CONVEX" if "convex" in b.flags else ""
-            self.w(f"BOUNDARY {bid} PARAMETERS {b.nparams}{opts}")
+            self.w(f"BOUNDARY {bnames.get(bid, bid)} PARAMETERS {b.nparams}{opts}")
             self.w(_comps("x", b.coords))
             if b.energy:
                 self.w("ENERGY:\n" + _comps("e", b.energy))
@@ -287,6 +299,9 @@ class _FeWriter:
                 out.append(aname + " " + " ".join(num(x) for x in np.ravel(v)))
         return out
 
+    def _blabel(self, bid):
+        return getattr(self.s, "boundary_names", {}).get(bid, str(bid))
+
     def _cons(self, table, k, signed=False):
         ids = []
         for cid, arr in sorted(table.items()):
@@ -294,7 +309,8 @@ class _FeWriter:
                 continue
             v = arr[k]
             if v:
-                ids.append(str(-cid if signed and v < 0 else cid))
+                name = getattr(self.s, "constraint_names", {}).get(cid, str(cid))
+                ids.append(("-" if signed and v < 0 else "") + name)
         return f"constraints {' '.join(ids)}" if ids else None
 
     def _vertices(self):
@@ -307,7 +323,7 @@ class _FeWriter:
         for k in range(s.nv):
             if bnd is not None and bnd[k]:
                 b = s.boundaries[int(bnd[k])]
-                parts = [num(v) for v in params[k, :b.nparams]] + [f"boundary {int(bnd[k])}"]
+                parts = [num(v) for v in params[k, :b.nparams]] + [f"boundary {self._blabel(int(bnd[k]))}"]
             else:
                 parts = [num(v) for v in s.X[k]]
             if fixed is not None and fixed[k]:
@@ -336,7 +352,7 @@ class _FeWriter:
             if ea.get("fixed") is not None and ea["fixed"][k]:
                 parts.append("fixed")
             if ea.get("boundary") is not None and ea["boundary"][k]:
-                parts.append(f"boundary {int(ea['boundary'][k])}")
+                parts.append(f"boundary {self._blabel(int(ea['boundary'][k]))}")
             c = self._cons(s.econ, k, signed=True)
             if c:
                 parts.append(c)
@@ -361,7 +377,7 @@ class _FeWriter:
             if fa.get("fixed") is not None and fa["fixed"][k]:
                 parts.append("fixed")
             if fa.get("boundary") is not None and fa["boundary"][k]:
-                parts.append(f"boundary {int(fa['boundary'][k])}")
+                parts.append(f"boundary {self._blabel(int(fa['boundary'][k]))}")
             c = self._cons(s.fcon, k)
             if c:
                 parts.append(c)
