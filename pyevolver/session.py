@@ -129,6 +129,7 @@ class Session(SessionAPI):
             self.write_err(f"{where}: warning: {msg}\n")
         self._warn_bare_edges(filename, scene, surface)
         self._record_order(scene, surface)     # constraints in datafile order
+        self.on_assign_call = dict(scene.on_assign)
         if scene.constraint_names:             # named constraints and boundaries
             surface.constraint_names = dict(scene.constraint_names)
         if scene.boundary_names:
@@ -1024,6 +1025,16 @@ class Session(SessionAPI):
             raise CommandError(f"'{name}' is a quantity; assign to {name}.target or "
                                f"{name}.modulus")
         self.variables[name] = value
+        proc = getattr(self, "on_assign_call", {}).get(name)
+        if proc is not None and proc in self.commands:
+            # PARAMETER name ... ON_ASSIGN_CALL proc: run it after each assignment
+            busy = self.__dict__.setdefault("_on_assign_busy", set())
+            if name not in busy:
+                busy.add(name)
+                try:
+                    self.interp.run_proc(self.commands[proc], [])
+                finally:
+                    busy.discard(name)
 
     def internal(self, name):
         s = self.surface

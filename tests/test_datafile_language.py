@@ -287,7 +287,6 @@ def test_settings_that_change_no_number(evolver, tmp_path, top):
 
 @pytest.mark.parametrize("top,word,line", [
     ("optimizing_parameter xx = 1 pdelta = 0.001", "OPTIMIZING_PARAMETER", 1),
-    ("procedure tt();\nparameter yy = 2 on_assign_call tt", "ON_ASSIGN_CALL", 2),
     ("constraint 1 content_rank 2\nformula: z = 0", "CONTENT_RANK", 1),
     ("square_gaussian_curvature 1", "SQUARE_GAUSSIAN_CURVATURE", 1),
     ("define vertex attribute kk real function { self.kk := 1 }", "FUNCTION", 1),
@@ -382,3 +381,20 @@ def test_dump_keeps_the_names(evolver, tmp_path):
                                               "edge[1].on_constraint aa"])
     same(again, ref_numbers(evolver, path, ["vertex[2].on_constraint aa", "total_area",
                                             "edge[1].on_constraint aa"]))
+
+
+def test_on_assign_call(evolver, tmp_path):
+    # the manual's example: the procedure runs after each assignment
+    top = ("procedure tester();\nparameter aaa = 4\nparameter bbb = 5 on_assign_call tester\n"
+           "procedure tester() { aaa := bbb + 1 }\n")
+    path = write(tmp_path, tetra(top))
+    compare(evolver, path, ["aaa", "bbb"])
+    compare(evolver, path, ["aaa", "bbb"], "bbb := 7")
+    compare(evolver, path, ["aaa", "bbb"], "bbb := 7; bbb += 2")
+
+
+def test_on_assign_call_needs_a_declared_procedure(tmp_path):
+    path = write(tmp_path, tetra("parameter bbb = 5 on_assign_call tester\n"))
+    with pytest.raises(DatafileError) as info:
+        Session.load(path)
+    assert "tester" in str(info.value) and info.value.line == 1

@@ -479,6 +479,7 @@ class Reader:
         """
         text = sec.text
         self._functions = set()
+        self._procedures = set()
         af = _ATTR_FUNCTION.search(text)
         if af:
             line = text.count("\n", 0, af.start(1)) + 1
@@ -500,6 +501,8 @@ class Reader:
                                  m.start() - text.rfind("\n", 0, m.start()))
             body = text[m.start():end]
             self.scene.top_commands.append((body.rstrip().rstrip(";"), self._src(sec, line)))
+            if m.group(1).lower() == "procedure":
+                self._procedures.add(re.match(r"\w+\s+(\w+)", body).group(1).lower())
             if m.group(1).lower() == "function":
                 self._functions.add(re.match(r"\w+\s+(?:\w+\s+)?(\w+)", body).group(1).lower())
             out.append(text[pos:m.start()])
@@ -744,8 +747,13 @@ class Reader:
             if key in opts:
                 self._const(opts[key][0], line, f"{key} of parameter {name}")
         if "on_assign_call" in opts:
+            # the procedure runs whenever the variable is assigned (manual); it
+            # must have been declared before, in the top section
             proc, col = opts["on_assign_call"]
-            self._defer(f"ON_ASSIGN_CALL ({name} calls {proc})", line, col)
+            if proc not in getattr(self, "_procedures", ()):
+                raise self.error(f"ON_ASSIGN_CALL: '{proc}' is not a procedure declared "
+                                 f"above (e.g. procedure {proc}();)", line, col)
+            self.scene.on_assign[name] = proc
 
     def _dim(self, expr, line, name):
         """An attribute's array dimension: a constant expression (REF:
