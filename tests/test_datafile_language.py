@@ -117,6 +117,13 @@ def test_named_constraints_take_the_lowest_free_number(evolver, tmp_path):
                             "sum(vertex where on_constraint bb, 1)"])
 
 
+def test_valid_constraint_and_boundary(evolver, tmp_path):
+    path = write(tmp_path, tetra(NAMED, v2="constraint aa"))
+    compare(evolver, path, ["valid_constraint(aa)", "valid_constraint(top)",
+                            "valid_constraint(5)", "valid_constraint(2)",
+                            "valid_boundary(1)"])
+
+
 def test_named_constraints_in_commands(evolver, tmp_path):
     path = write(tmp_path, tetra(NAMED, v2="constraint aa"))
     cmds = ("set vertex[4] constraint aa\nunset vertex[2] constraint aa\n"

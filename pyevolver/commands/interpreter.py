@@ -1195,6 +1195,16 @@ class Interpreter:
             if not isinstance(v, str):
                 raise ExpressionError("is_defined() needs a name in a string")
             return float(self.is_defined(v.lower()))
+        if name in ("valid_constraint", "valid_boundary"):
+            # 1 if the constraint / boundary (a number, or a name) is defined
+            if len(arg_nodes) != 1:
+                raise ExpressionError(f"{name}() takes one argument")
+            v = self.value(arg_nodes[0])
+            if isinstance(v, str) or not math.isfinite(float(v)):
+                raise ExpressionError(f"{name}() needs a number or a name")
+            table = (s.surface.constraints if name == "valid_constraint"
+                     else s.surface.boundaries) if s.surface is not None else {}
+            return float(float(v) == int(v) and int(v) in table)
         if name in ("new_vertex", "new_edge", "new_facet", "new_body"):
             raise UnsupportedError(f"{name}() (creating elements from a script)")
         if name == "valid_element":
