@@ -121,7 +121,9 @@ def test_valid_constraint_and_boundary(evolver, tmp_path):
     path = write(tmp_path, tetra(NAMED, v2="constraint aa"))
     compare(evolver, path, ["valid_constraint(aa)", "valid_constraint(top)",
                             "valid_constraint(5)", "valid_constraint(2)",
-                            "valid_boundary(1)"])
+                            "valid_boundary(1)", "is_constraint[top].nonnegative",
+                            "is_constraint[top].fixed", "is_constraint[aa].fixed",
+                            "is_constraint[1].nonpositive"])
 
 
 def test_named_constraints_in_commands(evolver, tmp_path):

@@ -245,6 +245,8 @@ class Attr(N.Node):
         self.index = index
 
     def ev(self, env):
+        if isinstance(self.base, ArrayRef) and self.base.name == "is_constraint":
+            return _is_constraint(env, self.base, self.name)
         base = self.base.ev(env)
         if self.index is None:
             idx = None
@@ -258,6 +260,22 @@ class Attr(N.Node):
         if isinstance(self.index, list):
             return (self.base,) + tuple(self.index)
         return (self.base,) + ((self.index,) if self.index is not None else ())
+
+
+def _is_constraint(env, ref, what):
+    """``is_constraint[n].fixed`` / ``.nonnegative`` / ``.nonpositive``: the
+    kind of level-set constraint n (a number or a name; manual, constrnt.htm)."""
+    if len(ref.index) != 1 or what not in ("fixed", "nonnegative", "nonpositive"):
+        raise ExpressionError("is_constraint[n] has .fixed, .nonnegative and .nonpositive")
+    s = env.session
+    v = s.interp.value(ref.index[0])
+    cons = s.surface.constraints if s.surface is not None else {}
+    if isinstance(v, str) or float(v) != int(v) or int(v) not in cons:
+        raise ExpressionError(f"is_constraint[{v}]: no such constraint")
+    flags = cons[int(v)].flags
+    if what == "fixed":
+        return float(not flags & {"nonnegative", "nonpositive"})
+    return float(what in flags)
 
 
 class Aggregate(N.Node):
