@@ -254,6 +254,9 @@ ATTRIBUTES = ["id", "oid", "original", "x", "y", "z", "length", "area", "volume"
               "pressure", "volconst", "density", "tension", "color", "frontcolor",
               "backcolor", "fixed", "valence", "on_constraint", "on_boundary",
               "vertex_normal", "no_refine", "value", "modulus"]
+ATTRIBUTES += ["sqcurve", "mean_curvature", "dihedral", "facet_normal", "edge_vector",
+               "value_of_constraint", "hit_constraint", "volfixed", "v_force", "v_velocity",
+               "v_oldx", "on_quantity", "on_method_instance", "tolerance", "opacity", "bare"]
 
 
 def _completer(session):

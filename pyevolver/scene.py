@@ -89,6 +89,8 @@ class Scene:
     method_instances: dict = field(default_factory=dict)  # name -> MethodDecl
     attributes: dict = field(default_factory=dict)     # (etype, name) -> (type, size)
     periods: np.ndarray | None = None
+    read_warnings: list = field(default_factory=list)  # (line, message) of the read section
+    macros: dict = field(default_factory=dict)         # #define macros kept (keep_macros)
     vertices: ElementBlock = field(default_factory=ElementBlock)
     edges: ElementBlock = field(default_factory=ElementBlock)
     faces: ElementBlock = field(default_factory=ElementBlock)
@@ -96,6 +98,7 @@ class Scene:
     read_text: str | None = None
     read_line: int = 0
     wraps: dict = field(default_factory=dict)          # edge position -> wrap list
+    arrays: dict = field(default_factory=dict)         # global arrays: name -> (type, ndarray)
     source_lines: list | None = None                   # the text's lines (error excerpts)
     constraint_names: dict = field(default_factory=dict)  # id -> name (named constraints)
     boundary_names: dict = field(default_factory=dict)    # id -> name (named boundaries)

@@ -19,11 +19,12 @@ import numpy as np
 
 from .api import SessionAPI, progress_bar
 from .commands import interpreter as I
+from .datafile.preprocess import _TooLong as _MacroTooLong, expand_macros
 from .datafile.reader import read_datafile
 from .errors import (CommandError, DatafileError, ExpressionError, InternalError,
                      PyEvolverError, UnsupportedError)
 from .expr import nodes as N
-from .limits import MAX_NESTING
+from .limits import MAX_EXPANDED_LINE, MAX_NESTING
 from .surface import (build_surface, constrained_vertices, project_to_constraints,
                       restore_state, state)
 
@@ -145,7 +146,8 @@ class Session(SessionAPI):
                                       bool(b.n and np.any(b.density)))
         self.variables = surface.params        # parameters and variables share one namespace
         self._scene_settings(scene)
-        for flag in ("area_normalization", "autopop", "conj_grad"):
+        for flag in ("area_normalization", "autopop", "conj_grad", "torus_filled",
+                     "effective_area", "normal_curvature", "approximate_curvature", "jiggle"):
             if flag in scene.flags:             # top-section toggles (100grain.fe)
                 self.toggles[flag] = 1
         if scene.values.get("autochop"):
@@ -154,7 +156,11 @@ class Session(SessionAPI):
         self.commands = {}
         self.letters = {}
         self.arrays = {}
+        self.macros = dict(scene.macros)       # keep_macros: expanded in commands
         self._init_view_matrix()
+        for name, (typ, arr) in scene.arrays.items():     # a dump's global arrays
+            self.arrays[name] = arr.copy()
+            self.array_types[name] = typ
         try:
             self.recalc()
         except DatafileError:
@@ -169,9 +175,22 @@ class Session(SessionAPI):
                                 else None) from None
         for text, line in scene.top_commands:  # top-section procedures and functions
             self.run(text, where=filename, line=line, stop_on_error=False)
+        for wline, msg in scene.read_warnings:
+            self.err.write(f"{filename}:{wline}: {msg}\n")
         if run_read and scene.read_text:
-            self.run(scene.read_text, where=filename, line=scene.read_line + 1,
-                     stop_on_error=False)
+            # an error abandons the rest of the read section (as in the
+            # Evolver); the surface stays loaded.  A command refused by name
+            # (a feature pyevolver lacks, which the Evolver would run) is
+            # reported and the section goes on.
+            for chunk, ln in I.split_commands(scene.read_text):
+                try:
+                    self.run_one(chunk, filename, scene.read_line + ln)
+                except (I.Quit, I.Interrupted):
+                    raise
+                except PyEvolverError as exc:
+                    self.write_err(f"{exc}\n")
+                    if "not supported in pyevolver" not in str(exc):
+                        break
         return self
 
     def _warn_bare_edges(self, filename, scene, s):
@@ -195,6 +214,8 @@ class Session(SessionAPI):
         for k in ("scale_limit", "constraint_tolerance"):
             if k in scene.values:
                 self.settings[k] = scene.values[k]
+        if "total_time" in scene.values:        # TOTAL_TIME: a dump goes on with its clock
+            self.total_time = float(scene.values["total_time"])
         if "scale" in scene.values:
             self.settings["scale"] = scene.values["scale"]
             if scene.values.get("scale_fixed"):
@@ -205,7 +226,6 @@ class Session(SessionAPI):
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
         from .datafile.writer import dump
-        self.no_string("dump")
         if name is None:
             name = (self.filename or "pyevolver") + ".dmp"
         self.write(f"Dumping to {name}.\n")
@@ -338,6 +358,12 @@ class Session(SessionAPI):
                 raise CommandError(f"{where}:{line}: {exc}") from None
             self.write(old + "\n\n")
             return self.run_one(old, where, line)
+        if getattr(self, "macros", None):
+            try:
+                text = expand_macros(text, self.macros)
+            except _MacroTooLong:
+                raise CommandError(f"{where}:{line}: #define macros expand this command "
+                                   f"beyond {MAX_EXPANDED_LINE} characters") from None
         ast = I.parse_command(text, where, line)
         self._remember(stripped)
         snap = self._snapshot()
@@ -440,7 +466,7 @@ class Session(SessionAPI):
                                                     b.volconst.copy(), b.density.copy(),
                                                     b.lagrange.copy()),
                 None if s is None else {k: (q.target, q.modulus, q.kind, q.pressure,
-                                            q.tolerance)
+                                            q.tolerance, list(q.methods))
                                         for k, q in s.quantities.items()},
                 None if s is None else {k: v.copy() for k, v in s.extra.items()},
                 None if s is None else {k: v.copy() for k, v in s.vattr.items()},
@@ -451,7 +477,8 @@ class Session(SessionAPI):
                 None if s is None else ({k: m.copy() for k, m in s.econ.items()},
                                         {k: m.copy() for k, m in s.fcon.items()},
                                         s.gravity_constant, s.sq_curvature_modulus),
-                self.filename)
+                self.filename,
+                {k: dict(v) for k, v in self.__dict__.get("_attr_store", {}).items()})
 
     def _iterator_state(self):
         it = self._iterator
@@ -461,8 +488,9 @@ class Session(SessionAPI):
 
     def _restore(self, snap):
         (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
-         fattr, vcon, surface, totals, it_state, more, filename) = snap
+         fattr, vcon, surface, totals, it_state, more, filename, attr_store) = snap
         self.filename = filename
+        self._attr_store = attr_store          # graphics-only attributes (commands.attributes)
         self.surface = surface
         self.totals = totals            # the energies of the restored coordinates
         if self._iterator is not None:
@@ -484,9 +512,10 @@ class Session(SessionAPI):
             if bod is not None:
                 b = s.bodies
                 b.target, b.pressure, b.volconst, b.density, b.lagrange = bod
-            for k, (t, m, kind, p, tol) in qs.items():
+            for k, (t, m, kind, p, tol, methods) in qs.items():
                 q = s.quantities[k]
                 q.target, q.modulus, q.kind, q.pressure, q.tolerance = t, m, kind, p, tol
+                q.methods[:] = methods          # set/unset element membership
             s.extra = extra
             s.vattr = vattr
             s.eattr = eattr
@@ -1261,6 +1290,11 @@ class Session(SessionAPI):
             raise ExpressionError(f"the {el.kind} no longer exists (deleted by this command)")
 
     def get_attr(self, base, name, idx):
+        from .commands import attributes as A
+        if isinstance(base, A.ConstraintAt):
+            return A.constraint_attr(self, base, name, idx)
+        if name in ("on_quantity", "on_method_instance"):
+            return A.on_quantity(self, base, name, idx)
         if idx is not None:                     # indices are integers (C truncation)
             idx = tuple(I.as_int(j, f"the index of '{name}'") for j in idx) \
                 if isinstance(idx, tuple) else I.as_int(idx, f"the index of '{name}'")
@@ -1294,6 +1328,10 @@ class Session(SessionAPI):
             if k == "edge":
                 return float(bool(s.eattr["fixed"][i]) or
                              len(self.sub_elements(base, "facet")) != 2)
+        from .commands import attributes as A
+        v = A.element_attr(self, base, name, idx)
+        if v is not A.MISSING:
+            return v
         if s.sdim == 2 and name in ("z", "x3") and k in ("vertex", "edge", "facet"):
             raise ExpressionError("Coordinate dimension exceeds space dimension.")  # REF 2475
         if k == "vertex":
@@ -1409,13 +1447,14 @@ class Session(SessionAPI):
             if name == "volume":
                 return float(t.volumes[i])
             if name == "target":
-                return float(b.target[i]) if not math.isnan(b.target[i]) else 0.0
+                return float(b.target[i]) if not math.isnan(b.target[i]) else \
+                    A.unset_value(self, i, "target", 0.0)
             if name == "volconst":
                 return float(b.volconst[i])
             if name == "pressure":
                 if not math.isnan(b.pressure[i]):
                     return float(b.pressure[i])
-                return float(b.lagrange[i])
+                return A.unset_value(self, i, "pressure", float(b.lagrange[i]))
             if name == "density":
                 return float(b.density[i])
             if name == "fixed":
@@ -1430,8 +1469,8 @@ class Session(SessionAPI):
                 raise ExpressionError(f"{base}.{kind}[{j}] does not exist ({k} {int(eid)} has "
                                       f"{len(subs)} {kind}{'s' if len(subs) != 1 else ''})")
             return subs[j - 1]
-        if name in s.quantities:
-            raise UnsupportedError(f"per-element quantity values ({k}.{name})")
+        if name in s.quantities and k in ("vertex", "edge", "facet"):
+            return A.element_quantity_value(self, base, name)
         raise ExpressionError(f"{k} has no attribute '{name}'")
 
     @staticmethod
@@ -1453,6 +1492,9 @@ class Session(SessionAPI):
 
     def _quantity_attr(self, qname, name):
         q = self.surface.quantities[qname]
+        if q.kind == "instance" and name not in ("value", "modulus"):
+            raise ExpressionError(f"method instance {qname} has no attribute '{name}' "
+                                  f"(possible method instance attributes: value, modulus)")
         if name == "value":
             return float(self.totals.quantity_values[qname])
         if name == "target":
@@ -1463,7 +1505,8 @@ class Session(SessionAPI):
             return float(q.pressure)
         if name == "tolerance":
             return float(q.tolerance)
-        raise ExpressionError(f"quantity has no attribute '{name}'")
+        from .commands import attributes as A
+        return A.quantity_attr(self, q, name)
 
     def set_attr(self, base, name, idx, value):
         if idx is not None:
@@ -1491,6 +1534,9 @@ class Session(SessionAPI):
             raise CommandError(f"'.{name}' needs an element or a quantity")
         self._check_alive(base)
         k, i = base.kind, base.i
+        from .commands import attributes as A
+        if (k, name) not in s.extra and A.set_element_attr(self, base, name, idx, value):
+            return
         if (k, name) in s.extra:
             arr = s.extra[(k, name)]
             if self.attr_types.get((k, name)) == "integer":
@@ -1511,6 +1557,7 @@ class Session(SessionAPI):
             if not math.isfinite(value):
                 raise CommandError(f"vertex coordinates must be finite numbers, got {value:g}")
             s.X[i, j] = value
+            A.cache(self).touch(self)           # attributes read the live coordinates
             return
         if k == "body":
             b = s.bodies
@@ -1527,6 +1574,8 @@ class Session(SessionAPI):
                 return
             if name == "density":
                 b.density[i] = value
+                if value:           # REF: a body density switches gravity on
+                    self.toggles["gravity"] = 1
                 return
         if k == "facet" and name in ("tension", "density"):
             s.fattr["tension"][i] = value
@@ -1545,6 +1594,8 @@ class Session(SessionAPI):
                     if key in attrs:
                         attrs[key][i] = int(value)
             elif name == "frontcolor":
+                if k == "facet" and "backcolor" not in attrs:    # the back keeps its colour
+                    attrs["backcolor"] = attrs["color"].copy()
                 for key in ("color", "frontcolor"):
                     if key in attrs:
                         attrs[key][i] = int(value)
@@ -1565,7 +1616,16 @@ class Session(SessionAPI):
         raise CommandError(f"cannot assign to {k} attribute '{name}'")
 
     def set_elements(self, gen, attr, expr, env, unset, idx=None):
+        from .commands import attributes as A
         els = self.generate(gen, env)
+        qname = A.membership_name(self, gen.kind, attr, expr)
+        if qname is not None:
+            A.set_membership(self, gen.kind, els, qname, not unset)
+            return
+        if A.is_flag(gen.kind, attr) and (expr is None or unset):
+            for el in els:         # boolean attributes: set = 1, unset = 0
+                self.set_attr(el, attr, None, 0.0 if unset else 1.0)
+            return
         if attr in ("fixed", "no_refine") and (expr is None or unset):
             if gen.kind == "body":
                 raise CommandError(f"bodies cannot be {'un' if unset else ''}set {attr}; "
@@ -1574,18 +1634,20 @@ class Session(SessionAPI):
                 self.set_attr(el, attr, None, 0.0 if unset else 1.0)
             return
         if unset:
+            if attr == "boundary" and expr is not None:
+                A.unset_boundary(self, els, self.interp.value(expr))
+                return
             if attr in ("constraint",) and expr is not None:
                 self.unset_constraint(els, int(self.interp.value(expr)))
                 return
-            if attr == "target" and gen.kind == "body":
+            if attr == "density" and gen.kind == "body":
+                return      # REF: neither the printed density nor the energy changes
+            if attr in ("target", "pressure") and gen.kind == "body":
                 b = self.surface.bodies
-                for el in els:
-                    b.target[el.i] = np.nan
-                return
-            if attr == "pressure" and gen.kind == "body":
-                b = self.surface.bodies
-                for el in els:
-                    b.pressure[el.i] = np.nan
+                arr = getattr(b, attr)
+                for el in els:      # REF still prints the old value (volfixed 0)
+                    A.remember_unset(self, el.i, attr, arr[el.i])
+                    arr[el.i] = np.nan
                 return
             if (gen.kind, attr) in self.surface.extra:
                 for el in els:
@@ -1596,6 +1658,7 @@ class Session(SessionAPI):
             raise UnsupportedError(f"set {gen.kind} {attr} (without a value)")
         if attr == "constraint":
             self.set_constraint(els, self.interp.value(expr))
+            A.cache(self).touch(self)           # projected vertices moved
             return
         # compute every value first, then assign (like the Evolver's set)
         vals = []
@@ -1608,6 +1671,7 @@ class Session(SessionAPI):
             self.set_attr(el, attr, ix, v)
         if gen.kind == "vertex" and attr in ("x", "y", "z"):
             self._project_or_fail(self.surface, np.array([e.i for e in els], np.int64))
+            A.cache(self).touch(self)
 
     def _project_or_fail(self, surface, idx):
         """Project vertices to their constraints; a projection that diverges

@@ -459,6 +459,7 @@ class _Builder:
 
     def build(self):
         sc, s = self.sc, self.s
+        self._actual_volume = {}        # body position -> ACTUAL_VOLUME
         s.params = dict(sc.parameters)
         s.sdim = sc.space_dimension
         s.string = sc.string
@@ -496,6 +497,11 @@ class _Builder:
         self._project()
         if s.nf:
             record_edge_first_facet(s, first_facets_on_load(s.FE, self.facet_parent, s.ne))
+        if self._actual_volume:
+            # ACTUAL_VOLUME a: volconst is set so that the body's volume is a
+            vols = s.evaluate().volumes
+            for pos, a in self._actual_volume.items():
+                s.bodies.volconst[pos] += a - vols[pos]
         return s
 
     def _constraint_ids(self, vals, what, blk, pos):
@@ -574,7 +580,7 @@ class _Builder:
                 s.vcon[cid] = np.ones(n, bool)
         s.X = X
         s.vattr["fixed"] = fixed
-        s.vattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.vattr["original"] = self._originals(blk)
         if bnd is not None:
             s.vattr["boundary"] = bnd
             s.vattr["params"] = params
@@ -656,15 +662,22 @@ class _Builder:
                     self._member("edge", pos, vals)
                 elif kw == "attribute":
                     self._attr("edge", n, pos, vals)
+                elif kw == "orientation" and vals and vals[0] < 0:
+                    raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: "
+                                     "ORIENTATION -1 (an edge's oriented integrals reversed)",
+                                     blk.lines[pos])
                 elif kw in ("bare", "original", "orientation"):
                     pass
+                elif kw == "wrap":
+                    raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: WRAP "
+                                     "(symmetry groups are not implemented)", blk.lines[pos])
                 else:
                     raise self.error(f"edge {blk.ids[pos]}: '{kw}' is not an edge attribute",
                                      blk.lines[pos])
         s.E = E
         s.eattr["fixed"] = fixed
         s.eattr["no_refine"] = no_refine
-        s.eattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.eattr["original"] = self._originals(blk)
         if tension is not None:
             s.eattr["tension"] = tension
         if bnd is not None:
@@ -780,7 +793,7 @@ class _Builder:
         s.fattr["fixed"] = fixed[parent]
         s.fattr["tension"] = tension[parent]
         s.fattr["no_refine"] = no_refine[parent]
-        s.fattr["original"] = np.asarray(blk.ids, dtype=np.int64)[parent] if nface else \
+        s.fattr["original"] = self._originals(blk)[parent] if nface else \
             np.zeros(0, np.int64)
         for key, arr in colors.items():
             s.fattr[key] = arr[parent]
@@ -883,7 +896,11 @@ class _Builder:
                     colors.setdefault(key, np.zeros(nface, np.int64))[pos] = int(vals[0])
                 elif kw == "attribute":
                     self._attr("facet", nface, pos, vals)
-                elif kw in ("nodisplay", "no_display", "opacity", "original", "phase", "tag"):
+                elif kw == "phase":
+                    raise self.error(f"face {blk.ids[pos]}: not supported in pyevolver: PHASE "
+                                     "(phases need a PHASEFILE, which is not implemented)",
+                                     blk.lines[pos])
+                elif kw in ("nodisplay", "no_display", "opacity", "original", "tag"):
                     pass
                 elif kw == "quantity" and string:
                     raise self.error(f"face {blk.ids[pos]}: not supported in pyevolver: "
@@ -948,12 +965,24 @@ class _Builder:
         s.fattr["fixed"] = fixed
         s.fattr["tension"] = tension
         s.fattr["no_refine"] = no_refine
-        s.fattr["original"] = np.asarray(blk.ids, dtype=np.int64)
+        s.fattr["original"] = self._originals(blk)
         for key, arr in colors.items():
             s.fattr[key] = arr
 
     def children(self, pos):
         return self.split_children.get(pos, [pos])
+
+    @staticmethod
+    def _originals(blk):
+        """The ``original`` attribute of a section's elements: the datafile
+        id, or the value of an ``original N`` keyword (the Evolver's dump
+        writes it for elements made by refining element N)."""
+        orig = np.asarray(blk.ids, dtype=np.int64).copy()
+        for pos, attrs in blk.attrs.items():
+            for kw, vals in attrs:
+                if kw == "original" and vals:
+                    orig[pos] = int(vals[0])
+        return orig
 
     def _face_center(self, rim):
         return self.s.X[rim].mean(axis=0)
@@ -995,7 +1024,7 @@ class _Builder:
         b.pressure = np.full(nb, np.nan)
         b.density = np.zeros(nb)
         b.lagrange = np.zeros(nb)
-        b.original = np.asarray(blk.ids, dtype=np.int64)
+        b.original = self._originals(blk)
         lens = [len(d) for d in blk.data]
         flat = np.concatenate([np.asarray(d, dtype=np.int64) for d in blk.data]) if nb else \
             np.zeros(0, np.int64)
@@ -1029,10 +1058,18 @@ class _Builder:
                     b.pressure[pos] = v[0]
                 elif kw == "density":
                     b.density[pos] = v[0]
-                elif kw in ("actual_volume", "lagrange_multiplier"):
-                    pass
+                elif kw == "actual_volume":
+                    self._actual_volume[pos] = v[0]
+                elif kw == "lagrange_multiplier":
+                    b.lagrange[pos] = v[0]      # the pressure REF reports until the next step
+                elif kw in ("centerofmass", "original"):
+                    pass        # centerofmass is a display flag; original above
                 elif kw == "attribute":
                     self._attr("body", nb, pos, v)
+                elif kw == "phase":
+                    raise self.error(f"body {blk.ids[pos]}: not supported in pyevolver: PHASE "
+                                     "(phases need a PHASEFILE, which is not implemented)",
+                                     blk.lines[pos])
                 else:
                     raise self.error(f"body {blk.ids[pos]}: '{kw}' is not a body attribute",
                                      blk.lines[pos])
@@ -1094,6 +1131,7 @@ class _Builder:
             s.quantities[name] = q
         for name, qd in sc.quantities.items():
             q = Quantity(name, qd.kind, qd.target, qd.modulus, qd.tolerance, line=qd.line)
+            q.pressure = qd.lagrange_multiplier      # a dump's multiplier, until the next step
             for m in qd.methods:
                 try:
                     etype, _ = method_info(m.method)

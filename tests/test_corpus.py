@@ -7,7 +7,7 @@ relative.
 The generated elastic sheets use energies pyevolver does not have yet: until
 they land, loading them must be refused by name (the whole file read first);
 once a sheet loads, its numbers are compared like the others.  The Evolver
-dumps wait for the dump syntax of another branch (marked xfail).
+dumps (``.dmp``) are compared like the datafiles.
 
 Skipped only when the corpus folder is absent.  The corpus files are never
 copied into the repository.
@@ -36,7 +36,6 @@ CORPUS = next((os.path.normpath(c) for c in _CANDIDATES
 # features the generated elastic sheets use that pyevolver refuses today
 ELASTIC_FEATURES = ("linear_elastic", "star_perp_sq_mean_curvature", "star_gauss_curvature",
                     "OPTIMIZING_PARAMETER")
-DUMP_REASON = "Evolver dump syntax (H1)"
 # values printed by SCRIPT.txt (one per line, after a 'STAGE name' line)
 _VALUE = re.compile(r"(?:Enter command: )?(total_energy|total_area|vertex_count|edge_count|"
                     r"facet_count|body_count) (\S+)")
@@ -53,10 +52,7 @@ def _rows():
 def _params():
     out = []
     for name, kind in _rows():
-        marks = []
-        if name.endswith(".dmp"):
-            marks.append(pytest.mark.xfail(strict=False, reason=DUMP_REASON))
-        out.append(pytest.param(name, kind, id=name.split("__")[-1], marks=marks))
+        out.append(pytest.param(name, kind, id=name.split("__")[-1]))
     if not out:
         out.append(pytest.param(None, None, id="corpus-absent",
                                 marks=pytest.mark.skip(reason="no third-party corpus")))

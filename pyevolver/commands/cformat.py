@@ -89,9 +89,11 @@ def c_format(fmt, args):
 
 def print_array(a):
     """``print array``: nested braces, numbers ``%2.15g`` (REF layout)."""
+    fmt = "%d" if np.issubdtype(np.asarray(a).dtype, np.integer) else "%2.15g"
+
     def row(x, depth):
-        if x.ndim == 1:
-            return "{" + ",".join(v if isinstance(v, str) else "%2.15g" % v for v in x) + "}"
+        if x.ndim == 1:       # integer arrays (v_constraint_list) as REF: %d
+            return "{" + ",".join(v if isinstance(v, str) else fmt % v for v in x) + "}"
         return "{" + (",\n" + " " * (depth + 1)).join(row(y, depth + 1) for y in x) + "}"
     return row(a, 0)
 

@@ -118,9 +118,13 @@ def _scan(text):
             continue                # blank and comment lines neither start nor end one
         if start is None:
             start = lineno
+        spliced = not in_str and code.rstrip().endswith("\\")
+        if spliced:                 # backslash-newline: the line goes on (REF's dump writes it)
+            k = code.rstrip().rfind("\\")
+            code = code[:k] + " " + code[k + 1:]
         buf.append(code)
         tail = code.rstrip()
-        if depth > 0 or in_str or in_comment or tail.endswith(_CONT_END) or \
+        if depth > 0 or in_str or in_comment or spliced or tail.endswith(_CONT_END) or \
                 _ends_with_keyword(tail):
             continue
         if not opened and not tail.endswith(";") and _PROC_START.match("\n".join(buf)):
@@ -250,6 +254,8 @@ class Attr(N.Node):
         base = self.base.ev(env)
         if self.index is None:
             idx = None
+        elif self.name in ("on_quantity", "on_method_instance"):
+            idx = _quantity_arg(self.index, env)
         elif isinstance(self.index, list):
             idx = tuple(i.ev(env) for i in self.index)
         else:
@@ -295,8 +301,8 @@ class Aggregate(N.Node):
                 vals.append(as_float(self.expr.ev(env), f"the value of {self.op}()"))
         if self.op == "count":
             return float(len(vals))
-        if not vals:
-            return 0.0
+        if not vals:                # REF: max -1e38, min 1e38 over no elements
+            return {"max": -1e38, "min": 1e38}.get(self.op, 0.0)
         if self.op == "sum":
             return float(sum(vals))
         if self.op == "avg":
@@ -317,7 +323,18 @@ class OnTest(N.Node):
         el = env.current()
         if el is None:
             raise ExpressionError(f"{self.what} needs an element (use it in a where clause)")
+        if self.what in ("on_quantity", "on_method_instance"):
+            return env.session.get_attr(el, self.what, _quantity_arg(self.arg, env))
         return env.session.get_attr(el, self.what, self.arg.ev(env))
+
+
+def _quantity_arg(node, env):
+    """The quantity named after ``on_quantity`` (a name that inside an
+    element loop would otherwise read the element's own quantity value)."""
+    s = env.session.surface
+    if isinstance(node, N.Var) and s is not None and node.name.lower() in s.quantities:
+        return QRef(node.name.lower())
+    return node.ev(env)
 
 
 class ArrayLit(N.Node):
@@ -585,6 +602,10 @@ class _CmdTransformer(ExprTransformer):
     def array_ref(self, name, *idx):
         return ArrayRef(str(name), list(idx))
 
+    def string_concat(self, *parts):
+        # "a" "b": adjacent literals are one string, as in C and the Evolver
+        return N.Str("".join(p.value for p in parts))
+
     def sprintf_expr(self, _s, *args):
         return Sprintf(list(args))
 
@@ -709,13 +730,17 @@ class _CmdTransformer(ExprTransformer):
     def bare_arg(self, name, expr):
         return ("bare", str(name), expr)
 
-    def graphics(self, tok):
+    def set_background(self, _s, _b, expr):
+        # the graphics window's background colour: no effect without graphics
         return ("seq", [])
+
+    def graphics(self, tok):
+        return _graphics_toggle(tok) or ("seq", [])
 
     def define_graphics(self, lv, _a, tok):
         if lv[0] != "name":
             raise CommandError("only a name can be defined as a command")
-        return ("define", lv[1], ("seq", []))
+        return ("define", lv[1], _graphics_toggle(tok) or ("seq", []))
 
     def unsupported(self, tok, body=None):
         words = str(tok).split()
@@ -983,7 +1008,7 @@ TOGGLES = {
     "show_all_quantities", "show_inner", "show_outer", "colormap", "bezier_basis",
     "volgrads_every", "zener_drag", "backcull", "debug", "autodisplay",
 }
-GRAPHICS = {"s", "P", "show", "show_expr", "transforms", "transform_expr", "geomview",
+GRAPHICS = {"s", "P", "show", "show_expr", "transform_expr", "geomview",
             "postscript", "showq", "view_transforms", "ps", "oogl", "gv", "screen"}
 SETTABLE_ATTRS = {"x", "y", "z", "x1", "x2", "x3", "color", "colour", "frontcolor", "backcolor",
                   "tension", "density", "fixed", "no_refine", "target", "pressure", "volconst",
@@ -1013,6 +1038,129 @@ TOGGLE_WORDS = {
     "break_after_warning": "Break after warning", "show_inner": "show inner",
     "show_outer": "show outer", "memdebug": "Memory debugging", "autodisplay": "Autodisplay",
 }
+
+# -- every toggle of the manual (toggle.htm) -------------------------------------
+# The rest of the list; REF's synonyms share one state.
+TOGGLES |= {
+    "ambient_pressure", "approx_curv", "augmented_hessian", "autopop_quartic", "big_endian",
+    "little_endian", "blas_flag", "boundary_curvature", "break_on_warning", "bunch_kaufman",
+    "bunch_kauffman", "calculate_in_3d", "circular_arc_draw", "clip_view", "clipped_cells",
+    "connected_cells", "raw_cells", "conf_edge", "detorus_sticky", "deturck", "dirichlet_mode",
+    "sobolev_mode", "facet_colors", "force_deletion", "force_edgeswap",
+    "function_quantity_sparse", "gv_binary", "hessian_double_normal", "hessian_normal_one",
+    "hessian_normal_perp", "hessian_quiet", "hessian_special_normal", "homothety",
+    "immediate_autopop", "interp_normals", "k_altitude_mode", "kusner", "metric_conversion",
+    "metric_convert", "old_area", "pop_disjoin", "pop_enjoin", "pop_to_edge", "pop_to_face",
+    "ps_cmykflag", "ps_colorflag", "ps_crossingflag", "ps_gridflag", "ps_labelflag",
+    "quantities_only", "quietload", "rotate_lights", "septum_flag", "shading", "show_all_edges",
+    "show_bounding_box", "slice_view", "sparse_constraints", "squared_gradient",
+    "star_finagling", "torus_filled", "transforms", "view_4d",
+    "view_transforms_use_unique_point", "ysmp",
+}
+# synonyms -> the name REF stores the state under
+TOGGLE_ALIASES = {
+    "approx_curv": "approximate_curvature", "metric_convert": "metric_conversion",
+    "clipped_cells": "clipped", "connected_cells": "connected",
+    "bunch_kauffman": "bunch_kaufman", "ps_crossingflag": "crossingflag",
+    "gridflag": "ps_gridflag", "labelflag": "ps_labelflag", "pscolorflag": "ps_colorflag",
+}
+# initial states other than off (measured: print NAME after loading); -1 is "unset"
+TOGGLE_DEFAULTS.update({
+    "detorus_sticky": 1, "facet_colors": 1, "function_quantity_sparse": 1, "hessian_quiet": 1,
+    "kraynikpopvertex": 1, "little_endian": 1, "shading": 1, "show_all_edges": 1,
+    "show_inner": 1, "show_outer": 1, "sparse_constraints": 1, "transforms": 1, "raw_cells": 1,
+    "augmented_hessian": -1, "crossingflag": -1, "ps_crossingflag": -1,
+    "ps_colorflag": -1, "pscolorflag": -1, "ps_gridflag": -1, "gridflag": -1,
+    "ps_labelflag": -1, "labelflag": -1, "septum_flag": -1,
+})
+TOGGLE_WORDS.update({
+    "approximate_curvature": "approx_curvature", "augmented_hessian": "augmented Hessian",
+    "boundary_curvature": "Boundary curvature", "break_on_warning": "Break on warning",
+    "bunch_kaufman": "Bunch-Kaufman version of minimal degree",
+    "circular_arc_draw": "Circular arc drawing", "conf_edge": "Conformal edge square curvature",
+    "facet_colors": "Facet colors", "gv_binary": "Geomview binary mode",
+    "k_altitude_mode": "K altitude mode", "kusner": "Edge square curvature",
+    "metric_conversion": "Metric conversion", "quietload": "QuietLoad",
+    "shading": "Facet shading", "sparse_constraints": "sparse constraints",
+    "transforms": "Transform showing", "view_transforms_use_unique_point":
+    "view_transforms_use_unique", "dirichlet_mode": "Dirichlet area mode",
+    "sobolev_mode": "Sobolev area mode", "ps_gridflag": "ps_gridflag",
+    "ps_labelflag": "ps_labelflag", "ps_colorflag": "ps_colorflag",
+})
+# REF's message when the generic "WORD ON. (was off)" does not fit: (on, off)
+# formats with {was} ("on", "off" or "unset") and {WAS} (upper case)
+TOGGLE_MESSAGES = {
+    "autopop": ("Autopopping ON.\n (was {was})\n", "Autopopping OFF.\n (was {was})\n"),
+    "autopop_quartic": ("Autopop quartic mode ON.\n (was {was})\n",
+                        "Autopop quartic mode OFF.\n (was {was})\n"),
+    "immediate_autopop": ("Immediate autopop mode ON.\n (was {was})\n",
+                          "Immediate autopop mode OFF.\n (was {was})\n"),
+    "debug": ("YACC debugging was {WAS_}Now ON.\n", "YACC debugging was {WAS_}Now OFF.\n"),
+    "itdebug": ("Iteration debugging was {WAS_}Now ON.\n",
+                "Iteration debugging was {WAS_}Now OFF.\n"),
+    "ysmp": ("Using YSMP. (was {alg})\n", "Using alternate minimal degree. (was {alg})\n"),
+    "interp_bdry_param": ("interpolation of boundary parameters  ON. (was {was})\n",
+                          "interpolation of boundary parameters OFF (using extrapolation). "
+                          "(was {was})\n"),
+    "linear_metric": ("Linear interpolation metric with Hessian ON.(was {WAS})\n",
+                      "Linear interpolation metric with Hessian OFF.(was {WAS})\n"),
+    "quantities_only": ("Using quantities only ON.(was {WAS})\n",
+                        "Using quantities only OFF.(was {WAS})\n"),
+    "squared_gradient": ("Squared gradient minimization with Hessian ON.(was {WAS})\n",
+                         "Squared gradient minimization with Hessian OFF.(was {WAS})\n"),
+    "ambient_pressure": ("", "Ambient pressure OFF.\n"),
+    "view_4d": ("4D graphics  ON. (was {was})\n", "4D graphics  OFF. (was {was})\n"),
+    "zener_drag": ("", "Zener_drag OFF. (was {was})  ({zener})\n"),
+}
+for _name in ("bezier_basis", "hessian_normal", "hessian_normal_one", "hessian_normal_perp",
+              "hessian_quiet", "hessian_double_normal"):      # two spaces before ON
+    TOGGLE_MESSAGES[_name] = (_name + "  ON. (was {was})\n", _name + " OFF. (was {was})\n")
+# toggles REF switches without a word
+TOGGLE_SILENT = {"colormap", "connected", "thicken", "raw_cells", "interp_normals"}
+# graphics display of the torus model: one of three modes
+TOGGLE_CELLS = ("clipped", "connected", "raw_cells")
+# toggles that change numbers in a model pyevolver supports but are not
+# implemented: refused when turned on (off is their initial state)
+TOGGLE_REFUSED = {
+    "ambient_pressure": "the ideal gas model is not implemented",
+    "boundary_curvature": "the boundary star rule of the curvature integrals is not "
+                          "implemented",
+    "conf_edge": "the conformal edge formula of squared curvature is not implemented",
+    "kusner": "the edge formula of squared curvature is not implemented",
+    "deturck": "unit normal motion is not implemented",
+    "dirichlet_mode": "the Dirichlet area Hessian is not implemented",
+    "sobolev_mode": "the Sobolev area Hessian is not implemented",
+    "homothety": "homothety scaling is not implemented",
+    "hessian_special_normal": "HESSIAN_SPECIAL_NORMAL_VECTOR is not supported",
+    "hessian_double_normal": "the Hessian normal variants are not implemented",
+    "hessian_normal_one": "the Hessian normal variants are not implemented",
+    "hessian_normal_perp": "the Hessian normal variants are not implemented",
+    "squared_gradient": "squared gradient minimization is not implemented",
+    "quantities_only": "switching off the energies other than named quantities is not "
+                       "implemented",
+    "zener_drag": "Zener drag is not implemented",
+    "force_deletion": "delete keeps its checks", "star_finagling": "delete keeps its checks",
+    "force_edgeswap": "edgeswap keeps its checks",
+    "pop_disjoin": "the pop variants are not implemented",
+    "pop_enjoin": "the pop variants are not implemented",
+    "pop_to_edge": "the pop variants are not implemented",
+    "pop_to_face": "the pop variants are not implemented",
+    "septum_flag": "the pop variants are not implemented",
+    "k_altitude_mode": "K (skinny triangle refinement) uses the median",
+}
+
+
+def _graphics_toggle(tok):
+    """A display word of the command grammar that is also a toggle
+    (``transforms off``, ``clipped on``, ``ps_colorflag``): the toggle command,
+    or None for a graphics command."""
+    words = str(tok).split()
+    if not words or words[0].lower() not in TOGGLES or len(words) > 2:
+        return None
+    if len(words) == 2 and words[1].lower() not in ("on", "off"):
+        return None
+    arg = N.Var(words[1].lower()) if len(words) == 2 else None
+    return ("bare", words[0].lower(), arg)
 
 
 class Interpreter:
@@ -1498,8 +1646,27 @@ class Interpreter:
                                f"list vertex[3] or list facets where area > 0.1)")
         self.session.list_elements(node[1], self.env)
 
+    def _quantity_gen(self, gen):
+        """The quantity or method instance a ``set``/``unset`` names, if any."""
+        s = self.session.surface
+        if gen.base[0] == "var" and s is not None and gen.base[1] in s.quantities \
+                and self._var_elem(gen.base[1]) is None:
+            return gen.base[1]
+        return None
+
     def _x_set(self, node):
         idx = node[4] if len(node) > 4 else None
+        if node[1].base == ("var", "quantity") and self._var_elem("quantity") is None:
+            raise CommandError("set quantity NAME ...: write set NAME target value (the "
+                               "Evolver reads 'set quantity' as a syntax error)")
+        qname = self._quantity_gen(node[1])
+        if qname is not None:
+            from .attributes import set_quantity
+            if node[1].where is not None or node[1].var is not None or idx is not None:
+                raise CommandError(f"set {qname}: expected set {qname} attribute [value]")
+            value = None if node[3] is None else self.value(node[3])
+            set_quantity(self.session, qname, node[2], value)
+            return
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=False, idx=idx)
 
     def _x_fix(self, node):
@@ -1596,6 +1763,10 @@ class Interpreter:
         raise CommandError("Command aborted (abort).")
 
     def _x_unset(self, node):
+        qname = self._quantity_gen(node[1])
+        if qname is not None:
+            raise CommandError(f"unset {qname}: a quantity is not an element (REF: syntax "
+                               f"error); use unfix {qname} or set {qname} info_only")
         self.session.set_elements(node[1], node[2], node[3], self.env, unset=True)
 
     def _x_refine(self, node):
@@ -1702,6 +1873,19 @@ class Interpreter:
             return
         if name == "linear":
             return        # a no-op on a linear surface, as in REF
+        if name == "convert_to_quantities" and arg is None:
+            # REF's dump writes it in the read section of files that used
+            # named-quantity energies; pyevolver computes the same numbers
+            # either way, so only the message is kept
+            # REF converts at load a surface whose boundaries carry integrals
+            bnd = getattr(s.surface, "boundaries", None) or {}
+            if s.toggles.get("_all_quantities") or any(
+                    b.energy or b.content for b in bnd.values()):
+                s.note("Everything already quantities.\n")
+            else:
+                s.toggles["_all_quantities"] = 1
+                s.note("Converting to all named quantities...Done.\n")
+            return
         if raw == "g" or re.fullmatch(r"g\d+", raw):
             n = int(raw[1:]) if len(raw) > 1 else (1 if arg is None else self._count(arg))
             s.go(n)
@@ -1807,28 +1991,83 @@ class Interpreter:
         else:
             v = self.value(arg)
             new = (1 if v else 0) if isinstance(v, str) else int(is_true(v, "a toggle value"))
-        old = s.toggles.get(name, TOGGLE_DEFAULTS.get(name, 0))
+        key = TOGGLE_ALIASES.get(name, name)
+        names = [key] + [a for a, k in TOGGLE_ALIASES.items() if k == key]
+        default = TOGGLE_DEFAULTS.get(key, 0)
+        if key == "show_all_edges" and s.surface is not None and s.surface.string:
+            default = 0                         # REF: off in the string model
+        old = s.toggles.get(key, default)
         if name == "autopop" and new:
             raise UnsupportedError("autopop", "vertex and edge popping (o, O) is not implemented")
-        s.toggles[name] = new
-        was = "on" if old else "off"
+        if key in TOGGLE_REFUSED and new:
+            raise UnsupportedError(f"{name} on", TOGGLE_REFUSED[key])
+        surf = s.surface
+        torus = surf is not None and surf.periods is not None
+        if key == "blas_flag":                   # REF's build has no BLAS either
+            s.write_err("WARNING 2472: This Evolver not compiled with BLAS.\n")
+            return
+        if key == "torus_filled":
+            if not torus:
+                s.write_err("WARNING 2042: torus_filled is invalid toggle because not in "
+                            "torus model.\n")
+                return
+            if new != old:
+                raise UnsupportedError(f"torus_filled {'on' if new else 'off'} at run time",
+                                       "the torus_filled model is fixed by the datafile")
+        if key == "calculate_in_3d" and new and surf is not None and surf.sdim > 3:
+            raise UnsupportedError("calculate_in_3d on", "curvature in the first three "
+                                   "coordinates is not implemented")
+        for n in names:
+            s.toggles[n] = new
+        if key in TOGGLE_CELLS:                  # one display mode of three
+            for other in TOGGLE_CELLS:
+                if other != key:
+                    for n in [other] + [a for a, k in TOGGLE_ALIASES.items() if k == other]:
+                        s.toggles[n] = 0
+            if key == "clipped" and not torus:
+                s.write_err("WARNING 1254: CLIPPED mode has no effect since torus model not "
+                            "used.\n")
+            return
+        if key == "big_endian" and new:
+            s.toggles["little_endian"] = 0
+        elif key == "little_endian" and new:
+            s.toggles["big_endian"] = 0
+        was = {1: "on", 0: "off"}.get(old, "unset")
         now = "ON" if new else "OFF"
-        if name == "quietgo":               # REF prints this one even when quiet
+        if key in TOGGLE_SILENT:
+            pass
+        elif key == "quietgo":               # REF prints this one even when quiet
             s.write(f"QuietGo {now}. (was {was})\n")
-        elif name == "quiet":
+        elif key == "quiet":
             if not new:                     # turning it on is silent
                 s.write(f"Quiet OFF. (was {was})\n")
-        elif name == "autochop":
+        elif key == "autochop":
             if new:
                 s.note(f"Autochopping ON. Chop length {s.settings.get('autochop_length', 0.0):g}"
                        f"  (was {was})\n"
                        "Set autochop length with  AUTOCHOP_LENGTH := value\n")
             else:
                 s.note(f"Autochopping OFF. (was {was})\n")
+        elif key in TOGGLE_MESSAGES:
+            fmt = TOGGLE_MESSAGES[key][0 if new else 1]
+            zc = s.variables.get("zener_coeff")
+            if key == "ysmp" and new == old:      # REF says nothing then
+                fmt = ""
+            s.note(fmt.format(was=was, WAS=was.upper(),
+                              WAS_="OFF.\n" if old == 0 else was.upper() + ".",
+                              alg="YSMP" if old else "alt min deg",
+                              zener="zener_coeff not set" if zc is None else
+                              f"zener_coeff: {zc:g}" if isinstance(zc, (int, float))
+                              else "zener_coeff"))
         else:
-            word = TOGGLE_WORDS.get(name, name)
+            word = TOGGLE_WORDS.get(key, key)
             s.note(f"{word} {now}. (was {was})\n")
-        if name == "gravity":
+        if key == "sparse_constraints" and not new:     # REF settles an unset one too
+            old_aug = s.toggles.get("augmented_hessian", TOGGLE_DEFAULTS["augmented_hessian"])
+            if old_aug == -1:
+                s.toggles["augmented_hessian"] = 0
+                s.note("augmented Hessian OFF. (was unset)\n")
+        if key == "gravity":
             s.recalc()
 
     # -- expressions ------------------------------------------------------------

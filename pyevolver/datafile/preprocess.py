@@ -34,6 +34,7 @@ class Section:
     text: str
     line: int
     lines: list = field(default_factory=list)  # source line of each text line
+    warnings: list = field(default_factory=list)  # (source line, message)
 
 
 def normalise_newlines(text):
@@ -103,8 +104,55 @@ def preprocess(text, filename="<datafile>", include_depth=0):
         clean, src_lines = _directives(clean, filename, macros, src_lines, include_depth)
     sections = _split(clean, src_lines)
     if read_text is not None:
-        sections.append(Section("read", read_text, read_line))
+        keep = _KEEP_MACROS_RE.search(clean) is not None
+        read_text, warnings = _read_directives(read_text, read_line, filename, macros,
+                                               keep)
+        sections.append(Section("read", read_text, read_line, warnings=warnings))
     return sections, macros
+
+
+_KEEP_MACROS_RE = re.compile(r"^[ \t]*keep_macros\b", re.I | re.M)
+
+
+def _read_directives(text, first_line, filename, macros, keep_macros):
+    """``#include`` and ``#define`` lines of the read section.
+
+    ``#include "f"`` becomes ``read "path"`` (the file found as for the top
+    section: the current directory, the datafile's directory, EVOLVERPATH),
+    so its commands run in place.  ``#define`` draws the Evolver's warning
+    2853 ("valid only in top of datafile"); with ``keep_macros`` it still
+    defines the macro, and the top section's macros are expanded in the
+    read section, as in the Evolver.  Lines keep their numbers.
+    """
+    if "#" not in text and not (keep_macros and macros):
+        return text, []
+    warnings = []
+    lines = text.split("\n")
+    for k, line in enumerate(lines):
+        m = _DIRECTIVE_RE.match(line)
+        if m and m.group(1).lower() == "include":
+            mm = re.match(r'\s*"([^"]*)"', m.group(2))
+            if mm:
+                inc = _find_include(mm.group(1), filename)
+                path = os.path.abspath(inc) if inc else mm.group(1)
+                lines[k] = 'read "' + path.replace("\\", "\\\\").replace('"', '\\"') + '"'
+            continue
+        if m:
+            warnings.append((first_line + k,
+                             "WARNING 2853: #define valid only in top of datafile."))
+            mm = re.match(r"\s*([A-Za-z_][A-Za-z0-9_]*)(.*)$", m.group(2))
+            if keep_macros and mm:
+                macros[mm.group(1)] = mm.group(2).strip()[:500]
+            lines[k] = ""
+            continue
+        if keep_macros and macros:
+            try:
+                lines[k] = expand_macros(line, macros)
+            except _TooLong:
+                raise DatafileError(f"#define macros expand this line beyond "
+                                    f"{MAX_EXPANDED_LINE} characters", filename,
+                                    first_line + k, 1, line) from None
+    return "\n".join(lines), warnings
 
 
 def _splice(text):

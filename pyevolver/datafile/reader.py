@@ -46,7 +46,8 @@ _ELEM_KWS = frozenset(
     "fixed bare no_refine nodisplay no_display constraint constraints boundary tension "
     "density volume volconst actual_volume pressure color colour frontcolor frontcolour "
     "backcolor backcolour wrap orientation original opacity tag phase no_hessian_normal "
-    "hessian_normal_one axial_point triple_point tetra_point lagrange_multiplier".split())
+    "hessian_normal_one axial_point triple_point tetra_point lagrange_multiplier "
+    "centerofmass".split())
 _WORD = re.compile(r"\S+")
 _PLAIN = re.compile(_NUMBER + r"\Z")
 
@@ -126,6 +127,9 @@ def line_parser():
                 maybe_placeholders=False, cache=True)
 
 
+# ``define edge attribute bbb real function { ... }``: refused by name
+_ATTR_FUNCTION = re.compile(r"\bdefine\s+\w+\s+attribute\s+\w+\s+\w+(?:\s*\[[^\]\n]*\])*"
+                            r"\s+(function)\b", re.I)
 _MATRIX_RE = re.compile(r"\b(torus_periods|periods|view_matrix|view_transforms|"
                         r"view_transform_generators)\b", re.I)
 _NUMTOK_RE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)(?=\s|$)")
@@ -305,11 +309,35 @@ class _TopTransformer(ExprTransformer):
     def unsupported(self, kw):
         raise _Unsupported(kw)
 
+    # -- what the Evolver's dump writes --
+    def slice_coeff(self, kw, _nums):
+        return ("ignored", "slice_coeff")       # the slicing plane of the graphics
+
+    def quantity_forward(self, kw, name):
+        return ("quantity_forward", str(name).lower(), kw.line)
+
+    def instance_forward(self, kw, name):
+        return ("instance_forward", str(name).lower(), kw.line)
+
+    def global_array(self, kw, name, atype, dims, init):
+        # ``define arr real[2][3] = {{...},{...}}``: a global array with its values
+        return ("global_array", str(name).lower(), str(atype).lower(), dims, str(init),
+                kw.line, init.line)
+
 
 @v_args(inline=True)
 class _LineTransformer(ExprTransformer):
     def _line(self, idtok, *items):
-        return (int(idtok), list(items))
+        flat = []
+        for it in items:
+            if isinstance(it, list):        # braced array values
+                flat.extend(it)
+            else:
+                flat.append(it)
+        return (int(idtok), flat)
+
+    def braced(self, *exprs):
+        return list(exprs)
 
     vertex_line = edge_line = face_line = body_line = _line
 
@@ -338,7 +366,7 @@ class Reader:
         self.text = read_source(filename) if text is None else text
         self.scene = Scene(filename=filename)
         self._src_lines = None
-        self._forward = set()           # names declared ahead ("constraint pinned;")
+        self._named_forward = set()     # names declared ahead ("constraint pinned;")
 
     @property
     def src_lines(self):
@@ -356,6 +384,8 @@ class Reader:
         sections, self.macros = preprocess(self.text, self.filename)
         top = sections[0]
         self._top(top)
+        if "keep_macros" in self.scene.flags:
+            self.scene.macros = self.macros     # active at run time too (manual)
         seen = []
         for k in range(1, len(sections)):
             sec = sections[k]
@@ -363,6 +393,7 @@ class Reader:
             if sec.kind == "read":
                 self.scene.read_text = sec.text
                 self.scene.read_line = sec.line
+                self.scene.read_warnings = sec.warnings
                 continue
             if sec.kind in seen:
                 raise self.error(f"section '{sec.kind}' appears twice", sec.line, 1)
@@ -375,7 +406,42 @@ class Reader:
         if self.scene.unsupported:
             feature, line, col = self.scene.unsupported[0]
             raise self.error(f"not supported in pyevolver: {feature}", line, col)
+        if "keep_originals" in self.scene.flags:
+            self._keep_originals()
         return self.scene
+
+    def _keep_originals(self):
+        """KEEP_ORIGINALS: the elements keep their datafile ids (the Evolver
+        otherwise numbers them in reading order).  pyevolver numbers elements
+        1..n by position, so a section whose ids are 1..n in another order
+        (the Evolver's dump after refining) is put in id order; ids with gaps
+        cannot be kept and are refused."""
+        sc = self.scene
+        for kind, what in (("vertices", "vertex"), ("edges", "edge"), ("faces", "face"),
+                           ("bodies", "body")):
+            blk = getattr(sc, kind)
+            ids = np.asarray(blk.ids, dtype=np.int64)
+            n = len(ids)
+            if not n or np.array_equal(ids, np.arange(1, n + 1)):
+                continue
+            order = np.argsort(ids, kind="stable")
+            if not np.array_equal(ids[order], np.arange(1, n + 1)):
+                missing = int(np.setdiff1d(np.arange(1, n + 1), ids)[0])
+                line = sc.decl_lines.get("keep_originals")
+                raise self.error(f"not supported in pyevolver: KEEP_ORIGINALS with {what} ids "
+                                 f"that are not 1 to {n} ({what} {missing} is missing); "
+                                 f"elements are numbered 1..n", line)
+            inv = np.empty(n, np.int64)
+            inv[order] = np.arange(n)
+            blk.ids = ids[order] if isinstance(blk.ids, np.ndarray) else ids[order].tolist()
+            if isinstance(blk.data, np.ndarray):
+                blk.data = blk.data[order]
+            else:
+                blk.data = [blk.data[k] for k in order.tolist()]
+            blk.lines = type(blk.lines)("l", [blk.lines[k] for k in order.tolist()])
+            blk.attrs = {int(inv[pos]): a for pos, a in blk.attrs.items()}
+            if kind == "edges" and sc.wraps:
+                sc.wraps = {int(inv[pos]): w for pos, w in sc.wraps.items()}
 
     # -- top section --------------------------------------------------------
     def _describe(self, exc, text):
@@ -532,6 +598,12 @@ class Reader:
             line = text.count("\n", 0, bad.start()) + 1
             col = bad.start() - (text.rfind("\n", 0, bad.start()) + 1) + 1
             raise self.error(f"malformed number '{bad.group(0)}'", self._src(sec, line), col)
+        fdef = _ATTR_FUNCTION.search(text)
+        if fdef:
+            line = text.count("\n", 0, fdef.start(1)) + 1
+            col = fdef.start(1) - (text.rfind("\n", 0, fdef.start(1)) + 1) + 1
+            raise self.error("not supported in pyevolver: DEFINE ... ATTRIBUTE ... FUNCTION "
+                             "(attributes computed when read)", self._src(sec, line), col)
         try:
             if _MATRIX_RE.search(text):
                 text = self._extract_matrices(text)
@@ -622,6 +694,7 @@ class Reader:
 
     def _fill_scene(self, decls, sec):
         sc = self.scene
+        self._forward = {}
         for d in decls:
             kind = d[0]
             try:
@@ -630,6 +703,11 @@ class Reader:
                 raise self.error(f"undefined parameter '{exc.name}'",
                                  self._src(sec, exc.line) if exc.line else None,
                                  exc.col) from None
+        for name, (kind, line) in self._forward.items():
+            known = sc.quantities if kind == "quantity_forward" else sc.method_instances
+            if name not in known:
+                what = "quantity" if kind == "quantity_forward" else "method_instance"
+                raise self.error(f"{what} {name} is declared but never defined", line)
 
     def _decl(self, d, sc, sec):
         kind = d[0]
@@ -706,6 +784,11 @@ class Reader:
         elif kind == "attribute":
             _, etype, name, atype, dims, line = d
             dims = [self._dim(e, self._src(sec, line), name) for e in dims]
+            if atype in _INT_ATTR_TYPES:
+                atype = "integer"        # the Evolver's integer types; stored as numbers
+            elif atype != "real":
+                raise self.error(f"not supported in pyevolver: {atype.upper()} element "
+                                 f"attributes (attribute {name})", self._src(sec, line))
             size = math.prod(dims) if dims else 1
             if size > MAX_ARRAY_ENTRIES:
                 raise self.error(f"attribute {name}: {size} entries per {etype}; at most "
@@ -717,7 +800,13 @@ class Reader:
                             else (sc.boundaries, sc.boundary_names))
             if name not in names.values():
                 self._number_named(name, table, names, what, self._src(sec, line))
-                self._forward.add((what, name))
+                self._named_forward.add((what, name))
+        elif kind == "global_array":
+            self._global_array(d, sc, sec)
+        elif kind in ("quantity_forward", "instance_forward"):
+            # ``quantity name;``, ``method_instance name;``: declared now, defined
+            # later in the top section
+            self._forward.setdefault(d[1], (kind, self._src(sec, d[2])))
         elif kind == "periods":
             exprs = getattr(self, "_period_exprs", None)
             if exprs is not None:       # expressions: evaluated here, in order
@@ -782,8 +871,8 @@ class Reader:
                 names[new] = name
             return key
         if key in names.values():
-            if (what, key) in self._forward:     # declared ahead, defined now
-                self._forward.discard((what, key))
+            if (what, key) in self._named_forward:     # declared ahead, defined now
+                self._named_forward.discard((what, key))
                 return next(c for c, n in names.items() if n == key)
             raise self.error(f"{what} '{key}' defined twice", line)
         if key in self.scene.parameters:
@@ -791,6 +880,40 @@ class Reader:
         new = _lowest_free(table, names)
         names[new] = key
         return new
+
+    def _global_array(self, d, sc, sec):
+        _, name, atype, dims, init, line, iline = d
+        where = self._src(sec, line)
+        dims = [self._dim(e, where, name) for e in dims]
+        if atype not in ("real", "string") and atype not in _INT_ATTR_TYPES:
+            raise self.error(f"not supported in pyevolver: {atype.upper()} arrays "
+                             f"(array {name})", where)
+        size = math.prod(dims) if dims else 1
+        if size > MAX_ARRAY_ENTRIES:
+            raise self.error(f"array {name}: {size} entries; at most {MAX_ARRAY_ENTRIES} are "
+                             f"allowed", where)
+        # the values in braces, row by row: numbers or strings
+        depth, shape_ok, vals = 0, True, []
+        for m in _ARRAY_TOKEN.finditer(init):
+            tok = m.group(0)
+            if tok == "{":
+                depth += 1
+                shape_ok = shape_ok and depth <= len(dims)
+            elif tok == "}":
+                depth -= 1
+            elif tok.startswith('"'):
+                vals.append(tok[1:-1].encode("latin-1").decode("unicode_escape"))
+            else:
+                vals.append(float(tok.replace("d", "e").replace("D", "e")))
+        strings = atype == "string"
+        if not shape_ok or len(vals) != size or any(isinstance(v, str) != strings
+                                                     for v in vals):
+            raise self.error(f"array {name}: expected {size} "
+                             f"{'strings' if strings else 'numbers'} in "
+                             f"{len(dims)} levels of braces for {atype}"
+                             + "".join(f"[{k}]" for k in dims), self._src(sec, iline))
+        arr = np.array(vals, dtype=object if strings else float).reshape(dims)
+        sc.arrays[name] = ("integer" if atype in _INT_ATTR_TYPES else atype, arr)
 
     def _method(self, mname, is_global, opts, sec, line, qname):
         m = MethodDecl(mname, is_global, name=qname)
@@ -1270,6 +1393,12 @@ def _lowest_free(table, names, also=None):
     while k in table or k in names or k == also:
         k += 1
     return k
+# the integer types of ``define ... attribute`` (the Evolver's dump writes them)
+_INT_ATTR_TYPES = {"integer", "uchar", "char", "uint", "ulong_int", "short_int", "ushort_int",
+                   "long_int"}
+
+
+_ARRAY_TOKEN = re.compile(r'[{}]|"(?:\\.|[^"\\\n])*"|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?')
 
 
 class _MatrixError(Exception):

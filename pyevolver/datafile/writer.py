@@ -108,7 +108,7 @@ class _FeWriter:
 
     def text(self):
         s = self.s
-        if s.sdim != 3:
+        if s.sdim != 3 and not (s.string and s.sdim == 2):
             self.refuse(f"space dimension {s.sdim}")
         self._check()
         self._header()
@@ -124,6 +124,9 @@ class _FeWriter:
         s = self.s
         known_v = {"fixed", "original", "boundary", "params", "id"}
         known_e = {"fixed", "original", "boundary", "tension", "no_refine", "color", "wrap", "id"}
+        if s.string:                 # the string model's own bookkeeping (rebuilt on reading)
+            known_v = known_v | {"ring_head"}
+            known_e = known_e | {"ring_time"}
         known_f = {"fixed", "original", "boundary", "tension", "no_refine", "color", "frontcolor",
                    "backcolor", "id"}
         for what, attrs, known in (("vertex", s.vattr, known_v), ("edge", s.eattr, known_e),
@@ -137,7 +140,7 @@ class _FeWriter:
         b = s.bodies
         if b.n:
             ob, of, osg = b.occurrences
-            M = sp.csr_matrix((osg, (ob, of)), shape=(b.n, s.nf))
+            M = sp.csr_matrix((osg, (ob, of)), shape=(b.n, s.n_facets))
             if (M != b.facet_matrix.tocsr()).nnz:
                 self.refuse("bodies whose facet list differs from their facets")
 
@@ -147,10 +150,14 @@ class _FeWriter:
         name = getattr(sess, "filename", "") if sess is not None else ""
         self.w(f"// Dump of a surface by pyevolver{' (datafile ' + name + ')' if name else ''}")
         self.w()
+        if s.string:
+            self.w("STRING")
+            if s.sdim != 3:
+                self.w(f"SPACE_DIMENSION {s.sdim}")
         if s.periods is not None:
             self.w("TORUS_FILLED" if s.torus_filled else "TORUS")
             self.w("PERIODS")
-            for row in s.periods:
+            for row in np.asarray(s.periods)[:s.sdim, :s.sdim]:
                 self.w(" ".join(num(v) for v in row))
         if s.symmetric_content:
             self.w("SYMMETRIC_CONTENT")
@@ -171,6 +178,8 @@ class _FeWriter:
             self.w(f"SCALE {num(st['scale'])}{fixed}")
             self.w(f"SCALE_LIMIT {num(st['scale_limit'])}")
             self.w(f"CONSTRAINT_TOLERANCE {num(st['constraint_tolerance'])}")
+            if sess.toggles.get("autochop"):
+                self.w(f"AUTOCHOP {num(st.get('autochop_length', 0.0))}")
         self.w()
         for pname, v in s.params.items():
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.number)):
@@ -325,7 +334,7 @@ class _FeWriter:
                 b = s.boundaries[int(bnd[k])]
                 parts = [num(v) for v in params[k, :b.nparams]] + [f"boundary {self._blabel(int(bnd[k]))}"]
             else:
-                parts = [num(v) for v in s.X[k]]
+                parts = [num(v) for v in s.X[k, :s.sdim]]
             if fixed is not None and fixed[k]:
                 parts.append("fixed")
             c = self._cons(s.vcon, k)
@@ -372,8 +381,12 @@ class _FeWriter:
         fa = s.fattr
         mem = self.members["facet"]
         self.w("faces")
-        for k in range(s.nf):
-            parts = [str(int(e) + 1) if e >= 0 else str(int(e)) for e in s.FE[k]]
+        for k in range(s.n_facets):
+            if s.string:                 # a chain of edges (encoded ~e when reversed)
+                parts = [str(int(e) + 1) if e >= 0 else str(int(e))
+                         for e in s.sf_enc[s.sf_ptr[k]:s.sf_ptr[k + 1]]]
+            else:
+                parts = [str(int(e) + 1) if e >= 0 else str(int(e)) for e in s.FE[k]]
             if fa.get("fixed") is not None and fa["fixed"][k]:
                 parts.append("fixed")
             if fa.get("boundary") is not None and fa["boundary"][k]:
@@ -382,7 +395,7 @@ class _FeWriter:
             if c:
                 parts.append(c)
             t = fa["tension"][k]
-            if t != 1.0:
+            if t != 1.0 and not s.string:      # string facets carry no tension
                 parts.append(f"tension {num(t)}")
             if fa.get("no_refine") is not None and fa["no_refine"][k]:
                 parts.append("no_refine")
@@ -422,6 +435,20 @@ class _FeWriter:
         if sess is None:
             return
         out = []
+        tg = sess.toggles
+        # the motion toggles, as the Evolver's dump restores them (its names)
+        for name, word in (("conj_grad", "conj_grad"), ("autochop", "autochop"),
+                           ("approximate_curvature", "approx_curv"),
+                           ("runge_kutta", "runge_kutta"), ("check_increase", "check_increase"),
+                           ("area_normalization", "area_normalization"),
+                           ("post_project", "post_project"), ("normal_motion", "normal_motion"),
+                           ("autopop", "autopop"), ("jiggle", "jiggle"),
+                           ("diffusion", "diffusion")):
+            if tg.get(name):
+                out.append(f"{word} on")
+        for name in ("ribiere", "hessian_normal"):          # on by default
+            if not tg.get(name, 1):
+                out.append(f"{name} off")
         b = self.s.bodies
         if b.n and np.any(b.density) or self.s.gravity_constant != 1.0:
             out.append(f"gravity {'on' if sess.toggles.get('gravity', 1) else 'off'}")

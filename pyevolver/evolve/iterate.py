@@ -267,6 +267,11 @@ class Iterator:
         cons = _Constraints(s)
         t0 = s.evaluate()
         f = -GR.energy_gradient(t0)
+        # the vertex attributes v_force and v_oldx read the last step's force
+        # (REF: FIXED vertices included, not projected onto constraints; +0.0
+        # turns -0 into 0) and the moving vertices' starting coordinates
+        # (pyevolver.commands.attributes)
+        sess._last_motion = (s, f + 0.0, np.where(mobile[:, None], s.X, 0.0))
         f[~mobile] = 0.0
         f_raw = f
         s._one_sided_released = None
@@ -311,6 +316,7 @@ class Iterator:
             self.cg_f_old = f_raw      # the Evolver keeps the unprojected force
             vel = h
         X0 = state(s)
+        sess._last_motion += (vel,)             # v_velocity: the motion direction
         warnings = []
         trial_msgs = []
         # Trial moves start from the directions at X0 (REF resets them after
