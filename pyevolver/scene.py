@@ -102,6 +102,8 @@ class Scene:
     source_lines: list | None = None                   # the text's lines (error excerpts)
     constraint_names: dict = field(default_factory=dict)  # id -> name (named constraints)
     boundary_names: dict = field(default_factory=dict)    # id -> name (named boundaries)
+    on_assign: dict = field(default_factory=dict)         # parameter -> procedure
+                                                          # (ON_ASSIGN_CALL)
     unsupported: list = field(default_factory=list)       # (feature, line, column): refused
                                                           # once the whole file is read
     warnings: list = field(default_factory=list)          # (message, line, column): the

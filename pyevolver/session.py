@@ -128,6 +128,9 @@ class Session(SessionAPI):
         for msg, line, col in scene.warnings:  # lines the Evolver warns about
             where = f"{filename}:{line}:{col}" if col else f"{filename}:{line}"
             self.write_err(f"{where}: warning: {msg}\n")
+        self._warn_bare_edges(filename, scene, surface)
+        self._record_order(scene, surface)     # constraints in datafile order
+        self.on_assign_call = dict(scene.on_assign)
         if scene.constraint_names:             # named constraints and boundaries
             surface.constraint_names = dict(scene.constraint_names)
         if scene.boundary_names:
@@ -192,6 +195,23 @@ class Session(SessionAPI):
                     if "not supported in pyevolver" not in str(exc):
                         break
         return self
+
+    def _warn_bare_edges(self, filename, scene, s):
+        """REF warns at load about each edge of a soapfilm surface that is on
+        no facet and not marked BARE ("Edge 19 has no facets, and is not
+        marked "bare".")."""
+        if s.string or not s.nf or not s.ne or len(scene.edges.ids) > s.ne:
+            return
+        FE = np.asarray(s.FE)
+        used = np.zeros(s.ne, bool)
+        used[np.where(FE >= 0, FE, ~FE).ravel()] = True
+        blk = scene.edges
+        for i in np.nonzero(~used[:len(blk.ids)])[0].tolist():
+            attrs = blk.attrs.get(i, ())
+            if any(kw == "bare" for kw, _ in attrs):
+                continue
+            self.write_err(f"{filename}:{blk.lines[i]}: warning: edge {blk.ids[i]} has no "
+                           f"facets and is not marked bare\n")
 
     def _scene_settings(self, scene):
         for k in ("scale_limit", "constraint_tolerance"):
@@ -1042,6 +1062,16 @@ class Session(SessionAPI):
             raise CommandError(f"'{name}' is a quantity; assign to {name}.target or "
                                f"{name}.modulus")
         self.variables[name] = value
+        proc = getattr(self, "on_assign_call", {}).get(name)
+        if proc is not None and proc in self.commands:
+            # PARAMETER name ... ON_ASSIGN_CALL proc: run it after each assignment
+            busy = self.__dict__.setdefault("_on_assign_busy", set())
+            if name not in busy:
+                busy.add(name)
+                try:
+                    self.interp.run_proc(self.commands[proc], [])
+                finally:
+                    busy.discard(name)
 
     def internal(self, name):
         s = self.surface
@@ -1670,7 +1700,14 @@ class Session(SessionAPI):
                                f"is not defined")
         cid = int(cid)
         moved = []
+        order = getattr(s, "con_order", None)
         for el in els:
+            if order is not None and el.kind in ("vertex", "edge"):
+                # REF lists a constraint set later after the element's others
+                table = s.vcon if el.kind == "vertex" else s.econ
+                had = [c for c in sorted(table) if table[c][el.i] and c != cid]
+                seq = [c for c in order.get((el.kind, el.i), had) if c in had]
+                order[(el.kind, el.i)] = seq + [c for c in had if c not in seq] + [cid]
             if el.kind == "vertex":
                 m = s.vcon.setdefault(cid, np.zeros(s.nv, bool))
                 m[el.i] = True
@@ -1723,6 +1760,30 @@ class Session(SessionAPI):
     def constraint_label(self, cid):
         """A constraint's number, or its name when defined at run time."""
         return getattr(self.surface, "constraint_names", {}).get(cid, str(cid))
+
+    def _in_order(self, kind, i, cons):
+        """An element's constraints in the order REF lists them: as the
+        datafile line gave them, then those set later, in turn (``cons``:
+        the constraints it is on, by number)."""
+        order = getattr(self.surface, "con_order", None)
+        seq = order.get((kind, i)) if order else None
+        if not seq or len(cons) < 2:
+            return cons
+        first = [c for c in seq if c in cons]
+        return first + [c for c in cons if c not in first]
+
+    def _record_order(self, scene, surface):
+        """The datafile order of the constraints of vertices and edges named
+        with several (see :meth:`_in_order`)."""
+        order = {}
+        for kind, blk, n in (("vertex", scene.vertices, surface.nv),
+                             ("edge", scene.edges, surface.ne)):
+            for pos, attrs in blk.attrs.items():
+                cids = [int(abs(v)) for kw, vals in attrs
+                        if kw in ("constraint", "constraints") for v in vals]
+                if len(cids) > 1 and cids != sorted(cids) and pos < n:
+                    order[(kind, pos)] = cids
+        surface.con_order = order
 
     def boundary_label(self, bid):
         """A boundary's number, or its name when declared by name."""
@@ -1862,7 +1923,7 @@ class Session(SessionAPI):
             line = f"{vid[i]:3d}  {par}  boundary {self.boundary_label(int(bnd[i]))}  /* ({xyz}) */"
         else:
             line = f"{vid[i]:3d}  " + " ".join(f"{x:17.15g}" for x in s.X[i, :sd])
-        cons = [c for c in sorted(s.vcon) if s.vcon[c][i]]
+        cons = self._in_order("vertex", i, [c for c in sorted(s.vcon) if s.vcon[c][i]])
         if cons:
             line += "  constraints " + " ".join(map(self.constraint_label, cons)) + " "
         if s.vattr["fixed"][i]:
@@ -1904,7 +1965,7 @@ class Session(SessionAPI):
         ten = s.edge_tension[i]
         if ten != (1.0 if s.string else 0.0):
             line += f"  density {ten:g} "
-        cons = [c for c in sorted(s.econ) if s.econ[c][i]]
+        cons = self._in_order("edge", i, [c for c in sorted(s.econ) if s.econ[c][i]])
         if cons:
             line += "  constraints " + " ".join(
                 ("-" if s.econ[c][i] < 0 else "") + self.constraint_label(c) for c in cons) + " "
@@ -1941,7 +2002,7 @@ class Session(SessionAPI):
         attrs = ""
         cons = [c for c in sorted(s.fcon) if s.fcon[c][i]]
         if cons:
-            attrs += " constraints " + " ".join(map(str, cons)) + "  "
+            attrs += " constraints " + " ".join(map(self.constraint_label, cons)) + "  "
         if not s.string and s.facet_tension[i] != 1.0:
             attrs += f" density {s.facet_tension[i]:g} "
         if s.fattr["fixed"][i]:

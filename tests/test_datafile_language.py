@@ -117,6 +117,15 @@ def test_named_constraints_take_the_lowest_free_number(evolver, tmp_path):
                             "sum(vertex where on_constraint bb, 1)"])
 
 
+def test_valid_constraint_and_boundary(evolver, tmp_path):
+    path = write(tmp_path, tetra(NAMED, v2="constraint aa"))
+    compare(evolver, path, ["valid_constraint(aa)", "valid_constraint(top)",
+                            "valid_constraint(5)", "valid_constraint(2)",
+                            "valid_boundary(1)", "is_constraint[top].nonnegative",
+                            "is_constraint[top].fixed", "is_constraint[aa].fixed",
+                            "is_constraint[1].nonpositive"])
+
+
 def test_named_constraints_in_commands(evolver, tmp_path):
     path = write(tmp_path, tetra(NAMED, v2="constraint aa"))
     cmds = ("set vertex[4] constraint aa\nunset vertex[2] constraint aa\n"
@@ -287,7 +296,6 @@ def test_settings_that_change_no_number(evolver, tmp_path, top):
 
 @pytest.mark.parametrize("top,word,line", [
     ("optimizing_parameter xx = 1 pdelta = 0.001", "OPTIMIZING_PARAMETER", 1),
-    ("procedure tt();\nparameter yy = 2 on_assign_call tt", "ON_ASSIGN_CALL", 2),
     ("constraint 1 content_rank 2\nformula: z = 0", "CONTENT_RANK", 1),
     ("square_gaussian_curvature 1", "SQUARE_GAUSSIAN_CURVATURE", 1),
     ("define vertex attribute kk real function { self.kk := 1 }", "FUNCTION", 1),
@@ -326,3 +334,76 @@ def test_too_few_coordinates_warns(evolver, tmp_path):
     path = write(tmp_path, text)
     err = compare(evolver, path, ["vertex[4].z", "total_area"])
     assert "t.fe:6" in err and "coordinates" in err
+
+
+def test_user_function_on_an_element_line_refused_by_name(tmp_path):
+    # REF evaluates it with its command interpreter (vertex x = 4 here)
+    top = "function real sq(real xx) { return xx*xx }\n"
+    path = write(tmp_path, tetra(top).replace("2 1 0 0 \n", "2 sq(1) 0 0\n"))
+    with pytest.raises(DatafileError) as info:
+        Session.load(path)
+    assert "not supported in pyevolver" in str(info.value) and "sq" in str(info.value)
+    assert info.value.line == 5
+
+
+def test_forward_declared_names(evolver, tmp_path):
+    # REF's dumps declare named constraints ahead: "constraint pinned;"
+    top = ("constraint bb;\nconstraint aa;\nconstraint 1\nformula: z = 0\n"
+           "constraint aa\nformula: x = 0.5\nconstraint bb\nformula: y = 0.25\n")
+    path = write(tmp_path, tetra(top, v2="constraint aa", v3="constraint 1,bb"))
+    compare(evolver, path, ["aa", "bb", "high_constraint", "vertex[2].x", "vertex[3].y",
+                            "total_area"])
+
+
+def test_list_keeps_the_order_of_constraints(evolver, tmp_path):
+    # REF lists an element's constraints as its datafile line gave them, then
+    # those set later (named ones have small numbers: aa is 3 here)
+    path = write(tmp_path, tetra(NAMED, v2="constraint 1,aa", v3="constraints bb 1",
+                                 e1="constraint aa 1"))
+    cmds = "list vertex\nlist edge[1]\nset vertex[4] constraint bb\nlist vertex[4]\n"
+    ref = [l for l in run_reference(evolver, path, cmds) if "constraints" in l]
+    out = io.StringIO()
+    Session.load(path, out=out).run(cmds)
+    mine = [l for l in out.getvalue().splitlines() if "constraints" in l]
+    assert len(ref) == 4
+    assert [l.split("constraints")[1].split("/*")[0].split() for l in mine] == \
+        [l.split("constraints")[1].split("/*")[0].split() for l in ref]
+
+
+@pytest.mark.parametrize("etype", ["facet", "facets", "face", "faces"])
+def test_define_takes_plural_and_face(evolver, tmp_path, etype):
+    path = write(tmp_path, tetra(f"define {etype} attribute kk real\n", f1="kk 2.5"))
+    compare(evolver, path, ["facet[1].kk", "facet[2].kk", "total_area"])
+
+
+def test_dump_keeps_the_names(evolver, tmp_path):
+    # a dump writes named constraints and boundaries by name (declared ahead,
+    # as REF's dumps do) and loads back with the same geometry
+    path = write(tmp_path, tetra(NAMED, v2="constraint aa", v3="constraint 1,bb",
+                                 e1="constraint aa"))
+    out = io.StringIO()
+    ses = Session.load(path, out=out)
+    ses.run(f'dump "{tmp_path / "d.dmp"}"')
+    text = (tmp_path / "d.dmp").read_text()
+    assert "constraint aa;" in text and "CONSTRAINT aa" in text
+    again, _ = ours(str(tmp_path / "d.dmp"), ["vertex[2].on_constraint aa", "total_area",
+                                              "edge[1].on_constraint aa"])
+    same(again, ref_numbers(evolver, path, ["vertex[2].on_constraint aa", "total_area",
+                                            "edge[1].on_constraint aa"]))
+
+
+def test_on_assign_call(evolver, tmp_path):
+    # the manual's example: the procedure runs after each assignment
+    top = ("procedure tester();\nparameter aaa = 4\nparameter bbb = 5 on_assign_call tester\n"
+           "procedure tester() { aaa := bbb + 1 }\n")
+    path = write(tmp_path, tetra(top))
+    compare(evolver, path, ["aaa", "bbb"])
+    compare(evolver, path, ["aaa", "bbb"], "bbb := 7")
+    compare(evolver, path, ["aaa", "bbb"], "bbb := 7; bbb += 2")
+
+
+def test_on_assign_call_needs_a_declared_procedure(tmp_path):
+    path = write(tmp_path, tetra("parameter bbb = 5 on_assign_call tester\n"))
+    with pytest.raises(DatafileError) as info:
+        Session.load(path)
+    assert "tester" in str(info.value) and info.value.line == 1

@@ -249,6 +249,8 @@ class Attr(N.Node):
         self.index = index
 
     def ev(self, env):
+        if isinstance(self.base, ArrayRef) and self.base.name == "is_constraint":
+            return _is_constraint(env, self.base, self.name)
         base = self.base.ev(env)
         if self.index is None:
             idx = None
@@ -264,6 +266,22 @@ class Attr(N.Node):
         if isinstance(self.index, list):
             return (self.base,) + tuple(self.index)
         return (self.base,) + ((self.index,) if self.index is not None else ())
+
+
+def _is_constraint(env, ref, what):
+    """``is_constraint[n].fixed`` / ``.nonnegative`` / ``.nonpositive``: the
+    kind of level-set constraint n (a number or a name; manual, constrnt.htm)."""
+    if len(ref.index) != 1 or what not in ("fixed", "nonnegative", "nonpositive"):
+        raise ExpressionError("is_constraint[n] has .fixed, .nonnegative and .nonpositive")
+    s = env.session
+    v = s.interp.value(ref.index[0])
+    cons = s.surface.constraints if s.surface is not None else {}
+    if isinstance(v, str) or float(v) != int(v) or int(v) not in cons:
+        raise ExpressionError(f"is_constraint[{v}]: no such constraint")
+    flags = cons[int(v)].flags
+    if what == "fixed":
+        return float(not flags & {"nonnegative", "nonpositive"})
+    return float(what in flags)
 
 
 class Aggregate(N.Node):
@@ -1344,6 +1362,16 @@ class Interpreter:
             if not isinstance(v, str):
                 raise ExpressionError("is_defined() needs a name in a string")
             return float(self.is_defined(v.lower()))
+        if name in ("valid_constraint", "valid_boundary"):
+            # 1 if the constraint / boundary (a number, or a name) is defined
+            if len(arg_nodes) != 1:
+                raise ExpressionError(f"{name}() takes one argument")
+            v = self.value(arg_nodes[0])
+            if isinstance(v, str) or not math.isfinite(float(v)):
+                raise ExpressionError(f"{name}() needs a number or a name")
+            table = (s.surface.constraints if name == "valid_constraint"
+                     else s.surface.boundaries) if s.surface is not None else {}
+            return float(float(v) == int(v) and int(v) in table)
         if name in ("new_vertex", "new_edge", "new_facet", "new_body"):
             raise UnsupportedError(f"{name}() (creating elements from a script)")
         if name == "valid_element":

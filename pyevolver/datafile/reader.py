@@ -164,6 +164,12 @@ class _TopTransformer(ExprTransformer):
     def p_on_assign(self, kw, name):
         return ("on_assign_call", (str(name).lower(), kw.column))
 
+    def constraint_forward(self, kw, name):
+        return ("forward", "constraint", str(name).lower(), kw.line)
+
+    def boundary_forward(self, kw, name):
+        return ("forward", "boundary", str(name).lower(), kw.line)
+
     def value_decl2(self, kw, e):
         return ("ignored", str(kw).lower().rstrip(":"))
 
@@ -280,7 +286,9 @@ class _TopTransformer(ExprTransformer):
         return list(exprs)          # (expressions: evaluated in order, _decl)
 
     def define_attr(self, kw, etype, _a, name, atype, dims=None):
-        return ("attribute", str(etype).lower(), str(name).lower(), str(atype).lower(),
+        # (REF also takes the plural and 'face' forms: define faces attribute ...)
+        etype = _ETYPE.get(str(etype).lower(), str(etype).lower())
+        return ("attribute", etype, str(name).lower(), str(atype).lower(),
                 dims or [], kw.line)
 
     def flag_decl(self, kw):
@@ -361,6 +369,7 @@ class Reader:
         self.text = read_source(filename) if text is None else text
         self.scene = Scene(filename=filename)
         self._src_lines = None
+        self._named_forward = set()     # names declared ahead ("constraint pinned;")
 
     @property
     def src_lines(self):
@@ -539,6 +548,7 @@ class Reader:
         """
         text = sec.text
         self._functions = set()
+        self._procedures = set()
         af = _ATTR_FUNCTION.search(text)
         if af:
             line = text.count("\n", 0, af.start(1)) + 1
@@ -560,6 +570,8 @@ class Reader:
                                  m.start() - text.rfind("\n", 0, m.start()))
             body = text[m.start():end]
             self.scene.top_commands.append((body.rstrip().rstrip(";"), self._src(sec, line)))
+            if m.group(1).lower() == "procedure":
+                self._procedures.add(re.match(r"\w+\s+(\w+)", body).group(1).lower())
             if m.group(1).lower() == "function":
                 self._functions.add(re.match(r"\w+\s+(?:\w+\s+)?(\w+)", body).group(1).lower())
             out.append(text[pos:m.start()])
@@ -793,6 +805,13 @@ class Reader:
                 raise self.error(f"attribute {name}: {size} entries per {etype}; at most "
                                  f"{MAX_ARRAY_ENTRIES} are allowed", self._src(sec, line))
             sc.attributes[(etype, name)] = (atype, size, dims)
+        elif kind == "forward":          # constraint NAME;  boundary NAME;
+            _, what, name, line = d
+            table, names = ((sc.constraints, sc.constraint_names) if what == "constraint"
+                            else (sc.boundaries, sc.boundary_names))
+            if name not in names.values():
+                self._number_named(name, table, names, what, self._src(sec, line))
+                self._named_forward.add((what, name))
         elif kind == "global_array":
             self._global_array(d, sc, sec)
         elif kind in ("quantity_forward", "instance_forward"):
@@ -828,8 +847,13 @@ class Reader:
             if key in opts:
                 self._const(opts[key][0], line, f"{key} of parameter {name}")
         if "on_assign_call" in opts:
+            # the procedure runs whenever the variable is assigned (manual); it
+            # must have been declared before, in the top section
             proc, col = opts["on_assign_call"]
-            self._defer(f"ON_ASSIGN_CALL ({name} calls {proc})", line, col)
+            if proc not in getattr(self, "_procedures", ()):
+                raise self.error(f"ON_ASSIGN_CALL: '{proc}' is not a procedure declared "
+                                 f"above (e.g. procedure {proc}();)", line, col)
+            self.scene.on_assign[name] = proc
 
     def _dim(self, expr, line, name):
         """An attribute's array dimension: a constant expression (REF:
@@ -850,13 +874,17 @@ class Reader:
         if isinstance(key, int):
             if key in names:
                 name = names.pop(key)
-                decl = table.pop(key)
+                decl = table.pop(key, None)     # (None: only declared ahead so far)
                 new = _lowest_free(table, names, also=key)
-                decl.id = new
-                table[new] = decl
+                if decl is not None:
+                    decl.id = new
+                    table[new] = decl
                 names[new] = name
             return key
         if key in names.values():
+            if (what, key) in self._named_forward:     # declared ahead, defined now
+                self._named_forward.discard((what, key))
+                return next(c for c, n in names.items() if n == key)
             raise self.error(f"{what} '{key}' defined twice", line)
         if key in self.scene.parameters:
             raise self.error(f"{what} name '{key}' is already a parameter", line)
@@ -994,6 +1022,12 @@ class Reader:
                 col = exc.column if exc.column not in (None, -1) else None
                 what = {"vertices": "vertex", "edges": "edge", "faces": "face",
                         "bodies": "body"}[kind]
+                for fn in getattr(self, "_functions", ()):
+                    call = re.search(r"\b" + re.escape(fn) + r"\s*\(", line, re.I)
+                    if call:
+                        raise self.error(f"not supported in pyevolver: calling the user "
+                                         f"function {fn} in a datafile element line",
+                                         srcline, call.start() + 1) from None
                 raise self.error(self._describe(exc, line) + f" in {what} line", srcline,
                                  col) from None
             except VisitError as exc:
@@ -1081,6 +1115,12 @@ class Reader:
             return " ".join(toks[:3] + toks[3 + sdim:])
         return line
 
+    def _undefined(self, exc, srcline):
+        if exc.name in getattr(self, "_functions", ()):
+            return self.error(f"not supported in pyevolver: calling the user function "
+                              f"{exc.name} in a datafile element line", srcline, exc.col)
+        return self.error(f"undefined parameter '{exc.name}'", srcline, exc.col)
+
     def warn(self, msg, line, col=None):
         """Record a warning about a line (the Evolver warns and goes on)."""
         self.scene.warnings.append((msg, line, col))
@@ -1158,7 +1198,7 @@ class Reader:
         try:
             values = [self._value(e, srcline, f"{etype} {eid}") for e in data]
         except _LocatedName as exc:
-            raise self.error(f"undefined parameter '{exc.name}'", srcline, exc.col) from None
+            raise self._undefined(exc, srcline) from None
         if not 1 <= eid <= MAX_ID:
             raise self.error(f"{etype} id {eid} is out of range (ids are 1 to {MAX_ID})",
                              srcline, 1)
@@ -1195,8 +1235,7 @@ class Reader:
                 try:
                     vals.append(self._value(a, srcline, what))
                 except _LocatedName as exc:
-                    raise self.error(f"undefined parameter '{exc.name}'", srcline,
-                                     exc.col) from None
+                    raise self._undefined(exc, srcline) from None
             if kw == "attribute":
                 cooked.append((kw, [args[0]] + vals))
             else:
@@ -1333,6 +1372,10 @@ def _skip_transforms(text, pos, sd):
                 return pos
             pos = mm.end()
     return pos
+
+
+_ETYPE = {"vertices": "vertex", "edges": "edge", "facets": "facet", "face": "facet",
+          "faces": "facet", "bodies": "body"}
 
 
 def _binary_minus_in_parens(line):

@@ -196,9 +196,21 @@ class _FeWriter:
             dims = "".join(f"[{d}]" for d in arr.shape[1:])
             self.w(f"define {etype} attribute {aname} {typ}{dims}")
         self.w()
+        cnames = getattr(s, "constraint_names", {})
+        bnames = getattr(s, "boundary_names", {})
+        if cnames or bnames:
+            # named constraints and boundaries are written by name, declared
+            # ahead as in REF's dumps ("constraint pinned;")
+            for cid in sorted(cnames):
+                if cid in s.constraints:
+                    self.w(f"constraint {cnames[cid]};")
+            for bid in sorted(bnames):
+                if bid in s.boundaries:
+                    self.w(f"boundary {bnames[bid]};")
+            self.w()
         for cid, c in sorted(s.constraints.items()):
             opts = "".join(f" {f.upper()}" for f in sorted(c.flags) if f in _CON_FLAGS)
-            self.w(f"CONSTRAINT {cid}{opts}")
+            self.w(f"CONSTRAINT {cnames.get(cid, cid)}{opts}")
             self.w(f"FORMULA: {expr_text(c.formula)} = 0")
             if c.energy:
                 self.w("ENERGY:\n" + _comps("e", c.energy))
@@ -207,7 +219,7 @@ class _FeWriter:
             self.w()
         for bid, b in sorted(s.boundaries.items()):
             opts = " CONVEX" if "convex" in b.flags else ""
-            self.w(f"BOUNDARY {bid} PARAMETERS {b.nparams}{opts}")
+            self.w(f"BOUNDARY {bnames.get(bid, bid)} PARAMETERS {b.nparams}{opts}")
             self.w(_comps("x", b.coords))
             if b.energy:
                 self.w("ENERGY:\n" + _comps("e", b.energy))
@@ -296,6 +308,9 @@ class _FeWriter:
                 out.append(aname + " " + " ".join(num(x) for x in np.ravel(v)))
         return out
 
+    def _blabel(self, bid):
+        return getattr(self.s, "boundary_names", {}).get(bid, str(bid))
+
     def _cons(self, table, k, signed=False):
         ids = []
         for cid, arr in sorted(table.items()):
@@ -303,7 +318,8 @@ class _FeWriter:
                 continue
             v = arr[k]
             if v:
-                ids.append(str(-cid if signed and v < 0 else cid))
+                name = getattr(self.s, "constraint_names", {}).get(cid, str(cid))
+                ids.append(("-" if signed and v < 0 else "") + name)
         return f"constraints {' '.join(ids)}" if ids else None
 
     def _vertices(self):
@@ -316,7 +332,7 @@ class _FeWriter:
         for k in range(s.nv):
             if bnd is not None and bnd[k]:
                 b = s.boundaries[int(bnd[k])]
-                parts = [num(v) for v in params[k, :b.nparams]] + [f"boundary {int(bnd[k])}"]
+                parts = [num(v) for v in params[k, :b.nparams]] + [f"boundary {self._blabel(int(bnd[k]))}"]
             else:
                 parts = [num(v) for v in s.X[k, :s.sdim]]
             if fixed is not None and fixed[k]:
@@ -345,7 +361,7 @@ class _FeWriter:
             if ea.get("fixed") is not None and ea["fixed"][k]:
                 parts.append("fixed")
             if ea.get("boundary") is not None and ea["boundary"][k]:
-                parts.append(f"boundary {int(ea['boundary'][k])}")
+                parts.append(f"boundary {self._blabel(int(ea['boundary'][k]))}")
             c = self._cons(s.econ, k, signed=True)
             if c:
                 parts.append(c)
@@ -374,7 +390,7 @@ class _FeWriter:
             if fa.get("fixed") is not None and fa["fixed"][k]:
                 parts.append("fixed")
             if fa.get("boundary") is not None and fa["boundary"][k]:
-                parts.append(f"boundary {int(fa['boundary'][k])}")
+                parts.append(f"boundary {self._blabel(int(fa['boundary'][k]))}")
             c = self._cons(s.fcon, k)
             if c:
                 parts.append(c)

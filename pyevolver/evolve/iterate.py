@@ -370,6 +370,7 @@ class Iterator:
         if not fixed_scale and e > E0 and scale > 0:
             scale = s1
             t = self._move(X0, vel, scale, cons, *self._carry, mobile, targets, report)
+            t = self._hold_one_sided(t)
             self.cg_history = None
             if not math.isfinite(t.energy) or self._diverged or not np.all(np.isfinite(s.X)):
                 return self._undo(X0, t0, scale, lam, report)
