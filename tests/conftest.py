@@ -109,11 +109,39 @@ def _repo_files():
     return out
 
 
+def _is_worker(config):
+    """A pytest-xdist worker (``-n 2``): the controller checks the repository
+    and prints the fuzz counts the workers send it."""
+    return hasattr(config, "workerinput")
+
+
 def pytest_sessionstart(session):
-    session.config._repo_before = _repo_files()
+    if not _is_worker(session.config):
+        session.config._repo_before = _repo_files()
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """xdist: add a worker's fuzz counts and times to the controller's."""
+    sent = getattr(node, "workeroutput", {}).get("fuzz")
+    if not sent:
+        return
+    import fuzzing
+    for target, n in sent["counts"].items():
+        fuzzing.COUNTS[target] = fuzzing.COUNTS.get(target, 0) + n
+    for target, (wall, cpu) in sent["times"].items():
+        w0, c0 = fuzzing.TIMES.get(target, (0.0, 0.0))
+        fuzzing.TIMES[target] = (w0 + wall, c0 + cpu)
 
 
 def pytest_sessionfinish(session, exitstatus):
+    if _is_worker(session.config):
+        import sys
+        fz = sys.modules.get("fuzzing")
+        if fz is not None and fz.COUNTS:
+            session.config.workeroutput["fuzz"] = {
+                "counts": dict(fz.COUNTS), "times": {k: list(v) for k, v in fz.TIMES.items()}}
+        return
     before = getattr(session.config, "_repo_before", None)
     if before is None:
         return

@@ -22,8 +22,7 @@ from pyevolver.errors import DatafileError, PyEvolverError
 from conftest import example
 from reference import run_reference
 
-# the examples pyevolver runs, and those it refuses (by name, or for relaxed.fe
-# an attribute in a constraint formula); crystal.fe is not dumped by REF (no
+# the examples pyevolver runs, and those it refuses by name; crystal.fe is not dumped by REF (no
 # Wulff file) and simplex3.fe only after r
 SUPPORTED = ["addload_example", "cat", "catbody", "catman", "column", "cube", "mound", "octa",
              "phelanc", "popstr", "qmound", "quad", "slidestr", "sphere", "tankex", "twointor"]
@@ -114,6 +113,7 @@ def test_reference_dump_refused_like_its_datafile(evolver, name, pre, tmp_path):
     want, _ = _refusal(example(name + ".fe"))
     got, full = _refusal(dmp)
     assert got == want, (got, want)
+    assert "not supported in pyevolver" in got, got     # a refusal by name, not a parse error
     if full.startswith(dmp):                     # refused while reading: located in the dump
         assert re.match(re.escape(dmp) + r":\d+", full), full
 

@@ -127,6 +127,7 @@ def line_parser():
                 maybe_placeholders=False, cache=True)
 
 
+_SPACE_DIM_RE = re.compile(r"^[ \t]*space_dimension[ \t:]+(\d+)", re.I | re.M)
 # ``define edge attribute bbb real function { ... }``: refused by name
 _ATTR_FUNCTION = re.compile(r"\bdefine\s+\w+\s+attribute\s+\w+\s+\w+(?:\s*\[[^\]\n]*\])*"
                             r"\s+(function)\b", re.I)
@@ -601,6 +602,14 @@ class Reader:
             line = text.count("\n", 0, bad.start()) + 1
             col = bad.start() - (text.rfind("\n", 0, bad.start()) + 1) + 1
             raise self.error(f"malformed number '{bad.group(0)}'", self._src(sec, line), col)
+        sdm = _SPACE_DIM_RE.search(text)
+        if sdm and int(sdm.group(1)) > 3:
+            # the model is refused whatever else the file says: say so before
+            # parsing what only that model allows (relaxed.fe's ref_coord[1])
+            line = text.count("\n", 0, sdm.start()) + 1
+            raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {sdm.group(1)} "
+                             f"(3, or 2 in the string model)", self._src(sec, line),
+                             sdm.start() - (text.rfind("\n", 0, sdm.start()) + 1) + 1)
         fdef = _ATTR_FUNCTION.search(text)
         if fdef:
             line = text.count("\n", 0, fdef.start(1)) + 1
