@@ -9,6 +9,7 @@ value before ``recalc`` is shown to be the stale one, so the test documents
 a real difference).  The list is in docs/differences.md.
 """
 import io
+import os
 
 import pytest
 
@@ -16,42 +17,19 @@ from pyevolver import Session
 
 from reference import run_reference
 
-CUBE_Q = """
+HERE = os.path.dirname(__file__)
+TOP = """
 QUANTITY qa ENERGY MODULUS 1 METHOD facet_area GLOBAL
 METHOD_INSTANCE mi METHOD facet_area GLOBAL
 QUANTITY qb ENERGY FUNCTION mi.value^2
-vertices
-1 0 0 0
-2 1 0 0
-3 1 1 0
-4 0 1 0
-5 0 0 1
-6 1 0 1
-7 1 1 1
-8 0 1 1
-edges
-1 1 2
-2 2 3
-3 3 4
-4 4 1
-5 5 6
-6 6 7
-7 7 8
-8 8 5
-9 1 5
-10 2 6
-11 3 7
-12 4 8
-faces
-1 1 10 -5 -9
-2 2 11 -6 -10
-3 3 12 -7 -11
-4 4 9 -8 -12
-5 5 6 7 8
-6 -4 -3 -2 -1
-bodies
-1 1 2 3 4 5 6 volume 1
 """
+
+
+def _cube_q():
+    """datafiles/cube.fe without its read section, with the quantities above."""
+    with open(os.path.join(HERE, "..", "datafiles", "cube.fe"), encoding="utf-8") as fh:
+        text = fh.read()
+    return TOP + text[:text.index("\nread")] + "\n"
 
 CASES = [
     ("qa.modulus := 3", ["total_energy", "qa.value"]),
@@ -66,7 +44,7 @@ def _values(lines):
 @pytest.mark.parametrize("change,exprs", CASES)
 def test_value_after_modulus_change_is_fresh(evolver, tmp_path, change, exprs):
     path = tmp_path / "q.fe"
-    path.write_text(CUBE_Q)
+    path.write_text(_cube_q())
     show = "".join(f'printf "V %.15g\\n", {e}\n' for e in exprs)
     ref = _values(run_reference(evolver, str(path), change + "\n" + show + "recalc\n" + show,
                                 cwd=str(tmp_path)))

@@ -1308,39 +1308,16 @@ _ATTR_FUNCTION = re.compile(r"\battribute\s+\w+\s+\w+(?:\s*\[[^\]\n]*\])*\s+(fun
                             re.I)
 
 
-def _proc_end(text, k):
-    """The end of a declaration whose parameter list opens at ``text[k]``:
-    after ``)`` and a ``;``, or after the ``{...}`` body (strings skipped);
-    None when the parentheses or braces do not balance."""
+def _balanced_end(text, i, open_, close):
+    """The index after the ``close`` that balances the ``open_`` at
+    ``text[i]`` (strings skipped), or None when it never balances."""
+    depth = 0
     n = len(text)
-    depth = 0
-    i = k
     while i < n:
         c = text[i]
-        if c == "(":
+        if c == open_:
             depth += 1
-        elif c == ")":
-            depth -= 1
-            if depth == 0:
-                break
-        elif c == '"':
-            i = _skip_string(text, i)
-        i += 1
-    else:
-        return None
-    i += 1
-    while i < n and text[i] in " \t\n":
-        i += 1
-    if i < n and text[i] == ";":
-        return i + 1
-    if i >= n or text[i] != "{":
-        return i                    # a declaration without ';'
-    depth = 0
-    while i < n:
-        c = text[i]
-        if c == "{":
-            depth += 1
-        elif c == "}":
+        elif c == close:
             depth -= 1
             if depth == 0:
                 return i + 1
@@ -1348,6 +1325,23 @@ def _proc_end(text, k):
             i = _skip_string(text, i)
         i += 1
     return None
+
+
+def _proc_end(text, k):
+    """The end of a declaration whose parameter list opens at ``text[k]``:
+    after ``)`` and a ``;``, or after the ``{...}`` body (strings skipped);
+    None when the parentheses or braces do not balance."""
+    i = _balanced_end(text, k, "(", ")")
+    if i is None:
+        return None
+    n = len(text)
+    while i < n and text[i] in " \t\n":
+        i += 1
+    if i < n and text[i] == ";":
+        return i + 1
+    if i >= n or text[i] != "{":
+        return i                    # a declaration without ';'
+    return _balanced_end(text, i, "{", "}")
 
 
 def _skip_string(text, i):
