@@ -1625,8 +1625,7 @@ def project_tangent(s, vecs):
     out = [v.copy() for v in vecs]
     for gi, key in enumerate(keys):
         rr = rows[inv == gi]
-        P = s.X[rr]
-        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        coords = vertex_coords(s, rr)
         Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(rr))
                        for c, k in zip(cids, key) if k], axis=2)     # (n, 3, k)
         GtG = np.einsum("nik,nil->nkl", Gm, Gm)
@@ -1654,8 +1653,7 @@ def _hit_one_sided(s, cids, on, env, tol=1e-10, rows=None, violated=False, hold=
         rr = np.nonzero(on[:, j])[0]
         if not len(rr):
             continue
-        P = s.X[rr if rows is None else rows[rr]]
-        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        coords = vertex_coords(s, rr if rows is None else rows[rr])
         c = s.constraints[cids[j]]
         phi = np.broadcast_to(_constraint_formula(c, "values", env, coords, len(rr)), (len(rr),))
         keep = np.abs(phi) <= tol
@@ -1688,8 +1686,7 @@ def release_one_sided(s, force):
         rr = np.nonzero(mask)[0]
         if not len(rr):
             continue
-        P = s.X[rr]
-        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        coords = vertex_coords(s, rr)
         phi = np.broadcast_to(_constraint_formula(con, "values", env, coords, len(rr)),
                               (len(rr),))
         g = np.broadcast_to(_constraint_formula(con, "gradient", env, coords, len(rr)),
@@ -1701,6 +1698,23 @@ def release_one_sided(s, force):
         if leave.any():
             out[c] = rr[leave]
     s._one_sided_released = out or None
+
+
+def vertex_coords(s, rows):
+    """The names a level-set formula may use at the vertices ``rows``: the
+    coordinates ``x, y, z`` and the vertex extra attributes (the manual:
+    ``constraint 1 formula: z = zfix`` with a vertex attribute ``zfix``).
+
+    Returns
+    -------
+    dict of str -> (n,) or (n, k) array
+    """
+    P = s.X[rows]
+    out = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+    for (etype, name), arr in s.extra.items():
+        if etype == "vertex" and name not in out:
+            out[name] = arr[rows]
+    return out
 
 
 def constrained_vertices(s):
@@ -1752,7 +1766,7 @@ def project_to_constraints(s, idx, tol=None, maxit=20, _again=True, hold=None):
         phi = phi0 = None
         for _ in range(maxit + 1):
             P = s.X[sel]
-            coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+            coords = vertex_coords(s, sel)
             phis = []
             grads = []
             for cid in active:

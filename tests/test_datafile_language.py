@@ -407,3 +407,21 @@ def test_on_assign_call_needs_a_declared_procedure(tmp_path):
     with pytest.raises(DatafileError) as info:
         Session.load(path)
     assert "tester" in str(info.value) and info.value.line == 1
+
+
+# ---------------------------------------------------------------------------
+# vertex extra attributes in a level-set formula (the manual: "z = zfix")
+
+ZFIX_TOP = """
+define vertex attribute zfix real
+constraint 1 formula: z = zfix
+"""
+
+
+@pytest.mark.parametrize("commands", ["", "g 3", "r; g 3; set vertex zfix 1.1 where id == 4; "
+                                      "recalc; g 4"])
+def test_vertex_attribute_in_a_constraint_formula(evolver, tmp_path, commands):
+    path = write(tmp_path, tetra(top=ZFIX_TOP, v4="constraint 1 zfix 1.2",
+                                 b1="volume 0.2"))
+    compare(evolver, path, ["vertex[4].z", "total_energy", "total_area", "body[1].volume"],
+            commands)

@@ -34,7 +34,7 @@ import scipy.sparse.linalg as spla
 from .. import geometry as G
 from ..errors import UnsupportedError
 from ..methods.jets import skew
-from ..surface import boundary_eval, boundary_groups
+from ..surface import boundary_eval, boundary_groups, vertex_coords
 from . import gradient as GR
 from .ordering import nested_dissection
 
@@ -555,8 +555,7 @@ def tangent_basis(s, mobile, normal=True):
         inv = inv.ravel()
         for gi, key in enumerate(keys):
             sel = con[inv == gi]
-            P = s.X[sel]
-            coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+            coords = vertex_coords(s, sel)
             active = [c for c, k in zip(cids, key) if k]
             Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(sel))
                            for c in active], axis=2)            # (n, 3, k)
@@ -581,8 +580,7 @@ def constraint_curvature(s, grads, force_grad):
     rows, cols, vals = [], [], []
     env = s.param_env()
     for key, (sel, active, Gm) in grads.items():
-        P = s.X[sel]
-        coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+        coords = vertex_coords(s, sel)
         GtG = np.einsum("nik,nil->nkl", Gm, Gm)
         rhs = np.einsum("nik,ni->nk", Gm, force_grad[sel])
         mu = np.linalg.solve(GtG, rhs[..., None])[..., 0]       # (n, k)
