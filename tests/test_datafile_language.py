@@ -425,3 +425,19 @@ def test_vertex_attribute_in_a_constraint_formula(evolver, tmp_path, commands):
                                  b1="volume 0.2"))
     compare(evolver, path, ["vertex[4].z", "total_energy", "total_area", "body[1].volume"],
             commands)
+
+
+@pytest.mark.parametrize("commands", ["", "g 3; r; g 3"])
+def test_array_attribute_entry_in_a_constraint_formula(evolver, tmp_path, commands):
+    top = "define vertex attribute zz real[2]\nconstraint 1 formula: z = zz[2] + 0*zz[1]\n"
+    path = write(tmp_path, tetra(top=top, v4="constraint 1 zz 0.5 1.3", b1="volume 0.2"))
+    compare(evolver, path, ["vertex[4].z", "total_energy", "body[1].volume"], commands)
+
+
+def test_array_attribute_entry_out_of_range_is_located(tmp_path):
+    top = "define vertex attribute zz real[2]\nconstraint 1 formula: z = zz[3]\n"
+    path = write(tmp_path, tetra(top=top, v4="constraint 1 zz 0.5 1.3"))
+    with pytest.raises(DatafileError) as exc:
+        Session.load(path, out=io.StringIO(), err=io.StringIO())
+    assert "zz[3]" in str(exc.value) and "out of range" in str(exc.value)
+    assert exc.value.line

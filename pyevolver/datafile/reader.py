@@ -273,6 +273,10 @@ class _TopTransformer(ExprTransformer):
     def q_function(self, _t, e):
         return ("function", e)
 
+    def index(self, name, idx):
+        # ``ref_coord[1]``: an entry of an array attribute in a formula
+        return N.Index(str(name), idx, name.line, name.column)
+
     def qvalue(self, tok):
         # ``inst.value``: the global value of a method instance (quantity FUNCTION)
         return N.Var(str(tok), tok.line, tok.column)

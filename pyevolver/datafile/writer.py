@@ -65,6 +65,8 @@ def _text(node):
         return ("G" if node.name == "g" else node.name), 9
     if isinstance(node, N.Func):
         return f"{node.name}({', '.join(expr_text(a) for a in node.args)})", 9
+    if isinstance(node, N.Index):
+        return f"{node.name}[{expr_text(node.index)}]", 9
     if isinstance(node, N.Neg):
         return f"-{_wrap(node.a, 9)}", 7
     if isinstance(node, N.Not):

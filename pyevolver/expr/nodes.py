@@ -270,6 +270,40 @@ class Var(Node):
         return f"Var({self.name!r})"
 
 
+class Index(Node):
+    """``name[i]``: the i-th entry (from 1) of an array attribute in a formula
+    of vertex values (``x4 = ref_coord[1]``); over n points the attribute
+    is an (n, k) array and the result its column i."""
+
+    __slots__ = ("name", "index", "line", "column")
+
+    def __init__(self, name, index, line=None, column=None):
+        self.name = name.lower()
+        self.index = index
+        self.line = line
+        self.column = column
+
+    def ev(self, env):
+        base = np.asarray(env.lookup(self.name), dtype=float)
+        k = self.index.ev(env)
+        if np.ndim(k) or k != int(k):
+            raise ExpressionError(f"{self.name}[...]: the index must be one integer")
+        size = base.shape[-1] if base.ndim else 0
+        if not 1 <= int(k) <= size:
+            raise ExpressionError(f"{self.name}[{int(k)}]: index out of range 1 to {size}")
+        return base[..., int(k) - 1]
+
+    def _names(self, out):
+        out.add(self.name)
+        self.index._names(out)
+
+    def children(self):
+        return (self.index,)
+
+    def __repr__(self):
+        return f"Index({self.name!r}, {self.index!r})"
+
+
 class Neg(Node):
     __slots__ = ("a",)
 
@@ -678,6 +712,8 @@ def canonical_coords(node):
         return Cond(canonical_coords(node.c), canonical_coords(node.a), canonical_coords(node.b))
     if isinstance(node, Func):
         return Func(node.name, [canonical_coords(a) for a in node.args])
+    if isinstance(node, Index):
+        return Index(node.name, canonical_coords(node.index), node.line, node.column)
     return node
 
 
