@@ -176,6 +176,14 @@ def geometry(session):
     return cache(session).geometry(session)
 
 
+def _vector_attr(vec, name, idx, whole, s):
+    """An edge's or facet's vector attribute: ``whole`` (or ``x[i]``) the
+    vector or its entry ``idx``; ``x``/``y``/``z``/``x1``... one coordinate."""
+    if name == whole or (name == "x" and idx is not None):
+        return _component(vec, idx, name)
+    return _component(vec, _coord_index(name, s), name)
+
+
 def _component(vec, idx, name):
     if idx is None:
         if np.issubdtype(np.asarray(vec).dtype, np.integer):    # printed with %d
@@ -302,10 +310,8 @@ def element_attr(session, base, name, idx):
                 raise ExpressionError("Dihedral only for vertices.")
             return float(cache(session).get(session, "edihedral", GA.edge_dihedral)[i])
         if name in ("x", "y", "z", "x1", "x2", "x3", "edge_vector"):
-            vec = geometry(session).edge_vec[i, :s.sdim] * base.sign
-            if name == "edge_vector" or (name == "x" and idx is not None):
-                return _component(vec, idx, name)
-            return _component(vec, _coord_index(name, s), name)
+            return _vector_attr(geometry(session).edge_vec[i, :s.sdim] * base.sign, name, idx,
+                                "edge_vector", s)
         if name == "length":
             return float(geometry(session).edge_length[i])
         if name == "midv":
@@ -321,10 +327,8 @@ def element_attr(session, base, name, idx):
         if s.string:
             return MISSING
         if name in ("x", "y", "z", "x1", "x2", "x3", "facet_normal"):
-            vec = _facet_normal(session, i) * base.sign
-            if name == "facet_normal" or (name == "x" and idx is not None):
-                return _component(vec, idx, name)
-            return _component(vec, _coord_index(name, s), name)
+            return _vector_attr(_facet_normal(session, i) * base.sign, name, idx,
+                                "facet_normal", s)
         if name == "area":
             return float(geometry(session).facet_area[i])
         if name == "no_refine":
