@@ -236,14 +236,21 @@ slice_coeff = { 1.00000, -2.5e-3, 0.00000}
     assert s.settings["constraint_tolerance"] == 1e-12
 
 
+def _g_lines_both(evolver, s, tmp_path, cmd):
+    """The ``g`` progress lines of ``cmd`` in the session ``s`` and in REF on
+    ``tmp_path/t.fe``."""
+    s.out = io.StringIO()
+    s.run(cmd)
+    ours = [ln for ln in s.out.getvalue().split("\n") if LINE.match(ln)]
+    ref = [ln for ln in run_reference(evolver, str(tmp_path / "t.fe"), cmd,
+                                      cwd=str(tmp_path)) if LINE.match(ln)]
+    return ours, ref
+
+
 def test_scale_fixed_is_fixed_scale_mode(evolver, tmp_path):
     s, _, _ = _load(tmp_path, "SCALE: 0.05     FIXED\n")
     assert s.toggles.get("_fixed_scale") == 1
-    s.out = io.StringIO()
-    s.run("g 3")
-    ours = [ln for ln in s.out.getvalue().split("\n") if LINE.match(ln)]
-    ref = [ln for ln in run_reference(evolver, str(tmp_path / "t.fe"), "g 3",
-                                      cwd=str(tmp_path)) if LINE.match(ln)]
+    ours, ref = _g_lines_both(evolver, s, tmp_path, "g 3")
     assert len(ours) == len(ref) == 3
     for a, b in zip(ours, ref):
         assert a.split()[-1] == b.split()[-1] == "0.0500000"      # the scale stays
@@ -531,11 +538,7 @@ def test_effective_area_keyword_and_command(evolver, tmp_path):
     REF's motion, which pyevolver refuses by name in g."""
     top = "effective_area\nsquared_curvature 0.1\n"
     s, _, _ = _load(tmp_path, top)
-    s.out = io.StringIO()
-    s.run("g 2")
-    ours = [ln for ln in s.out.getvalue().split("\n") if LINE.match(ln)]
-    ref = [ln for ln in run_reference(evolver, str(tmp_path / "t.fe"), "g 2",
-                                      cwd=str(tmp_path)) if LINE.match(ln)]
+    ours, ref = _g_lines_both(evolver, s, tmp_path, "g 2")
     assert len(ours) == len(ref) == 2
     for a, b in zip(ours, ref):
         assert _rel(a.split()[4], b.split()[4]) <= 1e-9, (ours, ref)
