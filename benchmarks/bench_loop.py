@@ -19,7 +19,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 
-from pyevolver.loop import LoopEvaluator  # noqa: E402
+from pyevolver.geometry.loop import LoopEvaluator  # noqa: E402
 from pyevolver.studies.meshes import icosphere, torus_grid  # noqa: E402
 
 

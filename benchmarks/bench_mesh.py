@@ -30,7 +30,7 @@ from _common import REPO, icosphere_file, wall
 CHILD = r"""
 import io, sys, time
 from pyevolver import Session
-import pyevolver.mesh.refine, pyevolver.mesh.equiangulate   # imports are start-up
+import pyevolver.remesh.refine, pyevolver.remesh.equiangulate   # imports are start-up
 path, cmd, repeat = sys.argv[1], sys.argv[2], int(sys.argv[3])
 best = None
 for _ in range(repeat):

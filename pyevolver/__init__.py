@@ -9,8 +9,8 @@ __version__ = "0.1.0"
 from .errors import (PyEvolverError, DatafileError, CommandError, UnsupportedError,  # noqa: E402
                      ExpressionError, ConstraintError, ConvergenceWarning)
 from .datafile.reader import read_datafile  # noqa: E402
-from .surface import Surface, build_surface  # noqa: E402
-from .session import Session  # noqa: E402
+from .model.surface import Surface, build_surface  # noqa: E402
+from .session.core import Session  # noqa: E402
 from .io.meshio_plugin import register as _register_meshio  # noqa: E402
 
 _register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)

@@ -459,7 +459,7 @@ def _fail(kind, what, text, exc=None):
 def check_surface(s):
     """The invariants of a valid surface: array shapes, indices in range,
     finite coordinates, a computable energy."""
-    from pyevolver.geometry import edge_index
+    from pyevolver.geometry.kernels import edge_index
     nv, ne, nf = s.nv, s.ne, s.nf
     assert s.X.ndim == 2 and s.X.shape[0] == nv, s.X.shape
     assert np.all(np.isfinite(s.X)), "non-finite coordinates"
@@ -484,7 +484,7 @@ def check_datafile(name, text):
     evaluation; the read section is not run).  Returns ``"ok"`` or
     ``"error"``; raises :class:`FuzzFailure` otherwise."""
     from pyevolver.errors import DatafileError, PyEvolverError
-    from pyevolver.session import Session
+    from pyevolver.session.core import Session
     try:
         with time_limit(HANG_SECONDS):
             sess = Session.load(name, out=io.StringIO(), err=io.StringIO(), run_read=False,

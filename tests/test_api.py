@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import pyevolver
-from pyevolver.api import progress_bar
+from pyevolver.session.api import progress_bar
 from pyevolver.errors import PyEvolverError
 
 from conftest import example

@@ -8,7 +8,7 @@ import pytest
 
 from pyevolver.atomic import NotRegularFile, atomic_path, atomic_write, check_regular
 from pyevolver.errors import CommandError
-from pyevolver.session import Session
+from pyevolver.session.core import Session
 
 CUBE = os.path.join(os.path.dirname(__file__), "..", "datafiles", "cube.fe")
 

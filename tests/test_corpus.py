@@ -22,10 +22,10 @@ import re
 import numpy as np
 import pytest
 
-from pyevolver import cli
+from pyevolver.cli import main as cli
 from pyevolver.commands import interpreter as I
 from pyevolver.errors import DatafileError
-from pyevolver.session import Session
+from pyevolver.session.core import Session
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 _CANDIDATES = [os.path.join(_HERE, "..", "..", "shared", "corpus"),

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from pyevolver.errors import DatafileError
-from pyevolver.session import Session
+from pyevolver.session.core import Session
 from reference import numbers, run_reference
 
 # a tetrahedron (4 vertices, 6 edges, 4 faces, 1 body): filled in by format()

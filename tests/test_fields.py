@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from pyevolver import Session
-from pyevolver.fields import DEFAULT_CURVATURE, curvature_method, mean_curvature, surface_fields
+from pyevolver.io.fields import DEFAULT_CURVATURE, curvature_method, mean_curvature, surface_fields
 from pyevolver.methods import METHODS
 from pyevolver.methods import curvature as C
 from pyevolver.studies.meshes import icosphere, write_fe

@@ -33,7 +33,7 @@ from hypothesis import strategies as st
 
 import fuzzing as F
 from pyevolver import limits
-from pyevolver.session import Session
+from pyevolver.session.core import Session
 
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
 
@@ -265,7 +265,7 @@ def test_commands_with_odd_numbers(cmd, v):
 # that cannot fail proves nothing)
 
 def test_checks_catch_internal_errors_and_changed_surfaces(monkeypatch):
-    import pyevolver.session as S
+    import pyevolver.session.core as S
     from pyevolver.errors import CommandError
     s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
     F.check_commands(s, "vertex[1].x := 0.25", "ok")        # a working command passes
@@ -288,7 +288,7 @@ def test_checks_catch_internal_errors_and_changed_surfaces(monkeypatch):
 
 
 def test_checks_catch_hangs_and_tracebacks(monkeypatch):
-    import pyevolver.session as S
+    import pyevolver.session.core as S
     from pyevolver.commands import interpreter as I
     from pyevolver.errors import DatafileError
     monkeypatch.setattr(F, "HANG_SECONDS", 0.3)

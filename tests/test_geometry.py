@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from pyevolver import geometry as G
+from pyevolver.geometry import kernels as G
 from pyevolver import read_datafile, build_surface
 
 ICOSA = """

@@ -3,7 +3,7 @@
 Expected numbers come from closed forms (4π for spheres, Willmore's and the
 isoperimetric inequalities, 2π² and √2 for the Clifford torus) or from an
 independent computation: a Loop subdivision written here from the rules
-alone (no code of pyevolver.loop), whose limit points (limit mask) form a
+alone (no code of pyevolver.geometry.loop), whose limit points (limit mask) form a
 fine polyhedron whose area and volume converge to those of the limit
 surface at second order (Richardson-extrapolated).
 """
@@ -14,7 +14,7 @@ import pytest
 
 from pyevolver import Session
 from pyevolver.errors import PyEvolverError, UnsupportedError
-from pyevolver.loop import LoopEvaluator, patches as P, stencils as St
+from pyevolver.geometry.loop import LoopEvaluator, patches as P, stencils as St
 from pyevolver.methods import GRADIENTS, METHODS
 from pyevolver.studies import loop_torus
 from pyevolver.studies.meshes import edges, icosahedron, icosphere, torus_grid, write_fe
@@ -172,7 +172,7 @@ def test_recursive_construction_reproduces_the_box_spline():
     X, F = torus_grid(5, 9)
     X = X + 0.05 * np.random.default_rng(3).standard_normal(X.shape)
     ctrl, _ = P.LoopTopology(F, len(X)).classes[6]
-    from pyevolver.loop.energy import densities
+    from pyevolver.geometry.loop.energy import densities
     res = []
     for comp in (False, True):
         B, w = St.patch_basis(6, 10, comp)

@@ -12,7 +12,7 @@ import pytest
 from conftest import example
 from reference import run_reference
 from pyevolver import Session
-from pyevolver import geometry as G
+from pyevolver.geometry import kernels as G
 
 
 def consistent(s):
@@ -211,7 +211,7 @@ def test_skinny_bisects_the_longest_edge_of_skinny_facets():
     at its midpoint (one new vertex per chosen edge, the total area unchanged,
     the chosen edges halved)."""
     import io
-    from pyevolver.mesh.edge_divide import skinny_edges
+    from pyevolver.remesh.edge_divide import skinny_edges
     s = Session.load(example("cube.fe"), out=io.StringIO())
     s.run("r\ng 5\nl 0.3")
     before = s.surface

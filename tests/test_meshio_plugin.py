@@ -15,9 +15,9 @@ import pytest
 
 import pyevolver
 from pyevolver import Session
-from pyevolver.cli import main as cli_main
+from pyevolver.cli.main import main as cli_main
 from pyevolver.errors import PyEvolverError
-from pyevolver.fields import surface_fields
+from pyevolver.io.fields import surface_fields
 from pyevolver.io import EXPORT_FORMATS
 
 from conftest import example

@@ -1,4 +1,4 @@
-"""``O`` (pop edges with four facets, pyevolver.mesh.pop) against
+"""``O`` (pop edges with four facets, pyevolver.remesh.pop) against
 evolver-nox-d, run live: the whole listing after the pop (coordinates to
 1e-12, edge and facet numbering and orientation exactly), the area, and the
 ``g`` lines that follow; refusals of what was not checked.
@@ -194,7 +194,7 @@ def test_nothing_to_pop_reports_zero():
 def test_first_facets_on_load():
     """The loop start of each edge: the first datafile face listing it;
     spokes of faces split on load are unknown (-1)."""
-    from pyevolver.surface import edge_first_facet
+    from pyevolver.model.surface import edge_first_facet
     s = Session.load(example("octa.fe"), out=io.StringIO()).surface
     first = edge_first_facet(s)
     assert first[12] == 0 and first[14] == 1 and first[15] == 2     # edges 13, 15, 16

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from pyevolver import Session
-from pyevolver.cli import main as cli_main
+from pyevolver.cli.main import main as cli_main
 from pyevolver.errors import PyEvolverError
-from pyevolver.render import camera
+from pyevolver.io.render import camera
 
 from conftest import example
 

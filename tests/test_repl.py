@@ -170,7 +170,7 @@ def test_completer_offers_session_names():
     import io
     from prompt_toolkit.document import Document
     from pyevolver import Session
-    from pyevolver.cli import _completer
+    from pyevolver.cli.main import _completer
     s = Session.load(example("qmound.fe"), out=io.StringIO(), err=io.StringIO())
     s.run("my_var := 3\ndefine edge attribute my_attr real\nmy_cmd := { print 1 }")
     comp = _completer(s)

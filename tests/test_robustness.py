@@ -20,8 +20,8 @@ import fuzzing as F
 from conftest import example
 from pyevolver import limits
 from pyevolver.errors import CommandError, DatafileError, InternalError
-from pyevolver.session import Session
-from pyevolver.surface import project_to_constraints
+from pyevolver.session.core import Session
+from pyevolver.model.surface import project_to_constraints
 from reference import run_reference
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -450,7 +450,7 @@ def test_the_interpreter_reaches_no_eval():
     import pyevolver.commands.cformat as cf
     import pyevolver.commands.interpreter as interp
     import pyevolver.expr.nodes as nodes
-    import pyevolver.session as session
+    import pyevolver.session.core as session
     for mod in (interp, cf, nodes, session):
         src = open(mod.__file__).read()
         for word in ("eval(", "exec(", "subprocess", "os.system", "os.popen", "__import__",
@@ -462,7 +462,7 @@ def test_the_interpreter_reaches_no_eval():
 
 def test_g_undoes_a_step_whose_projection_diverges(monkeypatch):
     """The wiring in the g step: a projection that reports runaway vertices
-    (pyevolver.surface.project_to_constraints, tested above) makes the step
+    (pyevolver.model.surface.project_to_constraints, tested above) makes the step
     undone, with the warning and the coordinates before it."""
     import pyevolver.evolve.iterate as it
     s = _session(os.path.join(HERE, "data", "atan_constraint.fe"))

@@ -17,8 +17,8 @@ import time
 import pytest
 
 from pyevolver import Session
-from pyevolver.cli import main as cli_main
-from pyevolver.sweep import SweepError, load_spec, run_sweep, spec_from_dict
+from pyevolver.cli.main import main as cli_main
+from pyevolver.studies.sweep import SweepError, load_spec, run_sweep, spec_from_dict
 
 from reference import run_reference
 

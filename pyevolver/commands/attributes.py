@@ -1,6 +1,6 @@
 """Element attributes of the manual's list that the session's basic table
-(:meth:`pyevolver.session.Session.get_attr`) does not hold: geometric ones
-computed on whole arrays (:mod:`pyevolver.geometry_attrs`), graphics-only
+(:meth:`pyevolver.session.core.Session.get_attr`) does not hold: geometric ones
+computed on whole arrays (:mod:`pyevolver.geometry.attributes`), graphics-only
 ones (kept, without effect), and the internal ones refused by name.
 
 :func:`element_attr` returns :data:`MISSING` for names it does not know;
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import geometry_attrs as GA
+from ..geometry import attributes as GA
 from ..errors import ExpressionError, UnsupportedError
 from ..expr import nodes as N
 
@@ -164,7 +164,7 @@ def _session_store(session):
 
 
 def cache(session):
-    """The session's :class:`~pyevolver.geometry_attrs.AttrCache`."""
+    """The session's :class:`~pyevolver.geometry.attributes.AttrCache`."""
     c = session.__dict__.get("_attr_cache")
     if c is None:
         c = session._attr_cache = GA.AttrCache()
@@ -381,7 +381,7 @@ class _Ref:
 def _string_edge_body(session, base, name):
     """String model: the body of the facet running along the edge
     (``frontbody``) or against it (``backbody``); 0 when there is none."""
-    from ..string_model import facets_of_edge
+    from ..model.string import facets_of_edge
     s = session.surface
     want = (1 if name == "frontbody" else -1) * base.sign
     for f, g in facets_of_edge(s, base.i):
@@ -591,7 +591,7 @@ def set_quantity(session, qname, attr, value):
 def _set_parameter(session, i, name, idx, value):
     """``set vertex p1 expr``: a boundary vertex's parameter; the vertex
     moves to its new place on the boundary at once (REF)."""
-    from ..surface import boundary_eval
+    from ..model.surface import boundary_eval
     s = session.surface
     bnd = s.vattr.get("boundary")
     if bnd is None or not bnd[i]:

@@ -1165,7 +1165,7 @@ def _graphics_toggle(tok):
 
 
 class Interpreter:
-    """Executes parsed commands against a :class:`pyevolver.session.Session`."""
+    """Executes parsed commands against a :class:`pyevolver.session.core.Session`."""
 
     def __init__(self, session):
         self.session = session
@@ -1281,7 +1281,7 @@ class Interpreter:
 
     def _check_free(self, name, what):
         s = self.session
-        from ..session import READ_ONLY
+        from ..session.core import READ_ONLY
         if name in READ_ONLY or name in s.settings or name in TOGGLES or \
                 (s.surface is not None and name in s.surface.quantities):
             raise CommandError(f"'{name}' is a built-in name; it cannot be a {what}")

@@ -1,4 +1,4 @@
-"""Datafile reader: text -> :class:`pyevolver.scene.Scene`.
+"""Datafile reader: text -> :class:`pyevolver.model.scene.Scene`.
 
 The top section and non-trivial element lines are parsed by the LALR
 grammar ``fe.lark`` (with the shared expression grammar); element lines made
@@ -19,7 +19,7 @@ from ..errors import DatafileError, ExpressionError, PyEvolverError
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
 from ..limits import MAX_ARRAY_ENTRIES, MAX_FACE_EDGES, MAX_ID, MAX_NESTING, nesting_depth
-from ..scene import (Scene, ConstraintDecl, BoundaryDecl, QuantityDecl, MethodDecl)
+from ..model.scene import (Scene, ConstraintDecl, BoundaryDecl, QuantityDecl, MethodDecl)
 from .preprocess import preprocess, read_source
 
 _HERE = os.path.dirname(__file__)

@@ -1,6 +1,6 @@
 """Writing a surface back as a datafile (the ``dump`` command).
 
-The writer turns the arrays of a :class:`pyevolver.surface.Surface` (and the
+The writer turns the arrays of a :class:`pyevolver.model.surface.Surface` (and the
 settings of its session) into a datafile that both pyevolver and the
 Evolver load back to the same surface: the same elements in the same order,
 coordinates written with 17 significant digits (so every double comes back
@@ -473,7 +473,7 @@ WRITERS = {"fe": write_fe}
 def dump(surface_or_session, path, fmt="fe"):
     """Write a surface (or a session's surface with its settings) to ``path``
     in the format ``fmt`` (a key of :data:`WRITERS`)."""
-    from ..session import Session
+    from ..session.core import Session
     if isinstance(surface_or_session, Session):
         sess, surface = surface_or_session, surface_or_session.surface
     else:

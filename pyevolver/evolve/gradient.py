@@ -1,6 +1,6 @@
 """Analytic gradients of energies and constrained values w.r.t. vertices.
 
-Every term of :class:`pyevolver.surface.Totals` has its gradient here; all
+Every term of :class:`pyevolver.model.surface.Totals` has its gradient here; all
 are checked against central finite differences in ``tests/test_gradient.py``.
 Shapes: gradients are ``(nv, 3)`` arrays.
 
@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import geometry as G
+from ..geometry import kernels as G
 
 
 def scatter(nv, idx, vecs):
@@ -124,7 +124,7 @@ def edge_vector_integral_grad(t, comps, idx, sign=None):
     Q = np.zeros((n, 2, 3))
     J = np.zeros((n, 2, 3, 3))                        # J[..., k, j] = dQ_k/dx_j
     env = _Env(t, env_coords, rep)
-    from ..surface import located
+    from ..model.surface import located
     with located(getattr(comps, "what", ""), getattr(comps, "line", None)):
         for k, comp in enumerate(comps[:3]):
             Q[:, :, k] = comp.values(env.params, env.coords, len(flat)).reshape(n, 2)
@@ -168,7 +168,7 @@ def edge_length_grad(t, idx, weights):
 
 def content_edge_terms(t):
     """Per-edge content integrals: ``[(components, edge indices, signs)]``."""
-    from ..surface import integral_edges
+    from ..model.surface import integral_edges
     return integral_edges(t.surface, "content")
 
 
@@ -176,14 +176,14 @@ def energy_gradient(t):
     """Gradient (nv, 3) of the total energy of :class:`Totals` ``t``."""
     s = t.surface
     if s.string:
-        from ..string_model import energy_gradient as string_gradient
+        from ..model.string import energy_gradient as string_gradient
         return string_gradient(t)
     g = corner_scatter(t, facet_area_grad(t), s.facet_tension)
     et = s.eattr.get("tension")
     if et is not None and np.any(et):
         nz = np.nonzero(et)[0]
         g += edge_length_grad(t, nz, et[nz])
-    from ..surface import integral_edges
+    from ..model.surface import integral_edges
     for comps, idx, sign in integral_edges(s, "energy"):
         g += edge_vector_integral_grad(t, comps, idx, sign)
     if "gap" in t.terms:
@@ -213,7 +213,7 @@ def gap_energy_grad(t):
     ``T_e = k |s.g_e| |s| / (12 |g_e|)``; differentiated through s and
     through g_e (the symbolic Hessian of the constraint function).
     """
-    from ..surface import convex_edges
+    from ..model.surface import convex_edges
     s = t.surface
     out = np.zeros((s.nv, 3))
     for c, idx in convex_edges(s):
@@ -245,14 +245,14 @@ def body_volume_gradients(t):
     """(nb, nv, 3) gradients of body volumes (content integrals included)."""
     s = t.surface
     if s.string:
-        from ..string_model import volume_gradients
+        from ..model.string import volume_gradients
         return volume_gradients(t)
     b = s.bodies
     vg = facet_volume_grad(t, s.symmetric_content)
     out = np.zeros((b.n, s.nv, 3))
     Bm = b.facet_matrix.tocsr()
     if s.periods is not None:
-        from ..surface import torus_lift_shifts
+        from ..model.surface import torus_lift_shifts
         D = torus_lift_shifts(s)
         P = _facet_points(t)
     content = content_edge_terms(t)

@@ -31,10 +31,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .. import geometry as G
+from ..geometry import kernels as G
 from ..errors import UnsupportedError
 from ..methods.jets import skew
-from ..surface import boundary_eval, boundary_groups, vertex_coords
+from ..model.surface import boundary_eval, boundary_groups, vertex_coords
 from . import gradient as GR
 from .ordering import nested_dissection
 

@@ -9,7 +9,7 @@
 
 work like any other meshio format (meshio's own ``register_format``).
 Reading loads the datafile without running its ``read`` section and
-returns the triangles with the data of :func:`pyevolver.fields.surface_fields`;
+returns the triangles with the data of :func:`pyevolver.io.fields.surface_fields`;
 writing turns triangles into vertices, edges and faces (point data
 ``fixed`` and cell data ``tension`` are kept, nothing else: no bodies) and
 writes them with the ``dump`` writer.
@@ -43,7 +43,7 @@ EXPORT_FORMATS = {".vtu": "vtu", ".xdmf": "xdmf", ".ply": "ply", ".obj": "obj",
 
 
 def _split(obj):
-    from ..session import Session
+    from ..session.core import Session
     if isinstance(obj, Session):
         return obj, obj.surface
     return None, obj
@@ -53,9 +53,9 @@ def surface_mesh(obj, data=True):
     """A :class:`meshio.Mesh` of a surface (or of a :class:`Session`'s):
     points ``X`` (nv, 3), one ``"triangle"`` block ``F`` (nf, 3) and, with
     ``data``, the point and cell data of
-    :func:`pyevolver.fields.surface_fields`."""
+    :func:`pyevolver.io.fields.surface_fields`."""
     import meshio
-    from ..fields import surface_fields
+    from .fields import surface_fields
     _, s = _split(obj)
     if s is None:
         raise CommandError("export: no surface is loaded")
@@ -77,7 +77,7 @@ def surface_mesh(obj, data=True):
 
 def read_fe(filename):
     """meshio reader: the datafile's surface (its ``read`` section not run)."""
-    from ..session import Session
+    from ..session.core import Session
     sess = Session.load(os.fspath(filename), out=io.StringIO(), err=io.StringIO(),
                         run_read=False)
     return surface_mesh(sess)
@@ -87,7 +87,7 @@ def _mesh_surface(mesh, filename):
     """Build a Surface from a meshio triangle mesh (through the datafile reader)."""
     from ..datafile.reader import read_datafile
     from ..studies.meshes import fe_text
-    from ..surface import build_surface
+    from ..model.surface import build_surface
     tris = []
     for block in mesh.cells:
         if block.type != "triangle":

@@ -8,7 +8,7 @@ user can add methods::
     register_method("my_area", "facet", lambda ctx, m, idx: ctx.facet_area[idx])
 
 ``fn(ctx, method, idx)`` gets the evaluation context (cached geometry of the
-surface), the :class:`pyevolver.scene.MethodDecl` and the element indices,
+surface), the :class:`pyevolver.model.scene.MethodDecl` and the element indices,
 and returns an array of per-element values (orientation signs are applied by
 the caller).
 """
@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UnsupportedError
-from .. import geometry as G
+from ..geometry import kernels as G
 
 METHODS = {}
 GRADIENTS = {}     # name -> fn(totals, method, idx, weights) -> (nv, 3)

@@ -228,7 +228,7 @@ def vertex_gradient(t, m, idx, w):
 def _dihedral(t, idx):
     """For the edges ``idx``: which have two facets (``ok``), those edges
     ``e``, and their facets running along (``f1``) and against (``f2``) them."""
-    from ..mesh.equiangulate import edge_facets
+    from ..remesh.equiangulate import edge_facets
     s = t.surface
     ef, ek, val = edge_facets(s)
     ok = val[idx] == 2
@@ -493,7 +493,7 @@ def cotan_gradient(t, m, idx, w):
 def _edge_quads(s):
     """For every edge with two facets: its ends ``i, j`` and the third
     vertices ``k, l`` of its two facets (edges (nq,), vertices 4 × (nq,))."""
-    from ..mesh.equiangulate import edge_facets
+    from ..remesh.equiangulate import edge_facets
     ef, ek, val = edge_facets(s)
     e = np.nonzero(val == 2)[0]
     F = s.F

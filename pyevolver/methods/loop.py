@@ -1,6 +1,6 @@
 """``loop_sq_mean_curvature``, ``loop_area``, ``loop_volume``: pyevolver's own
 quantity methods on the Loop subdivision surface whose control mesh is the
-triangulation (:mod:`pyevolver.loop`, issue 8).
+triangulation (:mod:`pyevolver.geometry.loop`, issue 8).
 
 They are global: the whole (closed) surface is the control mesh.  As vertex
 methods, each facet's share of the limit surface's W = ∫H² dA (H the mean
@@ -19,9 +19,9 @@ KIND = {"loop_sq_mean_curvature": "W", "loop_area": "A", "loop_volume": "V"}
 
 
 def evaluator(s, name="loop_sq_mean_curvature"):
-    """The :class:`pyevolver.loop.LoopEvaluator` of surface ``s``, cached
+    """The :class:`pyevolver.geometry.loop.LoopEvaluator` of surface ``s``, cached
     while its topology is unchanged."""
-    from ..loop import LoopEvaluator
+    from ..geometry.loop import LoopEvaluator
     topo = s.topology()
     c = s.__dict__.get("_loop_eval")
     if c is not None and c[0] is topo:

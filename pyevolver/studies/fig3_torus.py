@@ -48,7 +48,7 @@ sheared lattice, see :func:`~pyevolver.studies.meshes.torus_offset`).
 
 Measured per run: W (the discrete energy minimized, without λE), its relative
 error to 2π², W_Loop (the true Willmore energy of the Loop subdivision
-surface of the final mesh, :mod:`pyevolver.loop`, ≥ 2π² for every torus),
+surface of the final mesh, :mod:`pyevolver.geometry.loop`, ≥ 2π² for every torus),
 the radius ratio R/r (:func:`radius_ratio`), the smallest facet angle, wall
 seconds and iterations.
 
@@ -249,7 +249,7 @@ def loop_energy(X, F):
     NaN when the Loop methods refuse the mesh (valence above 12, which edge
     flips can produce)."""
     from ..errors import UnsupportedError
-    from ..loop import LoopEvaluator
+    from ..geometry.loop import LoopEvaluator
     try:
         return float(LoopEvaluator(F, len(X)).totals(X)["W"])
     except UnsupportedError:

@@ -25,7 +25,7 @@ import time
 
 import numpy as np
 
-from ..loop import LoopEvaluator
+from ..geometry.loop import LoopEvaluator
 from .meshes import torus_grid
 
 CLIFFORD = 2 * np.pi ** 2

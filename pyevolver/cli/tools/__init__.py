@@ -8,9 +8,9 @@ import argparse
 import importlib
 import sys
 
-from ..errors import PyEvolverError
+from ...errors import PyEvolverError
 
-#: subcommand -> module (under pyevolver.tools) and one-line help
+#: subcommand -> module (under pyevolver.cli.tools) and one-line help
 SUBCOMMANDS = {
     "convert": ("convert", "convert a surface between .fe and meshio formats"),
     "show": ("show", "render a datafile's surface to an image, headless"),

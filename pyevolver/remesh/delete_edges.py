@@ -29,7 +29,7 @@ import heapq
 
 import numpy as np
 
-from ..surface import project_to_constraints
+from ..model.surface import project_to_constraints
 from .shrink import subset
 
 

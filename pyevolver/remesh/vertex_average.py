@@ -29,8 +29,8 @@ import copy
 
 import numpy as np
 
-from .. import geometry as G
-from ..surface import project_tangent, project_to_constraints, vertex_facet_rank
+from ..geometry import kernels as G
+from ..model.surface import project_tangent, project_to_constraints, vertex_facet_rank
 
 
 def vertex_average(s, mode="V"):

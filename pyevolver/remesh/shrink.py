@@ -1,6 +1,6 @@
 """Drop vertices, edges and facets from a surface and renumber the rest.
 
-The counterpart of :func:`~pyevolver.mesh.grow.grow` for operations that
+The counterpart of :func:`~pyevolver.remesh.grow.grow` for operations that
 delete elements (``t``, ``w``, ``o``): the caller has already rewritten the
 connectivity ``E`` / ``FE`` of the surviving elements in terms of the old
 indices; :func:`subset` keeps the marked elements in their order and maps

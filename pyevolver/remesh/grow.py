@@ -1,7 +1,7 @@
 """Append elements to a surface with the Evolver's inheritance rules.
 
 Every topology-changing operation (``r``, ``refine edges``, ``notch``, ...)
-builds a *new* :class:`~pyevolver.surface.Surface` with :func:`grow` and
+builds a *new* :class:`~pyevolver.model.surface.Surface` with :func:`grow` and
 then fills in the coordinates and connectivity of the new elements.  The old
 surface object is left untouched, so a failing command can hand the session
 back its previous surface (spec §6.2 for the inheritance).

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from .. import geometry as G
+from ..geometry import kernels as G
 
 
 def _div(a, b):
@@ -57,13 +57,13 @@ def edge_facets(s):
 
 
 def _flip_rings(s, t, moves):
-    """Record REF's edge rings (:mod:`pyevolver.mesh.rings`) of ``t``, ``s``
+    """Record REF's edge rings (:mod:`pyevolver.remesh.rings`) of ``t``, ``s``
     with edges flipped: ``moves`` lists (edges, old tails, old heads).
     The pass flips in edge id order; each flip takes the edge out of the
     rings of its old ends and puts it in those of its new ends (measured
     with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
     Runs of flips with no vertex in common are replayed at once."""
-    from ..surface import record_vertex_rings
+    from ..model.surface import record_vertex_rings
     from .rings import Rings
     g = Rings(s, t.ne, t.nv)
     I = np.concatenate([m[0] for m in moves])
@@ -175,7 +175,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     E, FE = t.E, t.FE
     wrap = t.eattr.get("wrap")
     ef, ekk, val = edge_facets(t)
-    from ..surface import along_first
+    from ..model.surface import along_first
     first = along_first(s)
     wv = t.wrap_shift()
     lengths = np.linalg.norm(G.edge_vectors(t.X, E, wv), axis=1)
@@ -353,7 +353,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     t.__dict__.pop("_topo", None)          # E and FE were changed
     if flips + flips_at_once:
         # an edge's facet loop keeps its start through the flips (REF, ee.facet)
-        from ..surface import record_along_first
+        from ..model.surface import record_along_first
         record_along_first(t, first)
         for ed, p, q in seq_moves:
             moves.append((np.array([ed]), np.array([p]), np.array([q])))

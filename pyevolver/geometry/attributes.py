@@ -50,7 +50,7 @@ def star_sums_projected(s, t):
     -------
     A, F, N : ndarray
     """
-    from .surface import project_tangent
+    from ..model.surface import project_tangent
     nv = s.nv
     A = np.zeros(nv)
     F = np.zeros((nv, 3))
@@ -128,7 +128,7 @@ def edge_dihedral(s, t):
     """(ne,) the ``dihedral`` attribute of edges: the angle between the
     unit normals of the two facets on an edge (the second facet's normal
     flipped when both run along the edge the same way); 0 elsewhere."""
-    from .mesh.equiangulate import edge_facets
+    from ..remesh.equiangulate import edge_facets
     out = np.zeros(s.ne)
     if s.nf == 0:
         return out

@@ -1,7 +1,7 @@
 """The Scene: what a datafile declares, before any geometry is built.
 
 Text -> :class:`Scene` (this module, filled by :mod:`pyevolver.datafile.reader`)
--> :class:`pyevolver.surface.Surface` (arrays) -> methods, constraints ->
+-> :class:`pyevolver.model.surface.Surface` (arrays) -> methods, constraints ->
 evolve / remesh -> outputs.
 """
 from __future__ import annotations

@@ -11,7 +11,7 @@ import io
 import os
 import sys
 
-from ..errors import PyEvolverError
+from ...errors import PyEvolverError
 
 
 def add_args(parser):
@@ -30,8 +30,8 @@ def add_args(parser):
 
 def run(args):
     import numpy as np
-    from ..render import camera
-    from ..session import Session
+    from ...io.render import camera
+    from ...session.core import Session
     if not os.path.isfile(args.datafile):
         raise PyEvolverError(f"show: cannot open datafile '{args.datafile}': no such file")
     sess = Session.load(args.datafile, out=io.StringIO(), err=sys.stderr)

@@ -1,7 +1,7 @@
 """REF's edge rings at the vertices, as linked lists in arrays.
 
 The Evolver keeps the edges at a vertex in a cyclic list read from the
-vertex's first edge (``vv.edge``; :func:`pyevolver.surface.vertex_edge_rank`).
+vertex's first edge (``vv.edge``; :func:`pyevolver.model.surface.vertex_edge_rank`).
 Measured with evolver-nox-d (catbody.fe, column.fe, quad.fe after ``r`` and
 ``u``): an edge leaving a vertex's list makes the edge that followed it the
 vertex's first edge; an edge joining a list goes in right after the first
@@ -20,7 +20,7 @@ class Rings:
     edges and ``nv`` vertices."""
 
     def __init__(self, s, ne, nv):
-        from ..surface import vertex_edge_rank
+        from ..model.surface import vertex_edge_rank
         self.nxt = np.arange(2 * ne)
         self.prv = np.arange(2 * ne)
         self.head = np.full(nv, -1, np.int64)

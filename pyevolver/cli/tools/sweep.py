@@ -3,7 +3,7 @@
 Each point gets its own folder (final dump, energies, snapshot, result);
 finished points are not computed again when the sweep is run again.  The
 points run in a local process pool, or on a Dask distributed cluster with
-``--scheduler tcp://HOST:PORT``.  See :mod:`pyevolver.sweep` for the spec.
+``--scheduler tcp://HOST:PORT``.  See :mod:`pyevolver.studies.sweep` for the spec.
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ def add_args(parser):
 
 def run(args):
     """Returns the exit code: 1 when a point failed."""
-    from ..sweep import dask_executor, load_spec, run_sweep
+    from ...studies.sweep import dask_executor, load_spec, run_sweep
 
     def log(text):
         print(text, flush=True)

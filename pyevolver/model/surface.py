@@ -13,11 +13,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from . import geometry as G
-from .errors import DatafileError, PyEvolverError, UnsupportedError
-from .limits import MAX_ARRAY_ENTRIES
-from .expr import nodes as N
-from .methods import method_info
+from ..geometry import kernels as G
+from ..errors import DatafileError, PyEvolverError, UnsupportedError
+from ..limits import MAX_ARRAY_ENTRIES
+from ..expr import nodes as N
+from ..methods import method_info
 
 
 @dataclass
@@ -81,7 +81,7 @@ class Surface:
         self.sq_curvature_modulus = 0.0     # legacy SQUARED_CURVATURE c
         self.curvature_mode = "plain"       # toggles: effective_area -> eff, normal_curvature -> norm
         # the string model (surface dimension 1): facets are edge chains kept in
-        # sf_ptr / sf_enc (pyevolver.string_model) and FE stays empty
+        # sf_ptr / sf_enc (pyevolver.model.string) and FE stays empty
         self.string = False
         self.sf_ptr = np.zeros(1, np.int64)
         self.sf_enc = np.zeros(0, np.int64)
@@ -167,7 +167,7 @@ class Surface:
     def evaluate(self):
         """Compute energy, area, volumes and quantity values (a :class:`Totals`)."""
         if self.string:
-            from .string_model import StringTotals
+            from .string import StringTotals
             return StringTotals(self)
         return Totals(self)
 
@@ -217,7 +217,7 @@ class Totals:
         if s.sq_curvature_modulus:
             # legacy top-of-file SQUARED_CURVATURE (spec 5.3): the vertex
             # method picked by the effective_area / normal_curvature toggles
-            from .methods.curvature import legacy_energy
+            from ..methods.curvature import legacy_energy
             e = s.sq_curvature_modulus * legacy_energy(self)
             self.terms["sq_curvature"] = e
             energy += e
@@ -957,7 +957,7 @@ class _Builder:
                 f"vertex {orig[heads[j]]} but the next edge {flat[j + 1]} starts at vertex "
                 f"{orig[tails[j + 1]]}", blk.lines[k])
         s.sf_ptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
-        from .string_model import init_rings
+        from .string import init_rings
         init_rings(s)
         s.sf_enc = np.where(rev, ~eidx, eidx).astype(np.int64)
         self.split_children = {}
@@ -1120,7 +1120,7 @@ class _Builder:
             except UnsupportedError as exc:
                 raise self.error(f"method_instance {name}: {exc}", m.line) from None
             if s.string:
-                from .string_model import STRING_METHODS
+                from .string import STRING_METHODS
                 if m.method not in STRING_METHODS:
                     raise self.error(f"method_instance {name}: not supported in pyevolver: method "
                                      f"{m.method} in the string model", m.line)
@@ -1150,7 +1150,7 @@ class _Builder:
                         raise self.error(f"quantity {name}: FUNCTION uses {v!r}; expected "
                                          "method_instance values (name.value) and parameters",
                                          qd.line)
-                from .expr.nodes import Formula
+                from ..expr.nodes import Formula
                 q.function = Formula(qd.function)
             s.quantities[name] = q
         # declared attributes that no element set still exist
@@ -1163,7 +1163,7 @@ class _Builder:
     def _check_string_method(self, m, what, line):
         """The string model has its own methods (no facets)."""
         if self.s.string:
-            from .string_model import STRING_METHODS
+            from .string import STRING_METHODS
             if m.method not in STRING_METHODS:
                 raise self.error(f"{what}: not supported in pyevolver: method {m.method} in "
                                  f"the string model", line)

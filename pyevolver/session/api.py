@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import sys
 
-from .errors import CommandError
+from ..errors import CommandError
 
 #: ``progress=None`` shows a bar for runs of at least this many steps.
 PROGRESS_MIN_STEPS = 100
@@ -42,7 +42,7 @@ def progress_bar(total, progress=None, desc=None):
         from tqdm.auto import tqdm
     except ImportError:
         if progress:
-            from .errors import UnsupportedError
+            from ..errors import UnsupportedError
             raise UnsupportedError("progress bars without tqdm", "pip install tqdm") from None
         return None
     return tqdm(total=total, desc=desc, leave=False)
@@ -62,7 +62,7 @@ class SessionAPI:
     def value(self, expr):
         """The value of one expression of the command language, e.g.
         ``"total_energy"``, ``"body[1].volume"``, ``"max(vertex, z)"``."""
-        from .commands import interpreter as I
+        from ..commands import interpreter as I
         ast = I.parse_command(f"print {expr}", "<value>")
         stmts = ast[1] if ast[0] == "seq" else [ast]
         if len(stmts) != 1 or stmts[0][0] != "print":
@@ -74,20 +74,20 @@ class SessionAPI:
         """Write the surface to ``path`` in a meshio format chosen by the
         extension (``.vtu``, ``.ply``, ``.obj``, ``.stl``, ``.off``,
         ``.xdmf``, ...; ``.fe`` is ``dump``) with the per-vertex and
-        per-facet data arrays of :func:`pyevolver.fields.surface_fields`;
+        per-facet data arrays of :func:`pyevolver.io.fields.surface_fields`;
         returns the format name (:func:`pyevolver.io.export`)."""
-        from .io.meshio_plugin import export
+        from ..io.meshio_plugin import export
         return export(self, path, fmt, data)
 
     def snapshot(self, path, field="mean_curvature", view=None, **kwargs):
         """Render the surface to an image file, headless
-        (:func:`pyevolver.render.snapshot`; the camera is the session's
+        (:func:`pyevolver.io.render.snapshot`; the camera is the session's
         ``view_matrix`` unless ``view`` is given)."""
-        from .render import snapshot
+        from ..io.render import snapshot
         return snapshot(self, path, field=field, view=view, **kwargs)
 
     def plot_history(self, path, **kwargs):
         """Plot the energy of every ``g`` step so far
-        (:func:`pyevolver.render.plot_history`)."""
-        from .render import plot_history
+        (:func:`pyevolver.io.render.plot_history`)."""
+        from ..io.render import plot_history
         return plot_history(self, path, **kwargs)

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import geometry as G
-from ..surface import constrained_vertices, project_to_constraints
+from ..geometry import kernels as G
+from ..model.surface import constrained_vertices, project_to_constraints
 from .grow import grow
 
 
@@ -226,7 +226,7 @@ def _split_loops(s, t, R, half):
     keeps its edge's order, the head half has the other one, the edges
     cutting the facets have the facet along them first (measured with
     ``ee.facet`` after ``r`` on catbody.fe; it decides how ``u`` renumbers)."""
-    from ..surface import along_first, record_along_first
+    from ..model.surface import along_first, record_along_first
     out = np.ones(t.ne, bool)
     old = along_first(s)
     out[:s.ne] = old
@@ -235,7 +235,7 @@ def _split_loops(s, t, R, half):
 
 
 def _split_rings(s, t, R, half):
-    """Record REF's edge rings (:mod:`pyevolver.mesh.rings`) at the vertices
+    """Record REF's edge rings (:mod:`pyevolver.remesh.rings`) at the vertices
     of ``t``: ``s`` with the edges ``R`` split (new head halves ``half[R]``)
     and its facets cut.
 
@@ -245,7 +245,7 @@ def _split_rings(s, t, R, half):
     new half (first), then the old edge; then the edges cutting the facets
     join the rings at both their ends, in id order.
     """
-    from ..surface import record_vertex_rings
+    from ..model.surface import record_vertex_rings
     from .rings import Rings, rounds
     ne, k = s.ne, len(R)
     g = Rings(s, t.ne, t.nv)

@@ -18,8 +18,8 @@ import os
 
 import numpy as np
 
-from .atomic import atomic_path
-from .errors import CommandError, UnsupportedError
+from ..atomic import atomic_path
+from ..errors import CommandError, UnsupportedError
 
 #: Half-width of the picture in view coordinates: the initial view's
 #: [-1, 1] with a margin for a surface that grows.
@@ -58,7 +58,7 @@ def camera(X, azimuth=0.0, elevation=0.0, zoom=1.0):
 
 
 def _split(obj):
-    from .session import Session
+    from ..session.core import Session
     if isinstance(obj, Session):
         return obj, obj.surface
     return None, obj
@@ -88,7 +88,7 @@ def snapshot(obj, path, field="mean_curvature", view=None, size=600, cmap="virid
     Parameters
     ----------
     field : str or None
-        Colour facets by this field of :func:`pyevolver.fields.surface_fields`
+        Colour facets by this field of :func:`pyevolver.io.fields.surface_fields`
         (vertex fields averaged over each facet) with a colour bar; ``None``
         or ``"none"`` for a plain grey surface.  Facets are shaded by the
         angle of their normal to the viewing direction.

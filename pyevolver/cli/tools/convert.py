@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 
-from ..errors import PyEvolverError
+from ...errors import PyEvolverError
 
 
 def add_args(parser):
@@ -20,7 +20,7 @@ def add_args(parser):
 
 def run(args):
     import meshio
-    from ..io.meshio_plugin import file_format, write_mesh
+    from ...io.meshio_plugin import file_format, write_mesh
     if not os.path.isfile(args.input):
         raise PyEvolverError(f"convert: cannot open '{args.input}': no such file")
     fmt = file_format(args.output)

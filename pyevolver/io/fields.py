@@ -35,7 +35,7 @@ def curvature_method(surface):
     toggles, else :data:`DEFAULT_CURVATURE`.  Methods without a per-vertex
     estimate (``circle_willmore``, the Loop methods) count as absent.
     """
-    from .methods.curvature import _LEGACY, VERTEX_METHODS
+    from ..methods.curvature import _LEGACY, VERTEX_METHODS
     known = set(VERTEX_METHODS) | {"cotan_sq_mean_curvature"}
     found = [(q.kind != "energy", m.method) for q in surface.quantities.values()
              for m, *_ in q.methods if m.method in known]
@@ -64,7 +64,7 @@ def mean_curvature(surface, totals=None, method=None):
     itself, not h − h0.  NaN in the torus model (stars across the
     periodic wrap are not gathered here).
     """
-    from .methods import curvature as C
+    from ..methods import curvature as C
     s = surface
     if s.periods is not None or s.nf == 0:
         return np.full(s.nv, np.nan)

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import CommandError, UnsupportedError
+from ..errors import CommandError, UnsupportedError
 from .surface import Totals
 
 # quantity methods that make sense without facets
@@ -57,7 +57,7 @@ def chain_points(s, t=None):
     owner, e, sgn, tail, head = facet_entries(s)
     if s.periods is None:
         return s.X[tail], s.X[head]
-    from .geometry import edge_vectors
+    from ..geometry.kernels import edge_vectors
     ev = t.edge_vec if t is not None else edge_vectors(s.X, s.E, s.wrap_shift())
     d = ev[e] * sgn[:, None]
     if not len(d):
@@ -242,7 +242,7 @@ def facet_area_gradient(s, per_facet):
 
 def energy_gradient(t):
     """Gradient (nv, 3) of the total energy of a string surface."""
-    from .evolve.gradient import edge_length_grad, quantity_gradient
+    from ..evolve.gradient import edge_length_grad, quantity_gradient
     s = t.surface
     et = s.edge_tension
     nz = np.nonzero(et)[0]
@@ -347,7 +347,7 @@ def split_edges(s, R):
     order, the original edge keeps its tail half and the head halves are new
     edges in the same order; each facet chain gets the new half next to its
     parent (REF's numbering, ``list facets`` after ``r``)."""
-    from .mesh.grow import grow
+    from ..remesh.grow import grow
     from .surface import constrained_vertices, project_to_constraints
     R = np.asarray(R, np.int64)
     k = len(R)
@@ -358,7 +358,7 @@ def split_edges(s, R):
     if s.periods is None:
         t.X[mid] = 0.5 * (s.X[s.E[R, 0]] + s.X[s.E[R, 1]])
     else:                                 # the head as seen from the tail
-        from .geometry import edge_vectors
+        from ..geometry.kernels import edge_vectors
         t.X[mid] = s.X[s.E[R, 0]] + 0.5 * edge_vectors(s.X, s.E, s.wrap_shift())[R]
     if "wrap" in t.eattr:
         t.eattr["wrap"][R] = 0.0          # the tail half stays in the tail's cell
@@ -417,7 +417,7 @@ def vertex_average(s, mode="V"):
             use &= ~on_v[v] | on_e[e]
     deg = np.bincount(v, minlength=nv)
     cnt = np.bincount(v, weights=use.astype(float), minlength=nv)
-    from .geometry import edge_vectors
+    from ..geometry.kernels import edge_vectors
     ev = edge_vectors(s.X, s.E, s.wrap_shift())
     vec = np.concatenate([ev, -ev])
     D = np.zeros((nv, 3))
@@ -467,7 +467,7 @@ def check_no_facets_needed(s, what):
 
 class StringTotals(Totals):
     """Energy, length and body areas of a string surface (the attributes
-    of :class:`pyevolver.surface.Totals`; ``total_area`` is the total
+    of :class:`pyevolver.model.surface.Totals`; ``total_area`` is the total
     length, as in REF)."""
 
     def __init__(self, s):

@@ -18,14 +18,14 @@ import time
 import numpy as np
 
 from .api import SessionAPI, progress_bar
-from .commands import interpreter as I
-from .datafile.preprocess import _TooLong as _MacroTooLong, expand_macros
-from .datafile.reader import read_datafile
-from .errors import (CommandError, DatafileError, ExpressionError, InternalError,
+from ..commands import interpreter as I
+from ..datafile.preprocess import _TooLong as _MacroTooLong, expand_macros
+from ..datafile.reader import read_datafile
+from ..errors import (CommandError, DatafileError, ExpressionError, InternalError,
                      PyEvolverError, UnsupportedError)
-from .expr import nodes as N
-from .limits import MAX_EXPANDED_LINE, MAX_NESTING
-from .surface import (build_surface, constrained_vertices, project_to_constraints,
+from ..expr import nodes as N
+from ..limits import MAX_EXPANDED_LINE, MAX_NESTING
+from ..model.surface import (build_surface, constrained_vertices, project_to_constraints,
                       restore_state, state)
 
 READ_ONLY = {
@@ -75,7 +75,7 @@ UNSUPPORTED_MOTION = ("area_normalization", "normal_motion", "runge_kutta",
 
 class Session(SessionAPI):
     """A loaded surface with its variables, commands and output streams
-    (the Python API's extras: :class:`pyevolver.api.SessionAPI`)."""
+    (the Python API's extras: :class:`pyevolver.session.api.SessionAPI`)."""
 
     def __init__(self, out=None, err=None):
         self.out = out or sys.stdout
@@ -228,7 +228,7 @@ class Session(SessionAPI):
     def dump(self, name=None):
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
-        from .datafile.writer import dump
+        from ..datafile.writer import dump
         if name is None:
             name = (self.filename or "pyevolver") + ".dmp"
         self.write(f"Dumping to {name}.\n")
@@ -287,7 +287,7 @@ class Session(SessionAPI):
         """``addload "file"``: the file's elements added to the surface,
         numbered after the existing ones; its declarations override, its
         read section is not run."""
-        from .mesh.merge import append_surface
+        from ..remesh.merge import append_surface
         scene, new = self._read_new("addload", name)
         if self.surface is None:
             raise CommandError("addload: no surface is loaded")
@@ -541,7 +541,7 @@ class Session(SessionAPI):
         if s is None:
             return
         if reposition:
-            from .surface import boundary_eval, boundary_groups
+            from ..model.surface import boundary_eval, boundary_groups
             groups = boundary_groups(s) if s.boundaries else []
             if groups or s.vcon:
                 s.X = s.X.copy()
@@ -581,7 +581,7 @@ class Session(SessionAPI):
     @property
     def iterator(self):
         if self._iterator is None:
-            from .evolve.iterate import Iterator
+            from ..evolve.iterate import Iterator
             self._iterator = Iterator(self)
         return self._iterator
 
@@ -619,7 +619,7 @@ class Session(SessionAPI):
         return results
 
     def _steps(self, n, callback, echo, results, bar):
-        from .evolve.iterate import progress_line
+        from ..evolve.iterate import progress_line
         for k in range(n, 0, -1):
             self.interp.tick()
             r = self.iterator.step()
@@ -634,7 +634,7 @@ class Session(SessionAPI):
                 # the move are bisected ("Autochopped N edges." before the line).
                 # REF's choice of edges differs where it predicts lengths from
                 # the unrestored motion (mound.fe); equal on cube.fe
-                from .mesh.edge_divide import edge_divide, long_edges
+                from ..remesh.edge_divide import edge_divide, long_edges
                 chop = long_edges(self.surface, L)
                 if len(chop):
                     if self.surface.string:
@@ -682,9 +682,9 @@ class Session(SessionAPI):
         ``callback(result)`` may stop the run, and so does Ctrl-C (at the end
         of the current iteration, the surface that of the last one).
         ``progress``: a tqdm bar, as for :meth:`g` (never with ``echo``)."""
-        from .evolve import bfgs as B
-        from .evolve.gradient import energy_gradient
-        from .evolve.iterate import _Constraints
+        from ..evolve import bfgs as B
+        from ..evolve.gradient import energy_gradient
+        from ..evolve.iterate import _Constraints
         self.no_string("bfgs")
         s = self.surface
         if s is None or s.nv == 0:
@@ -747,7 +747,7 @@ class Session(SessionAPI):
         ``g``) and returns the :class:`~pyevolver.evolve.newton.NewtonResult`;
         ``callback(result)`` may stop the run, and so does Ctrl-C (after the
         current step)."""
-        from .evolve.newton import damped_newton
+        from ..evolve.newton import damped_newton
         self.no_string("newton")
         s = self.surface
         if s is None or s.nv == 0:
@@ -775,8 +775,8 @@ class Session(SessionAPI):
         """``hessian``: one Newton step on the constrained problem;
         ``hessian_seek [max]``: a line search along the Newton direction
         (scale at most ``max``, default 1).  Returns a :class:`StepResult`."""
-        from .evolve.hessian import newton_direction
-        from .evolve.iterate import StepResult, _Constraints
+        from ..evolve.hessian import newton_direction
+        from ..evolve.iterate import StepResult, _Constraints
         self.no_string("hessian")
         if self.surface is None or self.surface.nv == 0:
             # (everything deleted; REF: "No vertices" warnings or unrelated errors)
@@ -836,13 +836,13 @@ class Session(SessionAPI):
             raise UnsupportedError(f"{what} in the string model")
 
     def _string_split(self, edges):
-        from .string_model import split_edges
+        from ..model.string import split_edges
         self._replace_surface(split_edges(self.surface, edges))
         return len(edges)
 
     def refine(self, echo=True):
         """``r``: refine every edge and facet (spec §8.1)."""
-        from .mesh import refine
+        from ..remesh import refine
         s = self.surface
         if s.string:
             self._string_split(np.nonzero(~s.eattr["no_refine"])[0])
@@ -863,7 +863,7 @@ class Session(SessionAPI):
 
     def refine_edges(self, edges, echo=True):
         """``refine edges where ...``: bisect the given edges (spec §8)."""
-        from .mesh.edge_divide import edge_divide
+        from ..remesh.edge_divide import edge_divide
         edges = np.asarray(edges, np.int64)
         if self.surface.string:
             n = self._string_split(np.unique(edges))
@@ -876,7 +876,7 @@ class Session(SessionAPI):
     def refine_facets(self, facets, echo=True):
         """``refine facets where ...``: split each facet into three at its
         centroid (REF's report "Facets refined: N")."""
-        from .mesh.notch import split_facets_at_centre
+        from ..remesh.notch import split_facets_at_centre
         self.no_string("refine facets")
         f = np.unique(np.asarray(facets, np.int64))
         self._replace_surface(split_facets_at_centre(self.surface, f))
@@ -885,7 +885,7 @@ class Session(SessionAPI):
 
     def equiangulate(self, echo=True):
         """``u``: one equiangulation sweep (spec §8.2)."""
-        from .mesh.equiangulate import equiangulate
+        from ..remesh.equiangulate import equiangulate
         if self.surface.string:
             raise CommandError("Cannot equiangulate string model.")      # REF's ERROR 2200
         new, n = equiangulate(self.surface)
@@ -898,7 +898,7 @@ class Session(SessionAPI):
     def edgeswap(self, edges, echo=True):
         """``edgeswap gen``: flip the listed edges that are diagonals of
         quadrilaterals, whatever the angles (manual: EDGESWAP)."""
-        from .mesh.equiangulate import equiangulate
+        from ..remesh.equiangulate import equiangulate
         self.no_string("edgeswap")
         only = np.zeros(self.surface.ne, bool)
         only[np.asarray(edges, np.int64)] = True
@@ -909,7 +909,7 @@ class Session(SessionAPI):
         return n
 
     def _bisect(self, edges, echo):
-        from .mesh.edge_divide import edge_divide
+        from ..remesh.edge_divide import edge_divide
         if self.surface.string:
             n = self._string_split(np.asarray(edges, np.int64))
         else:
@@ -922,20 +922,20 @@ class Session(SessionAPI):
 
     def edge_divide_long(self, length, echo=True):
         """``l L``: bisect every edge longer than ``L`` once (spec §8)."""
-        from .mesh.edge_divide import long_edges
+        from ..remesh.edge_divide import long_edges
         n = self._bisect(long_edges(self.surface, length), echo)
         self.settings["edge_divide_length"] = length
         return n
 
     def skinny(self, angle, echo=True):
         """``K θ``: bisect the longest edge of facets with an angle below θ."""
-        from .mesh.edge_divide import skinny_edges
+        from ..remesh.edge_divide import skinny_edges
         self.no_string("K (skinny triangles)")
         return self._bisect(skinny_edges(self.surface, angle), echo)
 
     def notch(self, angle, echo=True):
         """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""
-        from .mesh.notch import notch
+        from ..remesh.notch import notch
         self.no_string("notch")
         new, n = notch(self.surface, angle)
         self._replace_surface(new)
@@ -945,8 +945,8 @@ class Session(SessionAPI):
         return n
 
     def pop_edges(self, echo=True):
-        """``O``: pop the edges with four facets (pyevolver.mesh.pop)."""
-        from .mesh.pop import pop_edges
+        """``O``: pop the edges with four facets (pyevolver.remesh.pop)."""
+        from ..remesh.pop import pop_edges
         new, n = pop_edges(self.surface)
         self._replace_surface(new)
         self.counts["edge_pop"] = n             # REF: a later O with no pops prints 0
@@ -959,7 +959,7 @@ class Session(SessionAPI):
 
     def delete_short_edges(self, length, echo=True):
         """``t L`` / ``edgeweed L``: delete edges shorter than ``L`` (spec §8.4)."""
-        from .mesh.delete_edges import delete_short_edges
+        from ..remesh.delete_edges import delete_short_edges
         self.no_string("t (edge weeding)")
         new, n = delete_short_edges(self.surface, length)
         self._replace_surface(new)
@@ -971,7 +971,7 @@ class Session(SessionAPI):
     def delete_elements(self, kind, items, echo=True):
         """``delete edges ...`` / ``delete facets ...``: delete the edges (or,
         per facet, its shortest deletable side) as ``t`` / ``w`` do."""
-        from .mesh.delete_edges import delete_edges, delete_facets
+        from ..remesh.delete_edges import delete_edges, delete_facets
         self.no_string("delete")
         fn = delete_edges if kind == "edge" else delete_facets
         new, n = fn(self.surface, items)
@@ -1007,7 +1007,7 @@ class Session(SessionAPI):
     def weed(self, area, echo=True):
         """``w A`` / ``areaweed A``: remove facets of area below ``A`` by
         deleting one of their edges, shortest first (spec §8.4)."""
-        from .mesh.delete_edges import weed_small_facets
+        from ..remesh.delete_edges import weed_small_facets
         if self.surface.string:
             raise CommandError("Can only do area weed on soapfilm model.")   # REF's ERROR 1339
         new, n = weed_small_facets(self.surface, area)
@@ -1019,9 +1019,9 @@ class Session(SessionAPI):
 
     def vertex_average(self, mode="V", echo=True):
         """``V``, ``rawv``, ``rawestv``: vertex averaging (spec §8.3)."""
-        from .mesh.vertex_average import vertex_average
+        from ..remesh.vertex_average import vertex_average
         if self.surface.string:
-            from .string_model import vertex_average as string_average
+            from ..model.string import vertex_average as string_average
             self._replace_surface(string_average(self.surface, mode))
         else:
             self._replace_surface(vertex_average(self.surface, mode))
@@ -1134,7 +1134,7 @@ class Session(SessionAPI):
     def _facetedge_count(self):
         s = self.surface
         if s.string:
-            from .string_model import facetedge_count
+            from ..model.string import facetedge_count
             return facetedge_count(s)
         return 3 * s.nf
 
@@ -1213,18 +1213,18 @@ class Session(SessionAPI):
             return self._string_sub_elements(el, kind)
         if el.kind == "vertex":
             if kind == "edge" and "ring_time" in s.eattr:
-                from .string_model import vertex_edges
+                from ..model.string import vertex_edges
                 return [I.ElemRef("edge", e, g) for e, g in vertex_edges(s, i)]
             if kind == "edge":
                 # oriented away from the vertex (oid < 0 where it is the head),
                 # in the Evolver's ring order (surface.vertex_rings)
-                from .surface import vertex_edge_rank
+                from ..model.surface import vertex_edge_rank
                 es, end = np.nonzero(s.E == i)
                 es = es[np.argsort(vertex_edge_rank(s)[es, end], kind="stable")]
                 es = list(dict.fromkeys(es.tolist()))
                 return [I.ElemRef("edge", int(e), 1 if s.E[e, 0] == i else -1) for e in es]
             if kind == "facet":
-                from .surface import vertex_facet_rank
+                from ..model.surface import vertex_facet_rank
                 fs, corner = np.nonzero(s.F == i)
                 fs = fs[np.argsort(vertex_facet_rank(s)[fs, corner], kind="stable")]
                 return [I.ElemRef("facet", int(f)) for f in dict.fromkeys(fs.tolist())]
@@ -1236,7 +1236,7 @@ class Session(SessionAPI):
                 return [I.ElemRef("vertex", int(a)), I.ElemRef("vertex", int(b))]
             if kind == "facet":
                 # oriented like the edge: oid < 0 where the facet runs against it
-                from .geometry import edge_index
+                from ..geometry.kernels import edge_index
                 idx, sgn = edge_index(s.FE)
                 out = []
                 for f in np.nonzero((idx == i).any(axis=1))[0]:
@@ -1245,12 +1245,12 @@ class Session(SessionAPI):
                 # REF's loop order of a two-facet edge: the facet running along
                 # the edge first, unless the loop is known to start with the
                 # other (surface.along_first)
-                from .surface import along_first
+                from ..model.surface import along_first
                 first = 1 if len(out) != 2 or along_first(s)[i] else -1
                 out.sort(key=lambda r: -r.sign * el.sign * first)
                 return out
         if el.kind == "facet":
-            from .geometry import edge_index
+            from ..geometry.kernels import edge_index
             if kind == "vertex":
                 return [I.ElemRef("vertex", int(v)) for v in s.F[i]]
             if kind == "edge":
@@ -1266,7 +1266,7 @@ class Session(SessionAPI):
 
     def _string_sub_elements(self, el, kind):
         """Facet navigation in the string model (facets are edge chains)."""
-        from . import string_model as SM
+        from ..model import string as SM
         s = self.surface
         i = el.i
         if el.kind == "facet":
@@ -1298,7 +1298,7 @@ class Session(SessionAPI):
             raise ExpressionError(f"the {el.kind} no longer exists (deleted by this command)")
 
     def get_attr(self, base, name, idx):
-        from .commands import attributes as A
+        from ..commands import attributes as A
         if isinstance(base, A.ConstraintAt):
             return A.constraint_attr(self, base, name, idx)
         if name in ("on_quantity", "on_method_instance"):
@@ -1336,7 +1336,7 @@ class Session(SessionAPI):
             if k == "edge":
                 return float(bool(s.eattr["fixed"][i]) or
                              len(self.sub_elements(base, "facet")) != 2)
-        from .commands import attributes as A
+        from ..commands import attributes as A
         v = A.element_attr(self, base, name, idx)
         if v is not A.MISSING:
             return v
@@ -1368,8 +1368,8 @@ class Session(SessionAPI):
             if name in ("vertexnormal", "vertex_normal"):
                 if isinstance(idx, tuple):
                     raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
-                from .geometry import vertex_normals
-                from .surface import vertex_facet_rank
+                from ..geometry.kernels import vertex_normals
+                from ..model.surface import vertex_facet_rank
                 if s.nf == 0:
                     raise UnsupportedError("vertex_normal in the string model")
                 nrm = vertex_normals(s.F, t.facet_N2, s.nv, vertex_facet_rank(s))[i]
@@ -1513,7 +1513,7 @@ class Session(SessionAPI):
             return float(q.pressure)
         if name == "tolerance":
             return float(q.tolerance)
-        from .commands import attributes as A
+        from ..commands import attributes as A
         return A.quantity_attr(self, q, name)
 
     def set_attr(self, base, name, idx, value):
@@ -1542,7 +1542,7 @@ class Session(SessionAPI):
             raise CommandError(f"'.{name}' needs an element or a quantity")
         self._check_alive(base)
         k, i = base.kind, base.i
-        from .commands import attributes as A
+        from ..commands import attributes as A
         if (k, name) not in s.extra and A.set_element_attr(self, base, name, idx, value):
             return
         if (k, name) in s.extra:
@@ -1624,7 +1624,7 @@ class Session(SessionAPI):
         raise CommandError(f"cannot assign to {k} attribute '{name}'")
 
     def set_elements(self, gen, attr, expr, env, unset, idx=None):
-        from .commands import attributes as A
+        from ..commands import attributes as A
         els = self.generate(gen, env)
         qname = A.membership_name(self, gen.kind, attr, expr)
         if qname is not None:
@@ -1727,8 +1727,8 @@ class Session(SessionAPI):
         ones and known by its name (REF: ``list`` shows the name,
         ``on_constraint NAME`` and ``set ... constraint NAME`` use it)."""
         import re
-        from .datafile.preprocess import Section
-        from .datafile.reader import Reader
+        from ..datafile.preprocess import Section
+        from ..datafile.reader import Reader
         m = re.match(r"\s*define\s+constraint\s+([a-z_]\w*)(.*)\Z", text, re.I | re.S)
         if m is None:
             raise CommandError("define constraint: expected a name, e.g. "
@@ -1990,12 +1990,12 @@ class Session(SessionAPI):
         t = self.totals
         eid, fid = s.ids("edge"), s.ids("facet")
         if s.string:
-            from .string_model import chain
+            from ..model.string import chain
             enc = chain(s, i)
             edges = [int(eid[e]) if e >= 0 else -int(eid[~e]) for e in enc]
             area = t.sfacet_area[i]
         else:
-            from .geometry import edge_index
+            from ..geometry.kernels import edge_index
             idx, sgn = edge_index(s.FE[i])
             edges = [int(eid[e] * g) for e, g in zip(idx, sgn)]
             area = t.facet_area[i]

@@ -4,7 +4,7 @@
 then reads commands from the terminal (prompt ``Enter command: ``) or from
 standard input when it is not a terminal; ``-f FILE`` runs a command file
 after loading.  ``pyevolver convert|show|sweep ...`` are the subcommands
-of :mod:`pyevolver.tools`.  Errors become messages and exit codes here only.
+of :mod:`pyevolver.cli.tools`.  Errors become messages and exit codes here only.
 """
 from __future__ import annotations
 
@@ -14,10 +14,10 @@ import sys
 
 import numpy as np
 
-from . import __version__
-from .commands import interpreter as I
-from .errors import InternalError, PyEvolverError
-from .session import Session
+from .. import __version__
+from ..commands import interpreter as I
+from ..errors import InternalError, PyEvolverError
+from ..session.core import Session
 
 PROMPT = "Enter command: "
 MORE = "more> "
@@ -272,7 +272,7 @@ def _completer(session):
             names |= set(session.commands) | set(session.arrays)
             names |= {k for k, v in session.variables.items()}
             names |= set(session.settings)
-            from .session import READ_ONLY
+            from ..session.core import READ_ONLY
             names |= READ_ONLY
             s = session.surface
             if s is not None:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import UnsupportedError
+from ...errors import UnsupportedError
 
 MAX_VALENCE = 12
 

@@ -1,0 +1,3 @@
+from .core import Session
+
+__all__ = ["Session"]
