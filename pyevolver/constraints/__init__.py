@@ -1,0 +1,1 @@
+"""Level-set constraints and boundaries: projection, tangent spaces, one-sided constraints."""
