@@ -137,7 +137,8 @@ def facet_volume_grad(t, symmetric):
     return g
 
 
-def facet_gravity_grad(t):
+def facet_gravity_grad(t) -> np.ndarray:
+    """Per-corner gradients (nf, 3, 3) of the facets' gravity integrals."""
     P = facet_points(t)
     z = P[..., 2]
     S = (z * z).sum(axis=1) + z[:, 0] * z[:, 1] + z[:, 1] * z[:, 2] + z[:, 0] * z[:, 2]
@@ -192,7 +193,8 @@ class _Env:
                 self.coords[name] = arr[rep]
 
 
-def edge_length_grad(t, idx, weights):
+def edge_length_grad(t, idx: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Gradient (nv, 3) of ``Σ_e w_e |e|`` over the edges ``idx``."""
     s = t.surface
     d = t.edge_vec[idx]
     L = t.edge_length[idx]

@@ -46,6 +46,7 @@ def _facet_values(t, name):
 
 
 def values(ctx, m, idx):
+    """Per-vertex third of the vertex's facets' shares (see the module docstring)."""
     s = ctx.surface
     v = _facet_values(ctx, m.method) / 3.0
     per_v = np.bincount(s.F.ravel(), weights=np.repeat(v, 3), minlength=s.nv)
@@ -53,6 +54,7 @@ def values(ctx, m, idx):
 
 
 def gradient(t, m, idx, w):
+    """Gradient (nv, 3) of ``Σ w_v value_v``."""
     s = t.surface
     wv = vertex_weights(s.nv, idx, w)
     coef = wv[s.F].sum(1) / 3.0

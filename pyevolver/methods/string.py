@@ -35,13 +35,15 @@ def vertex_integrand(s, which):
     return out
 
 
-def point_values(s, formula, idx):
+def point_values(s, formula, idx: np.ndarray) -> np.ndarray:
+    """(n,) values of ``formula`` at the vertices ``idx``."""
     P = s.X[idx]
     coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
     return formula.values(s.param_env(), coords, len(idx))
 
 
-def point_gradients(s, formula, idx):
+def point_gradients(s, formula, idx: np.ndarray) -> np.ndarray:
+    """(n, 3) gradients of ``formula`` at the vertices ``idx``."""
     P = s.X[idx]
     coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
     return formula.gradient(s.param_env(), coords, len(idx))
@@ -102,7 +104,8 @@ def chain_grad(s, per_facet, fn):
     return out
 
 
-def area_derivs(Pt, Ph):
+def area_derivs(Pt: np.ndarray, Ph: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Tail and head derivatives (m, 2) of the per-edge area terms."""
     dx = Ph[:, 0] - Pt[:, 0]
     sy = Pt[:, 1] + Ph[:, 1]
     gt = np.stack([sy / 2.0, -dx / 2.0], axis=1)
@@ -110,7 +113,8 @@ def area_derivs(Pt, Ph):
     return gt, gh
 
 
-def gravity_derivs(Pt, Ph):
+def gravity_derivs(Pt: np.ndarray, Ph: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Tail and head derivatives (m, 2) of the per-edge gravity terms."""
     dx = Ph[:, 0] - Pt[:, 0]
     yt, yh = Pt[:, 1], Ph[:, 1]
     q = (yt * yt + yt * yh + yh * yh) / 6.0
@@ -131,7 +135,8 @@ def facet_area_gradient(s, per_facet):
     return g
 
 
-def body_gradient(s, i):
+def body_gradient(s, i: int) -> np.ndarray:
+    """Gradient (nv, 3) of body ``i``'s area."""
     w = np.asarray(s.bodies.facet_matrix.getrow(i).todense()).ravel()
     return facet_area_gradient(s, w)
 

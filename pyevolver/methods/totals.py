@@ -13,7 +13,7 @@ from ..constraints import integral_edges, located
 from ..errors import PyEvolverError
 from ..geometry import kernels as G
 from ..model.records import convex_edges, torus_lift_shifts
-from ..model.surface import HOOKS, Surface
+from ..model.surface import HOOKS, Quantity, Surface
 from .curvature import legacy_energy
 from .registry import lookup
 
@@ -23,9 +23,26 @@ class Totals:
 
     Derived geometry (edge vectors, facet normals, areas) is computed once per
     evaluation and shared by every energy term and method.
+
+    Attributes
+    ----------
+    surface : Surface
+    energy : float
+        The total energy.
+    total_area : float
+    terms : dict of str -> float
+        The energy by term (``facet_tension``, ``edge_tension``, ``gap``,
+        ``gravity``, ``sq_curvature``).
+    facet_area, facet_volume : (nf,) arrays
+    facet_N2 : (nf, 3) array
+        Twice the facet area vectors.
+    volumes : (nbodies,) array
+    quantity_values : dict of str -> float
+    edge_vec, edge_length, facet_x0, facet_S
+        (ne, 3), (ne,), (nf, 3), (nf, 2, 3): computed on first use.
     """
 
-    def __init__(self, s):
+    def __init__(self, s: Surface):
         self.surface = s
         X = s.X
         wrap = s.wrap_shift()
@@ -128,8 +145,10 @@ class Totals:
              "facet_S": _make_facet_S}
 
     # ---- pieces -----------------------------------------------------------
-    def eval_points(self, formula, P, etype=None, idx=None):
-        """Evaluate a formula at points ``P (n, sdim)``."""
+    def eval_points(self, formula, P: np.ndarray, etype: str | None = None,
+                    idx: np.ndarray | None = None) -> np.ndarray:
+        """Evaluate a formula at points ``P (n, sdim)`` (the elements' extra
+        attributes of ``etype`` at ``idx`` available by name); (n,)."""
         s = self.surface
         coords = {"x": P[:, 0], "y": P[:, 1]}
         if P.shape[1] > 2:
@@ -142,8 +161,9 @@ class Totals:
                     coords[name] = arr[idx]
         return formula.values(s.param_env(), coords, len(P))
 
-    def edge_vector_integral(self, comps, idx):
-        """Sum of Gauss-Legendre line integrals of a vector field along edges."""
+    def edge_vector_integral(self, comps, idx: np.ndarray) -> np.ndarray:
+        """(n,) 2-point Gauss-Legendre line integrals of the vector field
+        ``comps`` along the edges ``idx``."""
         s = self.surface
         x0 = s.X[s.E[idx, 0]]
         d = self.edge_vec[idx]
@@ -189,7 +209,8 @@ class Totals:
                     total += float(np.sum(np.where(gn > 0, sg * L / (12.0 * gn), 0.0)))
         return s.gap_constant * total
 
-    def constraint_gradient(self, c, P):
+    def constraint_gradient(self, c, P: np.ndarray) -> np.ndarray:
+        """(n, 3) gradient of constraint ``c``'s formula at points ``P (n, 3)``."""
         coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
         return c.formula.gradient(self.surface.param_env(), coords, len(P))
 
@@ -218,7 +239,7 @@ class Totals:
             vols = vols + shift
         return vols
 
-    def facet_edge_sum(self, per_edge):
+    def facet_edge_sum(self, per_edge: np.ndarray) -> np.ndarray:
         """For each facet, sum of oriented per-edge values over its edges."""
         idx, sgn = G.edge_index(self.surface.FE)
         return np.sum(per_edge[idx] * sgn, axis=1)
@@ -235,13 +256,13 @@ class Totals:
         """(nf,) each facet's gravitational integral (unit density and G)."""
         return G.facet_gravity(self.facet_x0, self.facet_S)
 
-    def instance_values(self, q):
+    def instance_values(self, q: Quantity) -> dict[str, float]:
         """``{"inst.value": value}`` of the method instances a FUNCTION reads."""
         s = self.surface
         return {f"{n}.value": self.quantity_value(s.quantities[n])
                 for n in (v[:-6] for v in q.function.node.names() if v.endswith(".value"))}
 
-    def quantity_value(self, q, magnitude=False):
+    def quantity_value(self, q: Quantity, magnitude: bool = False) -> float:
         """Value of a named quantity; with ``magnitude=True`` the sum of the
         absolute values of its element contributions instead (the scale of
         its restoring tolerance).  A FUNCTION quantity's magnitude is its
@@ -278,7 +299,7 @@ class Totals:
             total += m.modulus * float(np.sum(vals))
         return abs(q.modulus) * total if magnitude else q.modulus * total
 
-    def volume_magnitudes(self):
+    def volume_magnitudes(self) -> np.ndarray:
         """Per body, the sum of absolute element contributions to its volume:
         facet contents and edge CONTENT integrals, shape (nbodies,)."""
         s = self.surface

@@ -150,7 +150,8 @@ def refuse(what):
     raise UnsupportedError(f"{what} in the string model")
 
 
-def check_no_facets_needed(s, what):
+def check_no_facets_needed(s, what: str) -> None:
+    """Refuse ``what`` (a command needing facets) in the string model."""
     if s.string:
         raise CommandError(f"{what} needs facets: not available in the string model")
 
