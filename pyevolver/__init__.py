@@ -9,7 +9,9 @@ __version__ = "0.1.0"
 from .errors import (PyEvolverError, DatafileError, CommandError, UnsupportedError,  # noqa: E402
                      ExpressionError, ConstraintError, ConvergenceWarning)
 from .datafile.reader import read_datafile  # noqa: E402
-from .model.surface import Surface, build_surface  # noqa: E402
+from .model.surface import Surface  # noqa: E402
+from .model.build import build_surface  # noqa: E402
+from . import methods as _methods  # noqa: E402,F401  (installs the model's evaluate/method hooks)
 from .session.core import Session  # noqa: E402
 from .io.meshio_plugin import register as _register_meshio  # noqa: E402
 

@@ -16,7 +16,7 @@ from reference import run_reference
 from test_commands_reference import _same, run_pyevolver
 
 import pyevolver
-from pyevolver.geometry import attributes as GA
+from pyevolver.methods import attributes as GA
 from pyevolver.errors import CommandError
 
 # per-vertex curvature attributes and edge dihedral angles over whole surfaces

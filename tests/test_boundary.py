@@ -21,7 +21,7 @@ import numpy as np
 from conftest import example
 from reference import run_reference
 from pyevolver import Session
-from pyevolver.model.surface import boundary_eval
+from pyevolver.constraints import boundary_eval
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 

@@ -120,7 +120,7 @@ def test_cli_reports_one_located_error(name):
 @pytest.mark.parametrize("name", FILES)
 def test_library_raises_located_error(name):
     from pyevolver.datafile.reader import read_datafile
-    from pyevolver.model.surface import build_surface
+    from pyevolver.model.build import build_surface
 
     path = str(REPO / MALFORMED / name)
     with pytest.raises((DatafileError, UnsupportedError)) as info:

@@ -194,7 +194,7 @@ def test_nothing_to_pop_reports_zero():
 def test_first_facets_on_load():
     """The loop start of each edge: the first datafile face listing it;
     spokes of faces split on load are unknown (-1)."""
-    from pyevolver.model.surface import edge_first_facet
+    from pyevolver.model.records import edge_first_facet
     s = Session.load(example("octa.fe"), out=io.StringIO()).surface
     first = edge_first_facet(s)
     assert first[12] == 0 and first[14] == 1 and first[15] == 2     # edges 13, 15, 16

@@ -21,7 +21,7 @@ from conftest import example
 from pyevolver import limits
 from pyevolver.errors import CommandError, DatafileError, InternalError
 from pyevolver.session.core import Session
-from pyevolver.model.surface import project_to_constraints
+from pyevolver.constraints import project_to_constraints
 from reference import run_reference
 
 HERE = os.path.dirname(os.path.abspath(__file__))

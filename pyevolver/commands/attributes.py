@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import attributes as GA
+from ..methods import attributes as GA
 from ..errors import ExpressionError, UnsupportedError
 from ..expr import nodes as N
 
@@ -591,7 +591,7 @@ def set_quantity(session, qname, attr, value):
 def _set_parameter(session, i, name, idx, value):
     """``set vertex p1 expr``: a boundary vertex's parameter; the vertex
     moves to its new place on the boundary at once (REF)."""
-    from ..model.surface import boundary_eval
+    from ..constraints import boundary_eval
     s = session.surface
     bnd = s.vattr.get("boundary")
     if bnd is None or not bnd[i]:

@@ -31,10 +31,14 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..geometry import kernels as G
+from ..constraints import boundary_eval, boundary_groups, vertex_coords
 from ..errors import UnsupportedError
-from ..methods.jets import skew
-from ..model.surface import boundary_eval, boundary_groups, vertex_coords
+from ..geometry import kernels as G
+from ..methods.basic import (edge_length_hessian, facet_area_hessian,  # noqa: F401
+                             facet_gravity_hessian, facet_volume_hessian)
+from ..methods.curvature import legacy_gradient
+from ..methods.curvature_hessian import legacy_hessian
+from ..methods.registry import lookup
 from . import gradient as GR
 from .ordering import nested_dissection
 
@@ -64,200 +68,6 @@ class Basis:
         cols = np.repeat(self.start[v] + jj, 3)
         vals = self.B[v, :, jj].ravel()
         return sp.csr_matrix((vals, (rows, cols)), shape=(3 * nv, self.n))
-
-
-def _assemble(nv, verts, blocks, basis=None):
-    """Sparse matrix from per-element blocks, in COO form with the elements'
-    entries not yet summed (:func:`_sum` adds all parts in one conversion).
-
-    verts : (m, k) vertex indices of each element; blocks : (m, k, k, 3, 3).
-    Without ``basis`` the (3nv, 3nv) matrix; with a :class:`Basis` the
-    projected ``Tᵀ H T`` (ndof, ndof), contracted per element before the
-    assembly (nine times fewer entries in the hessian_normal case).
-    """
-    m, k = verts.shape
-    if basis is not None:
-        Bv = basis.B[verts]                                        # (m, k, 3, d)
-        blocks = np.einsum("maip,mabij,mbjq->mabpq", Bv, blocks, Bv, optimize=True)
-        return _assemble_projected(verts, blocks, basis)
-    rows = (3 * verts[:, :, None, None, None] + np.arange(3)[None, None, None, :, None])
-    cols = (3 * verts[:, None, :, None, None] + np.arange(3)[None, None, None, None, :])
-    rows = np.broadcast_to(rows, (m, k, k, 3, 3)).ravel()
-    cols = np.broadcast_to(cols, (m, k, k, 3, 3)).ravel()
-    return sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(3 * nv, 3 * nv))
-
-
-def _assemble_projected(verts, blocks, basis):
-    """Sparse (ndof, ndof) matrix from projected element blocks (m, k, k, d, d)."""
-    m, k = verts.shape
-    d = blocks.shape[3]
-    idx = basis.start[verts][:, :, None] + np.arange(d)        # (m, k, d)
-    ok = np.arange(d)[None, None, :] < basis.ndof[verts][:, :, None]
-    idx = np.where(ok, idx, -1)
-    rows = np.broadcast_to(idx[:, :, None, :, None], (m, k, k, d, d)).ravel()
-    cols = np.broadcast_to(idx[:, None, :, None, :], (m, k, k, d, d)).ravel()
-    vals = blocks.ravel()
-    if (basis.ndof[verts] < d).any():
-        keep = (rows >= 0) & (cols >= 0)
-        rows, cols, vals = rows[keep], cols[keep], vals[keep]
-    return sp.coo_matrix((vals, (rows, cols)), shape=(basis.n, basis.n))
-
-
-def facet_area_hessian(t, weights, basis=None):
-    """Hessian of ``Σ_f w_f A_f`` (3nv, 3nv).
-
-    With ``N = (x1−x0)×(x2−x0)``, ``n = N/|N|`` and ``e_a`` the side opposite
-    corner a (``e_0 = x2−x1`` cyclic), ``∂A/∂x_a = ½ n × e_a`` and
-
-        ∂²A/∂x_a∂x_b = ½ ε_ab [n]x + [e_a]xᵀ (I − n nᵀ) [e_b]x / (2|N|)
-
-    with ε_ab = +1 if b = a+2, −1 if b = a+1 (mod 3), 0 if a = b.
-    """
-    s = t.surface
-    P = GR._facet_points(t)
-    N2 = t.facet_N2
-    L = np.linalg.norm(N2, axis=1)
-    ok = (L > 0) & (weights != 0)
-    P, N2, L, w = P[ok], N2[ok], L[ok], weights[ok]
-    n = N2 / L[:, None]
-    e = np.stack([P[:, 2] - P[:, 1], P[:, 0] - P[:, 2], P[:, 1] - P[:, 0]], 1)
-    if basis is not None and basis.B.shape[2] == 1:
-        # one free direction u_v per vertex: contract in closed form,
-        # u_aᵀ H_ab u_b = ½ ε_ab u_a·(n × u_b) + (w_a·w_b − (n·w_a)(n·w_b)) / (2|N|)
-        # with w_a = e_a × u_a
-        F = s.F[ok]
-        U = basis.B[F][:, :, :, 0]                                   # (m, 3, 3)
-        W = np.cross(e, U)
-        nw = np.einsum("mi,mai->ma", n, W)
-        K = np.einsum("mai,mbi->mab", W, W) - nw[:, :, None] * nw[:, None, :]
-        K /= (2 * L)[:, None, None]
-        nxU = np.cross(n[:, None, :], U)
-        T3 = np.einsum("mai,mbi->mab", U, nxU)                     # u_a·(n × u_b)
-        K[:, 0, 2] += 0.5 * T3[:, 0, 2]
-        K[:, 1, 0] += 0.5 * T3[:, 1, 0]
-        K[:, 2, 1] += 0.5 * T3[:, 2, 1]
-        K[:, 0, 1] -= 0.5 * T3[:, 0, 1]
-        K[:, 1, 2] -= 0.5 * T3[:, 1, 2]
-        K[:, 2, 0] -= 0.5 * T3[:, 2, 0]
-        K *= w[:, None, None]
-        return _assemble_projected(F, K[:, :, :, None, None], basis)
-    # [e_a]x^T (I - n n^T) [e_b]x = (e_a.e_b) I - e_b e_a^T - c_a c_b^T, c_a = n x e_a
-    c = np.cross(n[:, None, :], e)                                   # (m, 3, 3)
-    dots = np.einsum("mai,mbi->mab", e, e)
-    B = -(e[:, None, :, :, None] * e[:, :, None, None, :])           # (m, a, b, i, l)
-    B -= c[:, :, None, :, None] * c[:, None, :, None, :]
-    B[:, :, :, [0, 1, 2], [0, 1, 2]] += dots[:, :, :, None]
-    B /= (2 * L)[:, None, None, None, None]
-    nx = skew(n)
-    eps = np.zeros((3, 3))
-    for a in range(3):
-        eps[a, (a + 2) % 3] = 1.0
-        eps[a, (a + 1) % 3] = -1.0
-    B += 0.5 * eps[None, :, :, None, None] * nx[:, None, None]
-    B *= w[:, None, None, None, None]
-    return _assemble(s.nv, s.F[ok], B, basis)
-
-
-def edge_length_hessian(t, idx, weights, basis=None):
-    """Hessian of ``Σ_e w_e L_e``: blocks ``±(I − t tᵀ)/L``."""
-    s = t.surface
-    d = t.edge_vec[idx]
-    L = t.edge_length[idx]
-    ok = L > 0
-    d, L, w, idx = d[ok], L[ok], np.asarray(weights)[ok], idx[ok]
-    u = d / L[:, None]
-    K = (np.eye(3)[None] - u[:, :, None] * u[:, None, :]) * (w / L)[:, None, None]
-    B = np.stack([np.stack([K, -K], 1), np.stack([-K, K], 1)], 1)
-    return _assemble(s.nv, s.E[idx], B, basis)
-
-
-def facet_volume_hessian(t, weights, symmetric, basis=None):
-    """Hessian of ``Σ_f w_f v_f`` for the z-flux or symmetric facet volume."""
-    s = t.surface
-    P = GR._facet_points(t)
-    m = len(P)
-    if basis is not None and basis.B.shape[2] == 1:
-        # one free direction u_v per vertex: second directional derivatives
-        U = basis.B[s.F][:, :, :, 0]                                 # (m, 3, 3)
-        K = np.zeros((m, 3, 3))
-        if symmetric:
-            # v = det[x0, x1, x2]/6: u_a in slot a, u_b in slot b, x_c in slot c
-            for a in range(3):
-                for b in range(3):
-                    if a != b:
-                        c = 3 - a - b
-                        slots = [None, None, None]
-                        slots[a], slots[b], slots[c] = U[:, a], U[:, b], P[:, c]
-                        K[:, a, b] = np.einsum("mi,mi->m", slots[0],
-                                               np.cross(slots[1], slots[2])) / 6.0
-        else:
-            # v = Z cz / 6: Z = Σ z, cz bilinear in (x, y)
-            C = np.array([[0, 1, -1], [-1, 0, 1], [1, -1, 0]], float)
-            Z = P[:, :, 2].sum(axis=1)
-            dcz = GR._cz_grad(P)                                     # (m, 3, 3)
-            du = dcz[:, :, 0] * U[:, :, 0] + dcz[:, :, 1] * U[:, :, 1]   # dcz_a · u_a
-            uz = U[:, :, 2]
-            xy = U[:, :, 0][:, :, None] * U[:, :, 1][:, None, :]     # u_ax u_by
-            K = (Z[:, None, None] * (C[None] * xy + C.T[None] * xy.transpose(0, 2, 1))
-                 + uz[:, :, None] * du[:, None, :] + du[:, :, None] * uz[:, None, :]) / 6.0
-        K *= np.asarray(weights)[:, None, None]
-        return _assemble_projected(s.F, K[:, :, :, None, None], basis)
-    B = np.zeros((m, 3, 3, 3, 3))
-    if symmetric:
-        # v = det[x0, x1, x2]/6: d²v/dx_a^i dx_b^j = ±ε_ijk x_c^k / 6
-        for a in range(3):
-            for b in range(3):
-                if a == b:
-                    continue
-                c = 3 - a - b
-                sign = 1.0 if (a, b, c) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) else -1.0
-                B[:, a, b] = sign * skew(P[:, c]).transpose(0, 2, 1) / 6.0
-                # eps_ijk x^k = -[x]x_ij
-    else:
-        # v = (z0+z1+z2) cz / 6, cz bilinear in x and y
-        C = np.array([[0, 1, -1], [-1, 0, 1], [1, -1, 0]], float)
-        Z = P[:, :, 2].sum(axis=1)
-        dcz = GR._cz_grad(P)                      # (m, 3, 3): d cz / d corner
-        for a in range(3):
-            for b in range(3):
-                B[:, a, b, 0, 1] = Z * C[a, b] / 6.0
-                B[:, a, b, 1, 0] = Z * C[b, a] / 6.0
-                B[:, a, b, 2, 0] = dcz[:, b, 0] / 6.0
-                B[:, a, b, 2, 1] = dcz[:, b, 1] / 6.0
-                B[:, a, b, 0, 2] = dcz[:, a, 0] / 6.0
-                B[:, a, b, 1, 2] = dcz[:, a, 1] / 6.0
-    B *= np.asarray(weights)[:, None, None, None, None]
-    return _assemble(s.nv, s.F, B, basis)
-
-
-def facet_gravity_hessian(t, weights, basis=None):
-    """Hessian of ``Σ_f w_f g_f`` with ``g = S(z) cz / 24`` (see :mod:`.gradient`).
-
-    ``S = Σ z_a² + Σ_{a<b} z_a z_b`` is quadratic in the heights and ``cz``
-    bilinear in x and y, so the blocks are ``S/24 ∂²cz`` (xy-xy),
-    ``∂S/∂z_a ∂cz/∂(x,y)_b / 24`` (z-xy) and ``(1 + δ_ab) cz / 24`` (z-z).
-    """
-    s = t.surface
-    P = GR._facet_points(t)
-    m = len(P)
-    z = P[:, :, 2]
-    S = (z * z).sum(axis=1) + z[:, 0] * z[:, 1] + z[:, 1] * z[:, 2] + z[:, 0] * z[:, 2]
-    dS = z + z.sum(axis=1)[:, None]               # ∂S/∂z_a = 2 z_a + Σ_{b≠a} z_b
-    cz = t.facet_N2[:, 2]
-    dcz = GR._cz_grad(P)
-    C = np.array([[0, 1, -1], [-1, 0, 1], [1, -1, 0]], float)
-    B = np.zeros((m, 3, 3, 3, 3))
-    for a in range(3):
-        for b in range(3):
-            B[:, a, b, 0, 1] = S * C[a, b]
-            B[:, a, b, 1, 0] = S * C[b, a]
-            B[:, a, b, 2, 0] = dS[:, a] * dcz[:, b, 0]
-            B[:, a, b, 2, 1] = dS[:, a] * dcz[:, b, 1]
-            B[:, a, b, 0, 2] = dS[:, b] * dcz[:, a, 0]
-            B[:, a, b, 1, 2] = dS[:, b] * dcz[:, a, 1]
-            B[:, a, b, 2, 2] = (2.0 if a == b else 1.0) * cz
-    B *= (np.asarray(weights) / 24.0)[:, None, None, None, None]
-    return _assemble(s.nv, s.F, B, basis)
 
 
 def distance2_coloring(s, seed=0):
@@ -337,7 +147,7 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
     and whether they cover the whole Lagrangian.
 
     The Hessian is (3nv, 3nv), or projected on ``basis`` (see
-    :func:`_assemble`); with ``hessian=False`` only the gradient is formed
+    :func:`pyevolver.methods._common.assemble`); with ``hessian=False`` only the gradient is formed
     (``H`` is None), with ``gradient=False`` only the Hessian (``g`` is None).
     """
     parts = []                       # (hessian function, args) of each analytic term
@@ -365,8 +175,6 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
     if b.n and not np.all(np.isnan(b.pressure)):
         complete = False
     if "sq_curvature" in t.terms:
-        from ..methods.curvature import legacy_gradient
-        from ..methods.curvature_hessian import legacy_hessian
         k = s.sq_curvature_modulus
         parts.append((lambda basis=None: k * legacy_hessian(t, basis), ()))
         if gradient:
@@ -411,7 +219,6 @@ def _sum(mats):
 def _quantity_hessian(t, q, weight):
     """Hessian terms ``[(function, args)]`` of ``weight × q``, or None when
     one of its methods has no analytic Hessian."""
-    from ..methods import HESSIANS, NO_HESSIAN
     s = t.surface
     out = []
     if q.function is not None:
@@ -434,24 +241,14 @@ def _quantity_hessian(t, q, weight):
     for m, etype, idx, sign in q.methods:
         w = np.ones(len(idx)) if sign is None else np.asarray(sign, float)
         w = w * (m.modulus * q.modulus * weight)
-        name = m.method
-        if name in ("facet_area", "facet_volume"):
-            full = np.zeros(s.nf)
-            np.add.at(full, idx, w)
-            if name == "facet_area":
-                out.append((facet_area_hessian, (t, full)))
-            elif s.periods is None:
-                out.append((facet_volume_hessian, (t, full, s.symmetric_content)))
-            else:
-                return None
-        elif name == "edge_length":
-            out.append((edge_length_hessian, (t, np.asarray(idx, np.int64), w)))
-        elif name in HESSIANS:
-            out.append((HESSIANS[name], (t, m, np.asarray(idx, np.int64), w)))
-        elif name in NO_HESSIAN:
-            raise UnsupportedError(f"hessian with method {name}", NO_HESSIAN[name])
-        else:
+        entry = lookup(m.method)
+        if entry.hessian is None:
+            if entry.no_hessian:
+                raise UnsupportedError(f"hessian with method {m.method}", entry.no_hessian)
             return None
+        if entry.hessian_applies is not None and not entry.hessian_applies(s):
+            return None
+        out.append((entry.hessian, (t, m, np.asarray(idx, np.int64), w)))
     return out
 
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model.surface import (displace, project_tangent, project_to_constraints, release_one_sided,
+from ..constraints import (displace, project_tangent, project_to_constraints, release_one_sided,
                        restore_state, state)
 from . import gradient as GR
 

@@ -102,7 +102,7 @@ def damped_newton(session, n, callback=None, delta0=None, rtol=1e-10):
     -------
     NewtonResult
     """
-    from ..model.surface import restore_state, state
+    from ..constraints import restore_state, state
     from .iterate import _Constraints
     it = session.iterator
     res = NewtonResult(energy=session.surface.evaluate().energy)

@@ -87,7 +87,7 @@ def _mesh_surface(mesh, filename):
     """Build a Surface from a meshio triangle mesh (through the datafile reader)."""
     from ..datafile.reader import read_datafile
     from ..studies.meshes import fe_text
-    from ..model.surface import build_surface
+    from ..model.build import build_surface
     tris = []
     for block in mesh.cells:
         if block.type != "triangle":

@@ -26,6 +26,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UnsupportedError
+from ..model.records import edge_facets
+from ._common import corner_scatter, facet_points, n2_grad_dot, scatter
+from .basic import facet_area_grad
 
 # method -> (estimate, honours h_zero, old-style (zero at FIXED / boundary vertices))
 VERTEX_METHODS = {
@@ -204,23 +207,22 @@ def _area_hvp(P, n, L, U):
 
 def vertex_gradient(t, m, idx, w):
     """Gradient (nv, 3) of ``Σ_v w_v E_v`` over the vertices ``idx``."""
-    from ..evolve import gradient as GR
     s = t.surface
     _check_supported(s)
     A, F, N = star_sums(t)
     _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method)
-    P = GR._facet_points(t)
+    P = facet_points(t)
     L = 2.0 * t.facet_area
     with np.errstate(all="ignore"):
         n = np.nan_to_num(t.facet_N2 / L[:, None])
-    Ag = GR.facet_area_grad(t)
+    Ag = facet_area_grad(t)
     wv = vertex_weights(s.nv, idx, w)
     dF, dN, dA = dF * wv[:, None], dN * wv[:, None], dA * wv
     Fc = s.F
     g = _area_hvp(P, n, L, dF[Fc])                                # via F_v
-    g += 0.5 * GR._n2_grad_dot(P, dN[Fc].sum(axis=1))              # via N_v
+    g += 0.5 * n2_grad_dot(P, dN[Fc].sum(axis=1))              # via N_v
     g += Ag * dA[Fc].sum(axis=1)[:, None, None]                    # via A_v
-    return GR.corner_scatter(t, g)
+    return corner_scatter(t, g)
 
 
 # -- mean_curvature_integral ----------------------------------------------------------------
@@ -228,7 +230,6 @@ def vertex_gradient(t, m, idx, w):
 def _dihedral(t, idx):
     """For the edges ``idx``: which have two facets (``ok``), those edges
     ``e``, and their facets running along (``f1``) and against (``f2``) them."""
-    from ..remesh.equiangulate import edge_facets
     s = t.surface
     ef, ek, val = edge_facets(s)
     ok = val[idx] == 2
@@ -258,12 +259,11 @@ def mci_values(ctx, m, idx):
 
 
 def mci_gradient(t, m, idx, w):
-    from ..evolve import gradient as GR
     s = t.surface
     idx = np.asarray(idx, np.int64)
     ok, e, f1, f2 = _dihedral(t, idx)
     w = np.asarray(w, float)[ok]
-    P = GR._facet_points(t)
+    P = facet_points(t)
     P1, P2 = P[f1], P[f2]
     N1, N2 = t.facet_N2[f1], t.facet_N2[f2]
     d = t.edge_vec[e]
@@ -278,19 +278,19 @@ def mci_gradient(t, m, idx, w):
     a = (C / R)[:, None]
     b = (S / R)[:, None]
     # through N1 (facet f1 corners) and N2 (facet f2 corners)
-    g1 = GR._n2_grad_dot(P1, a * np.cross(N2, u) - b * N2)
-    g2 = GR._n2_grad_dot(P2, a * np.cross(u, N1) - b * N1)
+    g1 = n2_grad_dot(P1, a * np.cross(N2, u) - b * N2)
+    g2 = n2_grad_dot(P2, a * np.cross(u, N1) - b * N1)
     # through u = d/|d| (edge endpoints)
     du = a * X
     du = (du - u * np.einsum("ij,ij->i", u, du)[:, None]) / Le[:, None]
     coef = (0.5 * Le * w)[:, None, None]
     g = np.zeros((s.nv, 3))
-    g += GR.scatter(s.nv, s.F[f1].ravel(), (g1 * coef).reshape(-1, 3))
-    g += GR.scatter(s.nv, s.F[f2].ravel(), (g2 * coef).reshape(-1, 3))
+    g += scatter(s.nv, s.F[f1].ravel(), (g1 * coef).reshape(-1, 3))
+    g += scatter(s.nv, s.F[f2].ravel(), (g2 * coef).reshape(-1, 3))
     tail, head = s.E[e, 0], s.E[e, 1]
     gu = du * (0.5 * Le * w)[:, None] + (0.5 * theta * w)[:, None] * u   # + ½ θ dL
-    g += GR.scatter(s.nv, head, gu)
-    g -= GR.scatter(s.nv, tail, gu)
+    g += scatter(s.nv, head, gu)
+    g -= scatter(s.nv, tail, gu)
     return g
 
 
@@ -323,8 +323,7 @@ def _angles(P):
 def _gauss(t):
     """Angle defect K (nv,), star area A (nv,) and the per-facet pieces."""
     s = t.surface
-    from ..evolve import gradient as GR
-    P = GR._facet_points(t)
+    P = facet_points(t)
     ang, dang = _angles(P)
     K = 2 * np.pi - np.bincount(s.F.ravel(), weights=ang.ravel(), minlength=s.nv)
     A = np.bincount(s.F.ravel(), weights=np.repeat(t.facet_area, 3), minlength=s.nv)
@@ -346,7 +345,6 @@ def sq_gauss_values(ctx, m, idx):
 
 
 def _gauss_grad(t, idx, w, square):
-    from ..evolve import gradient as GR
     s = t.surface
     _check_supported(s)
     K, A, P, dang = _gauss(t)
@@ -359,8 +357,8 @@ def _gauss_grad(t, idx, w, square):
     Fc = s.F
     # K_v = 2π − Σ angles at v: d/dx of Σ_v dK_v K_v
     g = -np.einsum("fa,fabk->fbk", dK[Fc], dang)
-    g += GR.facet_area_grad(t) * dA[Fc].sum(axis=1)[:, None, None]
-    return GR.corner_scatter(t, g)
+    g += facet_area_grad(t) * dA[Fc].sum(axis=1)[:, None, None]
+    return corner_scatter(t, g)
 
 
 def star_gauss_gradient(t, m, idx, w):
@@ -434,12 +432,11 @@ def _mixed_areas(P, cot, cot_grad, Af, Ag):
 
 
 def _cotan_parts(t):
-    from ..evolve import gradient as GR
     s = t.surface
-    P = GR._facet_points(t)
+    P = facet_points(t)
     cot, cg = _cot_and_grad(P)
     Af = t.facet_area
-    Ag = GR.facet_area_grad(t)
+    Ag = facet_area_grad(t)
     Am, Amg = _mixed_areas(P, cot, cg, Af, Ag)
     Fc = s.F
     # S_v = Σ_f [cot_{c+2} (x_c − x_{c+1}) + cot_{c+1} (x_c − x_{c+2})]
@@ -466,7 +463,6 @@ def cotan_values(ctx, m, idx):
 
 
 def cotan_gradient(t, m, idx, w):
-    from ..evolve import gradient as GR
     s = t.surface
     _check_supported(s)
     P, cot, cg, Am, Amg, Sv, Av = _cotan_parts(t)
@@ -485,7 +481,7 @@ def cotan_gradient(t, m, idx, w):
         g[:, a] += cot[:, k, None] * dU
         g[:, b] -= cot[:, k, None] * dU
     g += np.einsum("fc,fcpk->fpk", uA[Fc], Amg)
-    return GR.corner_scatter(t, g)
+    return corner_scatter(t, g)
 
 
 # -- circle_willmore (Bobenko's conformal energy) ---------------------------------------------
@@ -493,7 +489,6 @@ def cotan_gradient(t, m, idx, w):
 def _edge_quads(s):
     """For every edge with two facets: its ends ``i, j`` and the third
     vertices ``k, l`` of its two facets (edges (nq,), vertices 4 × (nq,))."""
-    from ..remesh.equiangulate import edge_facets
     ef, ek, val = edge_facets(s)
     e = np.nonzero(val == 2)[0]
     F = s.F

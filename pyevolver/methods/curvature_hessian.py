@@ -27,16 +27,17 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import curvature as C
+from ._common import assemble, facet_points
+from .registry import register_method
 from . import jets as J
 
 # -- assembly ---------------------------------------------------------------------------------
 
 def _elements(nv, verts, H, basis):
     """Sparse matrix from per-element Hessians H (m, 3k, 3k) on ``verts`` (m, k)."""
-    from ..evolve.hessian import _assemble
     m, k = verts.shape
     H = _finite(H)
-    return _assemble(nv, verts, H.reshape(m, k, 3, k, 3).transpose(0, 1, 3, 2, 4), basis)
+    return assemble(nv, verts, H.reshape(m, k, 3, k, 3).transpose(0, 1, 3, 2, 4), basis)
 
 
 def _rows(nrows, ridx, verts, blocks, nv, basis):
@@ -171,10 +172,9 @@ def vertex_energy_hessian(s, A, F, N, name):
 def star_hessian(t, M, dA, dF, dN, basis=None):
     """Hessian of ``Σ_v φ_v(A_v, F_v, N_v)`` given the per-vertex Hessians
     M (nv, 7, 7) and first derivatives ``dA`` (nv,), ``dF``, ``dN`` (nv, 3)."""
-    from ..evolve import gradient as GR
     s = t.surface
     nv, Fc = s.nv, s.F
-    P = GR._facet_points(t)
+    P = facet_points(t)
     nf = len(P)
     x, N2, L, Aj = _facet_jets(P)
     # curvature of the star sums: α A_f + Σ_c λ_c · ∇_c A_f + ½ Λ · N_f
@@ -342,3 +342,22 @@ def cotan_hessian(t, m, idx, w, basis=None):
         M[:, :3, 3] = M[:, 3, :3] = -Sv / (8 * Av ** 2)[:, None]
         M[:, 3, 3] = SS / (8 * Av ** 3)
     return _gauss_newton(Jm, M * wv[:, None, None]) + H2
+
+
+# ---------------------------------------------------------------------------
+# the registry entries of the curvature family (values and gradients in
+# :mod:`pyevolver.methods.curvature`, Hessians here)
+
+for _name in C.VERTEX_METHODS:
+    register_method(_name, "vertex", C.vertex_values, C.vertex_gradient, vertex_hessian)
+for _name in ("mean_curvature_integral", "mean_curvature_integral_a"):
+    register_method(_name, "edge", C.mci_values, C.mci_gradient, mci_hessian)
+register_method("star_gauss_curvature", "vertex", C.star_gauss_values, C.star_gauss_gradient,
+                star_gauss_hessian)
+register_method("sq_gauss_curvature", "vertex", C.sq_gauss_values, C.sq_gauss_gradient,
+                sq_gauss_hessian)
+register_method("cotan_sq_mean_curvature", "vertex", C.cotan_values, C.cotan_gradient,
+                cotan_hessian)
+register_method("circle_willmore", "vertex", C.circle_willmore_values, C.circle_willmore_gradient,
+                no_hessian="Bobenko's energy is not smooth (REF has no Hessian for it); "
+                           "use bfgs (or g)")

@@ -14,6 +14,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UnsupportedError
+from ..geometry.loop import LoopEvaluator
+from .curvature import vertex_weights
+from .registry import register_method
 
 KIND = {"loop_sq_mean_curvature": "W", "loop_area": "A", "loop_volume": "V"}
 
@@ -21,7 +24,6 @@ KIND = {"loop_sq_mean_curvature": "W", "loop_area": "A", "loop_volume": "V"}
 def evaluator(s, name="loop_sq_mean_curvature"):
     """The :class:`pyevolver.geometry.loop.LoopEvaluator` of surface ``s``, cached
     while its topology is unchanged."""
-    from ..geometry.loop import LoopEvaluator
     topo = s.topology()
     c = s.__dict__.get("_loop_eval")
     if c is not None and c[0] is topo:
@@ -44,6 +46,7 @@ def _facet_values(t, name):
 
 
 def values(ctx, m, idx):
+    """Per-vertex third of the vertex's facets' shares (see the module docstring)."""
     s = ctx.surface
     v = _facet_values(ctx, m.method) / 3.0
     per_v = np.bincount(s.F.ravel(), weights=np.repeat(v, 3), minlength=s.nv)
@@ -51,8 +54,13 @@ def values(ctx, m, idx):
 
 
 def gradient(t, m, idx, w):
+    """Gradient (nv, 3) of ``Σ w_v value_v``."""
     s = t.surface
-    from .curvature import vertex_weights
     wv = vertex_weights(s.nv, idx, w)
     coef = wv[s.F].sum(1) / 3.0
     return evaluator(s, m.method).gradient(s.X, KIND[m.method], coef)
+
+
+for _name in KIND:
+    register_method(_name, "vertex", values, gradient,
+                    no_hessian="Loop patches couple vertex 2-rings; use g")

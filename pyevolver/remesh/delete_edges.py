@@ -29,7 +29,8 @@ import heapq
 
 import numpy as np
 
-from ..model.surface import project_to_constraints
+from ..constraints import project_to_constraints
+from ..errors import UnsupportedError
 from .shrink import subset
 
 
@@ -40,7 +41,6 @@ def _dec(x):
 class _Deleter:
     def __init__(self, s):
         if s.periods is not None:
-            from ..errors import UnsupportedError
             raise UnsupportedError("deleting edges in the torus model")
         self.s = s
         self.X = s.X.copy()

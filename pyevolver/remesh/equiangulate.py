@@ -13,12 +13,15 @@ in id order, so the result is that of the Evolver's sequential pass.
 """
 from __future__ import annotations
 
+import copy
 import heapq
 import math
 
 import numpy as np
 
 from ..geometry import kernels as G
+from ..model.records import along_first, edge_facets, record_along_first, record_vertex_rings
+from .rings import Rings
 
 
 def _div(a, b):
@@ -31,31 +34,6 @@ def _div(a, b):
     return a / b
 
 
-def edge_facets(s):
-    """(ne, 2) the two facets of each edge and their sides, valence (ne,).
-
-    Rows are filled for edges with exactly two facets (first and last
-    occurrence in facet order), ``-1`` elsewhere.
-    """
-    idx, sgn, _ = s.topology()
-    flat_e = idx.ravel()
-    flat_f = np.repeat(np.arange(s.nf), 3)
-    flat_k = np.tile(np.arange(3), s.nf)
-    val = np.bincount(flat_e, minlength=s.ne)
-    first_f = np.full(s.ne, -1, np.int64)
-    first_k = np.full(s.ne, -1, np.int64)
-    first_f[flat_e[::-1]] = flat_f[::-1]          # later writes win: the first occurrence
-    first_k[flat_e[::-1]] = flat_k[::-1]
-    last_f = np.full(s.ne, -1, np.int64)
-    last_k = np.full(s.ne, -1, np.int64)
-    last_f[flat_e] = flat_f
-    last_k[flat_e] = flat_k
-    two = val == 2
-    ef = np.where(two[:, None], np.stack([first_f, last_f], 1), -1)
-    ek = np.where(two[:, None], np.stack([first_k, last_k], 1), -1)
-    return ef, ek, val
-
-
 def _flip_rings(s, t, moves):
     """Record REF's edge rings (:mod:`pyevolver.remesh.rings`) of ``t``, ``s``
     with edges flipped: ``moves`` lists (edges, old tails, old heads).
@@ -63,8 +41,6 @@ def _flip_rings(s, t, moves):
     rings of its old ends and puts it in those of its new ends (measured
     with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
     Runs of flips with no vertex in common are replayed at once."""
-    from ..model.surface import record_vertex_rings
-    from .rings import Rings
     g = Rings(s, t.ne, t.nv)
     I = np.concatenate([m[0] for m in moves])
     o = np.argsort(I, kind="stable")
@@ -162,7 +138,6 @@ def equiangulate(s, threshold=-0.001, only=None):
     with ``threshold=inf`` they are flipped whatever the angles
     (``edgeswap``); the topological conditions are the same.
     """
-    import copy
     if s.nf == 0:
         return s, 0
     t = copy.copy(s)
@@ -175,7 +150,6 @@ def equiangulate(s, threshold=-0.001, only=None):
     E, FE = t.E, t.FE
     wrap = t.eattr.get("wrap")
     ef, ekk, val = edge_facets(t)
-    from ..model.surface import along_first
     first = along_first(s)
     wv = t.wrap_shift()
     lengths = np.linalg.norm(G.edge_vectors(t.X, E, wv), axis=1)
@@ -353,7 +327,6 @@ def equiangulate(s, threshold=-0.001, only=None):
     t.__dict__.pop("_topo", None)          # E and FE were changed
     if flips + flips_at_once:
         # an edge's facet loop keeps its start through the flips (REF, ee.facet)
-        from ..model.surface import record_along_first
         record_along_first(t, first)
         for ed, p, q in seq_moves:
             moves.append((np.array([ed]), np.array([p]), np.array([q])))

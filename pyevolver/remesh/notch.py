@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UnsupportedError
-from ..model.surface import project_to_constraints
+from ..constraints import project_to_constraints
 from .equiangulate import edge_facets
 from .grow import grow
 

@@ -38,7 +38,7 @@ import math
 import numpy as np
 
 from ..errors import UnsupportedError
-from ..model.surface import edge_first_facet, record_edge_first_facet
+from ..model.records import edge_first_facet, record_edge_first_facet
 from .grow import grow, reorder_new_edges
 
 TIE = 1e-12          # angles (radians) closer than this count as equal

@@ -11,8 +11,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import kernels as G
-from ..model.surface import constrained_vertices, project_to_constraints
+from ..constraints import constrained_vertices, project_to_constraints
+from ..model.records import along_first, record_along_first, record_vertex_rings
 from .grow import grow
+from .rings import Rings, rounds
 
 
 def _enc(e, forward):
@@ -222,11 +224,10 @@ def split_edges(s, ref):
 
 def _split_loops(s, t, R, half):
     """Record which edges of ``t`` have the facet along them first in their
-    facet loop (:func:`surface.along_first`): the tail half of a split edge
+    facet loop (:func:`pyevolver.model.records.along_first`): the tail half of a split edge
     keeps its edge's order, the head half has the other one, the edges
     cutting the facets have the facet along them first (measured with
     ``ee.facet`` after ``r`` on catbody.fe; it decides how ``u`` renumbers)."""
-    from ..model.surface import along_first, record_along_first
     out = np.ones(t.ne, bool)
     old = along_first(s)
     out[:s.ne] = old
@@ -245,8 +246,6 @@ def _split_rings(s, t, R, half):
     new half (first), then the old edge; then the edges cutting the facets
     join the rings at both their ends, in id order.
     """
-    from ..model.surface import record_vertex_rings
-    from .rings import Rings, rounds
     ne, k = s.ne, len(R)
     g = Rings(s, t.ne, t.nv)
     h_all = s.E[R, 1]

@@ -1,7 +1,7 @@
 """REF's edge rings at the vertices, as linked lists in arrays.
 
 The Evolver keeps the edges at a vertex in a cyclic list read from the
-vertex's first edge (``vv.edge``; :func:`pyevolver.model.surface.vertex_edge_rank`).
+vertex's first edge (``vv.edge``; :func:`pyevolver.model.records.vertex_edge_rank`).
 Measured with evolver-nox-d (catbody.fe, column.fe, quad.fe after ``r`` and
 ``u``): an edge leaving a vertex's list makes the edge that followed it the
 vertex's first edge; an edge joining a list goes in right after the first
@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.records import vertex_edge_rank
+
 
 class Rings:
     """The rings of surface ``s`` (``vertex_edge_rank``), room for ``ne``
     edges and ``nv`` vertices."""
 
     def __init__(self, s, ne, nv):
-        from ..model.surface import vertex_edge_rank
         self.nxt = np.arange(2 * ne)
         self.prv = np.arange(2 * ne)
         self.head = np.full(nv, -1, np.int64)

@@ -30,7 +30,8 @@ import copy
 import numpy as np
 
 from ..geometry import kernels as G
-from ..model.surface import project_tangent, project_to_constraints, vertex_facet_rank
+from ..constraints import project_tangent, project_to_constraints
+from ..model.records import vertex_facet_rank
 
 
 def vertex_average(s, mode="V"):

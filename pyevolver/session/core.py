@@ -25,8 +25,8 @@ from ..errors import (CommandError, DatafileError, ExpressionError, InternalErro
                      PyEvolverError, UnsupportedError)
 from ..expr import nodes as N
 from ..limits import MAX_EXPANDED_LINE, MAX_NESTING
-from ..model.surface import (build_surface, constrained_vertices, project_to_constraints,
-                      restore_state, state)
+from ..constraints import constrained_vertices, project_to_constraints, restore_state, state
+from ..model.build import build_surface
 
 READ_ONLY = {
     "total_energy", "total_area", "total_length", "vertex_count", "edge_count",
@@ -541,7 +541,7 @@ class Session(SessionAPI):
         if s is None:
             return
         if reposition:
-            from ..model.surface import boundary_eval, boundary_groups
+            from ..constraints import boundary_eval, boundary_groups
             groups = boundary_groups(s) if s.boundaries else []
             if groups or s.vcon:
                 s.X = s.X.copy()
@@ -836,7 +836,7 @@ class Session(SessionAPI):
             raise UnsupportedError(f"{what} in the string model")
 
     def _string_split(self, edges):
-        from ..model.string import split_edges
+        from ..remesh.string import split_edges
         self._replace_surface(split_edges(self.surface, edges))
         return len(edges)
 
@@ -1021,7 +1021,7 @@ class Session(SessionAPI):
         """``V``, ``rawv``, ``rawestv``: vertex averaging (spec §8.3)."""
         from ..remesh.vertex_average import vertex_average
         if self.surface.string:
-            from ..model.string import vertex_average as string_average
+            from ..remesh.string import vertex_average as string_average
             self._replace_surface(string_average(self.surface, mode))
         else:
             self._replace_surface(vertex_average(self.surface, mode))
@@ -1218,13 +1218,13 @@ class Session(SessionAPI):
             if kind == "edge":
                 # oriented away from the vertex (oid < 0 where it is the head),
                 # in the Evolver's ring order (surface.vertex_rings)
-                from ..model.surface import vertex_edge_rank
+                from ..model.records import vertex_edge_rank
                 es, end = np.nonzero(s.E == i)
                 es = es[np.argsort(vertex_edge_rank(s)[es, end], kind="stable")]
                 es = list(dict.fromkeys(es.tolist()))
                 return [I.ElemRef("edge", int(e), 1 if s.E[e, 0] == i else -1) for e in es]
             if kind == "facet":
-                from ..model.surface import vertex_facet_rank
+                from ..model.records import vertex_facet_rank
                 fs, corner = np.nonzero(s.F == i)
                 fs = fs[np.argsort(vertex_facet_rank(s)[fs, corner], kind="stable")]
                 return [I.ElemRef("facet", int(f)) for f in dict.fromkeys(fs.tolist())]
@@ -1245,7 +1245,7 @@ class Session(SessionAPI):
                 # REF's loop order of a two-facet edge: the facet running along
                 # the edge first, unless the loop is known to start with the
                 # other (surface.along_first)
-                from ..model.surface import along_first
+                from ..model.records import along_first
                 first = 1 if len(out) != 2 or along_first(s)[i] else -1
                 out.sort(key=lambda r: -r.sign * el.sign * first)
                 return out
@@ -1369,7 +1369,7 @@ class Session(SessionAPI):
                 if isinstance(idx, tuple):
                     raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
                 from ..geometry.kernels import vertex_normals
-                from ..model.surface import vertex_facet_rank
+                from ..model.records import vertex_facet_rank
                 if s.nf == 0:
                     raise UnsupportedError("vertex_normal in the string model")
                 nrm = vertex_normals(s.F, t.facet_N2, s.nv, vertex_facet_rank(s))[i]

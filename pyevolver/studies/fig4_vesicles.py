@@ -255,7 +255,7 @@ def newton_lm(session, tol=1e-9, maxit=80, mu=1e-2, guard=None):
     from ..evolve import gradient as GR
     from ..evolve.hessian import lagrangian_hessian
     from ..evolve.iterate import _Constraints
-    from ..model.surface import restore_state, state
+    from ..constraints import restore_state, state
     s = session.surface
     it = session.iterator
     cons = _Constraints(s)

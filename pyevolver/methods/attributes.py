@@ -30,6 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..constraints import project_tangent
+from ..model.records import edge_facets
+
 
 
 def star_sums_projected(s, t):
@@ -50,7 +53,6 @@ def star_sums_projected(s, t):
     -------
     A, F, N : ndarray
     """
-    from ..model.surface import project_tangent
     nv = s.nv
     A = np.zeros(nv)
     F = np.zeros((nv, 3))
@@ -128,7 +130,6 @@ def edge_dihedral(s, t):
     """(ne,) the ``dihedral`` attribute of edges: the angle between the
     unit normals of the two facets on an edge (the second facet's normal
     flipped when both run along the edge the same way); 0 elsewhere."""
-    from ..remesh.equiangulate import edge_facets
     out = np.zeros(s.ne)
     if s.nf == 0:
         return out

@@ -1,0 +1,53 @@
+"""Datafile element ids -> array positions (elements are renumbered in
+reading order), for :mod:`pyevolver.model.build`."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import DatafileError
+
+
+class Lazy:
+    """Index-computed sequence (line numbers for error messages only)."""
+
+    def __init__(self, fn):
+        self.fn = fn
+
+    def __getitem__(self, j):
+        return self.fn(int(j))
+
+
+class IdMap:
+    """Datafile ids -> positions (elements are renumbered in reading order)."""
+
+    def __init__(self, ids, what, filename, lines):
+        self.ids = np.asarray(ids, dtype=np.int64)
+        self.what = what
+        self.filename = filename
+        order = np.argsort(self.ids, kind="stable")
+        self.sorted = self.ids[order]
+        self.order = order
+        dup = np.nonzero(self.sorted[1:] == self.sorted[:-1])[0]
+        if len(dup):
+            k = order[dup[0] + 1]
+            raise DatafileError(f"{what} {self.ids[k]} is defined twice", filename, lines[k])
+
+    def lookup(self, raw, lines, user, user_ids):
+        raw = np.asarray(raw, dtype=np.int64)
+        if not len(self.sorted):
+            if raw.size:
+                raise DatafileError(f"{user} {user_ids[0]} refers to {self.what} "
+                                    f"{int(raw.flat[0])}, but there are no {self.what}s",
+                                    self.filename, lines[0])
+            return raw
+        pos = np.searchsorted(self.sorted, raw)
+        pos_c = np.minimum(pos, len(self.sorted) - 1)
+        ok = self.sorted[pos_c] == raw
+        if not ok.all():
+            flat = np.nonzero(~ok.reshape(len(ok), -1).all(axis=-1) if ok.ndim > 1 else ~ok)[0][0]
+            bad = raw[flat]
+            bad = int(np.asarray(bad).flat[np.nonzero(~np.asarray(ok[flat]).reshape(-1))[0][0]]) \
+                if np.ndim(bad) else int(bad)
+            raise DatafileError(f"{user} {user_ids[flat]} refers to {self.what} {bad}, "
+                                f"which is not defined", self.filename, lines[flat])
+        return self.order[pos_c]

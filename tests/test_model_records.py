@@ -1,0 +1,50 @@
+"""pyevolver.model.records: per-element records and topology queries."""
+import numpy as np
+
+from pyevolver.datafile.reader import read_datafile
+from pyevolver.model.build import build_surface
+from pyevolver.model.formulas import LocatedFormula, located
+from pyevolver.model.records import convex_edges, edge_facets, edge_first_facet, vertex_edge_rank
+from pyevolver.errors import PyEvolverError
+
+
+def cube():
+    return build_surface(read_datafile("datafiles/cube.fe"))
+
+
+def test_closed_surface_edges_have_two_facets():
+    s = cube()
+    ef, ek, val = edge_facets(s)
+    assert np.all(val == 2) and np.all(ef >= 0)
+    idx, _, _ = s.topology()
+    for e in range(s.ne):                     # the recorded facets do hold the edge
+        for f, k in zip(ef[e], ek[e]):
+            assert idx[f, k] == e
+
+
+def test_first_facet_and_ranks():
+    s = cube()
+    first = edge_first_facet(s)
+    assert first.shape == (s.ne,)
+    # the datafile's 12 edges have a first facet; the edges to the face
+    # centres are -1 (unknown: the facet order decides)
+    assert np.all(first[:12] >= 0) and np.all(first[12:] == -1)
+    rank = vertex_edge_rank(s)
+    assert rank.shape == (s.ne, 2)
+    assert convex_edges(s) == []
+
+
+def test_located_names_the_declaration():
+    try:
+        with located("constraint 3", 17):
+            raise PyEvolverError("division by zero")
+    except PyEvolverError as exc:
+        assert exc.line == 17 and str(exc).startswith("constraint 3:")
+
+    class F:
+        def values(self, *a):
+            raise PyEvolverError("bad")
+    try:
+        LocatedFormula(F(), "boundary 1", 4).values()
+    except PyEvolverError as exc:
+        assert exc.line == 4
