@@ -1,7 +1,7 @@
 """Writing a surface back as a datafile (the ``dump`` command).
 
 The writer turns the arrays of a :class:`pyevolver.model.surface.Surface` (and the
-settings of its session) into a datafile that both pyevolver and the
+settings of its session, :class:`DumpSettings`) into a datafile that both pyevolver and the
 Evolver load back to the same surface: the same elements in the same order,
 coordinates written with 17 significant digits (so every double comes back
 exactly), parameters, constraints, boundaries, quantities, method instances,
@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
@@ -24,6 +26,7 @@ import scipy.sparse as sp
 from ..atomic import atomic_write
 from ..errors import UnsupportedError
 from ..expr import nodes as N
+from ..model.surface import Surface
 
 _CON_FLAGS = ("global", "convex", "nonwall", "nonnegative", "nonpositive")
 _NAME = re.compile(r"^[a-z_][a-z0-9_]*$", re.I)
@@ -96,10 +99,34 @@ def _comps(letter, formulas):
 # ---------------------------------------------------------------------------
 
 
+@dataclass
+class DumpSettings:
+    """What a dump writes besides the surface: the settings of the session
+    that evolved it.
+
+    ``settings``: ``scale``, ``scale_limit``, ``constraint_tolerance``,
+    ``autochop_length``; ``toggles``: the motion and energy toggles (``conj_grad``,
+    ``gravity``, ``_fixed_scale``, ...); ``attr_types``: ``(kind, name) ->``
+    the declared type of an extra attribute (``"integer"``, ``"real"``).
+    """
+
+    filename: str = ""
+    settings: Mapping = field(default_factory=dict)
+    toggles: Mapping = field(default_factory=dict)
+    attr_types: Mapping = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, obj) -> "DumpSettings":
+        """Those of an object with the attributes ``filename``,
+        ``settings``, ``toggles`` and ``attr_types`` (a session)."""
+        return cls(getattr(obj, "filename", ""), obj.settings, obj.toggles,
+                   getattr(obj, "attr_types", {}))
+
+
 class _FeWriter:
-    def __init__(self, surface, session=None):
+    def __init__(self, surface, settings: DumpSettings | None = None):
         self.s = surface
-        self.sess = session
+        self.sess = settings
         self.lines = []
 
     def w(self, text=""):
@@ -149,7 +176,7 @@ class _FeWriter:
     # -- top section -------------------------------------------------------------
     def _header(self):
         s, sess = self.s, self.sess
-        name = getattr(sess, "filename", "") if sess is not None else ""
+        name = sess.filename if sess is not None else ""
         self.w(f"// Dump of a surface by pyevolver{' (datafile ' + name + ')' if name else ''}")
         self.w()
         if s.string:
@@ -190,7 +217,7 @@ class _FeWriter:
                 continue
             self.w(f"PARAMETER {pname} = {num(v)}")
         self.w()
-        types = getattr(self.sess, "attr_types", {}) if self.sess is not None else {}
+        types = self.sess.attr_types if self.sess is not None else {}
         for (etype, aname), arr in self.s.extra.items():
             typ = types.get((etype, aname), "real")
             if typ == "integer" and np.any(arr != np.round(arr)):
@@ -461,8 +488,10 @@ class _FeWriter:
                 self.w(line)
 
 
-def write_fe(surface, path, session=None):
-    text = _FeWriter(surface, session).text()
+def write_fe(surface: Surface, path: str, settings: DumpSettings | None = None) -> None:
+    """Write ``surface`` as a datafile to ``path`` (atomically), with the
+    session ``settings`` when given (SCALE, toggles in a ``read`` section)."""
+    text = _FeWriter(surface, settings).text()
     with atomic_write(path, "w", encoding="latin-1") as fh:
         fh.write(text)
 
@@ -470,18 +499,23 @@ def write_fe(surface, path, session=None):
 WRITERS = {"fe": write_fe}
 
 
-def dump(surface_or_session, path, fmt="fe"):
-    """Write a surface (or a session's surface with its settings) to ``path``
-    in the format ``fmt`` (a key of :data:`WRITERS`)."""
-    from ..session.core import Session
-    if isinstance(surface_or_session, Session):
-        sess, surface = surface_or_session, surface_or_session.surface
-    else:
-        sess, surface = None, surface_or_session
+def dump(surface: Surface, path: str, fmt: str = "fe",
+         settings: DumpSettings | None = None) -> None:
+    """Write ``surface`` with the session ``settings`` to ``path`` in the
+    format ``fmt`` (a key of :data:`WRITERS`).
+
+    ``surface`` may also be an object holding one in ``.surface`` with the
+    attributes of :meth:`DumpSettings.of` (a session): its settings are
+    written unless ``settings`` is given.
+    """
+    if surface is not None and not isinstance(surface, Surface):
+        if settings is None:
+            settings = DumpSettings.of(surface)
+        surface = surface.surface
     if surface is None:
         raise UnsupportedError("dump: no surface is loaded")
     try:
         writer = WRITERS[fmt]
     except KeyError:
         raise UnsupportedError(f"dump format '{fmt}'", f"known: {', '.join(WRITERS)}") from None
-    writer(surface, path, session=sess)
+    writer(surface, path, settings=settings)
