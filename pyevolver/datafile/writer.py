@@ -126,7 +126,7 @@ class DumpSettings:
 class _FeWriter:
     def __init__(self, surface, settings: DumpSettings | None = None):
         self.s = surface
-        self.sess = settings
+        self.opts = settings
         self.lines = []
 
     def w(self, text=""):
@@ -175,8 +175,8 @@ class _FeWriter:
 
     # -- top section -------------------------------------------------------------
     def _header(self):
-        s, sess = self.s, self.sess
-        name = sess.filename if sess is not None else ""
+        s, opts = self.s, self.opts
+        name = opts.filename if opts is not None else ""
         self.w(f"// Dump of a surface by pyevolver{' (datafile ' + name + ')' if name else ''}")
         self.w()
         if s.string:
@@ -201,13 +201,13 @@ class _FeWriter:
             self.w(f"GAP_CONSTANT {num(s.gap_constant)}")
         if s.sq_curvature_modulus:
             self.w(f"SQUARED_CURVATURE {num(s.sq_curvature_modulus)}")
-        if sess is not None:
-            st = sess.settings
-            fixed = " FIXED" if sess.toggles.get("_fixed_scale") else ""
+        if opts is not None:
+            st = opts.settings
+            fixed = " FIXED" if opts.toggles.get("_fixed_scale") else ""
             self.w(f"SCALE {num(st['scale'])}{fixed}")
             self.w(f"SCALE_LIMIT {num(st['scale_limit'])}")
             self.w(f"CONSTRAINT_TOLERANCE {num(st['constraint_tolerance'])}")
-            if sess.toggles.get("autochop"):
+            if opts.toggles.get("autochop"):
                 self.w(f"AUTOCHOP {num(st.get('autochop_length', 0.0))}")
         self.w()
         for pname, v in s.params.items():
@@ -217,7 +217,7 @@ class _FeWriter:
                 continue
             self.w(f"PARAMETER {pname} = {num(v)}")
         self.w()
-        types = self.sess.attr_types if self.sess is not None else {}
+        types = self.opts.attr_types if self.opts is not None else {}
         for (etype, aname), arr in self.s.extra.items():
             typ = types.get((etype, aname), "real")
             if typ == "integer" and np.any(arr != np.round(arr)):
@@ -460,11 +460,11 @@ class _FeWriter:
 
     def _read(self):
         """Toggles that change the energy, set as the surface had them."""
-        sess = self.sess
-        if sess is None:
+        opts = self.opts
+        if opts is None:
             return
         out = []
-        tg = sess.toggles
+        tg = opts.toggles
         # the motion toggles, as the Evolver's dump restores them (its names)
         for name, word in (("conj_grad", "conj_grad"), ("autochop", "autochop"),
                            ("approximate_curvature", "approx_curv"),
@@ -480,7 +480,7 @@ class _FeWriter:
                 out.append(f"{name} off")
         b = self.s.bodies
         if b.n and np.any(b.density) or self.s.gravity_constant != 1.0:
-            out.append(f"gravity {'on' if sess.toggles.get('gravity', 1) else 'off'}")
+            out.append(f"gravity {'on' if opts.toggles.get('gravity', 1) else 'off'}")
         if out:
             self.w("read")
             self.w()

@@ -8,7 +8,7 @@ restoring loop; the optimizing-scale line search or a fixed scale.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 

@@ -42,7 +42,7 @@ def triangle_edges(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([lo[first], hi[first]], 1), inv.reshape(F.shape)
 
 
-def _block(data: np.ndarray) -> ElementBlock:
+def _block(data) -> ElementBlock:
     n = len(data)
     return ElementBlock(ids=list(range(1, n + 1)), data=data,
                         lines=array("l", bytes(array("l").itemsize * n)))
@@ -51,6 +51,7 @@ def _block(data: np.ndarray) -> ElementBlock:
 def surface_from_arrays(vertices: np.ndarray, facets: np.ndarray, *,
                         fixed: np.ndarray | None = None,
                         tension: np.ndarray | None = None,
+                        body: bool = False,
                         filename: str = "<arrays>") -> Surface:
     """Build a Surface (soap film, 3 dimensions) from a triangle mesh.
 
@@ -66,6 +67,9 @@ def surface_from_arrays(vertices: np.ndarray, facets: np.ndarray, *,
         The ``fixed`` vertices.
     tension : (nf,) float array, optional
         Facet tensions (default 1).
+    body : bool
+        Add one body bounded by every facet (positively oriented; its
+        volume is not fixed).
     filename : str
         The name error messages give.
 
@@ -88,6 +92,8 @@ def surface_from_arrays(vertices: np.ndarray, facets: np.ndarray, *,
     scene.vertices = _block(np.ascontiguousarray(X))
     scene.edges = _block(E + 1)
     scene.faces = _block(sign * (idx + 1))
+    if body:
+        scene.bodies = _block([list(range(1, len(F) + 1))])
     s = build_surface(scene)
     if fixed is not None:
         s.vattr["fixed"] = np.asarray(fixed).reshape(-1) != 0

@@ -29,8 +29,9 @@ from ..evolve.iterate import IterateSettings, Iterator, _Constraints, progress_l
 from ..evolve.newton import damped_newton, hessian_step
 from ..expr import nodes as N
 from ..limits import MAX_EXPANDED_LINE, MAX_NESTING
-from ..model.surface import (build_surface, constrained_vertices, project_to_constraints,
-                      restore_state, state)
+from ..model.surface import (boundary_eval, boundary_groups, build_surface,
+                             constrained_vertices, project_to_constraints, restore_state, state)
+from ..remesh.edge_divide import edge_divide, long_edges
 
 READ_ONLY = {
     "total_energy", "total_area", "total_length", "vertex_count", "edge_count",
@@ -550,7 +551,6 @@ class Session(SessionAPI):
         if s is None:
             return
         if reposition:
-            from ..model.surface import boundary_eval, boundary_groups
             groups = boundary_groups(s) if s.boundaries else []
             if groups or s.vcon:
                 s.X = s.X.copy()
@@ -664,7 +664,6 @@ class Session(SessionAPI):
                 # the move are bisected ("Autochopped N edges." before the line).
                 # REF's choice of edges differs where it predicts lengths from
                 # the unrestored motion (mound.fe); equal on cube.fe
-                from ..remesh.edge_divide import edge_divide, long_edges
                 chop = long_edges(self.surface, L)
                 if len(chop):
                     if self.surface.string:
