@@ -93,7 +93,7 @@ def load_surface(filename: str) -> Surface:
     return s
 
 
-def read_fe(filename):
+def read_fe(filename: str):
     """meshio reader: the datafile's surface (its ``read`` section not run)."""
     return surface_mesh(load_surface(filename))
 
@@ -126,7 +126,7 @@ def _mesh_surface(mesh, filename) -> Surface:
                                filename=os.fspath(filename))
 
 
-def write_fe(filename, mesh, **kwargs):
+def write_fe(filename: str, mesh, **kwargs) -> None:
     """meshio writer: a triangle mesh as a datafile (by the ``dump`` writer)."""
     write_mesh(filename, mesh, FORMAT)
 
@@ -189,7 +189,7 @@ def write_mesh(path, mesh, fmt: str | None = None) -> str:
     return fmt
 
 
-def register():
+def register() -> None:
     """Register the ``.fe`` reader and writer with meshio (idempotent)."""
     import meshio
     if FORMAT not in meshio.extension_to_filetypes.get(".fe", []):

@@ -72,7 +72,7 @@ class SessionAPI:
         v = self.interp.value(stmts[0][1])
         return v if isinstance(v, str) else float(v)
 
-    def export(self, path, fmt=None, data=True):
+    def export(self, path: str, fmt: str | None = None, data: bool = True) -> str:
         """Write the surface to ``path`` in a meshio format chosen by the
         extension (``.vtu``, ``.ply``, ``.obj``, ``.stl``, ``.off``,
         ``.xdmf``, ...; ``.fe`` is ``dump``) with the per-vertex and
@@ -82,7 +82,7 @@ class SessionAPI:
                                     settings=DumpSettings(self.filename, self.settings,
                                                           self.toggles, self.attr_types))
 
-    def snapshot(self, path, field="mean_curvature", view=None, **kwargs):
+    def snapshot(self, path: str, field: str | None = "mean_curvature", view=None, **kwargs) -> str:
         """Render the surface to an image file, headless
         (:func:`pyevolver.io.render.snapshot`; the camera is the session's
         ``view_matrix`` unless ``view`` is given)."""
@@ -90,7 +90,7 @@ class SessionAPI:
             view = self.arrays.get("view_matrix")
         return render.snapshot(self.surface, path, field=field, view=view, **kwargs)
 
-    def plot_history(self, path, **kwargs):
+    def plot_history(self, path: str, **kwargs) -> str:
         """Plot the energy of every ``g`` step so far
         (:func:`pyevolver.io.render.plot_history`)."""
         return render.plot_history(self.history, path, **kwargs)

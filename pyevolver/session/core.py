@@ -230,7 +230,7 @@ class Session(SessionAPI):
                 self.toggles["_fixed_scale"] = 1      # SCALE x FIXED: the m command
 
     # -- dump and load (commands) --------------------------------------------------
-    def dump(self, name=None):
+    def dump(self, name: str | None = None) -> None:
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
         if name is None:
@@ -533,7 +533,7 @@ class Session(SessionAPI):
             s.econ, s.fcon, s.gravity_constant, s.sq_curvature_modulus = more
 
     # -- evaluation ------------------------------------------------------------------
-    def recalc(self, keep_cg=False, reposition=False, totals=None):
+    def recalc(self, keep_cg: bool = False, reposition: bool = False, totals=None) -> None:
         """Recompute energies, areas and volumes (and reset the CG history,
         as the Evolver's recalc does, unless ``keep_cg``).
 
@@ -603,12 +603,12 @@ class Session(SessionAPI):
         self._iterator.settings = IterateSettings.from_mappings(self.settings, self.toggles)
         return self._iterator
 
-    def reset_cg(self):
+    def reset_cg(self) -> None:
         """Forget the conjugate-gradient history."""
         if self._iterator is not None:
             self._iterator.cg_history = None
 
-    def g(self, n=1, callback=None, echo=False, progress=None):
+    def g(self, n: int = 1, callback=None, echo: bool = False, progress=None) -> list:
         """Run ``n`` iteration steps; returns the list of step results.
 
         ``callback(result)`` is called after each step; returning True stops
@@ -687,7 +687,7 @@ class Session(SessionAPI):
             if callback is not None and callback(r):
                 break
 
-    def go(self, n):
+    def go(self, n: int) -> None:
         """``g n`` at the prompt: steps with progress lines.
 
         Ctrl-C (SIGINT) during the run is deferred to the end of the current
@@ -700,7 +700,7 @@ class Session(SessionAPI):
             # surface is the one after the last complete iteration
             raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
-    def bfgs(self, n, echo=True, callback=None, progress=None):
+    def bfgs(self, n: int, echo: bool = True, callback=None, progress=None):
         """``bfgs n``: at most ``n`` iterations of BFGS with a weak Wolfe line
         search (:mod:`pyevolver.evolve.bfgs`; Lewis & Overton 2013), the
         minimizer for nonsmooth energies such as ``circle_willmore``.  Free
@@ -742,7 +742,7 @@ class Session(SessionAPI):
         self.recalc()
         return r
 
-    def newton(self, n, echo=True, callback=None):
+    def newton(self, n: int, echo: bool = True, callback=None):
         """``newton n``: at most ``n`` damped Newton (Levenberg–Marquardt)
         steps with the exact Hessian on all free coordinates
         (:mod:`pyevolver.evolve.newton`); fixed volumes, FIXED quantities
@@ -775,7 +775,7 @@ class Session(SessionAPI):
         self.recalc()
         return r
 
-    def hessian(self, seek=False, max_scale=None, echo=True):
+    def hessian(self, seek: bool = False, max_scale: float | None = None, echo: bool = True):
         """``hessian``: one Newton step on the constrained problem;
         ``hessian_seek [max]``: a line search along the Newton direction
         (scale at most ``max``, default 1).  Returns a :class:`StepResult`
