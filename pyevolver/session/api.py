@@ -82,7 +82,8 @@ class SessionAPI:
                                     settings=DumpSettings(self.filename, self.settings,
                                                           self.toggles, self.attr_types))
 
-    def snapshot(self, path: str, field: str | None = "mean_curvature", view=None, **kwargs) -> str:
+    def snapshot(self, path: str, field: str | None = "mean_curvature", view=None,
+                 **kwargs) -> str:
         """Render the surface to an image file, headless
         (:func:`pyevolver.io.render.snapshot`; the camera is the session's
         ``view_matrix`` unless ``view`` is given)."""
