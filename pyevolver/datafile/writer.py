@@ -1,7 +1,7 @@
 """Writing a surface back as a datafile (the ``dump`` command).
 
 The writer turns the arrays of a :class:`pyevolver.model.surface.Surface` (and the
-settings of its session) into a datafile that both pyevolver and the
+settings of its session, :class:`DumpSettings`) into a datafile that both pyevolver and the
 Evolver load back to the same surface: the same elements in the same order,
 coordinates written with 17 significant digits (so every double comes back
 exactly), parameters, constraints, boundaries, quantities, method instances,
@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
@@ -24,6 +26,7 @@ import scipy.sparse as sp
 from ..atomic import atomic_write
 from ..errors import UnsupportedError
 from ..expr import nodes as N
+from ..model.surface import Surface
 
 _CON_FLAGS = ("global", "convex", "nonwall", "nonnegative", "nonpositive")
 _NAME = re.compile(r"^[a-z_][a-z0-9_]*$", re.I)
@@ -96,10 +99,34 @@ def _comps(letter, formulas):
 # ---------------------------------------------------------------------------
 
 
+@dataclass
+class DumpSettings:
+    """What a dump writes besides the surface: the settings of the session
+    that evolved it.
+
+    ``settings``: ``scale``, ``scale_limit``, ``constraint_tolerance``,
+    ``autochop_length``; ``toggles``: the motion and energy toggles (``conj_grad``,
+    ``gravity``, ``_fixed_scale``, ...); ``attr_types``: ``(kind, name) ->``
+    the declared type of an extra attribute (``"integer"``, ``"real"``).
+    """
+
+    filename: str = ""
+    settings: Mapping = field(default_factory=dict)
+    toggles: Mapping = field(default_factory=dict)
+    attr_types: Mapping = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, obj) -> "DumpSettings":
+        """Those of an object with the attributes ``filename``,
+        ``settings``, ``toggles`` and ``attr_types`` (a session)."""
+        return cls(getattr(obj, "filename", ""), obj.settings, obj.toggles,
+                   getattr(obj, "attr_types", {}))
+
+
 class _FeWriter:
-    def __init__(self, surface, session=None):
+    def __init__(self, surface, settings: DumpSettings | None = None):
         self.s = surface
-        self.sess = session
+        self.opts = settings
         self.lines = []
 
     def w(self, text=""):
@@ -148,8 +175,8 @@ class _FeWriter:
 
     # -- top section -------------------------------------------------------------
     def _header(self):
-        s, sess = self.s, self.sess
-        name = getattr(sess, "filename", "") if sess is not None else ""
+        s, opts = self.s, self.opts
+        name = opts.filename if opts is not None else ""
         self.w(f"// Dump of a surface by pyevolver{' (datafile ' + name + ')' if name else ''}")
         self.w()
         if s.string:
@@ -174,13 +201,13 @@ class _FeWriter:
             self.w(f"GAP_CONSTANT {num(s.gap_constant)}")
         if s.sq_curvature_modulus:
             self.w(f"SQUARED_CURVATURE {num(s.sq_curvature_modulus)}")
-        if sess is not None:
-            st = sess.settings
-            fixed = " FIXED" if sess.toggles.get("_fixed_scale") else ""
+        if opts is not None:
+            st = opts.settings
+            fixed = " FIXED" if opts.toggles.get("_fixed_scale") else ""
             self.w(f"SCALE {num(st['scale'])}{fixed}")
             self.w(f"SCALE_LIMIT {num(st['scale_limit'])}")
             self.w(f"CONSTRAINT_TOLERANCE {num(st['constraint_tolerance'])}")
-            if sess.toggles.get("autochop"):
+            if opts.toggles.get("autochop"):
                 self.w(f"AUTOCHOP {num(st.get('autochop_length', 0.0))}")
         self.w()
         for pname, v in s.params.items():
@@ -190,7 +217,7 @@ class _FeWriter:
                 continue
             self.w(f"PARAMETER {pname} = {num(v)}")
         self.w()
-        types = getattr(self.sess, "attr_types", {}) if self.sess is not None else {}
+        types = self.opts.attr_types if self.opts is not None else {}
         for (etype, aname), arr in self.s.extra.items():
             typ = types.get((etype, aname), "real")
             if typ == "integer" and np.any(arr != np.round(arr)):
@@ -433,11 +460,11 @@ class _FeWriter:
 
     def _read(self):
         """Toggles that change the energy, set as the surface had them."""
-        sess = self.sess
-        if sess is None:
+        opts = self.opts
+        if opts is None:
             return
         out = []
-        tg = sess.toggles
+        tg = opts.toggles
         # the motion toggles, as the Evolver's dump restores them (its names)
         for name, word in (("conj_grad", "conj_grad"), ("autochop", "autochop"),
                            ("approximate_curvature", "approx_curv"),
@@ -453,7 +480,7 @@ class _FeWriter:
                 out.append(f"{name} off")
         b = self.s.bodies
         if b.n and np.any(b.density) or self.s.gravity_constant != 1.0:
-            out.append(f"gravity {'on' if sess.toggles.get('gravity', 1) else 'off'}")
+            out.append(f"gravity {'on' if opts.toggles.get('gravity', 1) else 'off'}")
         if out:
             self.w("read")
             self.w()
@@ -461,8 +488,10 @@ class _FeWriter:
                 self.w(line)
 
 
-def write_fe(surface, path, session=None):
-    text = _FeWriter(surface, session).text()
+def write_fe(surface: Surface, path: str, settings: DumpSettings | None = None) -> None:
+    """Write ``surface`` as a datafile to ``path`` (atomically), with the
+    session ``settings`` when given (SCALE, toggles in a ``read`` section)."""
+    text = _FeWriter(surface, settings).text()
     with atomic_write(path, "w", encoding="latin-1") as fh:
         fh.write(text)
 
@@ -470,18 +499,23 @@ def write_fe(surface, path, session=None):
 WRITERS = {"fe": write_fe}
 
 
-def dump(surface_or_session, path, fmt="fe"):
-    """Write a surface (or a session's surface with its settings) to ``path``
-    in the format ``fmt`` (a key of :data:`WRITERS`)."""
-    from ..session.core import Session
-    if isinstance(surface_or_session, Session):
-        sess, surface = surface_or_session, surface_or_session.surface
-    else:
-        sess, surface = None, surface_or_session
+def dump(surface: Surface, path: str, fmt: str = "fe",
+         settings: DumpSettings | None = None) -> None:
+    """Write ``surface`` with the session ``settings`` to ``path`` in the
+    format ``fmt`` (a key of :data:`WRITERS`).
+
+    ``surface`` may also be an object holding one in ``.surface`` with the
+    attributes of :meth:`DumpSettings.of` (a session): its settings are
+    written unless ``settings`` is given.
+    """
+    if surface is not None and not isinstance(surface, Surface):
+        if settings is None:
+            settings = DumpSettings.of(surface)
+        surface = surface.surface
     if surface is None:
         raise UnsupportedError("dump: no surface is loaded")
     try:
         writer = WRITERS[fmt]
     except KeyError:
         raise UnsupportedError(f"dump format '{fmt}'", f"known: {', '.join(WRITERS)}") from None
-    writer(surface, path, session=sess)
+    writer(surface, path, settings=settings)

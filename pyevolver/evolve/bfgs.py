@@ -17,9 +17,15 @@ every iteration (a true return value stops the run), as
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from ..errors import UnsupportedError
+from ..constraints import constrained_vertices
+from .gradient import energy_gradient
+from .iterate import _Constraints
 
 
 @dataclass
@@ -33,6 +39,7 @@ class BFGSResult:
     success: bool = False
     step: float = 0.0
     history: list = field(default_factory=list)     # energies after each iteration
+    area: float = math.nan       # the surface's area at ``x`` (minimize_surface)
 
 
 def weak_wolfe(fun, x, f, g, d, c1=1e-4, c2=0.9, max_evals=60):
@@ -65,9 +72,11 @@ def weak_wolfe(fun, x, f, g, d, c1=1e-4, c2=0.9, max_evals=60):
     return best + (k, False)
 
 
-def minimize(fun, x0, maxiter, callback=None, gtol=1e-12, dense_limit=3000, memory=30):
-    """Minimize ``fun`` (``x -> (f, grad)``) from ``x0`` by BFGS with the weak
-    Wolfe line search; see the module docstring."""
+def minimize(fun: Callable, x0: np.ndarray, maxiter: int, callback: Callable | None = None,
+             gtol: float = 1e-12, dense_limit: int = 3000, memory: int = 30) -> BFGSResult:
+    """Minimize ``fun`` (``x -> (f, grad)``, ``x`` and ``grad`` of shape
+    (n,)) from ``x0`` by BFGS with the weak Wolfe line search; see the
+    module docstring."""
     x = np.asarray(x0, float).copy()
     f, g = fun(x)
     n = len(x)
@@ -140,3 +149,55 @@ def _two_loop(g, pairs):
         b = rho * float(y @ q)
         q += (a - b) * s_
     return q
+
+
+def check_free(surface) -> None:
+    """Refuse (:class:`~pyevolver.errors.UnsupportedError`) a surface
+    :func:`minimize_surface` cannot minimize: fixed volumes, FIXED
+    quantities, mobile vertices on level-set constraints or boundaries."""
+    s = surface
+    if len(_Constraints(s)):
+        raise UnsupportedError("bfgs with fixed volumes or FIXED quantities",
+                               "the restoring of constraints is g's")
+    mobile = ~s.vattr["fixed"]
+    on = constrained_vertices(s)
+    if "boundary" in s.vattr:
+        on |= s.vattr["boundary"] != 0
+    if np.any(on & mobile):
+        raise UnsupportedError("bfgs on vertices with level-set constraints or boundaries")
+
+
+def minimize_surface(surface, maxiter: int, callback: Callable | None = None) -> BFGSResult:
+    """:func:`minimize` on the coordinates of the mobile vertices of a free
+    surface (the ``bfgs`` command); the surface ends at the result's ``x``.
+
+    Fixed vertices stay; bodies with fixed volumes, FIXED quantities,
+    level-set constraints and boundaries are refused
+    (:class:`~pyevolver.errors.UnsupportedError`).  ``callback(result)``
+    after every iteration, with ``result.area`` the area at ``result.x``;
+    a true value stops the run.  On an exception the coordinates are those
+    of the last evaluation: the caller restores them.
+    """
+    s = surface
+    check_free(s)
+    idx = np.nonzero(~s.vattr["fixed"])[0]
+    areas = {}                       # id of an evaluated point -> its area
+
+    def fun(x):
+        s.X[idx] = x.reshape(-1, 3)
+        t = s.evaluate()
+        areas.clear()
+        areas[id(x)] = t.total_area
+        return t.energy, energy_gradient(t)[idx].ravel()
+
+    def cb(r):
+        area = areas.get(id(r.x))
+        if area is None:     # the line search kept an earlier point
+            s.X[idx] = r.x.reshape(-1, 3)
+            area = s.evaluate().total_area
+        r.area = area
+        return callback is not None and callback(r)
+
+    r = minimize(fun, s.X[idx].ravel().copy(), int(maxiter), callback=cb)
+    s.X[idx] = r.x.reshape(-1, 3)
+    return r

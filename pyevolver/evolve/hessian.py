@@ -40,6 +40,7 @@ from ..methods.curvature import legacy_gradient
 from ..methods.curvature_hessian import legacy_hessian
 from ..methods.registry import lookup
 from . import gradient as GR
+from .iterate import _Constraints
 from .ordering import nested_dissection
 
 
@@ -469,13 +470,14 @@ def solve_bordered(K, B, r, d, method=None, points=None):
                                f"the bordered Hessian could not be factored ({exc})") from None
 
 
-def newton_direction(it):
-    """The Newton motion (nv, 3) and new multipliers for the iterator's surface.
+def newton_direction(it, normal: bool = True):
+    """The Newton motion (nv, 3) and new multipliers for the surface of the
+    :class:`~pyevolver.evolve.iterate.Iterator` ``it``.
 
+    ``normal``: move each vertex along its normal only (``hessian_normal``).
     Returns ``(dx, lam_new, cons, mobile)``.  The move restores the fixed
     values along the constraint gradients at the moved positions.
     """
-    from .iterate import _Constraints
     s = it.surface
     mobile = it._mobile()
     cons = _Constraints(s)
@@ -499,8 +501,7 @@ def newton_direction(it):
             for l, gg in zip(lam, cons.gradients(tt)):
                 g = g - l * gg
         return g
-    basis, grads = tangent_basis(s, mobile,
-                                 normal=bool(it.session.toggles.get("hessian_normal", 1)))
+    basis, grads = tangent_basis(s, mobile, normal=normal)
     T = basis.matrix()
     K = lagrangian_hessian(s, cons, lam, grad_L, basis)
     gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))

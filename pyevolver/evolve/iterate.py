@@ -8,7 +8,9 @@ restoring loop; the optimizing-scale line search or a fixed scale.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -41,8 +43,50 @@ class _Infinite(Exception):
 
 
 @dataclass
+class IterateSettings:
+    """What a ``g`` step reads of its caller's settings and toggles.
+
+    ``scale`` is the starting (or, with ``fixed_scale``, the fixed) scale;
+    the optimizing search ends at :attr:`StepResult.scale`, which the caller
+    keeps as its next ``scale``.
+    """
+
+    scale: float = 0.1
+    scale_limit: float = 1.0
+    scale_scale: float = 1.0
+    target_tolerance: float = 1e-4
+    fixed_scale: bool = False          # the ``m`` command: no line search
+    conj_grad: bool = False
+    ribiere: bool = True               # Polak-Ribiere, else Fletcher-Reeves
+    check_increase: bool = False
+    hessian_normal: bool = True        # ``hessian``: normal motion only
+
+    @classmethod
+    def from_mappings(cls, settings: Mapping, toggles: Mapping) -> "IterateSettings":
+        """From a settings dict (``scale``, ``scale_limit``, ...) and a
+        toggles dict (``conj_grad``, ``_fixed_scale``, ...) as the command
+        language keeps them."""
+        return cls(scale=settings["scale"], scale_limit=settings["scale_limit"],
+                   scale_scale=settings.get("scale_scale", 1.0),
+                   target_tolerance=settings.get("target_tolerance", 1e-4),
+                   fixed_scale=bool(toggles.get("_fixed_scale", 0)),
+                   conj_grad=bool(toggles.get("conj_grad", 0)),
+                   ribiere=bool(toggles.get("ribiere", 1)),
+                   check_increase=bool(toggles.get("check_increase", 0)),
+                   hessian_normal=bool(toggles.get("hessian_normal", 1)))
+
+
+@dataclass
 class StepResult:
-    """What one ``g`` step did (``scipy.optimize``-style result)."""
+    """What one ``g`` (or ``hessian``) step did (``scipy.optimize``-style result).
+
+    ``printed``: the step was taken (a progress line is due; the caller
+    counts the iteration and adds ``scale`` to its total time).  ``totals``:
+    the evaluation of the surface after the step.  ``motion``: the force
+    (nv, 3), the moving vertices' starting coordinates (nv, 3) and the
+    motion direction (nv, 3) of a ``g`` step, with its surface first (read
+    by the ``v_force``, ``v_oldx`` and ``v_velocity`` attributes).
+    """
 
     energy: float
     area: float
@@ -52,6 +96,8 @@ class StepResult:
     printed: bool = True
     message: str = ""
     warnings: list = field(default_factory=list)
+    totals: Any = None
+    motion: tuple | None = None
 
 
 class _Constraints:
@@ -118,21 +164,37 @@ class _Constraints:
 
 
 class Iterator:
-    """Runs ``g`` steps on a session's surface."""
+    """Runs ``g`` steps on a surface; keeps the state carried from step to
+    step (conjugate-gradient history, whether the pressures are valid, the
+    damping of ``newton``).
 
-    def __init__(self, session):
-        self.session = session
+    Parameters
+    ----------
+    surface : Surface or callable
+        The surface, or a function returning the current one (when the
+        caller replaces its surface between steps, e.g. by ``autochop``).
+    settings : IterateSettings, optional
+        Used by :meth:`step` and the restoring of :meth:`_move` unless a
+        step is given its own.
+    """
+
+    def __init__(self, surface, settings: IterateSettings | None = None):
+        self._surface = surface
+        self.settings = settings if settings is not None else IterateSettings()
         self.cg_history = None
         self.cg_S_old = 0.0
         self.cg_f_old = None
         # the multipliers (pressures) are set by a g step; hessian needs them
         self.pressures_valid = False
+        self.newton_delta = None      # the damping the last `newton` run ended with
         self._diverged = False        # a constraint projection of the last move diverged
 
     # -- helpers ----------------------------------------------------------------
     @property
     def surface(self):
-        return self.session.surface
+        """The current surface."""
+        s = self._surface
+        return s() if callable(s) else s
 
     def _mobile(self):
         s = self.surface
@@ -190,7 +252,7 @@ class Iterator:
         self._move_hits = None if trial else s._one_sided_hits
         if not len(cons):
             return s.evaluate()
-        tol = self.session.settings.get("target_tolerance", 1e-4)
+        tol = self.settings.target_tolerance
         t = s.evaluate()
         d = targets - cons.values(t)
         err = float(np.sum(np.abs(d) / cons.tolerances(t, tol)))
@@ -259,10 +321,25 @@ class Iterator:
         return t
 
     # -- the step --------------------------------------------------------------------
-    def step(self):
-        sess = self.session
+    def step(self, settings: IterateSettings | None = None) -> StepResult:
+        """One ``g`` step: the motion, the line search (or the fixed
+        scale) and the restoring of the fixed values.
+
+        Parameters
+        ----------
+        settings : IterateSettings, optional
+            Replaces :attr:`settings` (kept for later steps and moves).
+
+        Returns
+        -------
+        StepResult
+            With ``totals`` the evaluation after the step and ``motion``
+            the step's force, start and direction.
+        """
+        if settings is not None:
+            self.settings = settings
+        settings = self.settings
         s = self.surface
-        settings = sess.settings
         mobile = self._mobile()
         cons = _Constraints(s)
         t0 = s.evaluate()
@@ -271,7 +348,7 @@ class Iterator:
         # (REF: FIXED vertices included, not projected onto constraints; +0.0
         # turns -0 into 0) and the moving vertices' starting coordinates
         # (pyevolver.commands.attributes)
-        sess._last_motion = (s, f + 0.0, np.where(mobile[:, None], s.X, 0.0))
+        motion = (s, f + 0.0, np.where(mobile[:, None], s.X, 0.0))
         f[~mobile] = 0.0
         f_raw = f
         s._one_sided_released = None
@@ -295,7 +372,7 @@ class Iterator:
             if not getattr(s, "_one_sided_released", None):
                 break
         # conjugate gradient
-        if sess.toggles.get("conj_grad", 0):
+        if settings.conj_grad:
             # Fletcher-Reeves: gamma = S/S_old with S = sum vel.f; Polak-Ribiere
             # (the Evolver's default, toggle `ribiere`) subtracts sum vel.f_old;
             # a negative gamma restarts (PR+).  Found by printing v_velocity and
@@ -305,7 +382,7 @@ class Iterator:
                 gamma = 0.0
             else:
                 num = S
-                if sess.toggles.get("ribiere", 1):
+                if settings.ribiere:
                     num -= float(np.sum(vel[mobile] * self.cg_f_old[mobile]))
                 gamma = num / self.cg_S_old
                 if gamma > 10 or gamma < 0:     # negative: restart (PR+)
@@ -316,7 +393,7 @@ class Iterator:
             self.cg_f_old = f_raw      # the Evolver keeps the unprojected force
             vel = h
         X0 = state(s)
-        sess._last_motion += (vel,)             # v_velocity: the motion direction
+        motion += (vel,)                        # v_velocity: the motion direction
         warnings = []
         trial_msgs = []
         # Trial moves start from the directions at X0 (REF resets them after
@@ -338,44 +415,43 @@ class Iterator:
             return e if math.isfinite(e) else math.inf
         E.first = True
 
-        smax = settings["scale_limit"]
-        fixed_scale = sess.toggles.get("_fixed_scale", 0)
+        smax = settings.scale_limit
+        fixed_scale = settings.fixed_scale
         if fixed_scale:
-            scale = settings["scale"]
+            scale = settings.scale
             E0 = None
         else:
             try:
-                scale, E0, s1 = self._line_search(E, settings["scale"], smax)
+                scale, E0, s1 = self._line_search(E, settings.scale, smax)
             except _Infinite:
-                return self._undo(X0, t0, settings["scale"], lam, trial_msgs)
+                return self._undo(X0, t0, settings.scale, lam, trial_msgs, motion)
         # actual move (REF prints what the trial moves reported first)
         report = trial_msgs
         self._carry = (us, A)
         self._diverged = False
-        t = self._move(X0, vel, settings.get("scale_scale", 1.0) * scale, cons, us, A,
+        t = self._move(X0, vel, settings.scale_scale * scale, cons, us, A,
                        mobile, targets, report)
         t = self._hold_one_sided(t)
         e = t.energy
         if not math.isfinite(e) or self._diverged or not np.all(np.isfinite(s.X)):
-            return self._undo(X0, t0, scale, lam, report)
+            return self._undo(X0, t0, scale, lam, report, motion)
         if E0 is None:
             E0 = t0.energy
-        if sess.toggles.get("check_increase", 0) and e > E0:
+        if settings.check_increase and e > E0:
             restore_state(s, X0)
-            sess.recalc()
+            self.cg_history = None
             warnings.append("WARNING 1865: Motion would have increased energy. Restoring "
                             "coordinates.")
             return StepResult(t0.energy, t0.total_area, scale, lam, {}, False,
-                              message="increase", warnings=report + warnings)
+                              message="increase", warnings=report + warnings,
+                              totals=s.evaluate(), motion=motion)
         if not fixed_scale and e > E0 and scale > 0:
             scale = s1
             t = self._move(X0, vel, scale, cons, *self._carry, mobile, targets, report)
             t = self._hold_one_sided(t)
             self.cg_history = None
             if not math.isfinite(t.energy) or self._diverged or not np.all(np.isfinite(s.X)):
-                return self._undo(X0, t0, scale, lam, report)
-        if not fixed_scale:
-            settings["scale"] = scale
+                return self._undo(X0, t0, scale, lam, report, motion)
         # reported pressures: P = -lambda
         b = s.bodies
         qp = {}
@@ -390,24 +466,22 @@ class Iterator:
             qp[q.name] = q.pressure
             k += 1
         self.pressures_valid = True
-        sess.recalc(keep_cg=True)
-        sess.iteration_counter = getattr(sess, "iteration_counter", 0) + 1
-        sess.total_time = getattr(sess, "total_time", 0.0) + scale
-        return StepResult(sess.totals.energy, sess.totals.total_area, scale,
+        t = s.evaluate()
+        return StepResult(t.energy, t.total_area, scale,
                           b.lagrange.copy() if b.n else np.zeros(0), qp, True,
-                          warnings=report + warnings)
+                          warnings=report + warnings, totals=t, motion=motion)
 
-    def _undo(self, X0, t0, scale, lam, report):
+    def _undo(self, X0, t0, scale, lam, report, motion=None):
         """A motion to an infinite or NaN energy, or a constraint projection
         that diverged: the coordinates are put back, with the Evolver's
         warning, and no progress line."""
         s = self.surface
         restore_state(s, X0)
-        self.session.recalc()
         self.cg_history = None
         return StepResult(t0.energy, t0.total_area, scale, lam, {}, False,
                           message="infinite",
-                          warnings=report + [INFINITE_WARNING])
+                          warnings=report + [INFINITE_WARNING], totals=s.evaluate(),
+                          motion=motion)
 
     def _line_search(self, E, scale, smax):
         """The optimizing-scale search of spec §7.6; returns (s, E0, s1)."""
@@ -465,6 +539,7 @@ class Iterator:
         return s, E0, s1
 
 
-def progress_line(k, result, string_model=False):
+def progress_line(k: int, result: StepResult, string_model: bool = False) -> str:
+    """The Evolver's progress line ``k. area: ... energy: ...  scale: ...``."""
     return "%3d. %s: %#17.15g energy: %#17.15g  scale: %#g" % (
         k, "length" if string_model else "area", result.area, result.energy, result.scale)

@@ -29,14 +29,19 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..constraints import restore_state, state
 from . import gradient as GR
-from .hessian import _cholmod, constraint_curvature, lagrangian_hessian, tangent_basis
+from .hessian import (_cholmod, constraint_curvature, lagrangian_hessian, newton_direction,
+                      tangent_basis)
+from .iterate import Iterator, StepResult, _Constraints
 
 
 @dataclass
@@ -49,6 +54,7 @@ class NewtonResult:
     message: str = ""
     success: bool = False
     history: list = field(default_factory=list)      # energies after each step
+    totals: Any = None                                 # the evaluation after the last step
 
 
 def _factor(M):
@@ -79,16 +85,20 @@ def _solve(f, B, r, d):
     return Z[:, 0] - Z[:, 1:] @ mu, mu
 
 
-def damped_newton(session, n, callback=None, delta0=None, rtol=1e-10):
-    """At most ``n`` damped Newton steps on the session's surface.
+def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
+                  delta0: float | None = None, rtol: float = 1e-10) -> NewtonResult:
+    """At most ``n`` damped Newton steps on the surface of ``it``.
 
     Parameters
     ----------
-    session : Session
+    it : Iterator
+        Gives the surface and the restoring of the fixed values; keeps the
+        damping from run to run (``it.newton_delta``).
     n : int
         Maximal number of (accepted) steps.
     callback : callable, optional
-        ``callback(result)`` after every step; a true value stops the run.
+        ``callback(result)`` after every step (``result.totals`` the new
+        evaluation); a true value stops the run.
     delta0 : float, optional
         Initial damping; by default the one the last run ended with, else
         1e-4 times the mean absolute diagonal of ``K``.
@@ -102,13 +112,10 @@ def damped_newton(session, n, callback=None, delta0=None, rtol=1e-10):
     -------
     NewtonResult
     """
-    from ..constraints import restore_state, state
-    from .iterate import _Constraints
-    it = session.iterator
-    res = NewtonResult(energy=session.surface.evaluate().energy)
-    delta = delta0 if delta0 is not None else getattr(session, "_newton_delta", None)
+    res = NewtonResult(energy=it.surface.evaluate().energy)
+    delta = delta0 if delta0 is not None else it.newton_delta
     for k in range(1, int(n) + 1):
-        s = session.surface
+        s = it.surface
         mobile = it._mobile()
         cons = _Constraints(s)
         t = s.evaluate()
@@ -176,10 +183,10 @@ def damped_newton(session, n, callback=None, delta0=None, rtol=1e-10):
                 break
             restore_state(s, X0)
             delta *= 4.0
-        session._newton_delta = delta
+        it.newton_delta = delta
         if not accepted:
             restore_state(s, X0)
-            session.recalc()
+            it.cg_history = None
             if not res.message:
                 res.message = "no decrease found (round-off or a kink)"
                 res.success = True
@@ -193,13 +200,67 @@ def damped_newton(session, n, callback=None, delta0=None, rtol=1e-10):
             for kk, i in enumerate(cons.bodies):
                 b.lagrange[i] = lam[kk]
         it.pressures_valid = True
-        session.recalc()
-        res.energy, res.nit, res.delta = session.totals.energy, k, delta
+        it.cg_history = None
+        res.totals = s.evaluate()
+        res.energy, res.nit, res.delta = res.totals.energy, k, delta
         res.history.append(res.energy)
         if callback is not None and callback(res):
             res.message = "stopped by the callback"
             break
     else:
         res.message = res.message or "iteration limit"
-    res.energy = session.surface.evaluate().energy
+    res.energy = it.surface.evaluate().energy
     return res
+
+
+def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = None,
+                 normal: bool = True) -> StepResult:
+    """The ``hessian`` command: one Newton step on the constrained problem
+    (the bordered system of :mod:`.hessian`); with ``seek`` (``hessian_seek``)
+    a line search along the Newton direction, scale at most ``max_scale``
+    (default 1).
+
+    The multipliers of the last ``g`` or ``hessian`` step enter the Hessian
+    of the Lagrangian; the new ones are stored as the pressures.  A step to
+    a non-finite energy is undone: ``message`` "infinite", ``printed``
+    False.
+
+    Returns
+    -------
+    StepResult
+        ``totals`` the evaluation after the step.
+    """
+    s = it.surface
+    dx, lam, cons, mobile = newton_direction(it, normal=normal)
+    targets = cons.targets(s)
+    X0 = state(s)
+
+    def E(scale, report=None):
+        e = it._move(X0, dx, scale, cons, None, None, mobile, targets, report).energy
+        return e if math.isfinite(e) else math.inf
+    scale = 1.0
+    if seek:
+        smax = 1.0 if max_scale is None else max_scale
+        scale, _, _ = it._line_search(E, smax, smax)
+    report = []
+    t = it._move(X0, dx, scale, cons, None, None, mobile, targets, report)
+    if not math.isfinite(t.energy):
+        restore_state(s, X0)
+        it.cg_history = None
+        t = s.evaluate()
+        return StepResult(t.energy, t.total_area, scale, lam, {}, False, message="infinite",
+                          warnings=report, totals=t)
+    b = s.bodies
+    qp = {}
+    if b.n:
+        b.lagrange[:] = 0.0
+    for k, i in enumerate(cons.bodies):
+        b.lagrange[i] = lam[k]
+    for k, q in enumerate(cons.quantities):
+        q.pressure = lam[len(cons.bodies) + k]
+        qp[q.name] = q.pressure
+    it.cg_history = None
+    t = s.evaluate()
+    return StepResult(t.energy, t.total_area, scale,
+                      b.lagrange.copy() if b.n else np.zeros(0), qp, True, warnings=report,
+                      totals=t)

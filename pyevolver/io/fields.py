@@ -21,11 +21,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..methods import curvature as C
+from ..methods.curvature import _LEGACY, VERTEX_METHODS
+
 #: The estimate used when no curvature method is active.
 DEFAULT_CURVATURE = "star_perp_sq_mean_curvature"
 
 
-def curvature_method(surface):
+def curvature_method(surface) -> str:
     """The name of the active mean curvature method of ``surface``.
 
     The method of the first energy quantity that is a squared mean curvature
@@ -35,7 +38,6 @@ def curvature_method(surface):
     toggles, else :data:`DEFAULT_CURVATURE`.  Methods without a per-vertex
     estimate (``circle_willmore``, the Loop methods) count as absent.
     """
-    from ..methods.curvature import _LEGACY, VERTEX_METHODS
     known = set(VERTEX_METHODS) | {"cotan_sq_mean_curvature"}
     found = [(q.kind != "energy", m.method) for q in surface.quantities.values()
              for m, *_ in q.methods if m.method in known]
@@ -46,7 +48,7 @@ def curvature_method(surface):
     return DEFAULT_CURVATURE
 
 
-def mean_curvature(surface, totals=None, method=None):
+def mean_curvature(surface, totals=None, method: str | None = None) -> np.ndarray:
     """Per-vertex mean curvature (nv,) of ``method`` (default: the active one,
     :func:`curvature_method`).
 
@@ -64,7 +66,6 @@ def mean_curvature(surface, totals=None, method=None):
     itself, not h − h0.  NaN in the torus model (stars across the
     periodic wrap are not gathered here).
     """
-    from ..methods import curvature as C
     s = surface
     if s.periods is not None or s.nf == 0:
         return np.full(s.nv, np.nan)
@@ -93,7 +94,7 @@ def _flags(masks, n):
             for cid, m in sorted(masks.items())}
 
 
-def surface_fields(surface, totals=None):
+def surface_fields(surface, totals=None) -> tuple[dict, dict]:
     """``(vertex_fields, facet_fields)``: dicts of arrays (nv,) and (nf,)
     described in the module docstring."""
     s = surface

@@ -23,13 +23,19 @@ Files are written atomically (:mod:`pyevolver.atomic`).
 """
 from __future__ import annotations
 
-import io
 import os
 
 import numpy as np
 
 from ..atomic import atomic_path
+from ..datafile.reader import read_datafile
+from ..datafile import writer
+from ..datafile.writer import DumpSettings
 from ..errors import CommandError, PyEvolverError, UnsupportedError
+from ..model.arrays import surface_from_arrays
+from ..model.build import build_surface
+from ..model.surface import Surface
+from .fields import surface_fields
 
 FORMAT = "evolver"
 
@@ -42,21 +48,20 @@ EXPORT_FORMATS = {".vtu": "vtu", ".xdmf": "xdmf", ".ply": "ply", ".obj": "obj",
                   ".stl": "stl", ".off": "off"}
 
 
-def _split(obj):
-    from ..session.core import Session
-    if isinstance(obj, Session):
-        return obj, obj.surface
-    return None, obj
+def _surface(obj):
+    """A Surface, or the ``.surface`` of an object holding one (a session)."""
+    if obj is None or isinstance(obj, Surface):
+        return obj
+    return obj.surface
 
 
-def surface_mesh(obj, data=True):
-    """A :class:`meshio.Mesh` of a surface (or of a :class:`Session`'s):
-    points ``X`` (nv, 3), one ``"triangle"`` block ``F`` (nf, 3) and, with
-    ``data``, the point and cell data of
+def surface_mesh(surface, data: bool = True):
+    """A :class:`meshio.Mesh` of ``surface`` (a Surface, or an object
+    holding one in ``.surface``): points ``X`` (nv, 3), one ``"triangle"``
+    block ``F`` (nf, 3) and, with ``data``, the point and cell data of
     :func:`pyevolver.io.fields.surface_fields`."""
     import meshio
-    from .fields import surface_fields
-    _, s = _split(obj)
+    s = _surface(surface)
     if s is None:
         raise CommandError("export: no surface is loaded")
     if s.nf == 0:
@@ -75,19 +80,27 @@ def surface_mesh(obj, data=True):
                        point_data=point_data, cell_data=cell_data)
 
 
-def read_fe(filename):
+def load_surface(filename: str) -> Surface:
+    """The surface of a datafile as a session loads it, its ``read``
+    section and top-section commands not run: the curvature and gravity
+    toggles of its top section applied."""
+    scene = read_datafile(os.fspath(filename))
+    s = build_surface(scene)
+    b = s.bodies
+    s.gravity_on = bool(scene.values.get("gravity_constant", 0) != 0 or
+                        bool(b.n and np.any(b.density)))
+    s.curvature_mode = ("norm" if "normal_curvature" in scene.flags else
+                        "eff" if "effective_area" in scene.flags else "plain")
+    return s
+
+
+def read_fe(filename: str):
     """meshio reader: the datafile's surface (its ``read`` section not run)."""
-    from ..session.core import Session
-    sess = Session.load(os.fspath(filename), out=io.StringIO(), err=io.StringIO(),
-                        run_read=False)
-    return surface_mesh(sess)
+    return surface_mesh(load_surface(filename))
 
 
-def _mesh_surface(mesh, filename):
-    """Build a Surface from a meshio triangle mesh (through the datafile reader)."""
-    from ..datafile.reader import read_datafile
-    from ..studies.meshes import fe_text
-    from ..model.build import build_surface
+def _mesh_surface(mesh, filename) -> Surface:
+    """Build a Surface from a meshio triangle mesh (:func:`surface_from_arrays`)."""
     tris = []
     for block in mesh.cells:
         if block.type != "triangle":
@@ -100,30 +113,26 @@ def _mesh_surface(mesh, filename):
     X = np.asarray(mesh.points, float)
     if X.ndim != 2 or X.shape[1] not in (2, 3):
         raise UnsupportedError(f"writing {X.shape[-1]}-dimensional points to a datafile")
-    if X.shape[1] == 2:
-        X = np.hstack([X, np.zeros((len(X), 1))])
     if len(F) and (F.min() < 0 or F.max() >= len(X)):
         raise PyEvolverError(f"{filename}: a triangle refers to a point that does not exist")
     bad = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 0] == F[:, 2])
     if bad.any():
         raise PyEvolverError(f"{filename}: triangle {int(np.argmax(bad))} repeats a vertex")
-    s = build_surface(read_datafile(os.fspath(filename), fe_text(X, F)))
-    fixed = mesh.point_data.get("fixed")
-    if fixed is not None:
-        s.vattr["fixed"] = np.asarray(fixed).reshape(-1) != 0
     tension = mesh.cell_data.get("tension")
     if tension is not None and len(tension) == len(tris):
-        s.fattr["tension"] = np.concatenate([np.asarray(a, float).reshape(-1)
-                                             for a in tension])
-    return s
+        tension = np.concatenate([np.asarray(a, float).reshape(-1) for a in tension])
+    else:
+        tension = None
+    return surface_from_arrays(X, F, fixed=mesh.point_data.get("fixed"), tension=tension,
+                               filename=os.fspath(filename))
 
 
-def write_fe(filename, mesh, **kwargs):
+def write_fe(filename: str, mesh, **kwargs) -> None:
     """meshio writer: a triangle mesh as a datafile (by the ``dump`` writer)."""
     write_mesh(filename, mesh, FORMAT)
 
 
-def file_format(path):
+def file_format(path) -> str:
     """The meshio format of ``path``, from its extension."""
     import meshio
     name = os.path.basename(os.fspath(path)).lower()
@@ -137,29 +146,29 @@ def file_format(path):
                        f"(for example .vtu, .ply, .obj, .stl, .off, .xdmf)")
 
 
-def export(obj, path, fmt=None, data=True):
-    """Write the surface of ``obj`` (a Session or a Surface) to ``path`` in
-    the meshio format ``fmt`` (default: from the extension); returns the
-    format name.  ``.fe`` is the ``dump`` datafile.  Atomic: on any error
+def export(surface, path: str, fmt: str | None = None, data: bool = True,
+           settings: DumpSettings | None = None) -> str:
+    """Write ``surface`` to ``path`` in the meshio format ``fmt`` (default:
+    from the extension); returns the format name.  ``.fe`` is the ``dump``
+    datafile, with the session ``settings``.  ``surface`` may also be an
+    object holding one in ``.surface`` (a session).  Atomic: on any error
     ``path`` is left as it was."""
     fmt = fmt or file_format(path)
     if fmt == FORMAT:
-        from ..datafile.writer import dump
         try:
             with atomic_path(path, ".fe") as tmp:
-                dump(obj, tmp)
+                writer.dump(surface, tmp, settings=settings)
         except OSError as exc:
             raise CommandError(f"cannot write '{path}': {exc.strerror or exc}") from None
         return fmt
-    write_mesh(path, surface_mesh(obj, data), fmt)
+    write_mesh(path, surface_mesh(surface, data), fmt)
     return fmt
 
 
-def write_mesh(path, mesh, fmt=None):
+def write_mesh(path, mesh, fmt: str | None = None) -> str:
     """Write a meshio mesh atomically in ``fmt`` (default: by the extension;
     ``evolver`` for ``.fe``) with :data:`WRITE_OPTIONS`."""
     import meshio
-    from ..datafile.writer import write_fe as dump_fe
     fmt = fmt or file_format(path)
     if fmt == "xdmf":
         try:
@@ -171,7 +180,7 @@ def write_mesh(path, mesh, fmt=None):
     try:
         with atomic_path(path, ext) as tmp:
             if fmt == FORMAT:
-                dump_fe(_mesh_surface(mesh, path), tmp)
+                writer.write_fe(_mesh_surface(mesh, path), tmp)
             else:
                 meshio.write(tmp, mesh, file_format=fmt, **WRITE_OPTIONS.get(fmt, {}))
     except OSError as exc:
@@ -181,7 +190,7 @@ def write_mesh(path, mesh, fmt=None):
     return fmt
 
 
-def register():
+def register() -> None:
     """Register the ``.fe`` reader and writer with meshio (idempotent)."""
     import meshio
     if FORMAT not in meshio.extension_to_filetypes.get(".fe", []):

@@ -15,11 +15,14 @@ moves it from the command language, :func:`camera` builds one from angles.
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 
 import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import CommandError, UnsupportedError
+from ..model.surface import Surface
+from .fields import curvature_method, surface_fields
 
 #: Half-width of the picture in view coordinates: the initial view's
 #: [-1, 1] with a margin for a surface that grows.
@@ -36,7 +39,8 @@ def _matplotlib():
     return matplotlib, Figure, FigureCanvasAgg
 
 
-def camera(X, azimuth=0.0, elevation=0.0, zoom=1.0):
+def camera(X: np.ndarray, azimuth: float = 0.0, elevation: float = 0.0,
+           zoom: float = 1.0) -> np.ndarray:
     """A (4, 4) view matrix: the bounding box of ``X`` (n, 3) centred and
     scaled into [-zoom, zoom]³ (the session's initial view), then turned by
     ``azimuth`` degrees about the vertical z axis and tipped by
@@ -57,17 +61,9 @@ def camera(X, azimuth=0.0, elevation=0.0, zoom=1.0):
     return R @ M
 
 
-def _split(obj):
-    from ..session.core import Session
-    if isinstance(obj, Session):
-        return obj, obj.surface
-    return None, obj
-
-
 def _facet_values(s, field):
     """Per-facet values of ``field`` (a facet field, or a vertex field
     averaged over each facet's corners) and its label."""
-    from .fields import curvature_method, surface_fields
     v, f = surface_fields(s)
     if field in f:
         return np.asarray(f[field], float), f"facet {field}"
@@ -80,21 +76,25 @@ def _facet_values(s, field):
     raise CommandError(f"snapshot: no field '{field}' (known: {', '.join(names)}, none)")
 
 
-def snapshot(obj, path, field="mean_curvature", view=None, size=600, cmap="viridis",
-             edges=None, clim=None, title=None):
-    """Draw the surface of ``obj`` (a Session or a Surface) into an image
-    file (png, pdf, svg: by the extension), written atomically.
+def snapshot(surface: Surface | None, path: str, field: str | None = "mean_curvature",
+             view: np.ndarray | None = None, size: int = 600, cmap: str = "viridis",
+             edges: bool | None = None, clim: tuple | None = None,
+             title: str | None = None) -> str:
+    """Draw ``surface`` into an image file (png, pdf, svg: by the
+    extension), written atomically.
 
     Parameters
     ----------
+    surface : Surface
+        Its vertices ``X`` (nv, 3) and triangles ``F`` (nf, 3) are drawn.
     field : str or None
         Colour facets by this field of :func:`pyevolver.io.fields.surface_fields`
         (vertex fields averaged over each facet) with a colour bar; ``None``
         or ``"none"`` for a plain grey surface.  Facets are shaded by the
         angle of their normal to the viewing direction.
     view : (4, 4) array, optional
-        The view matrix; default the session's ``view_matrix`` (for a bare
-        Surface, :func:`camera` of its vertices).
+        The view matrix (a session passes its ``view_matrix``); default
+        :func:`camera` of the vertices.
     size : int
         Width of the picture in pixels (the height is the same).
     edges : bool, optional
@@ -109,13 +109,11 @@ def snapshot(obj, path, field="mean_curvature", view=None, size=600, cmap="virid
     """
     mpl, Figure, FigureCanvasAgg = _matplotlib()
     from matplotlib.collections import PolyCollection
-    sess, s = _split(obj)
+    s = surface
     if s is None or s.nf == 0:
         raise CommandError("snapshot: no facets to draw")
     if view is None:
-        view = sess.arrays.get("view_matrix") if sess is not None else None
-        if view is None:
-            view = camera(s.X)
+        view = camera(s.X)
     M = np.asarray(view, float)
     if M.shape != (4, 4):
         raise CommandError(f"snapshot: the view matrix must be 4x4, not {M.shape}")
@@ -176,13 +174,21 @@ def _save(fig, path):
         raise CommandError(f"cannot write '{path}': {exc.strerror or exc}") from None
 
 
-def plot_history(obj, path, size=(6.4, 4.0), log=None):
-    """Plot the energy of each ``g`` step of a session (``Session.history``)
-    against the iteration number; written atomically.  ``log``: plot
-    E − min E on a log scale (default: when the energy fell by more than a
-    factor 100 of its final decrease)."""
+def plot_history(history: Sequence, path: str, size: tuple = (6.4, 4.0),
+                 log: bool | None = None) -> str:
+    """Plot the energy of each ``g`` step against the iteration number;
+    written atomically.
+
+    Parameters
+    ----------
+    history : sequence of (iteration, energy, area)
+        A session's ``history``.
+    log : bool, optional
+        Plot E − min E on a log scale (default: when the energy fell by
+        more than a factor 100 of its final decrease).
+    """
     _, Figure, FigureCanvasAgg = _matplotlib()
-    hist = getattr(obj, "history", None)
+    hist = history
     if not hist:
         raise CommandError("plot_history: no iterations yet (run g first)")
     H = np.asarray(hist, float)

@@ -19,7 +19,9 @@ from __future__ import annotations
 
 import sys
 
+from ..datafile.writer import DumpSettings
 from ..errors import CommandError
+from ..io import meshio_plugin, render
 
 #: ``progress=None`` shows a bar for runs of at least this many steps.
 PROGRESS_MIN_STEPS = 100
@@ -70,24 +72,26 @@ class SessionAPI:
         v = self.interp.value(stmts[0][1])
         return v if isinstance(v, str) else float(v)
 
-    def export(self, path, fmt=None, data=True):
+    def export(self, path: str, fmt: str | None = None, data: bool = True) -> str:
         """Write the surface to ``path`` in a meshio format chosen by the
         extension (``.vtu``, ``.ply``, ``.obj``, ``.stl``, ``.off``,
         ``.xdmf``, ...; ``.fe`` is ``dump``) with the per-vertex and
         per-facet data arrays of :func:`pyevolver.io.fields.surface_fields`;
         returns the format name (:func:`pyevolver.io.export`)."""
-        from ..io.meshio_plugin import export
-        return export(self, path, fmt, data)
+        return meshio_plugin.export(self.surface, path, fmt, data,
+                                    settings=DumpSettings(self.filename, self.settings,
+                                                          self.toggles, self.attr_types))
 
-    def snapshot(self, path, field="mean_curvature", view=None, **kwargs):
+    def snapshot(self, path: str, field: str | None = "mean_curvature", view=None,
+                 **kwargs) -> str:
         """Render the surface to an image file, headless
         (:func:`pyevolver.io.render.snapshot`; the camera is the session's
         ``view_matrix`` unless ``view`` is given)."""
-        from ..io.render import snapshot
-        return snapshot(self, path, field=field, view=view, **kwargs)
+        if view is None:
+            view = self.arrays.get("view_matrix")
+        return render.snapshot(self.surface, path, field=field, view=view, **kwargs)
 
-    def plot_history(self, path, **kwargs):
+    def plot_history(self, path: str, **kwargs) -> str:
         """Plot the energy of every ``g`` step so far
         (:func:`pyevolver.io.render.plot_history`)."""
-        from ..io.render import plot_history
-        return plot_history(self, path, **kwargs)
+        return render.plot_history(self.history, path, **kwargs)

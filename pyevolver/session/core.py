@@ -19,14 +19,20 @@ import numpy as np
 
 from .api import SessionAPI, progress_bar
 from ..commands import interpreter as I
+from ..datafile.writer import DumpSettings, dump as write_dump
 from ..datafile.preprocess import _TooLong as _MacroTooLong, expand_macros
 from ..datafile.reader import read_datafile
 from ..errors import (CommandError, DatafileError, ExpressionError, InternalError,
                      PyEvolverError, UnsupportedError)
+from ..evolve.bfgs import check_free, minimize_surface
+from ..evolve.iterate import IterateSettings, Iterator, _Constraints, progress_line
+from ..evolve.newton import damped_newton, hessian_step
 from ..expr import nodes as N
 from ..limits import MAX_EXPANDED_LINE, MAX_NESTING
-from ..constraints import constrained_vertices, project_to_constraints, restore_state, state
+from ..constraints import (boundary_eval, boundary_groups, constrained_vertices,
+                           project_to_constraints, restore_state, state)
 from ..model.build import build_surface
+from ..remesh.edge_divide import edge_divide, long_edges
 
 READ_ONLY = {
     "total_energy", "total_area", "total_length", "vertex_count", "edge_count",
@@ -225,15 +231,16 @@ class Session(SessionAPI):
                 self.toggles["_fixed_scale"] = 1      # SCALE x FIXED: the m command
 
     # -- dump and load (commands) --------------------------------------------------
-    def dump(self, name=None):
+    def dump(self, name: str | None = None) -> None:
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
-        from ..datafile.writer import dump
         if name is None:
             name = (self.filename or "pyevolver") + ".dmp"
         self.write(f"Dumping to {name}.\n")
         try:
-            dump(self, name)
+            write_dump(self.surface, name,
+                       settings=DumpSettings(self.filename, self.settings, self.toggles,
+                                             self.attr_types))
         except OSError as exc:
             raise CommandError(f"dump: cannot write '{name}': {exc.strerror}") from None
 
@@ -527,9 +534,13 @@ class Session(SessionAPI):
             s.econ, s.fcon, s.gravity_constant, s.sq_curvature_modulus = more
 
     # -- evaluation ------------------------------------------------------------------
-    def recalc(self, keep_cg=False, reposition=False):
+    def recalc(self, keep_cg: bool = False, reposition: bool = False, totals=None) -> None:
         """Recompute energies, areas and volumes (and reset the CG history,
         as the Evolver's recalc does, unless ``keep_cg``).
+
+        ``totals``: an evaluation of the current coordinates a solver has
+        just made; taken as it is unless the session's settings change how
+        the surface is evaluated (gravity, curvature mode, periods).
 
         ``reposition`` (the ``recalc`` command): first put the vertices on
         parametric boundaries where their parameters now say (cat.fe's
@@ -541,7 +552,6 @@ class Session(SessionAPI):
         if s is None:
             return
         if reposition:
-            from ..constraints import boundary_eval, boundary_groups
             groups = boundary_groups(s) if s.boundaries else []
             if groups or s.vcon:
                 s.X = s.X.copy()
@@ -551,13 +561,20 @@ class Session(SessionAPI):
                 if on.any():
                     project_to_constraints(s, np.nonzero(on)[0])
                 s.__dict__.pop("_lift_cache", None)
+        before = (s.periods, s.gravity_constant, getattr(s, "gravity_on", None),
+                  getattr(s, "curvature_mode", None))
         if getattr(s, "period_exprs", None) is not None:
             self._eval_periods(s)
         s.gravity_constant = self.variables.get("gravity_constant", s.gravity_constant)
         s.gravity_on = bool(self.toggles.get("gravity", 1))
         s.curvature_mode = ("norm" if self.toggles.get("normal_curvature") else
                             "eff" if self.toggles.get("effective_area") else "plain")
-        t = s.evaluate()
+        after = (s.periods, s.gravity_constant, s.gravity_on, s.curvature_mode)
+        if (totals is None or totals.surface is not s or after[0] is not before[0]
+                or after[1:] != before[1:]):
+            t = s.evaluate()
+        else:
+            t = totals
         s.bodies.volume = t.volumes
         self.totals = t
         if not keep_cg:
@@ -580,16 +597,19 @@ class Session(SessionAPI):
     # -- evolution -------------------------------------------------------------------
     @property
     def iterator(self):
+        """The :class:`~pyevolver.evolve.iterate.Iterator` of the session's
+        surface (created on first use), its settings those of the session."""
         if self._iterator is None:
-            from ..evolve.iterate import Iterator
-            self._iterator = Iterator(self)
+            self._iterator = Iterator(lambda: self.surface)
+        self._iterator.settings = IterateSettings.from_mappings(self.settings, self.toggles)
         return self._iterator
 
-    def reset_cg(self):
+    def reset_cg(self) -> None:
+        """Forget the conjugate-gradient history."""
         if self._iterator is not None:
             self._iterator.cg_history = None
 
-    def g(self, n=1, callback=None, echo=False, progress=None):
+    def g(self, n: int = 1, callback=None, echo: bool = False, progress=None) -> list:
         """Run ``n`` iteration steps; returns the list of step results.
 
         ``callback(result)`` is called after each step; returning True stops
@@ -619,10 +639,21 @@ class Session(SessionAPI):
         return results
 
     def _steps(self, n, callback, echo, results, bar):
-        from ..evolve.iterate import progress_line
         for k in range(n, 0, -1):
             self.interp.tick()
-            r = self.iterator.step()
+            it = self.iterator
+            r = it.step()
+            # what the step did, kept by the session: the motion (the v_force,
+            # v_oldx, v_velocity attributes), the optimized scale, the totals,
+            # the iteration count and the time
+            self._last_motion = r.motion
+            if r.printed and not it.settings.fixed_scale:
+                self.settings["scale"] = r.scale
+            self.recalc(keep_cg=True, totals=r.totals)
+            if r.printed:
+                self.iteration_counter += 1
+                self.total_time += r.scale
+                r.energy, r.area = self.totals.energy, self.totals.total_area
             results.append(r)
             self.history.append((self.iteration_counter, r.energy, r.area))
             if bar is not None:
@@ -634,7 +665,6 @@ class Session(SessionAPI):
                 # the move are bisected ("Autochopped N edges." before the line).
                 # REF's choice of edges differs where it predicts lengths from
                 # the unrestored motion (mound.fe); equal on cube.fe
-                from ..remesh.edge_divide import edge_divide, long_edges
                 chop = long_edges(self.surface, L)
                 if len(chop):
                     if self.surface.string:
@@ -658,7 +688,7 @@ class Session(SessionAPI):
             if callback is not None and callback(r):
                 break
 
-    def go(self, n):
+    def go(self, n: int) -> None:
         """``g n`` at the prompt: steps with progress lines.
 
         Ctrl-C (SIGINT) during the run is deferred to the end of the current
@@ -671,7 +701,7 @@ class Session(SessionAPI):
             # surface is the one after the last complete iteration
             raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
-    def bfgs(self, n, echo=True, callback=None, progress=None):
+    def bfgs(self, n: int, echo: bool = True, callback=None, progress=None):
         """``bfgs n``: at most ``n`` iterations of BFGS with a weak Wolfe line
         search (:mod:`pyevolver.evolve.bfgs`; Lewis & Overton 2013), the
         minimizer for nonsmooth energies such as ``circle_willmore``.  Free
@@ -682,50 +712,25 @@ class Session(SessionAPI):
         ``callback(result)`` may stop the run, and so does Ctrl-C (at the end
         of the current iteration, the surface that of the last one).
         ``progress``: a tqdm bar, as for :meth:`g` (never with ``echo``)."""
-        from ..evolve import bfgs as B
-        from ..evolve.gradient import energy_gradient
-        from ..evolve.iterate import _Constraints
         self.no_string("bfgs")
         s = self.surface
         if s is None or s.nv == 0:
             raise CommandError("bfgs: no surface loaded")
-        if len(_Constraints(s)):
-            raise UnsupportedError("bfgs with fixed volumes or FIXED quantities",
-                                   "the restoring of constraints is g's")
-        mobile = ~s.vattr["fixed"]
-        on = constrained_vertices(s)
-        if "boundary" in s.vattr:
-            on |= s.vattr["boundary"] != 0
-        if np.any(on & mobile):
-            raise UnsupportedError("bfgs on vertices with level-set constraints or boundaries")
+        check_free(s)
         X0 = state(s)
-        idx = np.nonzero(mobile)[0]
-        areas = {}                       # id of an evaluated point -> its area
-
-        def fun(x):
-            s.X[idx] = x.reshape(-1, 3)
-            t = s.evaluate()
-            areas.clear()
-            areas[id(x)] = t.total_area
-            return t.energy, energy_gradient(t)[idx].ravel()
 
         with _deferred_sigint() as flag:
             def cb(r):
                 self.interp.tick()
                 if echo and not self.toggles.get("quiet"):
-                    area = areas.get(id(r.x))
-                    if area is None:     # the line search kept an earlier point
-                        s.X[idx] = r.x.reshape(-1, 3)
-                        area = s.evaluate().total_area
                     self.write("%3d. area: %#17.15g energy: %#17.15g  scale: %#g\n"
-                               % (n - r.nit, area, r.energy, r.step))
+                               % (n - r.nit, r.area, r.energy, r.step))
                 if bar is not None:
                     bar.update(1)
                 return flag["hit"] or (callback is not None and callback(r))
             bar = None if echo else progress_bar(int(n), progress, "bfgs")
             try:
-                r = B.minimize(fun, s.X[idx].ravel().copy(), int(n), callback=cb)
-                s.X[idx] = r.x.reshape(-1, 3)
+                r = minimize_surface(s, int(n), callback=cb)
             except Exception:
                 restore_state(s, X0)
                 self.recalc()
@@ -738,7 +743,7 @@ class Session(SessionAPI):
         self.recalc()
         return r
 
-    def newton(self, n, echo=True, callback=None):
+    def newton(self, n: int, echo: bool = True, callback=None):
         """``newton n``: at most ``n`` damped Newton (Levenberg–Marquardt)
         steps with the exact Hessian on all free coordinates
         (:mod:`pyevolver.evolve.newton`); fixed volumes, FIXED quantities
@@ -747,13 +752,13 @@ class Session(SessionAPI):
         ``g``) and returns the :class:`~pyevolver.evolve.newton.NewtonResult`;
         ``callback(result)`` may stop the run, and so does Ctrl-C (after the
         current step)."""
-        from ..evolve.newton import damped_newton
         self.no_string("newton")
         s = self.surface
         if s is None or s.nv == 0:
             raise CommandError("newton: no surface loaded")
         with _deferred_sigint() as flag:
             def cb(r):
+                self.recalc(totals=r.totals)
                 self.interp.tick()
                 if echo and not self.toggles.get("quiet"):
                     self.write("%3d. area: %#17.15g energy: %#17.15g  delta: %#g\n"
@@ -761,7 +766,7 @@ class Session(SessionAPI):
                 return flag["hit"] or (callback is not None and callback(r))
             X0 = state(s)
             try:
-                r = damped_newton(self, n, callback=cb)
+                r = damped_newton(self.iterator, n, callback=cb)
             except Exception:
                 restore_state(self.surface, X0)
                 self.recalc()
@@ -771,54 +776,28 @@ class Session(SessionAPI):
         self.recalc()
         return r
 
-    def hessian(self, seek=False, max_scale=None, echo=True):
+    def hessian(self, seek: bool = False, max_scale: float | None = None, echo: bool = True):
         """``hessian``: one Newton step on the constrained problem;
         ``hessian_seek [max]``: a line search along the Newton direction
-        (scale at most ``max``, default 1).  Returns a :class:`StepResult`."""
-        from ..evolve.hessian import newton_direction
-        from ..evolve.iterate import StepResult, _Constraints
+        (scale at most ``max``, default 1).  Returns a :class:`StepResult`
+        (:func:`pyevolver.evolve.newton.hessian_step`)."""
         self.no_string("hessian")
         if self.surface is None or self.surface.nv == 0:
             # (everything deleted; REF: "No vertices" warnings or unrelated errors)
             raise CommandError(f"{'hessian_seek' if seek else 'hessian'}: the surface has "
                                f"no vertices")
         it = self.iterator
-        s = self.surface
-        if not it.pressures_valid and len(_Constraints(s)):
+        if not it.pressures_valid and len(_Constraints(self.surface)):
             raise CommandError("Pressures invalid. Do regular iteration before Hessian "
                                "to set pressures.")
-        dx, lam, cons, mobile = newton_direction(it)
-        targets = cons.targets(s)
-        X0 = state(s)
-
-        def E(scale, report=None):
-            e = it._move(X0, dx, scale, cons, None, None, mobile, targets, report).energy
-            return e if math.isfinite(e) else math.inf
-        scale = 1.0
-        if seek:
-            smax = 1.0 if max_scale is None else max_scale
-            scale, _, _ = it._line_search(E, smax, smax)
-        report = []
-        t = it._move(X0, dx, scale, cons, None, None, mobile, targets, report)
-        if not math.isfinite(t.energy):
-            restore_state(s, X0)
-            self.recalc()
+        r = hessian_step(it, seek, max_scale, normal=it.settings.hessian_normal)
+        self.recalc(totals=r.totals)
+        if r.message == "infinite":
             raise CommandError("hessian: the Newton step gives a non-finite energy; "
                                "the surface is unchanged")
-        b = s.bodies
-        qp = {}
-        if b.n:
-            b.lagrange[:] = 0.0
-        for k, i in enumerate(cons.bodies):
-            b.lagrange[i] = lam[k]
-        for k, q in enumerate(cons.quantities):
-            q.pressure = lam[len(cons.bodies) + k]
-            qp[q.name] = q.pressure
-        self.recalc()
-        r = StepResult(self.totals.energy, self.totals.total_area, scale,
-                       b.lagrange.copy() if b.n else np.zeros(0), qp, True, warnings=report)
+        r.energy, r.area = self.totals.energy, self.totals.total_area
         if echo:
-            for w in report:
+            for w in r.warnings:
                 self.write(w + "\n")
             if not self.toggles.get("quiet"):
                 self.write("%3d. area: %#17.15g energy: %#17.15g\n" % (1, r.area, r.energy))
