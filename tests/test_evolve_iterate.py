@@ -12,7 +12,7 @@ from pyevolver.datafile.reader import read_datafile
 from pyevolver.evolve import bfgs, iterate, newton
 from pyevolver.evolve.iterate import IterateSettings, Iterator
 from pyevolver.model.arrays import surface_from_arrays
-from pyevolver.model.surface import build_surface
+from pyevolver.model.build import build_surface
 from pyevolver.studies.meshes import icosphere
 
 from conftest import example

@@ -8,7 +8,7 @@ import pytest
 from pyevolver import Session
 from pyevolver.datafile.reader import read_datafile
 from pyevolver.model.arrays import surface_from_arrays, triangle_edges
-from pyevolver.model.surface import build_surface
+from pyevolver.model.build import build_surface
 from pyevolver.studies.meshes import fe_text, icosphere
 
 # the regular octahedron, outward-oriented triangles

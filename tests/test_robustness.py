@@ -462,7 +462,7 @@ def test_the_interpreter_reaches_no_eval():
 
 def test_g_undoes_a_step_whose_projection_diverges(monkeypatch):
     """The wiring in the g step: a projection that reports runaway vertices
-    (pyevolver.model.surface.project_to_constraints, tested above) makes the step
+    (pyevolver.constraints.project_to_constraints, tested above) makes the step
     undone, with the warning and the coordinates before it."""
     import pyevolver.evolve.iterate as it
     s = _session(os.path.join(HERE, "data", "atan_constraint.fe"))
