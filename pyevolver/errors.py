@@ -3,6 +3,9 @@
 Library code raises these; only the CLI/REPL turns them into messages and
 exit codes.
 """
+import os
+import sys
+import traceback
 
 
 class PyEvolverError(Exception):
@@ -77,9 +80,6 @@ class InternalError(CommandError):
 
     @classmethod
     def from_exception(cls, exc, where):
-        import os
-        import sys
-        import traceback
         if os.environ.get("PYEVOLVER_TRACEBACK"):
             traceback.print_exception(type(exc), exc, exc.__traceback__, file=sys.stderr)
         err = cls(f"{where}: internal error ({type(exc).__name__}: {exc}); the surface "

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.special import ellipe, ellipeinc, ellipk, ellipkinc
 
 from ..errors import ExpressionError
 
@@ -58,21 +59,18 @@ def _domain(bad, msg):
 def _ellipk(m):
     """Complete elliptic integral of the first kind K(m), parameter m
     (Abramowitz & Stegun 17.3.1; the Evolver's convention)."""
-    from scipy.special import ellipk
     _domain(np.asarray(m) >= 1, "ellipticK domain violation, parameter >= 1.")
     return ellipk(m)
 
 
 def _ellipe(m):
     """Complete elliptic integral of the second kind E(m) (A&S 17.3.3)."""
-    from scipy.special import ellipe
     _domain(np.asarray(m) > 1, "ellipticE domain violation, parameter > 1.")
     return ellipe(m)
 
 
 def _ellipf(phi, m):
     """Incomplete elliptic integral of the first kind F(phi|m) (A&S 17.2.7)."""
-    from scipy.special import ellipkinc
     _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
             "incompleteEllipticF domain violation, m*sin(phi)^2 > 1.")
     return ellipkinc(phi, m)
@@ -80,7 +78,6 @@ def _ellipf(phi, m):
 
 def _ellipeinc(phi, m):
     """Incomplete elliptic integral of the second kind E(phi|m) (A&S 17.2.8)."""
-    from scipy.special import ellipeinc
     _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
             "incompleteEllipticE domain violation, m*sin(phi)^2 > 1.")
     return ellipeinc(phi, m)

@@ -64,6 +64,7 @@ these runs) and ``fig3_torus.png``.
 from __future__ import annotations
 
 import argparse
+import csv
 import io
 import math
 import os
@@ -72,8 +73,15 @@ import shutil
 import subprocess
 import tempfile
 import time
+import warnings
 
 import numpy as np
+from scipy.optimize import minimize
+
+from ..errors import UnsupportedError
+from ..geometry.loop import LoopEvaluator
+from ..session.core import Session
+from .meshes import _outward, torus_grid, torus_offset, write_fe
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PAPER = os.path.join(HERE, "..", "..", "datafiles", "paper")
@@ -89,7 +97,6 @@ FIXED_LAMBDAS = [1.0, 0.5, 0.25, 0.12]
 # -- meshes and datafiles -------------------------------------------------------------------
 
 def _mesh(m, n, grid):
-    from .meshes import torus_grid, torus_offset
     if grid == "offset":
         return torus_offset(m, n, R=math.sqrt(2.0), r=1.0)
     if grid == "paper":
@@ -106,7 +113,6 @@ def datafile(m, n, energy, regularized, grid="offset", directory=None):
     sizes are written to ``directory`` (default: ``datafiles/paper``).
     Names: ``torus{m}x{n}[_offset]_{eff_area|normal}[_harmonic].fe``.
     """
-    from .meshes import write_fe
     tag = "_offset" if grid == "offset" else ""
     name = f"torus{m}x{n}{tag}_{SHORT[energy]}{'_harmonic' if regularized else ''}.fe"
     shipped = os.path.join(PAPER, name)
@@ -215,9 +221,7 @@ def moebius_radius_ratio(X, starts=16, seed=0):
     transformation.  Returns ``(R/r, dev, b)``; checked on inverted tori
     (tests/test_fig3_torus.py).
     """
-    import warnings
 
-    from scipy.optimize import minimize
     Y = X - X.mean(axis=0)
     Y = Y / math.sqrt(np.mean(np.einsum("ij,ij->i", Y, Y)))
 
@@ -248,8 +252,6 @@ def loop_energy(X, F):
     """Willmore energy ∫H² dA of the Loop subdivision surface of ``(X, F)``;
     NaN when the Loop methods refuse the mesh (valence above 12, which edge
     flips can produce)."""
-    from ..errors import UnsupportedError
-    from ..geometry.loop import LoopEvaluator
     try:
         return float(LoopEvaluator(F, len(X)).totals(X)["W"])
     except UnsupportedError:
@@ -295,7 +297,6 @@ def run_pyevolver(path, text, before="", where="<script>"):
     """Load ``path`` and run ``before`` and the script ``text`` (named
     ``where`` in messages) in pyevolver; returns (session, output lines,
     wall seconds, progress lines printed)."""
-    from .. import Session
     out = io.StringIO()
     s = Session.load(path, out=out, err=io.StringIO())
     t0 = time.perf_counter()
@@ -444,7 +445,6 @@ def almost_spherical_torus(m, n, eps):
 
     Returns ``X (m n, 3)``, ``F (2 m n, 3)`` oriented outward.
     """
-    from .meshes import _outward, torus_grid
     if not 0 < eps < 1:
         raise ValueError("eps must lie in (0, 1)")
     _, F = torus_grid(m, n)
@@ -460,8 +460,6 @@ def almost_spherical_torus(m, n, eps):
 def bobenko_energy(X, F):
     """``circle_willmore`` (Bobenko's W = Σ_e β_e − π #V) of a closed mesh,
     evaluated by pyevolver's quantity method."""
-    from .. import Session
-    from .meshes import write_fe
     with tempfile.TemporaryDirectory() as tmp:
         path = write_fe(os.path.join(tmp, "t.fe"), X, F, face_attrs="tension 0",
                         header="quantity wb energy method circle_willmore global")
@@ -526,7 +524,6 @@ def _record(method, row):
 # -- the study ----------------------------------------------------------------------------------
 
 def _write_csv(path, rows):
-    import csv
     keys = []
     for r in rows:
         keys += [k for k in r if k not in keys]

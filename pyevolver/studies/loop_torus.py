@@ -24,9 +24,10 @@ import argparse
 import time
 
 import numpy as np
+from scipy.optimize import minimize
 
 from ..geometry.loop import LoopEvaluator
-from .meshes import torus_grid
+from .meshes import torus_grid, write_fe
 
 CLIFFORD = 2 * np.pi ** 2
 
@@ -61,7 +62,6 @@ def minimize_torus(m=5, n=9, R=2.0, r=1.0, maxiter=2000, gtol=1e-9, order=None):
     ``X`` (the minimiser's control points), ``F``, ``iterations``,
     ``evaluations``, ``seconds``.
     """
-    from scipy.optimize import minimize
     X0, F = torus_grid(m, n, R, r)
     kw = {} if order is None else {"order": order}
     ev = LoopEvaluator(F, len(X0), **kw)
@@ -95,7 +95,6 @@ def main(argv=None):
     args = ap.parse_args(argv)
     out = minimize_torus(args.m, args.n, args.R, args.r, args.maxiter)
     if args.out:
-        from .meshes import write_fe
         hdr = ("quantity willmore energy method loop_sq_mean_curvature global\n"
                f"quantity larea fixed = {out['area']!r} method loop_area global\n"
                "quantity lvol info_only method loop_volume global\n")

@@ -47,12 +47,17 @@ import json
 import math
 import os
 import time
-from concurrent.futures import as_completed
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
 from ..atomic import atomic_path, atomic_write
+from ..commands.interpreter import Quit
+from ..datafile.writer import dump
 from ..errors import PyEvolverError
+from ..io.render import _matplotlib, _save
+from ..session.api import progress_bar
+from ..session.core import Session
 
 SPEC_KEYS = {"datafile", "output", "commands", "record", "snapshot", "parameters",
              "continuation", "plot"}
@@ -237,8 +242,6 @@ def _assign(sess, name, value):
 def run_point(spec, i, key, start=None):
     """Compute point ``i`` (its files in :func:`point_dir`); ``start``: the
     dump of the point it continues from.  Returns its result dict."""
-    from ..commands.interpreter import Quit
-    from ..session.core import Session
     folder = point_dir(spec, i)
     os.makedirs(folder, exist_ok=True)
     for name in os.listdir(folder):            # temporary files of a killed run
@@ -270,7 +273,6 @@ def run_point(spec, i, key, start=None):
             "record": {e: sess.value(e) for e in spec.record},
             "iterations": len(sess.history)})
         with atomic_path(os.path.join(folder, "final.fe"), ".fe") as tmp:
-            from ..datafile.writer import dump
             dump(sess, tmp)
         with atomic_write(os.path.join(folder, "energies.csv"), newline="") as fh:
             w = csv.writer(fh)
@@ -337,7 +339,6 @@ class SweepResult:
 def local_executor(workers=None):
     """The default executor: a process pool (``workers`` processes, default
     the number of CPUs)."""
-    from concurrent.futures import ProcessPoolExecutor
     return ProcessPoolExecutor(max_workers=workers)
 
 
@@ -364,7 +365,6 @@ def run_sweep(spec, executor=None, workers=None, progress=None, log=None):
     nothing); ``progress`` a tqdm bar over the points (as
     :func:`pyevolver.session.api.progress_bar`).  Returns a :class:`SweepResult`.
     """
-    from ..session.api import progress_bar
     os.makedirs(spec.output, exist_ok=True)
     keys = point_keys(spec)
     pts = spec.points()
@@ -462,7 +462,6 @@ def plot_phase(spec, rows):
     """``phase.png``: over two parameters, the points' snapshots in a grid
     (titled with the colour column); over one, the colour column against
     it.  More parameters: the plot is skipped (:class:`SweepError`)."""
-    from ..io.render import _matplotlib, _save
     _, Figure, FigureCanvasAgg = _matplotlib()
     names = list(spec.parameters)
     col = spec.plot_color
