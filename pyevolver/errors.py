@@ -3,6 +3,8 @@
 Library code raises these; only the CLI/REPL turns them into messages and
 exit codes.
 """
+from __future__ import annotations
+
 import os
 import sys
 import traceback
@@ -42,7 +44,8 @@ class DatafileError(PyEvolverError):
         return text
 
 
-def excerpt_window(line, column=None, width=120):
+def excerpt_window(line: str, column: int | None = None,
+                   width: int = 120) -> tuple[str, int | None]:
     """A source line cut to at most ``width`` characters around ``column``
     (1-based; None: the start), control characters shown as ``?``; returns
     ``(text, column in text)``."""

@@ -23,7 +23,7 @@ def _refuse(tok):
 
 
 @functools.lru_cache(maxsize=1)
-def top_parser():
+def top_parser() -> Lark:
     """LALR parser of the top section (``fe_top.lark`` + ``expr.lark``)."""
     with open(os.path.join(_HERE, "fe_top.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
@@ -34,7 +34,7 @@ def top_parser():
 
 
 @functools.lru_cache(maxsize=1)
-def line_parser():
+def line_parser() -> Lark:
     """LALR parser of one element line (``fe_elements.lark`` + ``expr.lark``)."""
     with open(os.path.join(_HERE, "fe_elements.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()

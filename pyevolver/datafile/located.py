@@ -53,7 +53,7 @@ def _expected(exp):
     return ", ".join(names)
 
 
-def describe(exc, text):
+def describe(exc: Exception, text: str) -> str:
     """The message for a parse error ``exc`` of ``text`` (without location)."""
     if isinstance(exc, UnexpectedCharacters):
         ch = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""

@@ -9,6 +9,7 @@ truncates), and whole-array values of the command language.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from scipy.special import ellipe, ellipeinc, ellipk, ellipkinc
@@ -94,7 +95,8 @@ class ArrayValue(np.ndarray):
     opposed to the per-point arrays of a vectorized formula evaluation."""
 
 
-def array_value(a):
+def array_value(a: Any) -> ArrayValue:
+    """``a`` as a float :class:`ArrayValue` (a copy)."""
     return np.array(a, dtype=float).view(ArrayValue)
 
 
@@ -105,7 +107,7 @@ def _num(v):
     return v
 
 
-def is_number(v):
+def is_number(v: Any) -> bool:
     """True for the values arithmetic accepts: numbers and numpy arrays (not
     strings, elements or quantities)."""
     return isinstance(v, (float, int, np.ndarray, np.number))

@@ -353,7 +353,8 @@ def _is(n, v):
     return isinstance(n, Num) and n.value == v
 
 
-def add(a, b):
+def add(a: Node, b: Node) -> Node:
+    """``a + b``, folded when a side is 0 or both are numbers."""
     if _is(a, 0):
         return b
     if _is(b, 0):
@@ -363,7 +364,8 @@ def add(a, b):
     return Bin("+", a, b)
 
 
-def sub(a, b):
+def sub(a: Node, b: Node) -> Node:
+    """``a - b``, folded when a side is 0 or both are numbers."""
     if _is(b, 0):
         return a
     if _is(a, 0):
@@ -373,7 +375,8 @@ def sub(a, b):
     return Bin("-", a, b)
 
 
-def mul(a, b):
+def mul(a: Node, b: Node) -> Node:
+    """``a * b``, folded when a side is 0 or 1 or both are numbers."""
     if _is(a, 0) or _is(b, 0):
         return ZERO
     if _is(a, 1):
@@ -385,7 +388,8 @@ def mul(a, b):
     return Bin("*", a, b)
 
 
-def div(a, b):
+def div(a: Node, b: Node) -> Node:
+    """``a / b``, folded when ``a`` is 0 or ``b`` is 1."""
     if _is(a, 0):
         return ZERO
     if _is(b, 1):
@@ -393,7 +397,8 @@ def div(a, b):
     return Bin("/", a, b)
 
 
-def neg(a):
+def neg(a: Node) -> Node:
+    """``-a``, folded for a number and a negation."""
     if isinstance(a, Num):
         return Num(-a.value)
     if isinstance(a, Neg):

@@ -104,7 +104,8 @@ def _mesh(m, n, grid):
     raise ValueError(f"unknown grid {grid!r} (offset or paper)")
 
 
-def datafile(m, n, energy, regularized, grid="offset", directory=None):
+def datafile(m: int, n: int, energy: str, regularized: bool, grid: str = "offset",
+             directory: str | None = None) -> str:
     """Path of the datafile for an ``m``×``n`` torus with ``energy`` (EffArea
     or NormalCur), with ``harmonic_energy`` (λ = 0.25, the quantity
     ``harmonic``) and the ``loop_w`` info quantity when ``regularized``.
@@ -153,7 +154,7 @@ def datafile(m, n, energy, regularized, grid="offset", directory=None):
 
 # -- measurements -----------------------------------------------------------------------------
 
-def min_angle(X, F):
+def min_angle(X: np.ndarray, F: np.ndarray) -> float:
     """Smallest corner angle of the triangles ``F`` (nf, 3) of ``X`` (nv, 3), degrees."""
     P = X[F]
     e = [P[:, (k + 2) % 3] - P[:, (k + 1) % 3] for k in range(3)]      # side opposite k
@@ -167,7 +168,7 @@ def min_angle(X, F):
     return float(np.degrees(np.min(ang)))
 
 
-def radius_ratio(X):
+def radius_ratio(X: np.ndarray) -> tuple[float, float]:
     """Radius ratio ``R/r`` of a torus of revolution fitted to the vertices.
 
     The axis is the direction of least spread of the vertices about their
@@ -192,7 +193,7 @@ def radius_ratio(X):
     return float(R / r), float(dev)
 
 
-def special_conformal(X, b):
+def special_conformal(X: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The Möbius transformation x ↦ (x + b|x|²)/(1 + 2 b·x + |b|²|x|²)
     (inversion, translation by b, inversion; the identity at b = 0)."""
     b = np.asarray(b, float)
@@ -201,7 +202,8 @@ def special_conformal(X, b):
     return (X + np.outer(x2, b)) / den[:, None]
 
 
-def moebius_radius_ratio(X, starts=16, seed=0):
+def moebius_radius_ratio(X: np.ndarray, starts: int = 16,
+                         seed: int = 0) -> tuple[float, float, np.ndarray]:
     """:func:`radius_ratio` of the Möbius image of ``X`` that is closest to a
     torus of revolution.
 
@@ -248,7 +250,7 @@ def moebius_radius_ratio(X, starts=16, seed=0):
     return ratio, d, best.x
 
 
-def loop_energy(X, F):
+def loop_energy(X: np.ndarray, F: np.ndarray) -> float:
     """Willmore energy ∫H² dA of the Loop subdivision surface of ``(X, F)``;
     NaN when the Loop methods refuse the mesh (valence above 12, which edge
     flips can produce)."""
@@ -258,7 +260,7 @@ def loop_energy(X, F):
         return math.nan
 
 
-def measure(session, moebius=True):
+def measure(session: Session, moebius: bool = True) -> dict:
     """W (the quantity willmore), relative error, W_Loop, R/r of the fitted
     torus of revolution and the fit's deviation (``revolution_dev``: how far
     the mesh is from a torus of revolution, :func:`radius_ratio`), the same
@@ -280,7 +282,7 @@ def measure(session, moebius=True):
 
 # -- running the shipped scripts ------------------------------------------------------------
 
-def script(name, call=None):
+def script(name: str, call: str | None = None) -> str:
     """Text of ``datafiles/paper/<name>`` with its default run (the line
     ending in ``// default run``) replaced by ``call`` when given."""
     with open(os.path.join(PAPER, name)) as fh:
@@ -293,7 +295,8 @@ def script(name, call=None):
 _PROGRESS = re.compile(r"^\s*-?\d+\. area: .* (energy|delta): ")
 
 
-def run_pyevolver(path, text, before="", where="<script>"):
+def run_pyevolver(path: str, text: str, before: str = "",
+                  where: str = "<script>") -> tuple[Session, list[str], float, int]:
     """Load ``path`` and run ``before`` and the script ``text`` (named
     ``where`` in messages) in pyevolver; returns (session, output lines,
     wall seconds, progress lines printed)."""
@@ -308,7 +311,8 @@ def run_pyevolver(path, text, before="", where="<script>"):
     return s, lines, dt, sum(1 for ln in lines if _PROGRESS.match(ln))
 
 
-def run_evolver(path, text, exe="evolver-nox-d"):
+def run_evolver(path: str, text: str,
+                exe: str = "evolver-nox-d") -> tuple[list[str], float] | None:
     """Run the script ``text`` on ``path`` in the reference Evolver; returns
     (output lines, wall seconds), or None when it is not installed."""
     if shutil.which(exe) is None:
@@ -344,8 +348,8 @@ def _fields(line):
 
 # -- the runs -----------------------------------------------------------------------------------
 
-def newton_run(m, n, energy, lam=None, grid="offset", steps=300, directory=None,
-               moebius=True):
+def newton_run(m: int, n: int, energy: str, lam: float | None = None, grid: str = "offset",
+               steps: int = 300, directory: str | None = None, moebius: bool = True) -> dict:
     """(a) with ``lam`` None, else (b): ``fig3_newton.cmd``.  Returns a row dict
     (:func:`measure`)."""
     path = datafile(m, n, energy, lam is not None, grid, directory)
@@ -362,9 +366,10 @@ def newton_run(m, n, energy, lam=None, grid="offset", steps=300, directory=None,
     return row
 
 
-def continuation_run(m, n, energy, grid="offset", lam0=0.25, factor=0.7, lammin=1e-3,
-                     steps=100, maxrises=2, directory=None, moebius=True, rule="loop",
-                     nbis=8):
+def continuation_run(m: int, n: int, energy: str, grid: str = "offset", lam0: float = 0.25,
+                     factor: float = 0.7, lammin: float = 1e-3, steps: int = 100,
+                     maxrises: int = 2, directory: str | None = None, moebius: bool = True,
+                     rule: str = "loop", nbis: int = 8) -> tuple[dict, list[dict]]:
     """(c): ``fig3_continuation.cmd``.  Returns (row, stages).
 
     ``rule``: ``"loop"`` keeps the stage with the lowest Loop energy (the
@@ -396,8 +401,9 @@ def continuation_run(m, n, energy, grid="offset", lam0=0.25, factor=0.7, lammin=
     return row, stages
 
 
-def recipe_run(m, n, energy, rounds=50, gsteps=20, evolver=True, directory=None,
-               moebius=True):
+def recipe_run(m: int, n: int, energy: str, rounds: int = 50, gsteps: int = 20,
+               evolver: bool = True, directory: str | None = None,
+               moebius: bool = True) -> tuple[list[dict], list[dict]]:
     """(d): ``fig3_evolver_recipe.cmd`` in pyevolver and (when installed and
     ``evolver``) in evolver-nox-d.  Returns (rows, per-round records)."""
     path = datafile(m, n, energy, False, "offset", directory)
@@ -430,7 +436,7 @@ def recipe_run(m, n, energy, rounds=50, gsteps=20, evolver=True, directory=None,
 
 # -- Proposition 1 ------------------------------------------------------------------------------
 
-def almost_spherical_torus(m, n, eps):
+def almost_spherical_torus(m: int, n: int, eps: float) -> tuple[np.ndarray, np.ndarray]:
     """A regular ``m``×``n`` torus (the connectivity of
     :func:`~pyevolver.studies.meshes.torus_grid`) with every vertex on the
     unit sphere and a hole of diameter 2ε along the z axis.
@@ -457,7 +463,7 @@ def almost_spherical_torus(m, n, eps):
     return X, _outward(X, F)
 
 
-def bobenko_energy(X, F):
+def bobenko_energy(X: np.ndarray, F: np.ndarray) -> float:
     """``circle_willmore`` (Bobenko's W = Σ_e β_e − π #V) of a closed mesh,
     evaluated by pyevolver's quantity method."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -466,8 +472,8 @@ def bobenko_energy(X, F):
         return float(Session.load(path, out=io.StringIO()).total_energy)
 
 
-def proposition1(grids=((5, 10), (10, 20), (20, 40)),
-                 eps=(0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 1e-3, 1e-4)):
+def proposition1(grids: tuple = ((5, 10), (10, 20), (20, 40)),
+                 eps: tuple = (0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 1e-3, 1e-4)) -> list[dict]:
     """Bobenko energies of :func:`almost_spherical_torus` for each grid size
     and hole size: a list of dicts (m, n, eps, W_bobenko, excess over 4π)."""
     rows = []
@@ -480,7 +486,8 @@ def proposition1(grids=((5, 10), (10, 20), (20, 40)),
 
 # -- the chart ----------------------------------------------------------------------------------
 
-def chart_records(full=False, directory=None, evolver=False, sizes=None):
+def chart_records(full: bool = False, directory: str | None = None, evolver: bool = False,
+                  sizes: list | None = None) -> list[dict]:
     """Points for the accuracy-versus-time chart: one per method and mesh
     resolution (5×10, 10×16 with ``full`` False; also 20×32 and 40×64).
 
@@ -547,7 +554,8 @@ def _line(r):
     return "  ".join(parts)
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", choices=("small", "full"), default="small")
     ap.add_argument("--out", default=".")

@@ -63,11 +63,12 @@ import shutil
 import subprocess
 import tempfile
 import time
+from typing import Any, Callable
 
 import numpy as np
 
 from ..session.core import Session
-from .axisymmetric import canham_reference
+from .axisymmetric import CanhamResult, canham_reference
 from .vesicle_newton import _solve_stage, harmonic_continuation, newton_lm
 from .vesicle_shapes import (LEVELS, METHODS, PAPER, RECIPE, REFERENCE_MODES, SHAPES, _profile,
                              area_volume, datafile, initial_shape, mesh_descriptors, min_angle,
@@ -84,7 +85,7 @@ __all__ = ["SHAPES", "METHODS", "LEVELS", "CHART_KEYS", "area_volume", "reduced_
 _REFERENCES = {}
 
 
-def reference(shape):
+def reference(shape: str) -> CanhamResult:
     """The axisymmetric reference (:func:`canham_reference`) of a shape, cached."""
     if shape not in _REFERENCES:
         v0, branch = SHAPES[shape]
@@ -92,7 +93,8 @@ def reference(shape):
     return _REFERENCES[shape]
 
 
-def record(shape, label, X, F, W, area, volume, seconds, cpu_seconds, **extra):
+def record(shape: str, label: str, X: np.ndarray, F: np.ndarray, W: float, area: float,
+           volume: float, seconds: float, cpu_seconds: float | None, **extra: Any) -> dict:
     """One result row: energy, error against the reference, mesh health,
     descriptors (see :func:`mesh_descriptors`)."""
     v0 = SHAPES[shape][0]
@@ -130,8 +132,9 @@ FLIP_ROUNDS = 10
 NEWTON_CYCLE = "cycle := { V; u; g 5; hessian_seek; hessian_seek }"
 
 
-def run(shape, method, max_nv=2562, first_nv=162, directory=PAPER, lam_min=1e-3,
-        recipe_vars=None, progress=None):
+def run(shape: str, method: str, max_nv: int = 2562, first_nv: int = 162,
+        directory: str = PAPER, lam_min: float = 1e-3, recipe_vars: dict | None = None,
+        progress: Callable[[dict], Any] | None = None) -> tuple[Session, list[dict]]:
     """Run one method on one shape coarse to fine up to ``max_nv`` vertices.
 
     ``method`` is a key of :data:`METHODS`.  Returns ``(session, rows)`` with
@@ -188,8 +191,9 @@ def run(shape, method, max_nv=2562, first_nv=162, directory=PAPER, lam_min=1e-3,
     return s, rows
 
 
-def run_evolver(shape, max_nv=642, first_nv=162, directory=PAPER,
-                executable="evolver-nox-d", recipe_vars=None, timeout=3600):
+def run_evolver(shape: str, max_nv: int = 642, first_nv: int = 162, directory: str = PAPER,
+                executable: str = "evolver-nox-d", recipe_vars: dict | None = None,
+                timeout: float = 3600) -> list[dict] | None:
     """The recipe run in the Surface Evolver (``evolver-nox-d``) on the same
     shipped datafile, refined up to ``max_nv`` vertices.  Its mesh after
     each resolution is printed by the script and measured here exactly as
@@ -294,7 +298,7 @@ def _write_csv(path, rows):
             fh.write(",".join("" if r.get(k) is None else str(r.get(k)) for k in keys) + "\n")
 
 
-def plot(path, results):
+def plot(path: str, results: dict) -> None:
     """The final meshes' profiles over the references' (one row per shape,
     one column per method) and W's relative error against time."""
     import matplotlib
@@ -351,7 +355,8 @@ def plot(path, results):
     plt.close(fig)
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     ap = argparse.ArgumentParser(prog="python -m pyevolver.studies.fig4_vesicles",
                                  description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", choices=["small", "full"], default="small",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import math
+from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -11,7 +12,8 @@ import scipy.sparse as sp
 from ..evolve import gradient as GR
 from ..evolve.hessian import _cholmod, lagrangian_hessian, solve_bordered
 from ..evolve.iterate import _Constraints
-from ..model.surface import restore_state, state
+from ..model.surface import Surface, restore_state, state
+from ..session.core import Session
 from .vesicle_shapes import min_angle
 
 
@@ -55,7 +57,8 @@ def _bordered(K, B, r, d, cache):
     return solve_bordered(K, B, r, d)[:K.shape[0]]
 
 
-def newton_lm(session, tol=1e-9, maxit=80, mu=1e-2, guard=None):
+def newton_lm(session: Session, tol: float = 1e-9, maxit: int = 80, mu: float = 1e-2,
+              guard: Callable[[Surface], bool] | None = None) -> tuple[bool, int, float]:
     """Levenberg–Marquardt Newton iteration on all vertex coordinates.
 
     Each step solves the bordered system of ``min ½ dᵀ(H + μ D) d + ∇Lᵀ d``
@@ -154,8 +157,10 @@ def _solve_stage(session, maxit, guard, flips):
     return ok, steps, flipped
 
 
-def harmonic_continuation(session, lam_min=1e-3, factor=2.0, min_angle_deg=10.0,
-                          maxit=80, require_converged=False, flips=0, log=None):
+def harmonic_continuation(session: Session, lam_min: float = 1e-3, factor: float = 2.0,
+                          min_angle_deg: float = 10.0, maxit: int = 80,
+                          require_converged: bool = False, flips: int = 0,
+                          log: list | None = None) -> float:
     """Lower λ (the modulus of quantity ``harm``) while the mesh stays healthy.
 
     At the current λ the surface is minimised by :func:`newton_lm` (at most

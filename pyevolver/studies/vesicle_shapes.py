@@ -14,6 +14,7 @@ import os
 import numpy as np
 from scipy.optimize import brentq
 
+from .axisymmetric import CanhamResult
 from .meshes import icosphere, write_fe
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -37,7 +38,7 @@ METHODS = {
 
 # -- geometry of triangle meshes ------------------------------------------------------------
 
-def area_volume(X, F):
+def area_volume(X: np.ndarray, F: np.ndarray) -> tuple[float, float]:
     """Total area and enclosed volume of the closed mesh ``(X (nv, 3), F (nf, 3))``."""
     a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
     A = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
@@ -45,13 +46,13 @@ def area_volume(X, F):
     return float(A), float(V)
 
 
-def reduced_volume(X, F):
+def reduced_volume(X: np.ndarray, F: np.ndarray) -> float:
     """``v = 3V/(4π) / (A/(4π))^{3/2}`` (1 for a sphere)."""
     A, V = area_volume(X, F)
     return 3.0 * V / (4 * np.pi) / (A / (4 * np.pi)) ** 1.5
 
 
-def min_angle(X, F):
+def min_angle(X: np.ndarray, F: np.ndarray) -> float:
     """Smallest corner angle of the triangles, in degrees."""
     P = X[F]
     out = np.inf
@@ -74,7 +75,7 @@ def _deform(X, shape, p):
     return out
 
 
-def initial_shape(shape, level):
+def initial_shape(shape: str, level: int) -> tuple[np.ndarray, np.ndarray]:
     """The start of a run: the icosphere of ``level`` deformed into the
     shape's family (prolate: an ellipsoid of revolution stretched along z;
     discocyte: one flattened along z; stomatocyte: a sphere with its top cap
@@ -93,7 +94,7 @@ def initial_shape(shape, level):
 
 # -- datafiles ------------------------------------------------------------------------------
 
-def write_datafile(path, X, F, shape, method):
+def write_datafile(path: str, X: np.ndarray, F: np.ndarray, shape: str, method: str) -> str:
     """Write the Canham problem on ``(X, F)`` as an Evolver datafile.
 
     ``method`` "perp": ``star_perp_sq_mean_curvature`` (loads in
@@ -119,7 +120,7 @@ def write_datafile(path, X, F, shape, method):
     return path
 
 
-def datafile(shape, method, directory=PAPER):
+def datafile(shape: str, method: str, directory: str = PAPER) -> str:
     """Path of the shipped 162-vertex start ``vesicle_<shape>_<perp|normal>.fe``
     (written by :func:`write_datafile` when missing)."""
     kind = "normal" if method.startswith("normal") else "perp"
@@ -168,7 +169,7 @@ def _classify(hw, dlo, dhi):
     return "other"
 
 
-def mesh_descriptors(X, F):
+def mesh_descriptors(X: np.ndarray, F: np.ndarray) -> dict:
     """Symmetry descriptors of a closed mesh, comparable with
     :func:`reference_descriptors`.
 
@@ -221,7 +222,7 @@ def mesh_descriptors(X, F):
             "axisym_dev": float(abs(ev[lat[1]] - ev[lat[0]]) / ev[lat[1]])}
 
 
-def reference_descriptors(res):
+def reference_descriptors(res: CanhamResult) -> dict:
     """The same descriptors for an axisymmetric reference profile
     (:class:`~pyevolver.studies.axisymmetric.CanhamResult`), its poles
     at the two ends of the profile."""
