@@ -25,9 +25,17 @@ __all__ = ["Reader", "read_datafile", "top_parser", "line_parser"]
 
 
 class Reader(TopSection, ElementSections):
-    """Reads one datafile into a :class:`Scene`."""
+    """Reads one datafile into a :class:`Scene`.
 
-    def __init__(self, filename, text=None):
+    Parameters
+    ----------
+    filename : str
+        The datafile's path (the name in messages).
+    text : str, optional
+        Its text; read from ``filename`` when None.
+    """
+
+    def __init__(self, filename: str, text: str | None = None):
         self.filename = filename
         self.text = read_source(filename) if text is None else text
         self.scene = Scene(filename=filename)
@@ -41,11 +49,14 @@ class Reader(TopSection, ElementSections):
         return self._src_lines
 
     # -- errors -----------------------------------------------------------
-    def error(self, msg, line, col=None):
+    def error(self, msg: str, line: int | None, col: int | None = None) -> DatafileError:
+        """A :class:`DatafileError` at ``line`` (and ``col``) with the source excerpt."""
         excerpt = self.src_lines[line - 1] if line and 0 < line <= len(self.src_lines) else None
         return DatafileError(msg, self.filename, line, col, excerpt)
 
-    def read(self):
+    def read(self) -> Scene:
+        """The preprocessed sections read in order; returns the scene
+        (raises :class:`DatafileError`, located)."""
         self.scene.source_lines = self.src_lines
         sections, self.macros = preprocess(self.text, self.filename)
         top = sections[0]
@@ -165,7 +176,7 @@ class Reader(TopSection, ElementSections):
                     break
             raise _LocatedName(name, line, col)
 
-    def warn(self, msg, line, col=None):
+    def warn(self, msg: str, line: int | None, col: int | None = None) -> None:
         """Record a warning about a line (the Evolver warns and goes on)."""
         self.scene.warnings.append((msg, line, col))
 
