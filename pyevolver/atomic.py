@@ -12,6 +12,7 @@ studies' files.  Devices, pipes and directories are refused
 from __future__ import annotations
 
 import contextlib
+from typing import IO, Any, Iterator
 import os
 import secrets
 import stat
@@ -21,7 +22,7 @@ class NotRegularFile(OSError):
     """The path names a device, FIFO, socket or directory."""
 
 
-def check_regular(path, for_writing=True):
+def check_regular(path: str, for_writing: bool = True) -> None:
     """Raise :class:`NotRegularFile` when ``path`` exists and is not a
     regular file (``/dev/zero``, ``/dev/tty``, a FIFO, a directory).  A
     missing path is fine for writing (FileNotFoundError for reading)."""
@@ -37,7 +38,7 @@ def check_regular(path, for_writing=True):
 
 
 @contextlib.contextmanager
-def atomic_path(path, suffix=".tmp"):
+def atomic_path(path: str, suffix: str = ".tmp") -> Iterator[str]:
     """Yield the name of a fresh temporary file next to ``path``; when the
     block ends without an exception it is renamed to ``path`` (``os.replace``,
     atomic on POSIX and Windows), else removed.
@@ -70,7 +71,8 @@ def atomic_path(path, suffix=".tmp"):
 
 
 @contextlib.contextmanager
-def atomic_write(path, mode="w", *, durable=True, **kwargs):
+def atomic_write(path: str, mode: str = "w", *, durable: bool = True,
+                 **kwargs: Any) -> Iterator[IO]:
     """``open(path, mode, **kwargs)`` written atomically.
 
     Parameters

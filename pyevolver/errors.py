@@ -3,6 +3,11 @@
 Library code raises these; only the CLI/REPL turns them into messages and
 exit codes.
 """
+from __future__ import annotations
+
+import os
+import sys
+import traceback
 
 
 class PyEvolverError(Exception):
@@ -39,7 +44,8 @@ class DatafileError(PyEvolverError):
         return text
 
 
-def excerpt_window(line, column=None, width=120):
+def excerpt_window(line: str, column: int | None = None,
+                   width: int = 120) -> tuple[str, int | None]:
     """A source line cut to at most ``width`` characters around ``column``
     (1-based; None: the start), control characters shown as ``?``; returns
     ``(text, column in text)``."""
@@ -77,9 +83,6 @@ class InternalError(CommandError):
 
     @classmethod
     def from_exception(cls, exc, where):
-        import os
-        import sys
-        import traceback
         if os.environ.get("PYEVOLVER_TRACEBACK"):
             traceback.print_exception(type(exc), exc, exc.__traceback__, file=sys.stderr)
         err = cls(f"{where}: internal error ({type(exc).__name__}: {exc}); the surface "

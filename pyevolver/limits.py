@@ -7,6 +7,8 @@ largest thing they allow fits in a few hundred megabytes.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 #: largest element id (the Evolver keeps ids in a C ``int``; it allocates by
@@ -38,7 +40,7 @@ MAX_STRING = 10_000_000
 MAX_EXPANDED_LINE = 100_000
 
 
-def nesting_depth(tree, limit=MAX_NESTING):
+def nesting_depth(tree: Any, limit: int = MAX_NESTING) -> int:
     """Depth of a parsed expression or command (an iterative walk: a tree
     too deep for Python's recursion is measured without recursing).
 

@@ -39,7 +39,7 @@ FORMULAS = ["x^2 + y^2 + z^2", "sqrt(x^2+y^2+z^2)", "sin(x)*cos(y) + exp(z/3)",
 
 @pytest.mark.parametrize("text", FORMULAS)
 def test_symbolic_gradient_matches_finite_differences(text):
-    from pyevolver.datafile.reader import top_parser, _TOP
+    from pyevolver.datafile.grammar import top_parser, _TOP
     tree = top_parser().parse(f"constraint 1 formula: {text}")
     decl = _TOP.transform(tree)[0]
     f = N.Formula(decl[3])

@@ -37,7 +37,9 @@ class Section:
     warnings: list = field(default_factory=list)  # (source line, message)
 
 
-def normalise_newlines(text):
+def normalise_newlines(text: str) -> str:
+    """LF line endings (CRLF and CR become LF) and no DOS end-of-file
+    character (``\\x1a`` becomes a space)."""
     if "\r" in text:
         text = text.replace("\r\n", "\n").replace("\r", "\n")
     if "\x1a" in text:
@@ -45,8 +47,15 @@ def normalise_newlines(text):
     return text
 
 
-def blank_comments(text, filename):
-    """Replace comments by spaces, keeping newlines (positions are kept)."""
+def blank_comments(text: str, filename: str) -> str:
+    """Replace ``//`` and ``/* */`` comments by spaces, keeping newlines
+    (lines and columns are kept); strings are left alone.
+
+    Raises
+    ------
+    DatafileError
+        At an unterminated ``/*``.
+    """
     if "/" not in text:
         return text
 
@@ -69,18 +78,39 @@ def blank_comments(text, filename):
     return out
 
 
-def read_source(path):
+def read_source(path: str) -> str:
+    """The text of the file ``path``, decoded as Latin-1 (any byte reads)."""
     with open(path, "rb") as fh:
         data = fh.read()
     return data.decode("latin-1")
 
 
-def preprocess(text, filename="<datafile>", include_depth=0):
-    """Return ``(sections, macros)`` for the datafile text.
+def preprocess(text: str, filename: str = "<datafile>",
+               include_depth: int = 0) -> tuple[list[Section], dict[str, str]]:
+    """Split a datafile's text into sections, macros expanded.
 
-    ``sections`` is a list of :class:`Section`: the first is always the top
-    section (kind ``"top"``); element sections follow in file order, and
-    ``read`` (raw command text) comes last if present.
+    Parameters
+    ----------
+    text : str
+        The datafile's text.
+    filename : str
+        Its name, for messages and to find ``#include`` files beside it.
+    include_depth : int
+        How deep in ``#include`` files this text is.
+
+    Returns
+    -------
+    sections : list of Section
+        The first is always the top section (kind ``"top"``); element
+        sections follow in file order, and ``read`` (raw command text, its
+        ``#include`` and ``#define`` lines handled) comes last if present.
+    macros : dict
+        The ``#define`` macros, name -> replacement text.
+
+    Raises
+    ------
+    DatafileError
+        An unterminated comment, a bad directive or a missing include file.
     """
     text = normalise_newlines(text)
     clean = blank_comments(text, filename)
@@ -232,13 +262,30 @@ def _find_include(name, filename):
 
 
 class _TooLong(Exception):
-    pass
+    """A line grew beyond :data:`~pyevolver.limits.MAX_EXPANDED_LINE` by macro expansion."""
 
 
-def expand_macros(line, macros):
-    """Textual replacement of whole tokens, rescanned (at most 100 passes;
-    a line growing beyond :data:`~pyevolver.limits.MAX_EXPANDED_LINE` raises
-    ``_TooLong``: macros that double at each level would exhaust memory)."""
+def expand_macros(line: str, macros: dict[str, str]) -> str:
+    """Replace whole tokens that are macro names, rescanning the result.
+
+    Parameters
+    ----------
+    line : str
+        One line (strings in it are left alone).
+    macros : dict
+        Name -> replacement text.
+
+    Returns
+    -------
+    str
+        The line after at most 100 passes.
+
+    Raises
+    ------
+    _TooLong
+        When the line grows beyond :data:`~pyevolver.limits.MAX_EXPANDED_LINE`
+        (macros that double at each level would exhaust memory).
+    """
     for _ in range(100):
         if len(line) > MAX_EXPANDED_LINE:
             raise _TooLong()

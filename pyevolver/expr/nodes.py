@@ -16,183 +16,26 @@ expression trees; they are used for constraint gradients and projections.
 """
 from __future__ import annotations
 
-import math
+from typing import Any, Protocol
 
 import numpy as np
 
 from ..errors import ExpressionError
-
-# ---------------------------------------------------------------------------
-# constants and functions
-
-COLOURS = {
-    "clear": -1, "transparent": -1, "black": 0, "blue": 1, "green": 2,
-    "cyan": 3, "red": 4, "magenta": 5, "brown": 6, "lightgray": 7,
-    "darkgray": 8, "lightblue": 9, "lightgreen": 10, "lightcyan": 11,
-    "lightred": 12, "lightmagenta": 13, "yellow": 14, "white": 15,
-}
-
-CONSTANTS = {"pi": math.pi, "e": math.e, **{k: float(v) for k, v in COLOURS.items()}}
-
-
-def _acos(a):
-    return np.arccos(np.clip(a, -1.0, 1.0))
-
-
-def _asin(a):
-    return np.arcsin(np.clip(a, -1.0, 1.0))
-
-
-FUNC1 = {
-    "abs": np.abs, "sqr": lambda a: a * a, "sqrt": np.sqrt, "sin": np.sin,
-    "cos": np.cos, "tan": np.tan, "asin": _asin, "acos": _acos,
-    "atan": np.arctan, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh,
-    "asinh": np.arcsinh, "acosh": np.arccosh, "atanh": np.arctanh,
-    "exp": np.exp, "log": np.log, "ceil": np.ceil, "floor": np.floor,
-}
-def _domain(bad, msg):
-    if np.any(bad):
-        raise ExpressionError(msg)
-
-
-def _ellipk(m):
-    """Complete elliptic integral of the first kind K(m), parameter m
-    (Abramowitz & Stegun 17.3.1; the Evolver's convention)."""
-    from scipy.special import ellipk
-    _domain(np.asarray(m) >= 1, "ellipticK domain violation, parameter >= 1.")
-    return ellipk(m)
-
-
-def _ellipe(m):
-    """Complete elliptic integral of the second kind E(m) (A&S 17.3.3)."""
-    from scipy.special import ellipe
-    _domain(np.asarray(m) > 1, "ellipticE domain violation, parameter > 1.")
-    return ellipe(m)
-
-
-def _ellipf(phi, m):
-    """Incomplete elliptic integral of the first kind F(phi|m) (A&S 17.2.7)."""
-    from scipy.special import ellipkinc
-    _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
-            "incompleteEllipticF domain violation, m*sin(phi)^2 > 1.")
-    return ellipkinc(phi, m)
-
-
-def _ellipeinc(phi, m):
-    """Incomplete elliptic integral of the second kind E(phi|m) (A&S 17.2.8)."""
-    from scipy.special import ellipeinc
-    _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
-            "incompleteEllipticE domain violation, m*sin(phi)^2 > 1.")
-    return ellipeinc(phi, m)
-
-
-FUNC1["elliptick"] = _ellipk
-FUNC1["elliptice"] = _ellipe
-FUNC2 = {
-    "atan2": np.arctan2, "pow": np.power, "maximum": np.maximum,
-    "minimum": np.minimum, "incompleteellipticf": _ellipf,
-    "incompleteelliptice": _ellipeinc,
-}
-# recognised but refused
-UNSUPPORTED_FUNCS = {
-    "wrap_compose", "wrap_inverse", "usr1", "usr2", "usr3", "usr4", "usr5",
-    "usr6", "usr7", "usr8", "usr9", "usr10",
-}
-
-
-class ArrayValue(np.ndarray):
-    """A whole array as a value in the command language (``vn :=
-    ff.vertex[1].vertex_normal``, ``2*vn``, ``vn*vn`` the dot product), as
-    opposed to the per-point arrays of a vectorized formula evaluation."""
-
-
-def array_value(a):
-    return np.array(a, dtype=float).view(ArrayValue)
-
-
-def _num(v):
-    """Python float for scalars, array otherwise."""
-    if isinstance(v, np.ndarray) and v.ndim == 0 and not isinstance(v, ArrayValue):
-        return float(v)
-    return v
-
-
-def is_number(v):
-    """True for the values arithmetic accepts: numbers and numpy arrays (not
-    strings, elements or quantities)."""
-    return isinstance(v, (float, int, np.ndarray, np.number))
-
-
-def _mod(a, b):
-    if not isinstance(b, np.ndarray) and b == 0:
-        return math.nan * (a if isinstance(a, np.ndarray) else 1.0)  # REF: 5 % 0 is nan
-    with np.errstate(all="ignore"):
-        return a - np.floor(np.true_divide(a, b)) * b
-
-
-def _idiv(a, b):
-    a = np.trunc(a)
-    b = np.trunc(b)
-    if not isinstance(b, np.ndarray) and b == 0:
-        raise ExpressionError("division by zero (idiv)")
-    with np.errstate(all="ignore"):
-        return np.trunc(np.true_divide(a, b))
-
-
-BINOPS = {
-    "+": lambda a, b: a + b,
-    "-": lambda a, b: a - b,
-    "*": lambda a, b: a * b,
-    "/": lambda a, b: a / b,
-    "^": lambda a, b: np.power(a, b) if isinstance(a, np.ndarray) or isinstance(b, np.ndarray) else _pow(a, b),
-    "%": _mod,
-    "mod": _mod,
-    "imod": lambda a, b: _mod(np.trunc(a), np.trunc(b)),
-    "idiv": _idiv,
-}
-
-
-def _pow(a, b):
-    a = float(a)
-    b = float(b)
-    try:
-        r = a ** b
-    except ZeroDivisionError:
-        return math.inf
-    except OverflowError:
-        return math.inf
-    if isinstance(r, complex):
-        return math.nan
-    return r
-
-
-CMPOPS = {
-    "==": lambda a, b: a == b, "!=": lambda a, b: a != b,
-    "<": lambda a, b: a < b, ">": lambda a, b: a > b,
-    "<=": lambda a, b: a <= b, ">=": lambda a, b: a >= b,
-}
-
-
-def _what(v):
-    """How a non-number is named in messages."""
-    if isinstance(v, str):
-        return "a string"
-    if isinstance(v, np.ndarray):
-        return f"an array of shape {list(v.shape)}"
-    kind = getattr(v, "kind", None)
-    if isinstance(kind, str):
-        return f"a {kind}"
-    return "a quantity" if hasattr(v, "name") else "something else"
-
-
-def _bool(v):
-    if isinstance(v, np.ndarray):
-        return v.astype(float)
-    return 1.0 if v else 0.0
-
+from .functions import BINOPS, CMPOPS, FUNC1, FUNC2, _bool, _num, _what
+# (also the names of the language, used as nodes.X by the readers and the interpreter)
+from .functions import (COLOURS, CONSTANTS, UNSUPPORTED_FUNCS, ArrayValue,  # noqa: F401
+                        array_value, is_number)
 
 # ---------------------------------------------------------------------------
 # nodes
+
+
+class Env(Protocol):
+    """What :meth:`Node.ev` needs of an environment: ``lookup(name)``
+    returns a number, a string or an (n,) array, or raises
+    :class:`~pyevolver.errors.ExpressionError` for an unknown name."""
+
+    def lookup(self, name: str) -> Any: ...
 
 
 class Node:
@@ -201,13 +44,26 @@ class Node:
     __slots__ = ()
     pos = None  # (line, column) of the node, when known
 
-    def ev(self, env):  # pragma: no cover - abstract
+    def ev(self, env: Env) -> Any:  # pragma: no cover - abstract
+        """Evaluate in ``env``.
+
+        Parameters
+        ----------
+        env : Env
+            Supplies the names (parameters, coordinates as (n,) arrays).
+
+        Returns
+        -------
+        float, str or numpy.ndarray
+            A scalar, a string, or an (n,) array when a name is an array.
+        """
         raise NotImplementedError
 
-    def is_const(self):
+    def is_const(self) -> bool:
+        """True when the value needs no environment."""
         return False
 
-    def names(self):
+    def names(self) -> set[str]:
         """Set of variable names used by the expression."""
         out = set()
         self._names(out)
@@ -217,7 +73,8 @@ class Node:
         for c in self.children():
             c._names(out)
 
-    def children(self):
+    def children(self) -> tuple | list:
+        """The sub-expressions."""
         return ()
 
 
@@ -496,7 +353,8 @@ def _is(n, v):
     return isinstance(n, Num) and n.value == v
 
 
-def add(a, b):
+def add(a: Node, b: Node) -> Node:
+    """``a + b``, folded when a side is 0 or both are numbers."""
     if _is(a, 0):
         return b
     if _is(b, 0):
@@ -506,7 +364,8 @@ def add(a, b):
     return Bin("+", a, b)
 
 
-def sub(a, b):
+def sub(a: Node, b: Node) -> Node:
+    """``a - b``, folded when a side is 0 or both are numbers."""
     if _is(b, 0):
         return a
     if _is(a, 0):
@@ -516,7 +375,8 @@ def sub(a, b):
     return Bin("-", a, b)
 
 
-def mul(a, b):
+def mul(a: Node, b: Node) -> Node:
+    """``a * b``, folded when a side is 0 or 1 or both are numbers."""
     if _is(a, 0) or _is(b, 0):
         return ZERO
     if _is(a, 1):
@@ -528,7 +388,8 @@ def mul(a, b):
     return Bin("*", a, b)
 
 
-def div(a, b):
+def div(a: Node, b: Node) -> Node:
+    """``a / b``, folded when ``a`` is 0 or ``b`` is 1."""
     if _is(a, 0):
         return ZERO
     if _is(b, 1):
@@ -536,7 +397,8 @@ def div(a, b):
     return Bin("/", a, b)
 
 
-def neg(a):
+def neg(a: Node) -> Node:
+    """``-a``, folded for a number and a negation."""
     if isinstance(a, Num):
         return Num(-a.value)
     if isinstance(a, Neg):
@@ -544,7 +406,7 @@ def neg(a):
     return Neg(a)
 
 
-def diff(node, var):
+def diff(node: Node, var: str) -> Node:
     """Symbolic derivative of ``node`` with respect to the variable ``var``.
 
     ``var`` is a lower-case name ("x", "y", "z", "p1", ...).  Coordinate
@@ -688,7 +550,7 @@ COORD_ALIASES = {"x1": "x", "x2": "y", "x3": "z", "x4": "w"}
 
 
 
-def canonical_coords(node):
+def canonical_coords(node: Node) -> Node:
     """Rewrite ``x1 x2 x3`` to ``x y z`` so derivatives see one name."""
     if isinstance(node, Var):
         if node.name in COORD_ALIASES:
@@ -722,13 +584,23 @@ def canonical_coords(node):
 
 
 class MapEnv:
-    """Environment over a dict of names with a fallback environment."""
+    """Environment over a dict of names with a fallback environment.
 
-    def __init__(self, values, parent=None):
+    Parameters
+    ----------
+    values : dict
+        Name -> number, string or (n,) array.
+    parent : Env, optional
+        Asked for the names not in ``values``; without one, the constants
+        (``pi``, ``e``, colours) and then :class:`ExpressionError`.
+    """
+
+    def __init__(self, values: dict, parent: Env | None = None):
         self.values = values
         self.parent = parent
 
-    def lookup(self, name):
+    def lookup(self, name: str) -> Any:
+        """The value of ``name`` (see the class)."""
         v = self.values.get(name)
         if v is not None:
             return v
@@ -750,21 +622,22 @@ class Formula:
         Source text, for messages and ``print`` of formulas.
     """
 
-    def __init__(self, node, text=""):
+    def __init__(self, node: Node, text: str = ""):
         self.node = canonical_coords(node)
         self.text = text
         self._grads = {}
 
-    def __call__(self, env):
+    def __call__(self, env: Env) -> Any:
         return self.node.ev(env)
 
-    def grad(self, var):
+    def grad(self, var: str) -> Node:
+        """The derivative along ``var`` (symbolic, cached)."""
         g = self._grads.get(var)
         if g is None:
             g = self._grads[var] = diff(self.node, var)
         return g
 
-    def values(self, params, coords, n):
+    def values(self, params: Env, coords: dict, n: int) -> np.ndarray:
         """Evaluate at ``n`` points; returns an (n,) array.
 
         ``coords`` maps ``x, y, z`` (and ``p1`` ...) to (n,) arrays;
@@ -773,7 +646,8 @@ class Formula:
         v = self.node.ev(MapEnv(coords, params))
         return np.broadcast_to(np.asarray(v, dtype=float), (n,))
 
-    def hessian(self, params, coords, n, names=("x", "y", "z")):
+    def hessian(self, params: Env, coords: dict, n: int,
+                names: tuple[str, ...] = ("x", "y", "z")) -> np.ndarray:
         """(n, k, k) second derivatives (symbolic, cached)."""
         env = MapEnv(coords, params)
         k = len(names)
@@ -787,7 +661,8 @@ class Formula:
                 out[:, i, j] = np.broadcast_to(np.asarray(h.ev(env), dtype=float), (n,))
         return out
 
-    def gradient(self, params, coords, n, names=("x", "y", "z")):
+    def gradient(self, params: Env, coords: dict, n: int,
+                 names: tuple[str, ...] = ("x", "y", "z")) -> np.ndarray:
         """(n, len(names)) array of partial derivatives."""
         env = MapEnv(coords, params)
         out = np.empty((n, len(names)))

@@ -12,12 +12,15 @@ from . import nodes as N
 GRAMMAR_DIR = os.path.dirname(__file__)
 
 
-def expr_grammar():
+def expr_grammar() -> str:
+    """The text of ``expr.lark``, the expression rules shared by the grammars."""
     with open(os.path.join(GRAMMAR_DIR, "expr.lark")) as fh:
         return fh.read()
 
 
-def parse_number(text):
+def parse_number(text: str) -> float:
+    """A number token's value: decimal (``d`` exponents too), ``0x`` hex or
+    ``...b`` binary."""
     t = text.lower()
     if t.startswith("0x"):
         return float(int(t[2:], 16))
@@ -99,7 +102,8 @@ def _at(exc, tok):
 _ESCAPES = {"n": "\n", "r": "\r", "t": "\t", "b": "\b", "q": '"'}
 
 
-def unescape(s):
+def unescape(s: str) -> str:
+    """A string literal's backslash escapes (``\\n``, ``\\t``, ...) replaced."""
     if "\\" not in s:
         return s
     out = []

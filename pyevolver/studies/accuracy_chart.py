@@ -38,7 +38,7 @@ COLUMNS = ["problem", "method", "resolution", "seconds", "energy", "reference",
            "rel_error", "min_angle_deg"]
 
 
-def collect(size="small", studies=None):
+def collect(size: str = "small", studies: list[str] | None = None) -> list[dict]:
     """All chart records, each a dict with the keys of :data:`COLUMNS`.
 
     ``size``: "tiny" (the 5×10 torus and the 162-vertex prolate: what CI
@@ -57,7 +57,7 @@ def collect(size="small", studies=None):
     return rows
 
 
-def write_csv(rows, path):
+def write_csv(rows: list[dict], path: str) -> None:
     """Write ``rows`` with :data:`COLUMNS` (numbers with 12 significant digits)."""
     def fmt(v):
         return f"{v:.12g}" if isinstance(v, float) else str(v)
@@ -68,7 +68,7 @@ def write_csv(rows, path):
             w.writerow([fmt(r[k]) for k in COLUMNS])
 
 
-def plot(rows, path):
+def plot(rows: list[dict], path: str) -> None:
     """Log-log panels, one per problem: rel_error against seconds, one line
     per method through its resolutions (labelled with the vertex count)."""
     import matplotlib
@@ -98,7 +98,8 @@ def plot(rows, path):
     plt.close(fig)
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", choices=sorted(SIZES), default="small")
     ap.add_argument("--out", default=".")

@@ -357,7 +357,8 @@ def canham_reference(v0: float, branch: str, n: int = 48, n_profile: int = 401,
                         descriptors=descriptors(psi, r, z))
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     p = argparse.ArgumentParser(prog="python -m pyevolver.studies.axisymmetric",
                                 description=__doc__.split("\n")[0])
     p.add_argument("--v0", type=float, required=True)

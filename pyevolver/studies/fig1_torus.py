@@ -36,6 +36,11 @@ import time
 import numpy as np
 
 from ..atomic import atomic_write
+from ..evolve.gradient import _facet_points
+from ..methods.curvature import _angles
+from ..model.surface import Surface
+from ..session.core import Session
+from .meshes import torus_grid, write_fe
 
 RUNS = [("HKS", "star_sq_mean_curvature", "g"),
         ("MDSB", "cotan_sq_mean_curvature", "bfgs"),
@@ -45,10 +50,17 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PAPER = os.path.join(HERE, "..", "..", "datafiles", "paper")
 
 
-def datafile(method, directory=PAPER):
+def datafile(method: str, directory: str = PAPER) -> str:
     """Path of the shipped 5×9 torus datafile with ``method`` as its energy
-    (written from :func:`torus_grid` when missing)."""
-    from .meshes import torus_grid, write_fe
+    (written from :func:`torus_grid` when missing).
+
+    Parameters
+    ----------
+    method : str
+        A Willmore method name, e.g. ``"star_sq_mean_curvature"``.
+    directory : str
+        Where the datafile lives (``datafiles/paper``).
+    """
     path = os.path.join(directory, f"torus5x9_{method}.fe")
     if not os.path.exists(path):
         os.makedirs(directory, exist_ok=True)
@@ -61,17 +73,33 @@ def datafile(method, directory=PAPER):
     return path
 
 
-def min_angle(surface):
-    """Smallest corner angle of the surface, in degrees."""
-    from ..evolve.gradient import _facet_points
-    from ..methods.curvature import _angles
+def min_angle(surface: Surface) -> float:
+    """Smallest corner angle of the surface's facets, in degrees."""
     ang, _ = _angles(_facet_points(surface.evaluate()))
     return float(np.degrees(ang.min()))
 
 
-def run(label, method, minimizer, steps=3000, iters=2000, jitter=1e-3, seed=0):
-    """One run: returns (session, row dict)."""
-    from .. import Session
+def run(label: str, method: str, minimizer: str, steps: int = 3000, iters: int = 2000,
+        jitter: float = 1e-3, seed: int = 0) -> tuple[Session, dict]:
+    """One run of :data:`RUNS`.
+
+    Parameters
+    ----------
+    label, method, minimizer : str
+        A row of :data:`RUNS` (minimizer ``"g"`` or ``"bfgs"``).
+    steps, iters : int
+        ``g`` steps, or ``bfgs`` iterations.
+    jitter : float
+        Standard deviation of the seeded random move of the vertices.
+    seed : int
+        Seed of that move.
+
+    Returns
+    -------
+    (Session, dict)
+        The session after the run and its row (label, method, minimizer,
+        iterations, W, min_angle_deg, seconds).
+    """
     s = Session.load(datafile(method), out=io.StringIO())
     rng = np.random.default_rng(seed)
     s.surface.X += jitter * rng.standard_normal(s.surface.X.shape)
@@ -87,7 +115,8 @@ def run(label, method, minimizer, steps=3000, iters=2000, jitter=1e-3, seed=0):
                "W": s.total_energy, "min_angle_deg": min_angle(s.surface), "seconds": dt}
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=3000, help="g steps (HKS)")
     ap.add_argument("--iters", type=int, default=2000, help="bfgs iterations")

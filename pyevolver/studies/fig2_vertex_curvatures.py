@@ -33,7 +33,7 @@ from ..atomic import atomic_write
 from ..methods.curvature import _cot_and_grad, _mixed_areas
 
 
-def cone(n, h):
+def cone(n: int, h: float) -> np.ndarray:
     """Corners (n, 3, 3) of the n triangles (apex, p_k, p_{k+1})."""
     t = 2 * np.pi * np.arange(n) / n
     ring = np.stack([np.cos(t), np.sin(t), np.zeros(n)], axis=1)
@@ -41,7 +41,7 @@ def cone(n, h):
     return np.stack([np.broadcast_to(apex, (n, 3)), ring, np.roll(ring, -1, axis=0)], axis=1)
 
 
-def curvatures(n, h):
+def curvatures(n: int, h: float) -> tuple[float, float, float, float]:
     """(H_HKS, H_MDSB, H_EffArea, H_NormalCur) at the apex of the cone."""
     P = cone(n, h)
     N2 = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
@@ -62,13 +62,14 @@ def curvatures(n, h):
     return h_hks, h_mdsb, h_eff, h_norm
 
 
-def table(n=6, hmax=3.0, steps=301):
+def table(n: int = 6, hmax: float = 3.0, steps: int = 301) -> np.ndarray:
     """Rows (h, H_HKS, H_MDSB, H_EffArea, H_NormalCur) for h in (0, hmax]."""
     hs = np.linspace(hmax / steps, hmax, steps)
     return np.array([(h,) + curvatures(n, h) for h in hs])
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=6, help="number of corners of the n-gon")
     ap.add_argument("--hmax", type=float, default=3.0, help="largest height")

@@ -64,6 +64,7 @@ these runs) and ``fig3_torus.png``.
 from __future__ import annotations
 
 import argparse
+import csv
 import io
 import math
 import os
@@ -72,8 +73,15 @@ import shutil
 import subprocess
 import tempfile
 import time
+import warnings
 
 import numpy as np
+from scipy.optimize import minimize
+
+from ..errors import UnsupportedError
+from ..geometry.loop import LoopEvaluator
+from ..session.core import Session
+from .meshes import _outward, torus_grid, torus_offset, write_fe
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PAPER = os.path.join(HERE, "..", "..", "datafiles", "paper")
@@ -89,7 +97,6 @@ FIXED_LAMBDAS = [1.0, 0.5, 0.25, 0.12]
 # -- meshes and datafiles -------------------------------------------------------------------
 
 def _mesh(m, n, grid):
-    from .meshes import torus_grid, torus_offset
     if grid == "offset":
         return torus_offset(m, n, R=math.sqrt(2.0), r=1.0)
     if grid == "paper":
@@ -97,7 +104,8 @@ def _mesh(m, n, grid):
     raise ValueError(f"unknown grid {grid!r} (offset or paper)")
 
 
-def datafile(m, n, energy, regularized, grid="offset", directory=None):
+def datafile(m: int, n: int, energy: str, regularized: bool, grid: str = "offset",
+             directory: str | None = None) -> str:
     """Path of the datafile for an ``m``×``n`` torus with ``energy`` (EffArea
     or NormalCur), with ``harmonic_energy`` (λ = 0.25, the quantity
     ``harmonic``) and the ``loop_w`` info quantity when ``regularized``.
@@ -106,7 +114,6 @@ def datafile(m, n, energy, regularized, grid="offset", directory=None):
     sizes are written to ``directory`` (default: ``datafiles/paper``).
     Names: ``torus{m}x{n}[_offset]_{eff_area|normal}[_harmonic].fe``.
     """
-    from .meshes import write_fe
     tag = "_offset" if grid == "offset" else ""
     name = f"torus{m}x{n}{tag}_{SHORT[energy]}{'_harmonic' if regularized else ''}.fe"
     shipped = os.path.join(PAPER, name)
@@ -147,7 +154,7 @@ def datafile(m, n, energy, regularized, grid="offset", directory=None):
 
 # -- measurements -----------------------------------------------------------------------------
 
-def min_angle(X, F):
+def min_angle(X: np.ndarray, F: np.ndarray) -> float:
     """Smallest corner angle of the triangles ``F`` (nf, 3) of ``X`` (nv, 3), degrees."""
     P = X[F]
     e = [P[:, (k + 2) % 3] - P[:, (k + 1) % 3] for k in range(3)]      # side opposite k
@@ -161,7 +168,7 @@ def min_angle(X, F):
     return float(np.degrees(np.min(ang)))
 
 
-def radius_ratio(X):
+def radius_ratio(X: np.ndarray) -> tuple[float, float]:
     """Radius ratio ``R/r`` of a torus of revolution fitted to the vertices.
 
     The axis is the direction of least spread of the vertices about their
@@ -186,7 +193,7 @@ def radius_ratio(X):
     return float(R / r), float(dev)
 
 
-def special_conformal(X, b):
+def special_conformal(X: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The Möbius transformation x ↦ (x + b|x|²)/(1 + 2 b·x + |b|²|x|²)
     (inversion, translation by b, inversion; the identity at b = 0)."""
     b = np.asarray(b, float)
@@ -195,7 +202,8 @@ def special_conformal(X, b):
     return (X + np.outer(x2, b)) / den[:, None]
 
 
-def moebius_radius_ratio(X, starts=16, seed=0):
+def moebius_radius_ratio(X: np.ndarray, starts: int = 16,
+                         seed: int = 0) -> tuple[float, float, np.ndarray]:
     """:func:`radius_ratio` of the Möbius image of ``X`` that is closest to a
     torus of revolution.
 
@@ -215,9 +223,7 @@ def moebius_radius_ratio(X, starts=16, seed=0):
     transformation.  Returns ``(R/r, dev, b)``; checked on inverted tori
     (tests/test_fig3_torus.py).
     """
-    import warnings
 
-    from scipy.optimize import minimize
     Y = X - X.mean(axis=0)
     Y = Y / math.sqrt(np.mean(np.einsum("ij,ij->i", Y, Y)))
 
@@ -244,19 +250,17 @@ def moebius_radius_ratio(X, starts=16, seed=0):
     return ratio, d, best.x
 
 
-def loop_energy(X, F):
+def loop_energy(X: np.ndarray, F: np.ndarray) -> float:
     """Willmore energy ∫H² dA of the Loop subdivision surface of ``(X, F)``;
     NaN when the Loop methods refuse the mesh (valence above 12, which edge
     flips can produce)."""
-    from ..errors import UnsupportedError
-    from ..geometry.loop import LoopEvaluator
     try:
         return float(LoopEvaluator(F, len(X)).totals(X)["W"])
     except UnsupportedError:
         return math.nan
 
 
-def measure(session, moebius=True):
+def measure(session: Session, moebius: bool = True) -> dict:
     """W (the quantity willmore), relative error, W_Loop, R/r of the fitted
     torus of revolution and the fit's deviation (``revolution_dev``: how far
     the mesh is from a torus of revolution, :func:`radius_ratio`), the same
@@ -278,7 +282,7 @@ def measure(session, moebius=True):
 
 # -- running the shipped scripts ------------------------------------------------------------
 
-def script(name, call=None):
+def script(name: str, call: str | None = None) -> str:
     """Text of ``datafiles/paper/<name>`` with its default run (the line
     ending in ``// default run``) replaced by ``call`` when given."""
     with open(os.path.join(PAPER, name)) as fh:
@@ -291,11 +295,11 @@ def script(name, call=None):
 _PROGRESS = re.compile(r"^\s*-?\d+\. area: .* (energy|delta): ")
 
 
-def run_pyevolver(path, text, before="", where="<script>"):
+def run_pyevolver(path: str, text: str, before: str = "",
+                  where: str = "<script>") -> tuple[Session, list[str], float, int]:
     """Load ``path`` and run ``before`` and the script ``text`` (named
     ``where`` in messages) in pyevolver; returns (session, output lines,
     wall seconds, progress lines printed)."""
-    from .. import Session
     out = io.StringIO()
     s = Session.load(path, out=out, err=io.StringIO())
     t0 = time.perf_counter()
@@ -307,7 +311,8 @@ def run_pyevolver(path, text, before="", where="<script>"):
     return s, lines, dt, sum(1 for ln in lines if _PROGRESS.match(ln))
 
 
-def run_evolver(path, text, exe="evolver-nox-d"):
+def run_evolver(path: str, text: str,
+                exe: str = "evolver-nox-d") -> tuple[list[str], float] | None:
     """Run the script ``text`` on ``path`` in the reference Evolver; returns
     (output lines, wall seconds), or None when it is not installed."""
     if shutil.which(exe) is None:
@@ -343,8 +348,8 @@ def _fields(line):
 
 # -- the runs -----------------------------------------------------------------------------------
 
-def newton_run(m, n, energy, lam=None, grid="offset", steps=300, directory=None,
-               moebius=True):
+def newton_run(m: int, n: int, energy: str, lam: float | None = None, grid: str = "offset",
+               steps: int = 300, directory: str | None = None, moebius: bool = True) -> dict:
     """(a) with ``lam`` None, else (b): ``fig3_newton.cmd``.  Returns a row dict
     (:func:`measure`)."""
     path = datafile(m, n, energy, lam is not None, grid, directory)
@@ -361,9 +366,10 @@ def newton_run(m, n, energy, lam=None, grid="offset", steps=300, directory=None,
     return row
 
 
-def continuation_run(m, n, energy, grid="offset", lam0=0.25, factor=0.7, lammin=1e-3,
-                     steps=100, maxrises=2, directory=None, moebius=True, rule="loop",
-                     nbis=8):
+def continuation_run(m: int, n: int, energy: str, grid: str = "offset", lam0: float = 0.25,
+                     factor: float = 0.7, lammin: float = 1e-3, steps: int = 100,
+                     maxrises: int = 2, directory: str | None = None, moebius: bool = True,
+                     rule: str = "loop", nbis: int = 8) -> tuple[dict, list[dict]]:
     """(c): ``fig3_continuation.cmd``.  Returns (row, stages).
 
     ``rule``: ``"loop"`` keeps the stage with the lowest Loop energy (the
@@ -395,8 +401,9 @@ def continuation_run(m, n, energy, grid="offset", lam0=0.25, factor=0.7, lammin=
     return row, stages
 
 
-def recipe_run(m, n, energy, rounds=50, gsteps=20, evolver=True, directory=None,
-               moebius=True):
+def recipe_run(m: int, n: int, energy: str, rounds: int = 50, gsteps: int = 20,
+               evolver: bool = True, directory: str | None = None,
+               moebius: bool = True) -> tuple[list[dict], list[dict]]:
     """(d): ``fig3_evolver_recipe.cmd`` in pyevolver and (when installed and
     ``evolver``) in evolver-nox-d.  Returns (rows, per-round records)."""
     path = datafile(m, n, energy, False, "offset", directory)
@@ -429,7 +436,7 @@ def recipe_run(m, n, energy, rounds=50, gsteps=20, evolver=True, directory=None,
 
 # -- Proposition 1 ------------------------------------------------------------------------------
 
-def almost_spherical_torus(m, n, eps):
+def almost_spherical_torus(m: int, n: int, eps: float) -> tuple[np.ndarray, np.ndarray]:
     """A regular ``m``×``n`` torus (the connectivity of
     :func:`~pyevolver.studies.meshes.torus_grid`) with every vertex on the
     unit sphere and a hole of diameter 2ε along the z axis.
@@ -444,7 +451,6 @@ def almost_spherical_torus(m, n, eps):
 
     Returns ``X (m n, 3)``, ``F (2 m n, 3)`` oriented outward.
     """
-    from .meshes import _outward, torus_grid
     if not 0 < eps < 1:
         raise ValueError("eps must lie in (0, 1)")
     _, F = torus_grid(m, n)
@@ -457,19 +463,17 @@ def almost_spherical_torus(m, n, eps):
     return X, _outward(X, F)
 
 
-def bobenko_energy(X, F):
+def bobenko_energy(X: np.ndarray, F: np.ndarray) -> float:
     """``circle_willmore`` (Bobenko's W = Σ_e β_e − π #V) of a closed mesh,
     evaluated by pyevolver's quantity method."""
-    from .. import Session
-    from .meshes import write_fe
     with tempfile.TemporaryDirectory() as tmp:
         path = write_fe(os.path.join(tmp, "t.fe"), X, F, face_attrs="tension 0",
                         header="quantity wb energy method circle_willmore global")
         return float(Session.load(path, out=io.StringIO()).total_energy)
 
 
-def proposition1(grids=((5, 10), (10, 20), (20, 40)),
-                 eps=(0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 1e-3, 1e-4)):
+def proposition1(grids: tuple = ((5, 10), (10, 20), (20, 40)),
+                 eps: tuple = (0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 1e-3, 1e-4)) -> list[dict]:
     """Bobenko energies of :func:`almost_spherical_torus` for each grid size
     and hole size: a list of dicts (m, n, eps, W_bobenko, excess over 4π)."""
     rows = []
@@ -482,7 +486,8 @@ def proposition1(grids=((5, 10), (10, 20), (20, 40)),
 
 # -- the chart ----------------------------------------------------------------------------------
 
-def chart_records(full=False, directory=None, evolver=False, sizes=None):
+def chart_records(full: bool = False, directory: str | None = None, evolver: bool = False,
+                  sizes: list | None = None) -> list[dict]:
     """Points for the accuracy-versus-time chart: one per method and mesh
     resolution (5×10, 10×16 with ``full`` False; also 20×32 and 40×64).
 
@@ -526,7 +531,6 @@ def _record(method, row):
 # -- the study ----------------------------------------------------------------------------------
 
 def _write_csv(path, rows):
-    import csv
     keys = []
     for r in rows:
         keys += [k for k in r if k not in keys]
@@ -550,7 +554,8 @@ def _line(r):
     return "  ".join(parts)
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", choices=("small", "full"), default="small")
     ap.add_argument("--out", default=".")

@@ -58,447 +58,26 @@ from __future__ import annotations
 
 import argparse
 import io
-import math
 import os
 import shutil
 import subprocess
 import tempfile
 import time
+from typing import Any, Callable
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-PAPER = os.path.join(HERE, "..", "..", "datafiles", "paper")
-RECIPE = "vesicle_recipe.cmd"
+from ..session.core import Session
+from .axisymmetric import CanhamResult, canham_reference
+from .vesicle_newton import _solve_stage, harmonic_continuation, newton_lm
+from .vesicle_shapes import (LEVELS, METHODS, PAPER, RECIPE, REFERENCE_MODES, SHAPES, _profile,
+                             area_volume, datafile, initial_shape, mesh_descriptors, min_angle,
+                             reduced_volume, reference_descriptors, write_datafile)
 
-#: shape -> (reduced volume, branch of the axisymmetric reference)
-SHAPES = {"stomatocyte": (0.50, "stomatocyte"), "discocyte": (0.62, "oblate"),
-          "prolate": (0.85, "prolate")}
-#: sine modes of the reference per shape (converged to ≤ 1e-7 relative, see docs/paper.md)
-REFERENCE_MODES = {"stomatocyte": 128, "discocyte": 24, "prolate": 24}
-#: vertex count -> icosphere level
-LEVELS = {162: 2, 642: 3, 2562: 4, 10242: 5}
-METHODS = {
-    "normal": ("normal_sq_mean_curvature", "NormalCur+harmonic"),
-    "normal_u": ("normal_sq_mean_curvature", "NormalCur+harmonic+u"),
-    "perp": ("star_perp_sq_mean_curvature", "StarPerp+Evolver recipe"),
-    "perp_newton": ("star_perp_sq_mean_curvature", "StarPerp+recipe+Newton"),
-}
-
-
-# -- geometry of triangle meshes ------------------------------------------------------------
-
-def area_volume(X, F):
-    """Total area and enclosed volume of the closed mesh ``(X (nv, 3), F (nf, 3))``."""
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    A = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
-    V = np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0
-    return float(A), float(V)
-
-
-def reduced_volume(X, F):
-    """``v = 3V/(4π) / (A/(4π))^{3/2}`` (1 for a sphere)."""
-    A, V = area_volume(X, F)
-    return 3.0 * V / (4 * np.pi) / (A / (4 * np.pi)) ** 1.5
-
-
-def min_angle(X, F):
-    """Smallest corner angle of the triangles, in degrees."""
-    P = X[F]
-    out = np.inf
-    for k in range(3):
-        u = P[:, (k + 1) % 3] - P[:, k]
-        v = P[:, (k + 2) % 3] - P[:, k]
-        ang = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
-        out = min(out, float(ang.min()))
-    return math.degrees(out)
-
-
-def _deform(X, shape, p):
-    """The initial shape family of each branch at parameter ``p``."""
-    if shape in ("prolate", "discocyte"):
-        return X * np.array([1.0, 1.0, p])              # ellipsoid, semi-axes 1, 1, p
-    # a sphere whose cap z > p is reflected (smoothly) into the inside: a cup
-    eps = 0.08
-    out = X.copy()
-    out[:, 2] = X[:, 2] - 2 * eps * np.logaddexp(0.0, (X[:, 2] - p) / eps)
-    return out
-
-
-def initial_shape(shape, level):
-    """The start of a run: the icosphere of ``level`` deformed into the
-    shape's family (prolate: an ellipsoid of revolution stretched along z;
-    discocyte: one flattened along z; stomatocyte: a sphere with its top cap
-    pushed in) at exactly the shape's reduced volume, scaled to area 4π.
-
-    Returns ``X (nv, 3)``, ``F (nf, 3)``.
-    """
-    from scipy.optimize import brentq
-
-    from .meshes import icosphere
-    v0 = SHAPES[shape][0]
-    X, F = icosphere(level)
-    lo, hi = {"prolate": (1.0, 8.0), "discocyte": (0.02, 1.0),
-              "stomatocyte": (-0.9, 0.99)}[shape]
-    p = brentq(lambda p: reduced_volume(_deform(X, shape, p), F) - v0, lo, hi, xtol=1e-15)
-    Y = _deform(X, shape, p)
-    return Y * math.sqrt(4 * np.pi / area_volume(Y, F)[0]), F
-
-
-# -- datafiles ------------------------------------------------------------------------------
-
-def write_datafile(path, X, F, shape, method):
-    """Write the Canham problem on ``(X, F)`` as an Evolver datafile.
-
-    ``method`` "perp": ``star_perp_sq_mean_curvature`` (loads in
-    ``evolver-nox-d`` too); "normal": ``normal_sq_mean_curvature`` plus the
-    quantity ``harm`` (``harmonic_energy``, modulus λ = 1; pyevolver only).
-    """
-    from .meshes import write_fe
-    v0 = SHAPES[shape][0]
-    energy = METHODS[method][0]
-    lines = [f"// Figure 4 of the PL-methods paper: the Canham problem, {shape} branch,",
-             "// reduced volume v0, area 4*pi (FIXED quantity surf), volume v0*4*pi/3",
-             "// (body 1), W = sum over vertices of h^2 A/3 (a sphere: 4*pi).",
-             "// Written by pyevolver.studies.fig4_vesicles.",
-             f"parameter v0 = {v0}",
-             f"quantity willmore energy method {energy} global",
-             "quantity surf fixed = 4*pi method facet_area global"]
-    if method == "normal":
-        lines += ["// harmonic energy regularization (1/sqrt 3) sum |e|^2; modulus = lambda",
-                  "quantity harm energy modulus 1 method harmonic_energy global"]
-    write_fe(path, X, F, header="\n".join(lines), face_attrs="tension 0")
-    with open(path, "a") as fh:
-        fh.write("\nbodies\n1 " + " ".join(str(i + 1) for i in range(len(F)))
-                 + " volume v0*4*pi/3\n")
-    return path
-
-
-def datafile(shape, method, directory=PAPER):
-    """Path of the shipped 162-vertex start ``vesicle_<shape>_<perp|normal>.fe``
-    (written by :func:`write_datafile` when missing)."""
-    kind = "normal" if method.startswith("normal") else "perp"
-    path = os.path.join(directory, f"vesicle_{shape}_{kind}.fe")
-    if not os.path.exists(path):
-        os.makedirs(directory, exist_ok=True)
-        X, F = initial_shape(shape, 2)
-        write_datafile(path, X, F, shape, kind)
-    return path
-
-
-# -- damped Newton on all coordinates ----------------------------------------------------------
-
-def _rigid_motions(X):
-    """(3nv, 6) orthonormalised translations and infinitesimal rotations."""
-    nv = len(X)
-    R = np.zeros((3 * nv, 6))
-    c = X - X.mean(0)
-    for k in range(3):
-        R[k::3, k] = 1.0
-        e = np.zeros(3)
-        e[k] = 1.0
-        R[:, 3 + k] = np.cross(e, c).ravel()
-    q, _ = np.linalg.qr(R)
-    return q
-
-
-def _bordered(K, B, r, d, cache):
-    """Solve ``[[K, B], [Bᵀ, 0]] [y; μ] = [r; d]`` for the Newton step.
-
-    With CHOLMOD, first as a positive definite K (supernodal Cholesky, about
-    2.5 times faster than the LDLᵀ factorization; the symbolic analysis is
-    kept in ``cache`` for the matrices of one pattern); when K is not
-    positive definite, by the engine's indefinite solver
-    (:func:`~pyevolver.evolve.hessian.solve_bordered`).
-    """
-    from ..evolve.hessian import _cholmod, solve_bordered
-    chol = _cholmod()
-    if chol is not None:
-        try:
-            f = cache.get("factor")
-            if f is None:
-                f = cache["factor"] = chol.analyze(K, mode="supernodal")
-            f.cholesky_inplace(K)
-            Z = f(np.column_stack([r, B]))
-            mu = np.linalg.solve(B.T @ Z[:, 1:], B.T @ Z[:, 0] - d)
-            y = Z[:, 0] - Z[:, 1:] @ mu
-            if np.all(np.isfinite(y)):
-                return y
-        except (chol.CholmodNotPositiveDefiniteError, np.linalg.LinAlgError):
-            pass
-    return solve_bordered(K, B, r, d)[:K.shape[0]]
-
-
-def newton_lm(session, tol=1e-9, maxit=80, mu=1e-2, guard=None):
-    """Levenberg–Marquardt Newton iteration on all vertex coordinates.
-
-    Each step solves the bordered system of ``min ½ dᵀ(H + μ D) d + ∇Lᵀ d``
-    subject to the linearised fixed values (area quantity, body volume) and
-    to no rigid motion (translations and rotations, exact null directions of
-    the Lagrangian's Hessian ``H`` on a closed surface; the Evolver's
-    ``hessian`` with ``hessian_normal`` off does not remove them).  ``D`` is
-    the vertex area (a third of the star).  The move restores the fixed
-    values as ``g`` does.  It is kept when the energy drops, and μ is then
-    scaled by max(1/3, 1 − (2ρ − 1)³), ρ the ratio of the actual to the
-    predicted decrease; otherwise μ grows by 2, 4, 8, ... and the step is
-    solved again (Nielsen's rule, Madsen, Nielsen & Tingleff 2004,
-    *Methods for non-linear least squares problems*, §3.2).  Multipliers
-    are the least squares fit of ∇E on the constraint gradients.
-
-    ``guard(surface)`` returning False stops the iteration (used to abandon
-    a collapsing mesh early).  Returns ``(converged, steps, max |∇L|)``;
-    converged when max |∇L| < ``tol`` with the fixed values met to 1e-10
-    relative.
-    """
-    import scipy.sparse as sp
-
-    from ..evolve import gradient as GR
-    from ..evolve.hessian import lagrangian_hessian
-    from ..evolve.iterate import _Constraints
-    from ..constraints import restore_state, state
-    s = session.surface
-    it = session.iterator
-    cons = _Constraints(s)
-    mobile = ~s.vattr["fixed"]
-    gnorm = math.inf
-    nu = 2.0
-    for step in range(maxit):
-        t = s.evaluate()
-        gE = GR.energy_gradient(t)
-        gs = cons.gradients(t)
-        C = np.stack([g.ravel() for g in gs], 1)
-        lam = np.linalg.lstsq(C, gE.ravel(), rcond=None)[0]
-        gL = gE.ravel() - C @ lam
-        targets = cons.targets(s)
-        resid = targets - cons.values(t)
-        gnorm = float(np.abs(gL).max())
-        if gnorm < tol and np.all(np.abs(resid) < 1e-10 * np.abs(targets)):
-            return True, step, gnorm
-
-        def grad_L(tt, lam=lam):
-            g = GR.energy_gradient(tt)
-            for lv, gg in zip(lam, cons.gradients(tt)):
-                g = g - lv * gg
-            return g
-        H = lagrangian_hessian(s, cons, lam, grad_L).tocsc()
-        mass = sp.diags(np.repeat(np.bincount(s.F.ravel(), weights=np.repeat(t.facet_area, 3),
-                                              minlength=s.nv) / 3.0, 3)).tocsc()
-        B = np.column_stack([C, _rigid_motions(s.X)])
-        d = np.concatenate([resid, np.zeros(6)])
-        E0 = t.energy
-        X0 = state(s)
-        cache = {}
-        while True:
-            dx = _bordered((H + mu * mass).tocsc(), B, -gL, d, cache)
-            pred = -(gL @ dx + 0.5 * dx @ (H @ dx))
-            tt = it._move(X0, dx.reshape(-1, 3), 1.0, cons, None, None, mobile, targets,
-                          None, trial=True)
-            if math.isfinite(tt.energy) and tt.energy <= E0 + 1e-13 * abs(E0):
-                rho = (E0 - tt.energy) / pred if pred > 0 else 1.0
-                mu = max(mu * max(1 / 3, 1 - (2 * rho - 1) ** 3), 1e-12)
-                nu = 2.0
-                break
-            restore_state(s, X0)
-            mu *= nu
-            nu *= 2.0
-            if mu > 1e12:
-                session.recalc()
-                return False, step, gnorm
-        session.recalc()
-        if guard is not None and not guard(s):
-            return False, step + 1, gnorm
-    return False, maxit, gnorm
-
-
-def _solve_stage(session, maxit, guard, flips):
-    """Minimise at the current λ: :func:`newton_lm`; with ``flips`` > 0,
-    then equiangulate (``u`` sweeps until none flips) and solve again, at
-    most ``flips`` times, until a solve is followed by no flip.  Returns
-    ``(converged, Newton steps, edges flipped)``."""
-    ok, steps, _ = newton_lm(session, maxit=maxit, guard=guard)
-    flipped = 0
-    for _ in range(flips):
-        if guard is not None and not guard(session.surface):
-            break
-        n = 0
-        for _ in range(50):
-            k = session.equiangulate(echo=False)
-            n += k
-            if k == 0:
-                break
-        flipped += n
-        if n == 0:
-            break
-        ok, k, _ = newton_lm(session, maxit=maxit, guard=guard)
-        steps += k
-    return ok, steps, flipped
-
-
-def harmonic_continuation(session, lam_min=1e-3, factor=2.0, min_angle_deg=10.0,
-                          maxit=80, require_converged=False, flips=0, log=None):
-    """Lower λ (the modulus of quantity ``harm``) while the mesh stays healthy.
-
-    At the current λ the surface is minimised by :func:`newton_lm` (at most
-    ``maxit`` steps); then λ/``factor`` is tried from there, down to
-    ``lam_min``.  A stage is kept while the smallest angle stays at least
-    ``min_angle_deg`` (and, with ``require_converged``, Newton met its
-    tolerance).  The first stage that fails is undone (the surface and λ of
-    the last kept stage come back) and the continuation stops; after
-    refining, :func:`run` calls it again from the λ reached.  The failure it
-    guards against is abrupt: measured on all three shapes, the smallest
-    angle drops from 35–45° to below 10° within one halving of λ while W
-    drops sharply, mostly below the smooth minimum (docs/paper.md).
-
-    ``flips`` > 0 lets the triangulation follow the surface: after each
-    Newton solve the mesh is equiangulated (``u``) and solved again (see
-    :func:`_solve_stage`), so the harmonic energy measures the distortion
-    from the equilateral structure of the *current*, Delaunay-like
-    triangulation instead of the icosphere's.  ``log`` (a list) receives
-    one dict per stage.
-
-    Returns the final λ.
-    """
-    import copy
-
-    def healthy(surf):
-        return min_angle(surf.X, surf.F) >= min_angle_deg
-
-    def harm():
-        return session.surface.quantities["harm"]
-
-    def entry(lam, ok, n, nflip, good):
-        s = session.surface
-        return {"lambda": lam, "converged": ok, "steps": n, "flips": nflip, "kept": good,
-                "W": session.totals.quantity_values["willmore"],
-                "min_angle_deg": min_angle(s.X, s.F)}
-    lam = harm().modulus
-    ok, n, nflip = _solve_stage(session, maxit, None, flips)
-    good = (ok or not require_converged) and healthy(session.surface)
-    if log is not None:
-        log.append(entry(lam, ok, n, nflip, good))
-    if not good:
-        return lam
-    while lam / factor >= lam_min * (1 - 1e-12):
-        keep = copy.deepcopy(session.surface)
-        harm().modulus = lam / factor
-        session.recalc()
-        ok, n, nflip = _solve_stage(session, maxit, healthy, flips)
-        good = (ok or not require_converged) and healthy(session.surface)
-        if log is not None:
-            log.append(entry(lam / factor, ok, n, nflip, good))
-        if not good:
-            session._replace_surface(keep)
-            harm().modulus = lam
-            session.recalc()
-            break
-        lam = harm().modulus
-    return lam
-
-
-# -- shape descriptors ---------------------------------------------------------------------------
-
-def _line_hits(X, F, o, d):
-    """Sorted distinct parameters ``t`` where the line ``o + t d`` meets the
-    triangles (Möller–Trumbore, vectorised)."""
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    e1, e2 = b - a, c - a
-    p = np.cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, p)
-    ok = np.abs(det) > 1e-14 * np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
-    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    s = o - a
-    u = np.einsum("ij,ij->i", s, p) * inv
-    q = np.cross(s, e1)
-    v = (q @ d) * inv
-    t = np.einsum("ij,ij->i", e2, q) * inv
-    eps = 1e-10
-    hit = ok & (u >= -eps) & (v >= -eps) & (u + v <= 1 + eps)
-    t = np.sort(t[hit])
-    if len(t) == 0:
-        return t
-    keep = np.concatenate([[True], np.diff(t) > 1e-9])
-    return t[keep]
-
-
-def _classify(hw, dlo, dhi):
-    """Shape type from height/width and the two pole depths."""
-    if max(dlo, dhi) > 0.3 and abs(dhi - dlo) > 0.3:
-        return "stomatocyte"
-    if hw < 1 and min(dlo, dhi) > 0.02:
-        return "discocyte"
-    if max(dlo, dhi) <= 0.02:
-        if abs(hw - 1) < 0.02:
-            return "sphere"
-        return "prolate" if hw > 1 else "oblate"
-    return "other"
-
-
-def mesh_descriptors(X, F):
-    """Symmetry descriptors of a closed mesh, comparable with
-    :func:`reference_descriptors`.
-
-    The symmetry axis is the eigenvector of the surface's second-moment
-    tensor (about its area centroid) whose eigenvalue is farthest from the
-    other two.  With ``z`` the coordinate along it and ``r`` the distance
-    from it:
-
-    ``height_width``
-        z-extent / (2 max r): > 1 prolate, < 1 oblate (reference 2.285 at
-        v0 = 0.85, 0.274 at 0.62, 0.908 at 0.50).
-    ``pole_depth_min``, ``pole_depth_max``
-        where the axis pierces the surface (its poles), the depth of each
-        pole below the extreme plane on its side, relative to the height,
-        the smaller and the larger: both 0 for ellipsoid-like shapes, equal
-        and positive for a biconcave discocyte (its dimples), 0 and large
-        for a stomatocyte (its invagination).
-    ``axis_crossings``
-        how many times the axis pierces the surface (2 for all three shapes).
-    ``axisym_dev``
-        relative difference of the two lateral second moments (0 for a
-        surface of revolution).
-    ``type``
-        sphere / prolate / oblate / discocyte / stomatocyte / other.
-    """
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    fa = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    cen = (a + b + c) / 3.0
-    g = (fa[:, None] * cen).sum(0) / fa.sum()
-    D = cen - g
-    M = np.einsum("f,fi,fj->ij", fa, D, D) / fa.sum()
-    ev, evec = np.linalg.eigh(M)
-    k = 0 if ev[2] - ev[1] < ev[1] - ev[0] else 2
-    axis = evec[:, k]
-    lat = [i for i in range(3) if i != k]
-    Y = X - g
-    z = Y @ axis
-    r = np.linalg.norm(Y - np.outer(z, axis), axis=1)
-    hits = _line_hits(X, F, g, axis)
-    zmin, zmax = float(z.min()), float(z.max())
-    H = zmax - zmin
-    if len(hits):
-        dlo, dhi = (hits[0] - zmin) / H, (zmax - hits[-1]) / H
-    else:
-        dlo = dhi = float("nan")
-    hw = H / (2 * r.max())
-    return {"type": _classify(hw, dlo, dhi), "height_width": float(hw),
-            "pole_depth_min": float(min(dlo, dhi)), "pole_depth_max": float(max(dlo, dhi)),
-            "axis_crossings": len(hits),
-            "axisym_dev": float(abs(ev[lat[1]] - ev[lat[0]]) / ev[lat[1]])}
-
-
-def reference_descriptors(res):
-    """The same descriptors for an axisymmetric reference profile
-    (:class:`~pyevolver.studies.axisymmetric.CanhamResult`), its poles
-    at the two ends of the profile."""
-    z, r = res.z, res.r
-    zmin, zmax = float(z.min()), float(z.max())
-    H = zmax - zmin
-    lo, hi = sorted([float(z[0]), float(z[-1])])
-    hw = H / (2 * r.max())
-    dlo, dhi = (lo - zmin) / H, (zmax - hi) / H
-    return {"type": _classify(hw, dlo, dhi), "height_width": float(hw),
-            "pole_depth_min": float(min(dlo, dhi)), "pole_depth_max": float(max(dlo, dhi)),
-            "axis_crossings": 2, "axisym_dev": 0.0}
+__all__ = ["SHAPES", "METHODS", "LEVELS", "CHART_KEYS", "area_volume", "reduced_volume",
+           "min_angle", "initial_shape", "write_datafile", "datafile", "newton_lm",
+           "harmonic_continuation", "mesh_descriptors", "reference_descriptors", "reference",
+           "record", "run", "run_evolver", "chart_records", "plot", "main", "_solve_stage"]
 
 
 # -- runs ----------------------------------------------------------------------------------------
@@ -506,16 +85,16 @@ def reference_descriptors(res):
 _REFERENCES = {}
 
 
-def reference(shape):
+def reference(shape: str) -> CanhamResult:
     """The axisymmetric reference (:func:`canham_reference`) of a shape, cached."""
     if shape not in _REFERENCES:
-        from .axisymmetric import canham_reference
         v0, branch = SHAPES[shape]
         _REFERENCES[shape] = canham_reference(v0, branch, n=REFERENCE_MODES[shape])
     return _REFERENCES[shape]
 
 
-def record(shape, label, X, F, W, area, volume, seconds, cpu_seconds, **extra):
+def record(shape: str, label: str, X: np.ndarray, F: np.ndarray, W: float, area: float,
+           volume: float, seconds: float, cpu_seconds: float | None, **extra: Any) -> dict:
     """One result row: energy, error against the reference, mesh health,
     descriptors (see :func:`mesh_descriptors`)."""
     v0 = SHAPES[shape][0]
@@ -553,8 +132,9 @@ FLIP_ROUNDS = 10
 NEWTON_CYCLE = "cycle := { V; u; g 5; hessian_seek; hessian_seek }"
 
 
-def run(shape, method, max_nv=2562, first_nv=162, directory=PAPER, lam_min=1e-3,
-        recipe_vars=None, progress=None):
+def run(shape: str, method: str, max_nv: int = 2562, first_nv: int = 162,
+        directory: str = PAPER, lam_min: float = 1e-3, recipe_vars: dict | None = None,
+        progress: Callable[[dict], Any] | None = None) -> tuple[Session, list[dict]]:
     """Run one method on one shape coarse to fine up to ``max_nv`` vertices.
 
     ``method`` is a key of :data:`METHODS`.  Returns ``(session, rows)`` with
@@ -564,7 +144,6 @@ def run(shape, method, max_nv=2562, first_nv=162, directory=PAPER, lam_min=1e-3,
     the recipe (``recipe_g``, ``recipe_tol``, ``recipe_max``).  ``progress(row)``
     is called after each resolution.
     """
-    from .. import Session
     if shape not in SHAPES:
         raise ValueError(f"unknown shape {shape!r}; expected one of {', '.join(SHAPES)}")
     if method not in METHODS:
@@ -612,8 +191,9 @@ def run(shape, method, max_nv=2562, first_nv=162, directory=PAPER, lam_min=1e-3,
     return s, rows
 
 
-def run_evolver(shape, max_nv=642, first_nv=162, directory=PAPER,
-                executable="evolver-nox-d", recipe_vars=None, timeout=3600):
+def run_evolver(shape: str, max_nv: int = 642, first_nv: int = 162, directory: str = PAPER,
+                executable: str = "evolver-nox-d", recipe_vars: dict | None = None,
+                timeout: float = 3600) -> list[dict] | None:
     """The recipe run in the Surface Evolver (``evolver-nox-d``) on the same
     shipped datafile, refined up to ``max_nv`` vertices.  Its mesh after
     each resolution is printed by the script and measured here exactly as
@@ -718,25 +298,7 @@ def _write_csv(path, rows):
             fh.write(",".join("" if r.get(k) is None else str(r.get(k)) for k in keys) + "\n")
 
 
-def _profile(X, F):
-    """(r, z) of the vertices in the symmetry frame of :func:`mesh_descriptors`,
-    z centred on the extent and oriented so that the deeper pole is on top."""
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    fa = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    cen = (a + b + c) / 3.0
-    g = (fa[:, None] * cen).sum(0) / fa.sum()
-    D = cen - g
-    ev, evec = np.linalg.eigh(np.einsum("f,fi,fj->ij", fa, D, D))
-    axis = evec[:, 0 if ev[2] - ev[1] < ev[1] - ev[0] else 2]
-    z = (X - g) @ axis
-    r = np.linalg.norm((X - g) - np.outer(z, axis), axis=1)
-    hits = _line_hits(X, F, g, axis)
-    if len(hits) and (z.max() - hits[-1]) < (hits[0] - z.min()):
-        z, hits = -z, -hits[::-1]
-    return r, z - 0.5 * (z.max() + z.min())
-
-
-def plot(path, results):
+def plot(path: str, results: dict) -> None:
     """The final meshes' profiles over the references' (one row per shape,
     one column per method) and W's relative error against time."""
     import matplotlib
@@ -793,7 +355,8 @@ def plot(path, results):
     plt.close(fig)
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     ap = argparse.ArgumentParser(prog="python -m pyevolver.studies.fig4_vesicles",
                                  description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", choices=["small", "full"], default="small",

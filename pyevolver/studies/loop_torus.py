@@ -24,14 +24,15 @@ import argparse
 import time
 
 import numpy as np
+from scipy.optimize import minimize
 
 from ..geometry.loop import LoopEvaluator
-from .meshes import torus_grid
+from .meshes import torus_grid, write_fe
 
 CLIFFORD = 2 * np.pi ** 2
 
 
-def radius_ratio(P, a):
+def radius_ratio(P: np.ndarray, a: np.ndarray) -> tuple[float, float, float]:
     """Radius ratio R/r of a torus-like point cloud ``P (M, 3)`` with area
     weights ``a (M,)``: centre = weighted mean, axis = the direction of least
     weighted variance, then the meridian points ``(ρ, z)`` (distance from the
@@ -53,7 +54,8 @@ def radius_ratio(P, a):
     return R / r, R, r
 
 
-def minimize_torus(m=5, n=9, R=2.0, r=1.0, maxiter=2000, gtol=1e-9, order=None):
+def minimize_torus(m: int = 5, n: int = 9, R: float = 2.0, r: float = 1.0, maxiter: int = 2000,
+                   gtol: float = 1e-9, order: int | None = None) -> dict:
     """Minimise W of the Loop surface of the m×n torus at fixed limit area.
 
     Returns a dict: ``W`` (the minimum found), ``ratio`` (R/r of the
@@ -61,7 +63,6 @@ def minimize_torus(m=5, n=9, R=2.0, r=1.0, maxiter=2000, gtol=1e-9, order=None):
     ``X`` (the minimiser's control points), ``F``, ``iterations``,
     ``evaluations``, ``seconds``.
     """
-    from scipy.optimize import minimize
     X0, F = torus_grid(m, n, R, r)
     kw = {} if order is None else {"order": order}
     ev = LoopEvaluator(F, len(X0), **kw)
@@ -84,7 +85,8 @@ def minimize_torus(m=5, n=9, R=2.0, r=1.0, maxiter=2000, gtol=1e-9, order=None):
             "iterations": int(res.nit), "evaluations": int(res.nfev), "seconds": secs}
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit code."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--m", type=int, default=5)
     ap.add_argument("--n", type=int, default=9)
@@ -95,7 +97,6 @@ def main(argv=None):
     args = ap.parse_args(argv)
     out = minimize_torus(args.m, args.n, args.R, args.r, args.maxiter)
     if args.out:
-        from .meshes import write_fe
         hdr = ("quantity willmore energy method loop_sq_mean_curvature global\n"
                f"quantity larea fixed = {out['area']!r} method loop_area global\n"
                "quantity lvol info_only method loop_volume global\n")

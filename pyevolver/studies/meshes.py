@@ -11,14 +11,15 @@ import numpy as np
 from ..atomic import atomic_write
 
 
-def _outward(X, F):
+def _outward(X: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """``F`` with every triangle reversed when the enclosed volume is negative."""
     a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
     if np.einsum("ij,ij->i", a, np.cross(b, c)).sum() < 0:
         F = F[:, ::-1].copy()
     return F
 
 
-def torus_grid(m, n, R=2.0, r=1.0):
+def torus_grid(m: int, n: int, R: float = 2.0, r: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """The regularly triangulated torus of the paper's Figure 1: ``m`` grid
     points around the minor circle, ``n`` around the major circle, every
     grid quad split along the same diagonal, so every vertex has valence 6.
@@ -44,7 +45,8 @@ def torus_grid(m, n, R=2.0, r=1.0):
     return X, _outward(X, F)
 
 
-def torus_offset(m, n, R=2.0, r=1.0):
+def torus_offset(m: int, n: int, R: float = 2.0,
+                 r: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """The regular torus with offset rows: ``m`` points around the minor
     circle, ``n`` (even) rows around the major circle, odd rows turned by
     half a step (φ = 2π(i + ½)/m), each row joined to the next by a strip of
@@ -81,7 +83,7 @@ def torus_offset(m, n, R=2.0, r=1.0):
     return X, _outward(X, np.concatenate([F1, F2]))
 
 
-def icosahedron():
+def icosahedron() -> tuple[np.ndarray, np.ndarray]:
     """The unit icosahedron: ``X (12, 3)``, ``F (20, 3)``."""
     p = (1 + 5 ** 0.5) / 2
     X = np.array([[-1, p, 0], [1, p, 0], [-1, -p, 0], [1, -p, 0], [0, -1, p], [0, 1, p],
@@ -98,7 +100,7 @@ def icosahedron():
     return X, F
 
 
-def edges(F):
+def edges(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Undirected edges ``E (ne, 2)`` (E[:, 0] < E[:, 1]) and ``idx (nf, 3)``:
     the edge of side k of each facet (from corner k to corner k + 1)."""
     tail, head = F, np.roll(F, -1, axis=1)
@@ -108,7 +110,7 @@ def edges(F):
     return np.stack([lo[first], hi[first]], 1), inv.reshape(F.shape)
 
 
-def icosphere(level):
+def icosphere(level: int) -> tuple[np.ndarray, np.ndarray]:
     """The icosahedron refined ``level`` times (each triangle into four at
     its edge midpoints), vertices projected to the unit sphere:
     ``10 · 4^level + 2`` vertices (642, 2,562, 10,242 for levels 3, 4, 5)."""
@@ -126,7 +128,7 @@ def icosphere(level):
     return X, F
 
 
-def fe_text(X, F, header="", face_attrs=""):
+def fe_text(X: np.ndarray, F: np.ndarray, header: str = "", face_attrs: str = "") -> str:
     """``(X, F)`` as the text of an Evolver datafile (vertices, edges, faces
     with signed edge ids); ``header`` (e.g. quantity declarations) goes on
     top, ``face_attrs`` (e.g. ``"tension 0"``) after every face."""
@@ -143,7 +145,8 @@ def fe_text(X, F, header="", face_attrs=""):
     return "".join(out)
 
 
-def write_fe(path, X, F, header="", face_attrs=""):
+def write_fe(path: str, X: np.ndarray, F: np.ndarray, header: str = "",
+             face_attrs: str = "") -> str:
     """Write :func:`fe_text` of ``(X, F)`` to ``path``; returns ``path``."""
     with atomic_write(path, "w") as fh:
         fh.write(fe_text(X, F, header, face_attrs))

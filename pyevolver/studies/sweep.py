@@ -47,12 +47,18 @@ import json
 import math
 import os
 import time
-from concurrent.futures import as_completed
+from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from typing import Any, Callable
 
 import numpy as np
 
 from ..atomic import atomic_path, atomic_write
+from ..commands.interpreter import Quit
+from ..datafile.writer import dump
 from ..errors import PyEvolverError
+from ..io.render import _matplotlib, _save
+from ..session.api import progress_bar
+from ..session.core import Session
 
 SPEC_KEYS = {"datafile", "output", "commands", "record", "snapshot", "parameters",
              "continuation", "plot"}
@@ -127,7 +133,7 @@ def _values(where, name, v):
                      f"or {{start = a, stop = b, num = n}}")
 
 
-def load_spec(path):
+def load_spec(path: str) -> SweepSpec:
     """Read a sweep specification from a TOML file (:class:`SweepError` with
     the file and the problem when it is wrong)."""
     toml = _toml()
@@ -142,7 +148,7 @@ def load_spec(path):
     return spec_from_dict(raw, os.path.dirname(path), path)
 
 
-def spec_from_dict(raw, base=".", where="<spec>"):
+def spec_from_dict(raw: dict, base: str = ".", where: str = "<spec>") -> SweepSpec:
     """A :class:`SweepSpec` from a dict shaped like the TOML file; relative
     paths are taken from ``base``."""
     unknown = set(raw) - SPEC_KEYS
@@ -191,7 +197,7 @@ def spec_from_dict(raw, base=".", where="<spec>"):
 
 # -- keys: what a point's result depends on ----------------------------------------------
 
-def point_keys(spec):
+def point_keys(spec: SweepSpec) -> list[str]:
     """A key (hex digest) per point: the datafile's bytes, the commands, the
     recorded expressions, the snapshot field, the point's values and, with
     continuation, the key of the point it starts from."""
@@ -209,11 +215,12 @@ def point_keys(spec):
     return keys
 
 
-def point_dir(spec, i):
+def point_dir(spec: SweepSpec, i: int) -> str:
+    """The folder of point ``i``: ``<output>/pNNNN``."""
     return os.path.join(spec.output, f"p{i:04d}")
 
 
-def finished(spec, i, key):
+def finished(spec: SweepSpec, i: int, key: str) -> dict | None:
     """The stored result of point ``i`` if it was finished with ``key``, else None."""
     try:
         with open(os.path.join(point_dir(spec, i), "result.json")) as fh:
@@ -234,11 +241,9 @@ def _assign(sess, name, value):
     sess.run(f"{name} := {value:.17g}", where=f"<sweep parameter {name}>")
 
 
-def run_point(spec, i, key, start=None):
+def run_point(spec: SweepSpec, i: int, key: str, start: str | None = None) -> dict:
     """Compute point ``i`` (its files in :func:`point_dir`); ``start``: the
     dump of the point it continues from.  Returns its result dict."""
-    from ..commands.interpreter import Quit
-    from ..session.core import Session
     folder = point_dir(spec, i)
     os.makedirs(folder, exist_ok=True)
     for name in os.listdir(folder):            # temporary files of a killed run
@@ -270,7 +275,6 @@ def run_point(spec, i, key, start=None):
             "record": {e: sess.value(e) for e in spec.record},
             "iterations": len(sess.history)})
         with atomic_path(os.path.join(folder, "final.fe"), ".fe") as tmp:
-            from ..datafile.writer import dump
             dump(sess, tmp)
         with atomic_write(os.path.join(folder, "energies.csv"), newline="") as fh:
             w = csv.writer(fh)
@@ -291,7 +295,7 @@ def run_point(spec, i, key, start=None):
     return res
 
 
-def run_chain(spec, chain, keys):
+def run_chain(spec: SweepSpec, chain: list[int], keys: list[str]) -> list[dict]:
     """Run the points of ``chain`` in order, skipping finished ones (a
     finished point's dump is the start of the next).  Top level, so that
     process pools and Dask can pickle it."""
@@ -334,14 +338,13 @@ class SweepResult:
         return [r for r in self.rows if r["status"] != "ok"]
 
 
-def local_executor(workers=None):
+def local_executor(workers: int | None = None) -> ProcessPoolExecutor:
     """The default executor: a process pool (``workers`` processes, default
     the number of CPUs)."""
-    from concurrent.futures import ProcessPoolExecutor
     return ProcessPoolExecutor(max_workers=workers)
 
 
-def dask_executor(address):
+def dask_executor(address: str) -> tuple[Executor, Any]:
     """``(executor, client)`` for the Dask scheduler at ``address``
     (``tcp://HOST:PORT``); close the client when done."""
     try:
@@ -356,7 +359,8 @@ def dask_executor(address):
     return client.get_executor(), client
 
 
-def run_sweep(spec, executor=None, workers=None, progress=None, log=None):
+def run_sweep(spec: SweepSpec, executor: Executor | None = None, workers: int | None = None,
+              progress: Any = None, log: Callable[[str], Any] | None = None) -> SweepResult:
     """Run every unfinished point of ``spec`` through ``executor`` (default:
     :func:`local_executor`), then write ``results.csv`` and ``phase.png``.
 
@@ -364,7 +368,6 @@ def run_sweep(spec, executor=None, workers=None, progress=None, log=None):
     nothing); ``progress`` a tqdm bar over the points (as
     :func:`pyevolver.session.api.progress_bar`).  Returns a :class:`SweepResult`.
     """
-    from ..session.api import progress_bar
     os.makedirs(spec.output, exist_ok=True)
     keys = point_keys(spec)
     pts = spec.points()
@@ -417,7 +420,7 @@ def run_sweep(spec, executor=None, workers=None, progress=None, log=None):
     return SweepResult(ordered, table, plot, computed, reused)
 
 
-def table_columns(spec, rows):
+def table_columns(spec: SweepSpec, rows: list[dict]) -> list[str]:
     """Column names of ``results.csv``."""
     cols = ["index"] + list(spec.parameters) + ["status", "total_energy", "total_area",
                                                  "vertex_count", "facet_count"]
@@ -444,7 +447,7 @@ def _row_values(spec, r):
     return v
 
 
-def write_table(spec, rows):
+def write_table(spec: SweepSpec, rows: list[dict]) -> str:
     """``results.csv``: one row per point (numbers written so that they read back exactly)."""
     path = os.path.join(spec.output, "results.csv")
     cols = table_columns(spec, rows)
@@ -458,11 +461,10 @@ def write_table(spec, rows):
     return path
 
 
-def plot_phase(spec, rows):
+def plot_phase(spec: SweepSpec, rows: list[dict]) -> str:
     """``phase.png``: over two parameters, the points' snapshots in a grid
     (titled with the colour column); over one, the colour column against
     it.  More parameters: the plot is skipped (:class:`SweepError`)."""
-    from ..io.render import _matplotlib, _save
     _, Figure, FigureCanvasAgg = _matplotlib()
     names = list(spec.parameters)
     col = spec.plot_color

@@ -1,0 +1,72 @@
+"""Located errors of the datafile reader: the exceptions raised inside the
+scanners and transformers, which the reader turns into a
+:class:`~pyevolver.errors.DatafileError` with the source line and column, and
+the wording of a parser's "expected ..." list."""
+from __future__ import annotations
+
+import re
+
+from lark.exceptions import UnexpectedCharacters, UnexpectedToken
+
+
+class _Unsupported(Exception):
+    """A keyword the grammar knows and pyevolver refuses (the token)."""
+
+
+class _MatrixError(Exception):
+    """A PERIODS / VIEW_* matrix with the wrong count: ``(line, message)``."""
+
+
+class _LocatedName(Exception):
+    def __init__(self, name, line, col):
+        super().__init__(name)
+        self.name = name
+        self.line = line
+        self.col = col
+
+
+def _walk(node):
+    yield node
+    for c in node.children():
+        yield from _walk(c)
+
+
+_TERMINAL_NAMES = {
+    "NUMBER": "a number", "NAME": "a name", "INT": "an integer", "MINUS": "'-'",
+    "PLUS": "'+'", "LPAR": "'('", "RPAR": "')'", "FORMULA_KW": "FORMULA",
+    "COMPKW": "a component such as E1: or X1:", "EQUAL": "'='",
+    "BRACED_NUMBERS": "numbers in braces { ... }", "ARRAY_INIT": "values in braces { ... }",
+    "DUMP_FLAG_KW": "RUNGE_KUTTA", "SLICE_COEFF_KW": "slice_coeff",
+}
+
+
+def _expected(exp):
+    names = []
+    for e in sorted(exp):
+        if e.startswith("__") or e in ("LIST_NEG", "LIST_PLUS", "ON_NEVER", "NAME_NEG"):
+            continue
+        names.append(_TERMINAL_NAMES.get(e, e.replace("_KW", "").lower()))
+    if not names:
+        return "something else"
+    if len(names) > 6:
+        names = names[:6] + ["..."]
+    return ", ".join(names)
+
+
+def describe(exc: Exception, text: str) -> str:
+    """The message for a parse error ``exc`` of ``text`` (without location)."""
+    if isinstance(exc, UnexpectedCharacters):
+        ch = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        word = re.match(r"[A-Za-z_]\w*", text[exc.pos_in_stream:])
+        if word:
+            return (f"unexpected '{word.group(0)}': not a keyword, parameter or "
+                    f"value allowed here")
+        return f"unexpected character {ch!r}"
+    if isinstance(exc, UnexpectedToken):
+        tok = exc.token
+        if tok.type == "$END":
+            exp = _expected(exc.expected)
+            return f"unexpected end of line: expected {exp}"
+        exp = _expected(exc.expected)
+        return f"unexpected '{tok}': expected {exp}"
+    return str(exc).split("\n")[0]
