@@ -40,7 +40,7 @@ class Reader(TopSection, ElementSections):
         self.text = read_source(filename) if text is None else text
         self.scene = Scene(filename=filename)
         self._src_lines = None
-        self._named_forward = set()     # names declared ahead ("constraint pinned;")
+        self._named_forward: set[str] = set()     # names declared ahead ("constraint pinned;")
 
     @property
     def src_lines(self):
@@ -63,10 +63,10 @@ class Reader(TopSection, ElementSections):
         self._top(top)
         if "keep_macros" in self.scene.flags:
             self.scene.macros = self.macros     # active at run time too (manual)
-        seen = []
+        seen: list = []
         for k in range(1, len(sections)):
             sec = sections[k]
-            sections[k] = None           # let each section's text go once read
+            sections[k] = None  # type: ignore[call-overload]  # its text goes once read
             if sec.kind == "read":
                 self.scene.read_text = sec.text
                 self.scene.read_line = sec.line

@@ -82,7 +82,7 @@ def minimize(fun: Callable, x0: np.ndarray, maxiter: int, callback: Callable | N
     n = len(x)
     dense = n <= dense_limit
     Hinv = None
-    pairs = []                                       # (s, y, 1/(s·y)) for L-BFGS
+    pairs: list = []                                 # (s, y, 1/(s·y)) for L-BFGS
     res = BFGSResult(x, f, nfev=1)
     if not math.isfinite(f):
         res.message = "the energy is not finite at the start"
@@ -125,7 +125,7 @@ def minimize(fun: Callable, x0: np.ndarray, maxiter: int, callback: Callable | N
         if callback is not None and callback(res):
             res.message = "stopped by the callback"
             break
-        if not ok and np.linalg.norm(s_) <= 1e-15 * max(1.0, np.linalg.norm(x)):
+        if not ok and np.linalg.norm(s_) <= 1e-15 * max(1.0, float(np.linalg.norm(x))):
             res.message, res.success = "steps below round-off", True
             break
     else:
@@ -181,7 +181,7 @@ def minimize_surface(surface, maxiter: int, callback: Callable | None = None) ->
     s = surface
     check_free(s)
     idx = np.nonzero(~s.vattr["fixed"])[0]
-    areas = {}                       # id of an evaluated point -> its area
+    areas: dict = {}                 # id of an evaluated point -> its area
 
     def fun(x):
         s.X[idx] = x.reshape(-1, 3)

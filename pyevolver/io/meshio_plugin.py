@@ -41,7 +41,7 @@ FORMAT = "evolver"
 
 #: Writer options per meshio format: one file per export (xdmf's data
 #: inline, not in a sidecar .h5), binary STL.
-WRITE_OPTIONS = {"xdmf": {"data_format": "XML"}, "stl": {"binary": True}}
+WRITE_OPTIONS: dict[str, dict] = {"xdmf": {"data_format": "XML"}, "stl": {"binary": True}}
 
 #: Formats the tests round-trip, by extension.
 EXPORT_FORMATS = {".vtu": "vtu", ".xdmf": "xdmf", ".ply": "ply", ".obj": "obj",

@@ -8,7 +8,7 @@ exist only when the datafile declares them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -65,14 +65,14 @@ class Quantity:
 class Bodies:
     n: int = 0
     facet_matrix: object = None      # sparse (nb, nf) with +-1 entries
-    target: np.ndarray = None        # nan where no volume constraint
-    volconst: np.ndarray = None
-    pressure: np.ndarray = None      # prescribed pressure (nan = none)
-    density: np.ndarray = None
-    volume: np.ndarray = None        # last computed
-    lagrange: np.ndarray = None      # reported pressures (multipliers)
-    original: np.ndarray = None
-    occurrences: tuple = None        # (body, facet, sign) as listed (duplicates kept)
+    target: Optional[np.ndarray] = None        # nan where no volume constraint
+    volconst: Optional[np.ndarray] = None
+    pressure: Optional[np.ndarray] = None      # prescribed pressure (nan = none)
+    density: Optional[np.ndarray] = None
+    volume: Optional[np.ndarray] = None        # last computed
+    lagrange: Optional[np.ndarray] = None      # reported pressures (multipliers)
+    original: Optional[np.ndarray] = None
+    occurrences: Optional[tuple] = None        # (body, facet, sign) as listed (duplicates kept)
 
 
 class Surface:
