@@ -484,7 +484,7 @@ class Interpreter:
                 arr[pos] = value
             return
         base = lv[1].ev(self.env)
-        element_attrs.set_attr(s, base, lv[2], self._index(lv[3]), value)
+        s.set_attr(base, lv[2], self._index(lv[3]), value)
 
     @staticmethod
     def _fill(name, arr, pos, value):

@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 from .api import SessionAPI, progress_bar
-from ..commands import constraints, elements, files, remesh, variables
+from ..commands import constraints, element_attrs, elements, files, remesh, variables
 from ..commands import interpreter as I
 from ..commands.variables import DEFAULTS, READ_ONLY  # noqa: F401 (READ_ONLY: re-exported)
 from ..datafile.preprocess import _TooLong as _MacroTooLong, expand_macros
@@ -813,6 +813,15 @@ class Session(SessionAPI):
     def internal(self, name: str):
         """The value of a built-in name (``vertex_count``, a setting, a toggle)."""
         return variables.internal(self, name)
+
+    def get_attr(self, base, name: str, idx=None):
+        """``base.name[idx]`` of an element or quantity reference
+        (:func:`pyevolver.commands.element_attrs.get_attr`)."""
+        return element_attrs.get_attr(self, base, name, idx)
+
+    def set_attr(self, base, name: str, idx, value) -> None:
+        """``base.name[idx] := value`` (:func:`pyevolver.commands.element_attrs.set_attr`)."""
+        element_attrs.set_attr(self, base, name, idx, value)
 
     def set_variable(self, name: str, value) -> None:
         """``name := value`` (settings, parameters and user variables)."""
