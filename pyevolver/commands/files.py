@@ -8,6 +8,8 @@ from __future__ import annotations
 import copy
 import os
 
+import numpy as np
+
 from ..datafile.reader import read_datafile
 from ..errors import CommandError, PyEvolverError, UnsupportedError
 from ..limits import MAX_NESTING
@@ -61,7 +63,7 @@ def replace_load(session, name):
     session.surface = surface
     session.filename = name
     session._iterator = None
-    session._scene_settings(scene)
+    scene_settings(session, scene)
     session.recalc()
 
 
@@ -115,6 +117,59 @@ def read_file(session, name):
         # like the Evolver, an error abandons the rest of the file; what
         # ran before it stays done
         session.write_err(f"{exc}\n")
+
+
+# -- loading: warnings, settings, the view ------------------------------------------
+def warn_bare_edges(session, filename, scene, s):
+    """REF warns at load about each edge of a soapfilm surface that is on
+    no facet and not marked BARE ("Edge 19 has no facets, and is not
+    marked "bare".")."""
+    if s.string or not s.nf or not s.ne or len(scene.edges.ids) > s.ne:
+        return
+    FE = np.asarray(s.FE)
+    used = np.zeros(s.ne, bool)
+    used[np.where(FE >= 0, FE, ~FE).ravel()] = True
+    blk = scene.edges
+    for i in np.nonzero(~used[:len(blk.ids)])[0].tolist():
+        attrs = blk.attrs.get(i, ())
+        if any(kw == "bare" for kw, _ in attrs):
+            continue
+        session.write_err(f"{filename}:{blk.lines[i]}: warning: edge {blk.ids[i]} has no "
+                       f"facets and is not marked bare\n")
+
+
+def scene_settings(session, scene):
+    for k in ("scale_limit", "constraint_tolerance"):
+        if k in scene.values:
+            session.settings[k] = scene.values[k]
+    if "total_time" in scene.values:        # TOTAL_TIME: a dump goes on with its clock
+        session.total_time = float(scene.values["total_time"])
+    if "scale" in scene.values:
+        session.settings["scale"] = scene.values["scale"]
+        if scene.values.get("scale_fixed"):
+            session.toggles["_fixed_scale"] = 1      # SCALE x FIXED: the m command
+
+# -- dump and load (commands) --------------------------------------------------
+
+
+def init_view_matrix(session):
+    """The graphics view matrix (exporters read it): the Evolver's initial
+    view fits the bounding box into [-1, 1]^3."""
+    s = session.surface
+    d = s.sdim
+    M = np.eye(d + 1)
+    if s.nv:
+        lo, hi = s.X.min(axis=0), s.X.max(axis=0)
+        size = float(np.max(hi - lo))
+        if size > 0:
+            sc = 2.0 / size
+            for k in range(d):
+                M[k, k] = sc
+                M[k, d] = -sc * (lo[k] + hi[k]) / 2
+    session.arrays["view_matrix"] = M
+    session.array_types["view_matrix"] = "real"
+
+# -- output -----------------------------------------------------------------
 
 
 # -- the commands -------------------------------------------------------------------

@@ -18,6 +18,7 @@ import time
 
 import numpy as np
 
+from . import undo
 from .api import SessionAPI, progress_bar
 from ..commands import constraints, element_attrs, elements, files, remesh, variables
 from ..commands import interpreter as I
@@ -59,8 +60,17 @@ UNSUPPORTED_MOTION = ("area_normalization", "normal_motion", "runge_kutta",
 
 
 class Session(SessionAPI):
-    """A loaded surface with its variables, commands and output streams
-    (the Python API's extras: :class:`pyevolver.session.api.SessionAPI`)."""
+    """A loaded surface with its variables, settings, toggles, history,
+    undo and output streams.
+
+    The commands themselves live in :mod:`pyevolver.commands` (one
+    registry, :mod:`pyevolver.commands.registry`) and take the session as
+    their argument; the methods here are the public Python API: :meth:`load`,
+    :meth:`run`, :meth:`g`, :meth:`value`, :attr:`quantities`,
+    :attr:`total_energy`, :meth:`refine`, :meth:`equiangulate`, and from
+    :class:`~pyevolver.session.api.SessionAPI` ``export``, ``snapshot``,
+    ``plot_history``.
+    """
 
     def __init__(self, out=None, err=None):
         self.out = out or sys.stdout
@@ -95,14 +105,28 @@ class Session(SessionAPI):
 
     # -- loading ---------------------------------------------------------------
     @classmethod
-    def load(cls, filename, out=None, err=None, run_read=True, text=None):
-        """A session on the datafile ``filename`` (``text``: its contents,
-        when not to be read from disk)."""
+    def load(cls, filename: str, out=None, err=None, run_read: bool = True,
+             text: str | None = None) -> "Session":
+        """A session on a datafile.
+
+        Parameters
+        ----------
+        filename : str
+            The ``.fe`` datafile.
+        out, err : file-like, optional
+            Where output and messages go (default: stdout, stderr).
+        run_read : bool
+            Run the datafile's ``read`` section.
+        text : str, optional
+            The file's contents, when not to be read from disk.
+        """
         s = cls(out, err)
         s.load_file(filename, run_read, text)
         return s
 
-    def load_file(self, filename, run_read=True, text=None):
+    def load_file(self, filename: str, run_read: bool = True,
+                  text: str | None = None) -> "Session":
+        """Load a datafile into this session (see :meth:`load`)."""
         scene = read_datafile(filename, text)
         surface = build_surface(scene)
         return self._install(filename, scene, surface, run_read)
@@ -113,7 +137,7 @@ class Session(SessionAPI):
         for msg, line, col in scene.warnings:  # lines the Evolver warns about
             where = f"{filename}:{line}:{col}" if col else f"{filename}:{line}"
             self.write_err(f"{where}: warning: {msg}\n")
-        self._warn_bare_edges(filename, scene, surface)
+        files.warn_bare_edges(self, filename, scene, surface)
         constraints.record_order(self, scene, surface)     # constraints in datafile order
         self.on_assign_call = dict(scene.on_assign)
         if scene.constraint_names:             # named constraints and boundaries
@@ -130,7 +154,7 @@ class Session(SessionAPI):
         self.toggles["gravity"] = int(scene.values.get("gravity_constant", 0) != 0 or
                                       bool(b.n and np.any(b.density)))
         self.variables = surface.params        # parameters and variables share one namespace
-        self._scene_settings(scene)
+        files.scene_settings(self, scene)
         for flag in ("area_normalization", "autopop", "conj_grad", "torus_filled",
                      "effective_area", "normal_curvature", "approximate_curvature",
                      "runge_kutta", "jiggle"):
@@ -143,7 +167,7 @@ class Session(SessionAPI):
         self.letters = {}
         self.arrays = {}
         self.macros = dict(scene.macros)       # keep_macros: expanded in commands
-        self._init_view_matrix()
+        files.init_view_matrix(self)
         for name, (typ, arr) in scene.arrays.items():     # a dump's global arrays
             self.arrays[name] = arr.copy()
             self.array_types[name] = typ
@@ -181,35 +205,6 @@ class Session(SessionAPI):
                         break
         return self
 
-    def _warn_bare_edges(self, filename, scene, s):
-        """REF warns at load about each edge of a soapfilm surface that is on
-        no facet and not marked BARE ("Edge 19 has no facets, and is not
-        marked "bare".")."""
-        if s.string or not s.nf or not s.ne or len(scene.edges.ids) > s.ne:
-            return
-        FE = np.asarray(s.FE)
-        used = np.zeros(s.ne, bool)
-        used[np.where(FE >= 0, FE, ~FE).ravel()] = True
-        blk = scene.edges
-        for i in np.nonzero(~used[:len(blk.ids)])[0].tolist():
-            attrs = blk.attrs.get(i, ())
-            if any(kw == "bare" for kw, _ in attrs):
-                continue
-            self.write_err(f"{filename}:{blk.lines[i]}: warning: edge {blk.ids[i]} has no "
-                           f"facets and is not marked bare\n")
-
-    def _scene_settings(self, scene):
-        for k in ("scale_limit", "constraint_tolerance"):
-            if k in scene.values:
-                self.settings[k] = scene.values[k]
-        if "total_time" in scene.values:        # TOTAL_TIME: a dump goes on with its clock
-            self.total_time = float(scene.values["total_time"])
-        if "scale" in scene.values:
-            self.settings["scale"] = scene.values["scale"]
-            if scene.values.get("scale_fixed"):
-                self.toggles["_fixed_scale"] = 1      # SCALE x FIXED: the m command
-
-    # -- dump and load (commands) --------------------------------------------------
     def dump(self, name=None):
         """``dump "file"``: write the surface as a datafile (no name: the
         datafile name with ``.dmp`` appended, as the Evolver does)."""
@@ -222,27 +217,6 @@ class Session(SessionAPI):
         except OSError as exc:
             raise CommandError(f"dump: cannot write '{name}': {exc.strerror}") from None
 
-
-
-
-
-    def _init_view_matrix(self):
-        """The graphics view matrix (exporters read it): the Evolver's initial
-        view fits the bounding box into [-1, 1]^3."""
-        s = self.surface
-        d = s.sdim
-        M = np.eye(d + 1)
-        if s.nv:
-            lo, hi = s.X.min(axis=0), s.X.max(axis=0)
-            size = float(np.max(hi - lo))
-            if size > 0:
-                sc = 2.0 / size
-                for k in range(d):
-                    M[k, k] = sc
-                    M[k, d] = -sc * (lo[k] + hi[k]) / 2
-        self.arrays["view_matrix"] = M
-        self.array_types["view_matrix"] = "real"
-
     # -- output -----------------------------------------------------------------
     def note(self, text):
         """A message that ``quiet`` suppresses (REF: counts after r, v, toggle
@@ -250,19 +224,31 @@ class Session(SessionAPI):
         if not self.toggles.get("quiet"):
             self.write(text)
 
-    def write(self, text):
+    def write(self, text: str) -> None:
+        """Write to the output stream."""
         self.out.write(text)
 
-    def write_err(self, text):
+    def write_err(self, text: str) -> None:
+        """Write to the message stream (stderr)."""
         self.err.write(text)
 
     # -- running commands ----------------------------------------------------------
-    def run(self, text, where="<command>", line=1, stop_on_error=True):
+    def run(self, text: str, where: str = "<command>", line: int = 1,
+            stop_on_error: bool = True) -> None:
         """Run command text (any number of commands).
 
         Each complete command is parsed then executed; a failing command
-        leaves the surface and variables as they were, prints its error and
-        (``stop_on_error``) raises :class:`CommandError`.
+        leaves the surface and variables as they were.
+
+        Parameters
+        ----------
+        text : str
+            Commands of the Evolver's language, e.g. ``"r; u; g 10"``.
+        where, line : str, int
+            The location errors name.
+        stop_on_error : bool
+            Raise :class:`CommandError` at the first error (else print it
+            and go on).
         """
         for chunk, ln in I.split_commands(text):
             try:
@@ -274,7 +260,8 @@ class Session(SessionAPI):
                     raise
                 self.write_err(f"{exc}\n")
 
-    def run_one(self, text, where="<command>", line=1):
+    def run_one(self, text: str, where: str = "<command>", line: int = 1) -> None:
+        """Run one complete command; an error restores the state before it."""
         stripped = text.strip()
         if stripped.startswith("!") and not stripped.startswith("!="):
             # !!, !n, !prefix: a command from the history, echoed (manual)
@@ -382,29 +369,8 @@ class Session(SessionAPI):
         self.pending[word] = self.pending.get(word, 0) + n
 
     def _snapshot(self):
-        s = self.surface
-        b = s.bodies if s is not None else None
-        return (dict(self.variables), dict(self.commands), dict(self.letters),
-                {k: v.copy() for k, v in self.arrays.items()}, dict(self.toggles),
-                dict(self.settings),
-                None if s is None else s.X.copy(),
-                None if b is None or not b.n else (b.target.copy(), b.pressure.copy(),
-                                                    b.volconst.copy(), b.density.copy(),
-                                                    b.lagrange.copy()),
-                None if s is None else {k: (q.target, q.modulus, q.kind, q.pressure,
-                                            q.tolerance, list(q.methods))
-                                        for k, q in s.quantities.items()},
-                None if s is None else {k: v.copy() for k, v in s.extra.items()},
-                None if s is None else {k: v.copy() for k, v in s.vattr.items()},
-                None if s is None else {k: v.copy() for k, v in s.eattr.items()},
-                None if s is None else {k: v.copy() for k, v in s.fattr.items()},
-                None if s is None else {k: m.copy() for k, m in s.vcon.items()},
-                s, self.totals, self._iterator_state(),
-                None if s is None else ({k: m.copy() for k, m in s.econ.items()},
-                                        {k: m.copy() for k, m in s.fcon.items()},
-                                        s.gravity_constant, s.sq_curvature_modulus),
-                self.filename,
-                {k: dict(v) for k, v in self.__dict__.get("_attr_store", {}).items()})
+        """The state a failing command returns to (:func:`pyevolver.session.undo.snapshot`)."""
+        return undo.snapshot(self)
 
     def _iterator_state(self):
         it = self._iterator
@@ -413,43 +379,9 @@ class Session(SessionAPI):
         return (it.cg_history, it.cg_S_old, it.cg_f_old, it.pressures_valid)
 
     def _restore(self, snap):
-        (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
-         fattr, vcon, surface, totals, it_state, more, filename, attr_store) = snap
-        self.filename = filename
-        self._attr_store = attr_store          # graphics-only attributes (commands.attributes)
-        self.surface = surface
-        self.totals = totals            # the energies of the restored coordinates
-        if self._iterator is not None:
-            if it_state is None:
-                self._iterator = None
-            else:
-                (self._iterator.cg_history, self._iterator.cg_S_old, self._iterator.cg_f_old,
-                 self._iterator.pressures_valid) = it_state
-        self.variables.clear()
-        self.variables.update(vars_)
-        self.commands = cmds
-        self.letters = letters
-        self.arrays = arrays
-        self.toggles = toggles
-        self.settings = settings
-        s = self.surface
-        if s is not None:
-            s.X = X
-            if bod is not None:
-                b = s.bodies
-                b.target, b.pressure, b.volconst, b.density, b.lagrange = bod
-            for k, (t, m, kind, p, tol, methods) in qs.items():
-                q = s.quantities[k]
-                q.target, q.modulus, q.kind, q.pressure, q.tolerance = t, m, kind, p, tol
-                q.methods[:] = methods          # set/unset element membership
-            s.extra = extra
-            s.vattr = vattr
-            s.eattr = eattr
-            s.fattr = fattr
-            s.vcon = vcon
-            s.econ, s.fcon, s.gravity_constant, s.sq_curvature_modulus = more
+        """Return to a :meth:`_snapshot` (:func:`pyevolver.session.undo.restore`)."""
+        undo.restore(self, snap)
 
-    # -- evaluation ------------------------------------------------------------------
     def recalc(self, keep_cg=False, reposition=False):
         """Recompute energies, areas and volumes (and reset the CG history,
         as the Evolver's recalc does, unless ``keep_cg``).
