@@ -182,7 +182,7 @@ class ArrayRef(N.Node):
         if self.name not in env.session.arrays and env.current() is not None:
             # a bare indexed attribute inside a generator: form_factors[2]
             return element_attrs.get_attr(env.session, env.current(), self.name,
-                                        idx[0] if len(idx) == 1 else tuple(idx))
+                                          idx[0] if len(idx) == 1 else tuple(idx))
         arr, pos = interp.array_slot(self.name, idx, partial=True)
         v = arr[pos]
         if np.ndim(v):

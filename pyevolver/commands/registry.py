@@ -15,8 +15,9 @@ Three kinds of entries share :class:`Command`:
   arguments.
 
 Families register their commands at import (:mod:`~pyevolver.commands.remesh`,
-:mod:`~pyevolver.commands.evolution`, ...); :func:`load_families` imports
-them all.  The interpreter only dispatches::
+:mod:`~pyevolver.commands.evolution`, :mod:`~pyevolver.commands.toggles`,
+:mod:`~pyevolver.commands.files`, ...); :mod:`pyevolver.commands.interpreter`
+imports them all and only dispatches::
 
     from pyevolver.commands.registry import register
 
