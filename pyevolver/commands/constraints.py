@@ -15,10 +15,10 @@ from ..errors import CommandError, UnsupportedError
 from ..model.surface import project_to_constraints
 from . import element_attrs, elements
 from .registry import register
-from .values import ElemRef
+from .values import ElemRef, SessionLike
 
 
-def set_constraint(session, els, cid):
+def set_constraint(session: SessionLike, els, cid):
     """``set gen constraint n``: put the elements on level-set constraint
     ``n`` (a number or a name from ``define constraint``); vertices are
     projected onto it at once (REF)."""
@@ -50,7 +50,7 @@ def set_constraint(session, els, cid):
         project_to_constraints(s, np.array(moved, np.int64))
 
 
-def define_constraint(session, text):
+def define_constraint(session: SessionLike, text):
     """``define constraint NAME [flags] formula: expr [energy: ...] [content:
     ...]`` at run time: a level-set constraint numbered after the existing
     ones and known by its name (REF: ``list`` shows the name,
@@ -84,12 +84,12 @@ def define_constraint(session, text):
         project_to_constraints(s, np.arange(s.nv))
 
 
-def constraint_label(session, cid):
+def constraint_label(session: SessionLike, cid):
     """A constraint's number, or its name when defined at run time."""
     return getattr(session.surface, "constraint_names", {}).get(cid, str(cid))
 
 
-def in_order(session, kind, i, cons):
+def in_order(session: SessionLike, kind, i, cons):
     """An element's constraints in the order REF lists them: as the
     datafile line gave them, then those set later, in turn (``cons``:
     the constraints it is on, by number)."""
@@ -101,7 +101,7 @@ def in_order(session, kind, i, cons):
     return first + [c for c in cons if c not in first]
 
 
-def record_order(session, scene, surface):
+def record_order(session: SessionLike, scene, surface):
     """The datafile order of the constraints of vertices and edges named
     with several (see :meth:`_in_order`)."""
     order = {}
@@ -115,12 +115,13 @@ def record_order(session, scene, surface):
     surface.con_order = order
 
 
-def boundary_label(session, bid):
+def boundary_label(session: SessionLike, bid):
     """A boundary's number, or its name when declared by name."""
     return getattr(session.surface, "boundary_names", {}).get(bid, str(bid))
 
 
-def unset_constraint(session, els, cid):
+def unset_constraint(session: SessionLike, els, cid):
+    """``unset gen constraint n``: take the elements off constraint ``n``."""
     s = session.surface
     if cid not in s.vcon and cid not in s.econ and cid not in s.fcon:
         return
@@ -133,7 +134,7 @@ def unset_constraint(session, els, cid):
             m[el.i] = 0
 
 
-def fix_elements(session, els, on):
+def fix_elements(session: SessionLike, els, on):
     """``fix``/``unfix`` elements; returns how many changed."""
     n = 0
     for el in els:
@@ -147,7 +148,7 @@ def fix_elements(session, els, on):
     return n
 
 
-def fix_name(session, name, on):
+def fix_name(session: SessionLike, name, on):
     """``fix quantity`` / ``unfix quantity``."""
     s = session.surface
     if name in s.quantities:

@@ -18,10 +18,11 @@ from ..model.surface import project_to_constraints
 from . import attributes as A
 from . import constraints, elements
 from .registry import register
-from .values import _KIND, ElemRef, QRef, as_float, as_int
+from .values import _KIND, ElemRef, QRef, SessionLike, as_float, as_int
 
 
-def get_attr(session, base, name, idx):
+def get_attr(session: SessionLike, base, name, idx):
+    """The value of ``base.name`` (``idx``: its index, a number or a tuple)."""
     if isinstance(base, A.ConstraintAt):
         return A.constraint_attr(session, base, name, idx)
     if name in ("on_quantity", "on_method_instance"):
@@ -219,7 +220,7 @@ def attr_pos(k, name, arr, idx):
     return tuple(pos)
 
 
-def _quantity_attr(session, qname, name):
+def _quantity_attr(session: SessionLike, qname, name):
     q = session.surface.quantities[qname]
     if q.kind == "instance" and name not in ("value", "modulus"):
         raise ExpressionError(f"method instance {qname} has no attribute '{name}' "
@@ -237,7 +238,8 @@ def _quantity_attr(session, qname, name):
     return A.quantity_attr(session, q, name)
 
 
-def set_attr(session, base, name, idx, value):
+def set_attr(session: SessionLike, base, name, idx, value):
+    """Assign ``base.name[idx] := value``."""
     if idx is not None:
         idx = tuple(as_int(j, f"the index of '{name}'") for j in idx) \
             if isinstance(idx, tuple) else as_int(idx, f"the index of '{name}'")
@@ -344,7 +346,8 @@ def set_attr(session, base, name, idx, value):
     raise CommandError(f"cannot assign to {k} attribute '{name}'")
 
 
-def set_elements(session, gen, attr, expr, env, unset, idx=None):
+def set_elements(session: SessionLike, gen, attr, expr, env, unset, idx=None):
+    """``set gen attr expr`` / ``unset gen attr``: every value computed first, then assigned."""
     els = elements.generate(session, gen, env)
     qname = A.membership_name(session, gen.kind, attr, expr)
     if qname is not None:
@@ -402,7 +405,7 @@ def set_elements(session, gen, attr, expr, env, unset, idx=None):
         A.cache(session).touch(session)
 
 
-def project_or_fail(session, surface, idx):
+def project_or_fail(session: SessionLike, surface, idx):
     """Project vertices to their constraints; a projection that diverges
     fails the command (which leaves the surface as it was)."""
     bad = project_to_constraints(surface, idx)

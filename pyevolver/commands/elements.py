@@ -15,15 +15,17 @@ from ..geometry.kernels import edge_index
 from ..model import string as SM
 from ..model import surface as MS
 from .registry import register
-from .values import ElemRef, as_int, is_true
+from .values import ElemRef, SessionLike, as_int, is_true
 
 
-def count(session, kind):
+def count(session: SessionLike, kind):
+    """The number of ``kind`` elements (vertex, edge, facet, body)."""
     s = session.surface
     return {"vertex": s.nv, "edge": s.ne, "facet": s.n_facets, "body": s.bodies.n}[kind]
 
 
-def element(session, kind, index):
+def element(session: SessionLike, kind, index):
+    """``kind[index]`` by id (1-based; negative: reversed orientation)."""
     k = as_int(index, f"a {kind} index")
     n = count(session, kind)
     sign = -1 if k < 0 else 1
@@ -39,7 +41,7 @@ def element(session, kind, index):
     return ElemRef(kind, abs(k) - 1, sign)
 
 
-def generate(session, gen, env):
+def generate(session: SessionLike, gen, env):
     """Elements of a generator, with its ``where`` filter applied."""
     els = gen_base(session, gen.base, env)
     if gen.where is None:
@@ -55,7 +57,9 @@ def generate(session, gen, env):
     return out
 
 
-def gen_base(session, base, env):
+def gen_base(session: SessionLike, base, env):
+    """The elements of a generator's base (``all``, ``index``, ``var``,
+    ``sub``), before ``where``."""
     tag = base[0]
     if "facetedge" in base[1:3]:
         raise UnsupportedError("facetedge elements")
@@ -88,7 +92,9 @@ def gen_base(session, base, env):
     return out
 
 
-def sub_elements(session, el, kind):
+def sub_elements(session: SessionLike, el, kind):
+    """The ``kind`` elements of ``el`` (``ee.vertex``, ``ff.edge``,
+    ``vv.facet``), in REF's order."""
     check_alive(session, el)
     s = session.surface
     i = el.i
@@ -142,7 +148,7 @@ def sub_elements(session, el, kind):
     raise ExpressionError(f"{el.kind} has no {kind}s")
 
 
-def _string_sub_elements(session, el, kind):
+def _string_sub_elements(session: SessionLike, el, kind):
     """Facet navigation in the string model (facets are edge chains)."""
     s = session.surface
     i = el.i
@@ -167,7 +173,7 @@ def _string_sub_elements(session, el, kind):
     raise ExpressionError(f"{el.kind} has no {kind}s")
 
 
-def check_alive(session, el):
+def check_alive(session: SessionLike, el):
     """An element reference kept across a command that removed elements
     (``foreach ... do { delete ...; print vv.id }``) may point past the
     end: refused by name."""
@@ -175,7 +181,7 @@ def check_alive(session, el):
         raise ExpressionError(f"the {el.kind} no longer exists (deleted by this command)")
 
 
-def define_attribute(session, kind, name, typ, shape):
+def define_attribute(session: SessionLike, kind, name, typ, shape):
     """``define vertex attribute name real[3]`` at run time."""
     s = session.surface
     if typ not in ("real", "integer"):

@@ -16,10 +16,10 @@ from ..limits import MAX_NESTING
 from ..model.surface import build_surface
 from ..remesh.merge import append_surface
 from .registry import register
-from .values import Loaded, Quit
+from .values import Loaded, Quit, SessionLike
 
 
-def _read_new(session, cmd, name):
+def _read_new(session: SessionLike, cmd, name):
     if not os.path.isfile(name):
         if os.path.exists(name):
             raise CommandError(f"{cmd}: '{name}' is not a regular file (a directory, "
@@ -29,7 +29,7 @@ def _read_new(session, cmd, name):
     return scene, build_surface(scene)
 
 
-def load_command(session, name):
+def load_command(session: SessionLike, name):
     """``load "file"``: a fresh start on another datafile (variables,
     commands and toggles forgotten; its read section runs)."""
     scene, surface = _read_new(session, "load", name)
@@ -39,7 +39,7 @@ def load_command(session, name):
     session._install(name, scene, surface, True)
 
 
-def replace_load(session, name):
+def replace_load(session: SessionLike, name):
     """``replace_load "file"``: the surface of another datafile replaces
     the current one; variables, commands and toggles are kept, the new
     file's parameters and settings override, its read section is not run."""
@@ -67,7 +67,7 @@ def replace_load(session, name):
     session.recalc()
 
 
-def addload(session, name):
+def addload(session: SessionLike, name):
     """``addload "file"``: the file's elements added to the surface,
     numbered after the existing ones; its declarations override, its
     read section is not run."""
@@ -87,7 +87,7 @@ def addload(session, name):
     session.recalc()
 
 
-def read_file(session, name):
+def read_file(session: SessionLike, name):
     """``read "file"``: run a command file (the current directory first,
     then the directories of EVOLVERPATH).  An error stops the file."""
     cands = [name]
@@ -120,7 +120,7 @@ def read_file(session, name):
 
 
 # -- loading: warnings, settings, the view ------------------------------------------
-def warn_bare_edges(session, filename, scene, s):
+def warn_bare_edges(session: SessionLike, filename, scene, s):
     """REF warns at load about each edge of a soapfilm surface that is on
     no facet and not marked BARE ("Edge 19 has no facets, and is not
     marked "bare".")."""
@@ -138,7 +138,8 @@ def warn_bare_edges(session, filename, scene, s):
                        f"facets and is not marked bare\n")
 
 
-def scene_settings(session, scene):
+def scene_settings(session: SessionLike, scene):
+    """Settings a datafile gives (scale, scale_limit, constraint_tolerance, total_time)."""
     for k in ("scale_limit", "constraint_tolerance"):
         if k in scene.values:
             session.settings[k] = scene.values[k]
@@ -152,7 +153,7 @@ def scene_settings(session, scene):
 # -- dump and load (commands) --------------------------------------------------
 
 
-def init_view_matrix(session):
+def init_view_matrix(session: SessionLike):
     """The graphics view matrix (exporters read it): the Evolver's initial
     view fits the bounding box into [-1, 1]^3."""
     s = session.surface

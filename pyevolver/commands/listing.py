@@ -11,9 +11,10 @@ from ..expr import nodes as N
 from ..geometry.kernels import edge_index
 from ..model import string as SM
 from . import constraints, elements
+from .values import SessionLike
 
 
-def list_elements(session, gen, env):
+def list_elements(session: SessionLike, gen, env):
     """``list gen``: datafile-style lines in REF's formats (measured on
     evolver-nox-d: mound, catbody, column, twointor, string files)."""
     els = elements.generate(session, gen, env)
@@ -40,7 +41,7 @@ def _wrapped(items, indent):
     return "".join(out)
 
 
-def _list_vertex(session, i):
+def _list_vertex(session: SessionLike, i):
     s = session.surface
     vid = s.ids("vertex")
     sd = s.sdim
@@ -49,7 +50,8 @@ def _list_vertex(session, i):
         b = s.boundaries[int(bnd[i])]
         par = " ".join(f"{p:17.15g}" for p in s.vattr["params"][i, :b.nparams])
         xyz = "".join(f" {x:17.15g}" for x in s.X[i, :sd])
-        line = f"{vid[i]:3d}  {par}  boundary {constraints.boundary_label(session, int(bnd[i]))}  /* ({xyz}) */"
+        label = constraints.boundary_label(session, int(bnd[i]))
+        line = f"{vid[i]:3d}  {par}  boundary {label}  /* ({xyz}) */"
     else:
         line = f"{vid[i]:3d}  " + " ".join(f"{x:17.15g}" for x in s.X[i, :sd])
     cons = constraints.in_order(session, "vertex", i, [c for c in sorted(s.vcon) if s.vcon[c][i]])
@@ -60,7 +62,7 @@ def _list_vertex(session, i):
     return line + _extra_text(session, "vertex", i)
 
 
-def _extra_text(session, kind, i):
+def _extra_text(session: SessionLike, kind, i):
     """Defined attributes as REF lists them: `` name value`` each (reals
     ``%2.15g``, integers ``%d``, arrays in braces)."""
     out = []
@@ -83,7 +85,7 @@ def _colour_name(c):
     return names.get(int(c), str(int(c)))
 
 
-def _list_edge(session, i):
+def _list_edge(session: SessionLike, i):
     s = session.surface
     t = session.totals
     vid, eid = s.ids("vertex"), s.ids("edge")
@@ -117,7 +119,7 @@ def _list_edge(session, i):
     return line + _extra_text(session, "edge", i)
 
 
-def _list_facet(session, i):
+def _list_facet(session: SessionLike, i):
     s = session.surface
     t = session.totals
     eid, fid = s.ids("edge"), s.ids("facet")
@@ -155,7 +157,7 @@ def _list_facet(session, i):
     return line + _extra_text(session, "facet", i)
 
 
-def _list_body(session, i):
+def _list_body(session: SessionLike, i):
     s = session.surface
     t = session.totals
     b = s.bodies
@@ -177,7 +179,7 @@ def _list_body(session, i):
     return line + _extra_text(session, "body", i)
 
 
-def show_vol(session):
+def show_vol(session: SessionLike):
     """The ``v`` report (spec §9.3 formats)."""
     s = session.surface
     t = session.totals

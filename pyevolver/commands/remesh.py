@@ -19,10 +19,10 @@ from ..remesh import notch as NO, pop as POP, vertex_average as VA
 from ..remesh.refine import refine as _refine_all
 from . import element_attrs, elements, variables
 from .registry import register
-from .values import ElemRef, as_float, is_true
+from .values import ElemRef, SessionLike, as_float, is_true
 
 
-def refine(session, echo=True):
+def refine(session: SessionLike, echo=True):
     """``r``: refine every edge and facet (spec §8.1)."""
     s = session.surface
     if s.string:
@@ -37,14 +37,15 @@ def refine(session, echo=True):
         session.note(counts_line(session))
 
 
-def counts_line(session):
+def counts_line(session: SessionLike):
     """``Vertices: ..  Edges: ..`` as after ``r`` and ``c``."""
     s = session.surface
     return (f"Vertices: {s.nv}  Edges: {s.ne}  Facets: {s.n_facets}  "
-            f"Bodies: {s.bodies.n}  Facetedges: {variables.internal(session, 'facetedge_count'):.0f}\n")
+            f"Bodies: {s.bodies.n}  "
+            f"Facetedges: {variables.internal(session, 'facetedge_count'):.0f}\n")
 
 
-def refine_edges(session, edges, echo=True):
+def refine_edges(session: SessionLike, edges, echo=True):
     """``refine edges where ...``: bisect the given edges (spec §8)."""
     edges = np.asarray(edges, np.int64)
     if session.surface.string:
@@ -56,7 +57,7 @@ def refine_edges(session, edges, echo=True):
         session.report("Edges refined", n)
 
 
-def refine_facets(session, facets, echo=True):
+def refine_facets(session: SessionLike, facets, echo=True):
     """``refine facets where ...``: split each facet into three at its
     centroid (REF's report "Facets refined: N")."""
     session.no_string("refine facets")
@@ -66,7 +67,7 @@ def refine_facets(session, facets, echo=True):
         session.report("Facets refined", len(f))
 
 
-def equiangulate(session, echo=True):
+def equiangulate(session: SessionLike, echo=True):
     """``u``: one equiangulation sweep (spec §8.2)."""
     if session.surface.string:
         raise CommandError("Cannot equiangulate string model.")      # REF's ERROR 2200
@@ -78,7 +79,7 @@ def equiangulate(session, echo=True):
     return n
 
 
-def edgeswap(session, edges, echo=True):
+def edgeswap(session: SessionLike, edges, echo=True):
     """``edgeswap gen``: flip the listed edges that are diagonals of
     quadrilaterals, whatever the angles (manual: EDGESWAP)."""
     session.no_string("edgeswap")
@@ -91,7 +92,7 @@ def edgeswap(session, edges, echo=True):
     return n
 
 
-def _bisect(session, edges, echo):
+def _bisect(session: SessionLike, edges, echo):
     if session.surface.string:
         n = session._string_split(np.asarray(edges, np.int64))
     else:
@@ -103,20 +104,20 @@ def _bisect(session, edges, echo):
     return n
 
 
-def edge_divide_long(session, length, echo=True):
+def edge_divide_long(session: SessionLike, length, echo=True):
     """``l L``: bisect every edge longer than ``L`` once (spec §8)."""
     n = _bisect(session, ED.long_edges(session.surface, length), echo)
     session.settings["edge_divide_length"] = length
     return n
 
 
-def skinny(session, angle, echo=True):
+def skinny(session: SessionLike, angle, echo=True):
     """``K θ``: bisect the longest edge of facets with an angle below θ."""
     session.no_string("K (skinny triangles)")
     return _bisect(session, ED.skinny_edges(session.surface, angle), echo)
 
 
-def notch(session, angle, echo=True):
+def notch(session: SessionLike, angle, echo=True):
     """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""
     session.no_string("notch")
     new, n = NO.notch(session.surface, angle)
@@ -127,7 +128,7 @@ def notch(session, angle, echo=True):
     return n
 
 
-def pop_edges(session, echo=True):
+def pop_edges(session: SessionLike, echo=True):
     """``O``: pop the edges with four facets (pyevolver.remesh.pop)."""
     new, n = POP.pop_edges(session.surface)
     session._replace_surface(new)
@@ -137,11 +138,12 @@ def pop_edges(session, echo=True):
     return n
 
 
-def bump_count(session, key, n):
+def bump_count(session: SessionLike, key, n):
+    """Add ``n`` to the count ``key`` (``edge_delete_count``, ``notch_count``, ...)."""
     session.counts[key] = session.counts.get(key, 0) + n
 
 
-def delete_short_edges(session, length, echo=True):
+def delete_short_edges(session: SessionLike, length, echo=True):
     """``t L`` / ``edgeweed L``: delete edges shorter than ``L`` (spec §8.4)."""
     session.no_string("t (edge weeding)")
     new, n = DEL.delete_short_edges(session.surface, length)
@@ -152,7 +154,7 @@ def delete_short_edges(session, length, echo=True):
     return n
 
 
-def delete_elements(session, kind, items, echo=True):
+def delete_elements(session: SessionLike, kind, items, echo=True):
     """``delete edges ...`` / ``delete facets ...``: delete the edges (or,
     per facet, its shortest deletable side) as ``t`` / ``w`` do."""
     session.no_string("delete")
@@ -163,7 +165,7 @@ def delete_elements(session, kind, items, echo=True):
     return n
 
 
-def jiggle(session, temperature=None, echo=True):
+def jiggle(session: SessionLike, temperature=None, echo=True):
     """``j [T]``: move every vertex that is not FIXED or on a parametric
     boundary by a Gaussian displacement of deviation T × mean edge length
     (T defaults to ``jiggle_temperature``); vertices on constraints are
@@ -189,7 +191,7 @@ def jiggle(session, temperature=None, echo=True):
         session.write("One jiggle done.\n")
 
 
-def weed(session, area, echo=True):
+def weed(session: SessionLike, area, echo=True):
     """``w A`` / ``areaweed A``: remove facets of area below ``A`` by
     deleting one of their edges, shortest first (spec §8.4)."""
     if session.surface.string:
@@ -202,7 +204,7 @@ def weed(session, area, echo=True):
     return n
 
 
-def vertex_average(session, mode="V", echo=True):
+def vertex_average(session: SessionLike, mode="V", echo=True):
     """``V``, ``rawv``, ``rawestv``: vertex averaging (spec §8.3)."""
     if session.surface.string:
         session._replace_surface(SM.vertex_average(session.surface, mode))

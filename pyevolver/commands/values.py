@@ -6,11 +6,30 @@ converts), and the exceptions that carry ``break``/``continue``/``return``,
 from __future__ import annotations
 
 import math
+from typing import Any, Protocol
 
 import numpy as np
 
 from ..errors import CommandError, ExpressionError
 from ..expr import nodes as N
+
+class SessionLike(Protocol):
+    """What the commands use of a session (duck typing: no module of
+    :mod:`pyevolver.commands` imports :mod:`pyevolver.session`)."""
+
+    surface: Any
+    totals: Any
+    settings: dict
+    toggles: dict
+    variables: dict
+    interp: Any
+
+    def write(self, text: str) -> None: ...
+
+    def note(self, text: str) -> None: ...
+
+    def recalc(self, keep_cg: bool = False, reposition: bool = False) -> None: ...
+
 
 def as_float(v, what="a value"):
     """``v`` as a float; strings, elements and quantities are refused."""

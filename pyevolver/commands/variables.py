@@ -13,7 +13,7 @@ from ..errors import CommandError, ExpressionError
 from ..expr import nodes as N
 from ..model import string as SM
 from .toggles import TOGGLE_DEFAULTS, TOGGLES
-from .values import QRef, as_float, as_int
+from .values import QRef, SessionLike, as_float, as_int
 
 READ_ONLY = {
     "total_energy", "total_area", "total_length", "vertex_count", "edge_count",
@@ -32,7 +32,9 @@ DEFAULTS = {
 }
 
 
-def set_variable(session, name, value):
+def set_variable(session: SessionLike, name, value):
+    """``name := value``: settings, the gravity constant, parameters and
+    user variables (ON_ASSIGN_CALL procedures run after)."""
     if name in READ_ONLY:
         raise CommandError(f"'{name}' is read-only")
     if name in session.commands:
@@ -65,7 +67,9 @@ def set_variable(session, name, value):
                 busy.discard(name)
 
 
-def internal(session, name):
+def internal(session: SessionLike, name):
+    """The value of a built-in name (``total_energy``, ``vertex_count``, a
+    setting, a toggle, a named constraint)."""
     s = session.surface
     t = session.totals
     if name in session.settings:
@@ -124,7 +128,8 @@ def internal(session, name):
     return v if isinstance(v, str) else float(v)
 
 
-def facetedge_count(session):
+def facetedge_count(session: SessionLike):
+    """The number of facet-edges (3 per facet; the string model's chains)."""
     s = session.surface
     if s.string:
         return SM.facetedge_count(s)
