@@ -18,10 +18,16 @@ from .io.meshio_plugin import register as _register_meshio  # noqa: E402
 _register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)
 
 
-def load(filename, **kwargs):
-    """Load a datafile into a :class:`Session` (runs its ``read`` section);
-    keyword arguments go to :meth:`Session.load` (``out``, ``err``,
-    ``run_read``)."""
+def load(filename: str, **kwargs) -> Session:
+    """Load a datafile into a :class:`Session` (runs its ``read`` section).
+
+    Parameters
+    ----------
+    filename : str
+        The ``.fe`` datafile.
+    **kwargs
+        Passed to :meth:`Session.load` (``out``, ``err``, ``run_read``, ``text``).
+    """
     return Session.load(filename, **kwargs)
 
 

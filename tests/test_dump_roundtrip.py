@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from pyevolver import Session
-from pyevolver.commands.interpreter import (TOGGLE_ALIASES, TOGGLE_REFUSED, TOGGLES)
+from pyevolver.commands.toggles import TOGGLE_ALIASES, TOGGLE_REFUSED, TOGGLES
 from pyevolver.errors import DatafileError, PyEvolverError
 
 from conftest import example

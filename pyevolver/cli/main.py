@@ -16,8 +16,10 @@ import numpy as np
 
 from .. import __version__
 from ..commands import interpreter as I
+from ..commands.variables import READ_ONLY
 from ..errors import InternalError, PyEvolverError
 from ..session.core import Session
+from .tools import SUBCOMMANDS, main as tool_main
 
 PROMPT = "Enter command: "
 MORE = "more> "
@@ -93,10 +95,8 @@ def _flush_quietly():
 
 
 def _main(argv=None):
-    from .tools import SUBCOMMANDS
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv and argv[0] in SUBCOMMANDS:        # a datafile named so: ./show
-        from .tools import main as tool_main
         return tool_main(argv)
     args = build_parser().parse_args(argv)
     np.seterr(all="ignore")        # overflows are reported as Evolver warnings, not numpy's
@@ -272,7 +272,6 @@ def _completer(session):
             names |= set(session.commands) | set(session.arrays)
             names |= {k for k, v in session.variables.items()}
             names |= set(session.settings)
-            from ..session.core import READ_ONLY
             names |= READ_ONLY
             s = session.surface
             if s is not None:

@@ -14,6 +14,11 @@ import numpy as np
 from ..methods import attributes as GA
 from ..errors import ExpressionError, UnsupportedError
 from ..expr import nodes as N
+from ..methods import method_info
+from ..model.string import facets_of_edge
+from ..constraints import boundary_eval
+from . import elements
+from .values import ElemRef, QRef, as_float, as_int
 
 MISSING = object()
 
@@ -381,7 +386,6 @@ class _Ref:
 def _string_edge_body(session, base, name):
     """String model: the body of the facet running along the edge
     (``frontbody``) or against it (``backbody``); 0 when there is none."""
-    from ..model.string import facets_of_edge
     s = session.surface
     want = (1 if name == "frontbody" else -1) * base.sign
     for f, g in facets_of_edge(s, base.i):
@@ -479,7 +483,6 @@ def constraint_attr(session, base, name, idx):
         raise ExpressionError(f"constraint[{base.cid}] has no attribute '{name}' "
                               f"(only .normal)")
     if idx is not None and not isinstance(idx, tuple):
-        from .interpreter import as_int
         idx = as_int(idx, "the index of 'normal'")
     return _component(constraint_normal(session, base.i, base.cid), idx, "normal")
 
@@ -487,7 +490,6 @@ def constraint_attr(session, base, name, idx):
 def on_quantity(session, base, name, arg):
     """``on_quantity q`` / ``on_method_instance m``: whether the element
     contributes to the quantity (to one of its method instances)."""
-    from .interpreter import ElemRef, QRef
     if not isinstance(base, ElemRef):
         raise ExpressionError(f"'{name}' needs an element")
     s = session.surface
@@ -502,7 +504,7 @@ def on_quantity(session, base, name, arg):
     kind = base.kind
 
     def members(ss, tt):
-        mask = np.zeros(session.count(kind), bool)
+        mask = np.zeros(elements.count(session, kind), bool)
         for m, etype, idx, _sign in q.methods:
             if etype == kind and not m.is_global:     # REF: global methods mark none
                 mask[np.asarray(idx, np.int64)] = True
@@ -515,7 +517,6 @@ def element_quantity_value(session, base, qname):
     """``ff.qname``: the element's contribution to a named quantity (or
     method instance): Σ over the quantity's methods on elements of this kind
     of modulus × value (× orientation), times the quantity's modulus."""
-    from ..methods import method_info
     s = session.surface
     q = s.quantities[qname]
     if q.function is not None:
@@ -523,7 +524,7 @@ def element_quantity_value(session, base, qname):
     kind = base.kind
 
     def values(ss, tt):
-        out = np.zeros(session.count(kind))
+        out = np.zeros(elements.count(session, kind))
         for m, etype, idx, sign in q.methods:
             if etype != kind:
                 continue
@@ -562,7 +563,6 @@ def set_quantity(session, qname, attr, value):
     """``set q target|modulus|tolerance value`` and ``set q
     fixed|energy|info_only|conserved`` (the manual's SET quantityname forms);
     a method instance takes only ``modulus``."""
-    from .interpreter import as_float
     s = session.surface
     q = s.quantities[qname]
     if q.kind == "instance":
@@ -591,7 +591,6 @@ def set_quantity(session, qname, attr, value):
 def _set_parameter(session, i, name, idx, value):
     """``set vertex p1 expr``: a boundary vertex's parameter; the vertex
     moves to its new place on the boundary at once (REF)."""
-    from ..constraints import boundary_eval
     s = session.surface
     bnd = s.vattr.get("boundary")
     if bnd is None or not bnd[i]:
@@ -617,7 +616,6 @@ def unset_boundary(session, els, bid):
     """``unset vertex|edge|facet boundary n``: the elements leave boundary n
     (vertices keep their place and become free)."""
     s = session.surface
-    from .interpreter import as_int
     bid = as_int(bid, "a boundary number")
     if bid not in s.boundaries:
         raise ExpressionError(f"unset ... boundary {bid}: boundary {bid} is not defined")

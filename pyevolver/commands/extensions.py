@@ -11,30 +11,39 @@ session and the list of evaluated arguments::
     @register_command("hello", 'hello "name"', max_args=1)
     def hello(session, args):
         session.write(f"hello {args[0]}\\n")
+
+They go into the one registry of commands (:mod:`pyevolver.commands.registry`).
 """
 from __future__ import annotations
 
+from typing import Callable
+
 from ..errors import CommandError
+from . import registry
+from .registry import Command
 
-#: name -> (handler(session, args), usage, max_args)
-COMMANDS = {}
+
+def _bare(interp, raw, arg):
+    """``name`` or ``name expr``: the extension with its one argument."""
+    registry.call(interp.session, raw.lower(), [] if arg is None else [interp.value(arg)])
 
 
-def register_command(name, usage, max_args=1):
+def register_command(name: str, usage: str, max_args: int = 1) -> Callable:
     """Decorator: register ``fn(session, args)`` as the command ``name``."""
     def deco(fn):
-        COMMANDS[name.lower()] = (fn, usage, max_args)
+        registry.add(Command((name.lower(),), _bare, usage, usage, "extensions",
+                             call=fn, max_args=max_args))
         return fn
     return deco
 
 
-def run_command(session, name, args):
+def run_command(session, name: str, args: list) -> None:
     """Run the registered command ``name`` with evaluated ``args``."""
-    fn, usage, max_args = COMMANDS[name.lower()]
-    if len(args) > max_args:
-        raise CommandError(f"{name} takes at most {max_args} argument"
-                           f"{'s' if max_args != 1 else ''} (usage: {usage})")
-    fn(session, args)
+    registry.call(session, name, args)
+
+
+def _usage(name):
+    return registry.COMMANDS[name].usage
 
 
 def _strings(name, usage, args):
@@ -49,7 +58,7 @@ def _strings(name, usage, args):
 
 @register_command("export", 'export "out.vtu" (vtu, ply, obj, stl, off, xdmf, ...)')
 def _export(session, args):
-    (path,) = _strings("export", COMMANDS["export"][1], args)
+    (path,) = _strings("export", _usage("export"), args)
     fmt = session.export(path)
     session.write(f"Exported to {path} ({fmt}).\n")
 
@@ -57,13 +66,13 @@ def _export(session, args):
 @register_command("snapshot", 'snapshot "shape.png" or snapshot("shape.png", "area")',
                   max_args=2)
 def _snapshot(session, args):
-    path, *field = _strings("snapshot", COMMANDS["snapshot"][1], args)
+    path, *field = _strings("snapshot", _usage("snapshot"), args)
     session.snapshot(path, field=field[0] if field else "mean_curvature")
     session.write(f"Snapshot written to {path}.\n")
 
 
 @register_command("plot_history", 'plot_history "history.png"')
 def _plot_history(session, args):
-    (path,) = _strings("plot_history", COMMANDS["plot_history"][1], args)
+    (path,) = _strings("plot_history", _usage("plot_history"), args)
     session.plot_history(path)
     session.write(f"Energy history written to {path}.\n")

@@ -1,6 +1,6 @@
-"""The notebook side of :class:`pyevolver.Session`: values, data arrays,
-files and pictures (a mixin, so that the session's Evolver core stays in
-``session.py``)::
+"""The notebook side of :class:`pyevolver.Session`: files and pictures
+(``export``, ``snapshot``, ``plot_history``) and the progress bars of long
+runs.  The values (``quantities``, ``value``) are on the Session itself::
 
     import pyevolver
     s = pyevolver.load("cube.fe")
@@ -20,7 +20,7 @@ from __future__ import annotations
 import sys
 
 from ..datafile.writer import DumpSettings
-from ..errors import CommandError
+from ..errors import UnsupportedError
 from ..io import meshio_plugin, render
 
 #: ``progress=None`` shows a bar for runs of at least this many steps.
@@ -44,33 +44,13 @@ def progress_bar(total, progress=None, desc=None):
         from tqdm.auto import tqdm
     except ImportError:
         if progress:
-            from ..errors import UnsupportedError
             raise UnsupportedError("progress bars without tqdm", "pip install tqdm") from None
         return None
     return tqdm(total=total, desc=desc, leave=False)
 
 
 class SessionAPI:
-    """Methods that :class:`pyevolver.Session` offers to Python callers."""
-
-    @property
-    def quantities(self):
-        """``{name: value}`` of the named quantities and method instances at
-        the current coordinates (as ``v`` and ``name.value`` report them)."""
-        if self.totals is None:
-            return {}
-        return {k: float(v) for k, v in self.totals.quantity_values.items()}
-
-    def value(self, expr):
-        """The value of one expression of the command language, e.g.
-        ``"total_energy"``, ``"body[1].volume"``, ``"max(vertex, z)"``."""
-        from ..commands import interpreter as I
-        ast = I.parse_command(f"print {expr}", "<value>")
-        stmts = ast[1] if ast[0] == "seq" else [ast]
-        if len(stmts) != 1 or stmts[0][0] != "print":
-            raise CommandError(f"value: '{expr}' is not one expression")
-        v = self.interp.value(stmts[0][1])
-        return v if isinstance(v, str) else float(v)
+    """Files and pictures of :class:`pyevolver.Session` (a mixin)."""
 
     def export(self, path: str, fmt: str | None = None, data: bool = True) -> str:
         """Write the surface to ``path`` in a meshio format chosen by the

@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 
 from ...errors import PyEvolverError
+from ...io.meshio_plugin import file_format, write_mesh
 
 
 def add_args(parser):
@@ -20,7 +21,6 @@ def add_args(parser):
 
 def run(args):
     import meshio
-    from ...io.meshio_plugin import file_format, write_mesh
     if not os.path.isfile(args.input):
         raise PyEvolverError(f"convert: cannot open '{args.input}': no such file")
     fmt = file_format(args.output)

@@ -11,7 +11,11 @@ import io
 import os
 import sys
 
+import numpy as np
+
 from ...errors import PyEvolverError
+from ...io.render import camera
+from ...session.core import Session
 
 
 def add_args(parser):
@@ -29,9 +33,6 @@ def add_args(parser):
 
 
 def run(args):
-    import numpy as np
-    from ...io.render import camera
-    from ...session.core import Session
     if not os.path.isfile(args.datafile):
         raise PyEvolverError(f"show: cannot open datafile '{args.datafile}': no such file")
     sess = Session.load(args.datafile, out=io.StringIO(), err=sys.stderr)

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import sys
 
+from ...studies.sweep import dask_executor, load_spec, run_sweep
+
 
 def add_args(parser):
     parser.add_argument("spec", help="sweep specification (TOML)")
@@ -22,8 +24,6 @@ def add_args(parser):
 
 def run(args):
     """Returns the exit code: 1 when a point failed."""
-    from ...studies.sweep import dask_executor, load_spec, run_sweep
-
     def log(text):
         print(text, flush=True)
     spec = load_spec(args.spec)

@@ -1,0 +1,334 @@
+"""Mesh commands: ``r``, ``u``, ``l``, ``K``, ``n``, ``O``, ``t``, ``w``,
+``V``, ``j``, ``refine``/``edgeswap``/``delete`` of generated elements.
+
+Each takes the session (duck-typed: ``surface``, ``totals``, ``settings``,
+``counts``, ``note``, ``report``, ``_replace_surface``, ``_string_split``)
+and changes its surface through the algorithms of :mod:`pyevolver.remesh`.
+"""
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+
+from ..errors import CommandError, UnsupportedError
+from ..remesh import string as SM
+from ..remesh import delete_edges as DEL, edge_divide as ED, equiangulate as EQ
+from ..remesh import notch as NO, pop as POP, vertex_average as VA
+from ..remesh.refine import refine as _refine_all
+from . import element_attrs, elements, variables
+from .registry import register
+from .values import ElemRef, SessionLike, as_float, is_true
+
+
+def refine(session: SessionLike, echo=True):
+    """``r``: refine every edge and facet (spec §8.1)."""
+    s = session.surface
+    if s.string:
+        session._string_split(np.nonzero(~s.eattr["no_refine"])[0])
+    else:
+        session._replace_surface(_refine_all(s))
+    if "edge_divide_length" in session.settings:
+        session.settings["edge_divide_length"] /= 2
+    if "areaweed_area" in session.settings:
+        session.settings["areaweed_area"] /= 4
+    if echo:
+        session.note(counts_line(session))
+
+
+def counts_line(session: SessionLike):
+    """``Vertices: ..  Edges: ..`` as after ``r`` and ``c``."""
+    s = session.surface
+    return (f"Vertices: {s.nv}  Edges: {s.ne}  Facets: {s.n_facets}  "
+            f"Bodies: {s.bodies.n}  "
+            f"Facetedges: {variables.internal(session, 'facetedge_count'):.0f}\n")
+
+
+def refine_edges(session: SessionLike, edges, echo=True):
+    """``refine edges where ...``: bisect the given edges (spec §8)."""
+    edges = np.asarray(edges, np.int64)
+    if session.surface.string:
+        n = session._string_split(np.unique(edges))
+    else:
+        new, n = ED.edge_divide(session.surface, edges)
+        session._replace_surface(new)
+    if echo:
+        session.report("Edges refined", n)
+
+
+def refine_facets(session: SessionLike, facets, echo=True):
+    """``refine facets where ...``: split each facet into three at its
+    centroid (REF's report "Facets refined: N")."""
+    session.no_string("refine facets")
+    f = np.unique(np.asarray(facets, np.int64))
+    session._replace_surface(NO.split_facets_at_centre(session.surface, f))
+    if echo:
+        session.report("Facets refined", len(f))
+
+
+def equiangulate(session: SessionLike, echo=True):
+    """``u``: one equiangulation sweep (spec §8.2)."""
+    if session.surface.string:
+        raise CommandError("Cannot equiangulate string model.")      # REF's ERROR 2200
+    new, n = EQ.equiangulate(session.surface)
+    session._replace_surface(new)
+    session.counts["equi"] = n                 # REF: the last sweep's flips
+    if echo:
+        session.note(f"Edges switched in equiangulation: {n}\n")
+    return n
+
+
+def edgeswap(session: SessionLike, edges, echo=True):
+    """``edgeswap gen``: flip the listed edges that are diagonals of
+    quadrilaterals, whatever the angles (manual: EDGESWAP)."""
+    session.no_string("edgeswap")
+    only = np.zeros(session.surface.ne, bool)
+    only[np.asarray(edges, np.int64)] = True
+    new, n = EQ.equiangulate(session.surface, threshold=np.inf, only=only)
+    session._replace_surface(new)
+    if echo:
+        session.report("Edges swapped", n)
+    return n
+
+
+def _bisect(session: SessionLike, edges, echo):
+    if session.surface.string:
+        n = session._string_split(np.asarray(edges, np.int64))
+    else:
+        new, n = ED.edge_divide(session.surface, edges)
+        session._replace_surface(new)
+    bump_count(session, "refine", n)                # REF: l and K accumulate, r does not
+    if echo:
+        session.note(f"New edges: {n}\n")
+    return n
+
+
+def edge_divide_long(session: SessionLike, length, echo=True):
+    """``l L``: bisect every edge longer than ``L`` once (spec §8)."""
+    n = _bisect(session, ED.long_edges(session.surface, length), echo)
+    session.settings["edge_divide_length"] = length
+    return n
+
+
+def skinny(session: SessionLike, angle, echo=True):
+    """``K θ``: bisect the longest edge of facets with an angle below θ."""
+    session.no_string("K (skinny triangles)")
+    return _bisect(session, ED.skinny_edges(session.surface, angle), echo)
+
+
+def notch(session: SessionLike, angle, echo=True):
+    """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""
+    session.no_string("notch")
+    new, n = NO.notch(session.surface, angle)
+    session._replace_surface(new)
+    bump_count(session, "notch", n)
+    if echo:
+        session.note(f"Number of edges notched: {n}\n")
+    return n
+
+
+def pop_edges(session: SessionLike, echo=True):
+    """``O``: pop the edges with four facets (pyevolver.remesh.pop)."""
+    new, n = POP.pop_edges(session.surface)
+    session._replace_surface(new)
+    session.counts["edge_pop"] = n             # REF: a later O with no pops prints 0
+    if echo:
+        session.note(f"Edges popped: {n}\n")
+    return n
+
+
+def bump_count(session: SessionLike, key, n):
+    """Add ``n`` to the count ``key`` (``edge_delete_count``, ``notch_count``, ...)."""
+    session.counts[key] = session.counts.get(key, 0) + n
+
+
+def delete_short_edges(session: SessionLike, length, echo=True):
+    """``t L`` / ``edgeweed L``: delete edges shorter than ``L`` (spec §8.4)."""
+    session.no_string("t (edge weeding)")
+    new, n = DEL.delete_short_edges(session.surface, length)
+    session._replace_surface(new)
+    bump_count(session, "edge_delete", n)
+    if echo:
+        session.note(f"Deleted edges: {n}\n")
+    return n
+
+
+def delete_elements(session: SessionLike, kind, items, echo=True):
+    """``delete edges ...`` / ``delete facets ...``: delete the edges (or,
+    per facet, its shortest deletable side) as ``t`` / ``w`` do."""
+    session.no_string("delete")
+    fn = DEL.delete_edges if kind == "edge" else DEL.delete_facets
+    new, n = fn(session.surface, items)
+    session._replace_surface(new)
+    bump_count(session, "edge_delete", n)
+    return n
+
+
+def jiggle(session: SessionLike, temperature=None, echo=True):
+    """``j [T]``: move every vertex that is not FIXED or on a parametric
+    boundary by a Gaussian displacement of deviation T × mean edge length
+    (T defaults to ``jiggle_temperature``); vertices on constraints are
+    projected back.  Seeded by ``random_seed`` (pyevolver's generator,
+    so the numbers differ from the Evolver's)."""
+    s = session.surface
+    T = session.settings["jiggle_temperature"] if temperature is None else float(temperature)
+    if not math.isfinite(T):
+        raise CommandError(f"j: the temperature must be a finite number, got {T:g}")
+    t = session.totals
+    sigma = T * (float(np.mean(t.edge_length)) if s.ne else 0.0)
+    move = ~s.vattr["fixed"]
+    if "boundary" in s.vattr:
+        move &= s.vattr["boundary"] == 0
+    new = copy.copy(s)
+    new.__dict__.pop("_lift_cache", None)
+    new.X = s.X.copy()
+    idx = np.nonzero(move)[0]
+    new.X[idx, :s.sdim] += sigma * session.rng.standard_normal((len(idx), s.sdim))
+    element_attrs.project_or_fail(session, new, idx)
+    session._replace_surface(new)
+    if echo:
+        session.write("One jiggle done.\n")
+
+
+def weed(session: SessionLike, area, echo=True):
+    """``w A`` / ``areaweed A``: remove facets of area below ``A`` by
+    deleting one of their edges, shortest first (spec §8.4)."""
+    if session.surface.string:
+        raise CommandError("Can only do area weed on soapfilm model.")   # REF's ERROR 1339
+    new, n = DEL.weed_small_facets(session.surface, area)
+    session._replace_surface(new)
+    bump_count(session, "edge_delete", n)
+    if echo:
+        session.note(f"Skinny triangles weeded: {n}\n")
+    return n
+
+
+def vertex_average(session: SessionLike, mode="V", echo=True):
+    """``V``, ``rawv``, ``rawestv``: vertex averaging (spec §8.3)."""
+    if session.surface.string:
+        session._replace_surface(SM.vertex_average(session.surface, mode))
+    else:
+        session._replace_surface(VA.vertex_average(session.surface, mode))
+    if echo:
+        session.note("Vertex averaging done.\n")
+
+
+# -- the commands ---------------------------------------------------------------
+FAMILY = "remesh"
+
+
+@register("r", usage="r [n]", help="refine every edge and facet (n times)", family=FAMILY)
+def _r(interp, raw, arg):
+    for _ in range(1 if arg is None else interp.count(arg)):
+        interp.tick()
+        refine(interp.session)
+
+
+@register("j", usage="j [temperature]", help="jiggle the vertices", family=FAMILY)
+def _j(interp, raw, arg):
+    jiggle(interp.session,
+           None if arg is None else as_float(interp.value(arg), f"the argument of {raw}"))
+
+
+def _needs_value(interp, raw, arg, example):
+    if arg is None:
+        raise CommandError(f"{raw} needs a value (for example: {raw} {example})")
+    return as_float(interp.value(arg), f"the argument of {raw}")
+
+
+@register("t", "edgeweed", usage="t length", help="delete edges shorter than length",
+          family=FAMILY)
+def _t(interp, raw, arg):
+    delete_short_edges(interp.session, _needs_value(interp, raw, arg, "0.01"))
+
+
+@register("w", "areaweed", usage="w area", help="weed facets smaller than area",
+          family=FAMILY)
+def _w(interp, raw, arg):
+    weed(interp.session, _needs_value(interp, raw, arg, "0.01"))
+
+
+@register("l", "edge_divide", usage="l length", help="bisect edges longer than length",
+          family=FAMILY)
+def _l(interp, raw, arg):
+    edge_divide_long(interp.session, _needs_value(interp, raw, arg, "0.3"))
+
+
+@register("K", usage="K angle", help="bisect skinny triangles", family=FAMILY)
+def _k(interp, raw, arg):
+    skinny(interp.session, _needs_value(interp, raw, arg, "0.3"))
+
+
+@register("n", "notch", usage="n angle", help="notch edges sharper than angle",
+          family=FAMILY)
+def _n(interp, raw, arg):
+    notch(interp.session, _needs_value(interp, raw, arg, "0.3"))
+
+
+@register("V", "rawv", "rawestv", usage="V | rawv | rawestv", help="vertex averaging",
+          family=FAMILY)
+def _v_average(interp, raw, arg):
+    vertex_average(interp.session, {"V": "V", "rawv": "raw", "rawestv": "rawest"}[raw])
+
+
+@register("O", usage="O", help="pop edges with four facets", family=FAMILY)
+def _o(interp, raw, arg):
+    pop_edges(interp.session)
+
+
+@register("u", "equiangulate", usage="u", help="one equiangulation sweep", family=FAMILY)
+def _u(interp, raw, arg):
+    equiangulate(interp.session)
+
+
+@register("refine", usage="refine edges|facets [where ...]", statement="refine",
+          help="bisect the edges, or split the facets at their centres", family=FAMILY)
+def _x_refine(interp, node):
+    s = interp.session
+    els = elements.generate(s, node[1], interp.env)
+    kinds = {el.kind for el in els}
+    if kinds - {"edge", "facet"}:
+        raise UnsupportedError("refine of " + ", ".join(sorted(kinds - {"edge", "facet"}))
+                               + "s", "'refine edges' and 'refine facets' are supported")
+    if kinds == {"facet"}:
+        refine_facets(s, [el.i for el in els])
+    else:
+        refine_edges(s, [el.i for el in els])
+
+
+@register("edgeswap", usage="edgeswap edges [where ...]", statement="edgeswap",
+          help="flip the edges that are quadrilateral diagonals", family=FAMILY)
+def _x_edgeswap(interp, node):
+    s = interp.session
+    els = elements.generate(s, node[1], interp.env)
+    if {el.kind for el in els} - {"edge"}:
+        raise CommandError("edgeswap needs edges (for example: edgeswap edge[3])")
+    edgeswap(s, [el.i for el in els])
+
+
+@register("delete", usage="delete edges|facets [where ...]", statement="delete",
+          help="delete edges (facets: their shortest side)", family=FAMILY)
+def _x_delete(interp, node):
+    s = interp.session
+    gen = node[1]
+    if gen.kind not in ("edge", "facet"):
+        raise CommandError("delete needs edges or facets (for example: "
+                           "delete edges where length < 0.01)")
+    n = 0
+    if gen.where is None or gen.base[0] != "all":
+        n = delete_elements(s, gen.kind, [el.i for el in elements.generate(s, gen, interp.env)])
+    else:
+        # `delete edges where cond`: like the Evolver, visit the elements
+        # in id order and test cond when each is reached, on the surface
+        # the earlier deletions left (a merge can make a later edge short)
+        for eid in s.surface.ids(gen.kind).tolist():
+            hit = np.nonzero(s.surface.ids(gen.kind) == eid)[0]
+            if not len(hit):
+                continue
+            el = ElemRef(gen.kind, int(hit[0]))
+            with interp.env.element(el, gen.var):
+                v = gen.where.ev(interp.env)
+            if is_true(v):
+                n += delete_elements(s, gen.kind, [el.i])
+    s.report(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted", n)
