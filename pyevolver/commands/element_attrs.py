@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import CommandError, ExpressionError, UnsupportedError
 from ..expr import nodes as N
 from ..geometry import kernels
-from ..model import surface as MS
+from ..model import records as MS
 from ..constraints import project_to_constraints
 from . import attributes as A
 from . import constraints, elements

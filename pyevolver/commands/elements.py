@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import ExpressionError, UnsupportedError
 from ..geometry.kernels import edge_index
 from ..model import string as SM
-from ..model import surface as MS
+from ..model import records as MS
 from .registry import register
 from .values import ElemRef, SessionLike, as_int, is_true
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from .scene import ElementBlock, Scene
 from .build import build_surface
-from .surface import Surface
+from .surface import HOOKS, Surface
 
 
 def triangle_edges(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -101,3 +101,6 @@ def surface_from_arrays(vertices: np.ndarray, facets: np.ndarray, *,
     if tension is not None:
         s.fattr["tension"] = np.asarray(tension, float).reshape(-1)
     return s
+
+
+HOOKS.from_arrays = surface_from_arrays

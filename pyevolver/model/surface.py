@@ -25,12 +25,16 @@ class Hooks:
     * ``project(surface, idx) -> failed`` (:mod:`pyevolver.constraints`);
     * ``method_etype(name) -> "vertex" | "edge" | "facet"``, raising
       :class:`~pyevolver.errors.UnsupportedError` for an unknown method
-      (:mod:`pyevolver.methods.registry`).
+      (:mod:`pyevolver.methods.registry`);
+    * ``from_arrays(vertices, facets, **options) -> Surface``
+      (:mod:`pyevolver.model.arrays`, which builds through the Scene
+      builder; imported with the ``pyevolver.model`` package).
     """
 
     evaluate: Callable[[Any], Any] | None = None
     project: Callable[[Any, np.ndarray], np.ndarray] | None = None
     method_etype: Callable[[str], str] | None = None
+    from_arrays: Callable[..., Any] | None = None
 
     def require(self, name: str) -> Callable:
         fn = getattr(self, name)
@@ -192,6 +196,26 @@ class Surface:
         return (f"<Surface {model}{torus}, space dimension {self.sdim}: {self.nv} vertices, "
                 f"{self.ne} edges, {self.n_facets} facets, {self.bodies.n} bodies, "
                 f"{len(self.quantities)} quantities>")
+
+    @classmethod
+    def from_arrays(cls, vertices: np.ndarray, facets: np.ndarray, **options: Any) -> Surface:
+        """A surface from a triangle mesh, without a datafile.
+
+        Parameters
+        ----------
+        vertices : (nv, 3) float array
+        facets : (nf, 3) int array
+            0-based vertex indices; the orientation is the facet's.
+        **options
+            ``fixed`` (nv,) bool, ``tension`` (nf,) float, ``body`` bool,
+            ``filename`` str: see :func:`pyevolver.model.arrays.surface_from_arrays`.
+
+        Returns
+        -------
+        Surface
+            The surface the same mesh written as a datafile loads to.
+        """
+        return HOOKS.require("from_arrays")(vertices, facets, **options)
 
     # -- evaluation --------------------------------------------------------
     def evaluate(self):
