@@ -6,6 +6,8 @@ and the Python API.
 """
 __version__ = "0.1.0"
 
+from typing import Any  # noqa: E402
+
 from .errors import (PyEvolverError, DatafileError, CommandError, UnsupportedError,  # noqa: E402
                      ExpressionError, ConstraintError, ConvergenceWarning)
 from .datafile.reader import read_datafile  # noqa: E402
@@ -18,7 +20,7 @@ from .io.meshio_plugin import register as _register_meshio  # noqa: E402
 _register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)
 
 
-def load(filename: str, **kwargs) -> Session:
+def load(filename: str, **kwargs: Any) -> Session:
     """Load a datafile into a :class:`Session` (runs its ``read`` section).
 
     Parameters

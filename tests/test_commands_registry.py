@@ -8,7 +8,7 @@ import re
 import pytest
 
 from pyevolver.commands import interpreter as I
-from pyevolver.commands import (constraints, element_attrs, elements, files, listing,
+from pyevolver.commands import (constraints, element_attrs, elements, files, fixing, listing,
                                 registry, remesh, variables)
 from pyevolver.session.core import Session
 
@@ -119,7 +119,7 @@ def test_constraints_and_fix():
     assert s.surface.X[0, 0] == pytest.approx(0.25)
     assert s.value("vertex[1].on_constraint cc") == 1.0
     els = [elements.element(s, "vertex", 2)]
-    assert constraints.fix_elements(s, els, True) == 1
+    assert fixing.fix_elements(s, els, True) == 1
     assert s.value("vertex[2].fixed") == 1.0
 
 

@@ -1,7 +1,7 @@
 """Constraint commands: ``set gen constraint n``, ``unset gen constraint
-n``, ``define constraint NAME formula: ...``, ``fix``/``unfix`` of elements
-and quantities, and the labels ``list`` prints for constraints and
-boundaries (a number, or the name given by ``define constraint``).
+n``, ``define constraint NAME formula: ...``, and the labels ``list``
+prints for constraints and boundaries (a number, or the name given by
+``define constraint``).  ``fix``/``unfix``: :mod:`pyevolver.commands.fixing`.
 """
 from __future__ import annotations
 
@@ -13,9 +13,8 @@ from ..datafile.preprocess import Section
 from ..datafile.reader import Reader
 from ..errors import CommandError, UnsupportedError
 from ..constraints import project_to_constraints
-from . import element_attrs, elements
 from .registry import register
-from .values import ElemRef, SessionLike
+from .values import SessionLike
 
 
 def set_constraint(session: SessionLike, els, cid):
@@ -134,60 +133,7 @@ def unset_constraint(session: SessionLike, els, cid):
             m[el.i] = 0
 
 
-def fix_elements(session: SessionLike, els, on):
-    """``fix``/``unfix`` elements; returns how many changed."""
-    n = 0
-    for el in els:
-        if el.kind == "body":
-            raise CommandError("cannot fix or unfix bodies; to fix a volume use "
-                               "'set body target expr', to free it 'unset body target'")
-        old = element_attrs.get_attr(session, el, "fixed", None)
-        if bool(old) != bool(on):
-            element_attrs.set_attr(session, el, "fixed", None, 1.0 if on else 0.0)
-            n += 1
-    return n
-
-
-def fix_name(session: SessionLike, name, on):
-    """``fix quantity`` / ``unfix quantity``."""
-    s = session.surface
-    if name in s.quantities:
-        q = s.quantities[name]
-        if on:
-            q.target = float(session.totals.quantity_values[name])
-            q.kind = "fixed"
-        else:
-            q.kind = "info_only" if q.kind == "fixed" else q.kind
-        return
-    if name in session.variables:
-        raise UnsupportedError(f"{'fix' if on else 'unfix'} {name} (optimizing parameters)")
-    raise CommandError(f"{'fix' if on else 'unfix'}: '{name}' is not a quantity "
-                       f"(expected: fix element_generator or fix quantity_name)")
-
-
 # -- the commands -----------------------------------------------------------------------
-@register("fix", "unfix", usage="fix gen | fix QUANTITY (unfix alike)", statement="fix",
-          help="fix or free elements, or fix a quantity at its value", family="constraints")
-def _x_fix(interp, node):
-    gen, on = node[1], node[2]
-    s = interp.session
-    if gen.base[0] == "var" and gen.where is None and \
-            not isinstance(interp.var_elem(gen.base[1]), ElemRef):
-        fix_name(s, gen.base[1], on)
-        return
-    els = elements.generate(s, gen, interp.env)
-    n = fix_elements(s, els, on)
-    # REF reports the elements fixed and unfixed by a whole command at
-    # its end ("Fixed: N" then "Unfixed: M", nonzero counts only)
-    s.report("Fixed" if on else "Unfixed", n)
-
-
-@register("fix", "unfix", usage="fix QUANTITY | unfix QUANTITY", statement="fix_name",
-          help="fix a quantity at its value, or free it", family="constraints")
-def _x_fix_name(interp, node):
-    fix_name(interp.session, node[1], node[2])
-
-
 @register("define constraint", usage="define constraint NAME formula: expr",
           statement="define_constraint", help="a level-set constraint at run time",
           family="constraints")

@@ -159,4 +159,6 @@ def call(session: Any, name: str, args: list) -> None:
     if len(args) > cmd.max_args:
         raise CommandError(f"{name} takes at most {cmd.max_args} argument"
                            f"{'s' if cmd.max_args != 1 else ''} (usage: {cmd.usage})")
+    if cmd.call is None:
+        raise CommandError(f"{name} is not called with arguments in parentheses")
     cmd.call(session, args)

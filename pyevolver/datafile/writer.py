@@ -127,7 +127,7 @@ class _FeWriter:
     def __init__(self, surface, settings: DumpSettings | None = None):
         self.s = surface
         self.opts = settings
-        self.lines = []
+        self.lines: list[str] = []
 
     def w(self, text=""):
         self.lines.append(text)

@@ -186,7 +186,7 @@ class Iterator:
         self.cg_f_old = None
         # the multipliers (pressures) are set by a g step; hessian needs them
         self.pressures_valid = False
-        self.newton_delta = None      # the damping the last `newton` run ended with
+        self.newton_delta: float | None = None   # the damping the last `newton` run ended with
         self._diverged = False        # a constraint projection of the last move diverged
 
     # -- helpers ----------------------------------------------------------------
@@ -348,7 +348,7 @@ class Iterator:
         # (REF: FIXED vertices included, not projected onto constraints; +0.0
         # turns -0 into 0) and the moving vertices' starting coordinates
         # (pyevolver.commands.attributes)
-        motion = (s, f + 0.0, np.where(mobile[:, None], s.X, 0.0))
+        motion: tuple = (s, f + 0.0, np.where(mobile[:, None], s.X, 0.0))
         f[~mobile] = 0.0
         f_raw = f
         s._one_sided_released = None
@@ -394,26 +394,27 @@ class Iterator:
             vel = h
         X0 = state(s)
         motion += (vel,)                        # v_velocity: the motion direction
-        warnings = []
-        trial_msgs = []
+        warnings: list[str] = []
+        trial_msgs: list[str] = []
         # Trial moves start from the directions at X0 (REF resets them after
         # each trial); the repeated move after a rejected one starts from the
         # directions the rejected move last recomputed (REF keeps those),
         # checked restoring step by restoring step on check 14.
         self._carry = (us, A)
 
+        first = [True]          # the first trial motion of the step
+
         def E(scale):
             self._diverged = False
             t = self._move(X0, vel, scale, cons, us, A, mobile, targets, trial_msgs,
                            trial=True)
             e = math.nan if self._diverged else t.energy
-            if not math.isfinite(e) and scale > 0 and E.first:
+            if not math.isfinite(e) and scale > 0 and first[0]:
                 # REF: a first trial motion to an infinite (or NaN) energy ends
                 # the step with WARNING 1864 (checked on an overflowing gravity)
                 raise _Infinite()
-            E.first = False
+            first[0] = False
             return e if math.isfinite(e) else math.inf
-        E.first = True
 
         smax = settings.scale_limit
         fixed_scale = settings.fixed_scale
@@ -447,7 +448,8 @@ class Iterator:
                               totals=s.evaluate(), motion=motion)
         if not fixed_scale and e > E0 and scale > 0:
             scale = s1
-            t = self._move(X0, vel, scale, cons, *self._carry, mobile, targets, report)
+            us_c, A_c = self._carry
+            t = self._move(X0, vel, scale, cons, us_c, A_c, mobile, targets, report)
             t = self._hold_one_sided(t)
             self.cg_history = None
             if not math.isfinite(t.energy) or self._diverged or not np.all(np.isfinite(s.X)):

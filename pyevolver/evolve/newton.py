@@ -242,7 +242,7 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     if seek:
         smax = 1.0 if max_scale is None else max_scale
         scale, _, _ = it._line_search(E, smax, smax)
-    report = []
+    report: list[str] = []
     t = it._move(X0, dx, scale, cons, None, None, mobile, targets, report)
     if not math.isfinite(t.energy):
         restore_state(s, X0)

@@ -6,6 +6,8 @@ Shapes: ``X (nv, 3)`` coordinates, ``E (ne, 2)`` edge endpoints (tail, head),
 """
 from __future__ import annotations
 
+from math import factorial
+
 import numpy as np
 
 # Gauss-Legendre on [0, 1] with 2 points: exact to degree 3 (Evolver
@@ -24,7 +26,6 @@ def _dunavant6():
     a1, w1 = 0.063089014491502, 0.050844906370207
     a2, w2 = 0.249286745170910, 0.116786275726379
     b3, c3, w3 = 0.053145049844817, 0.310352451033784, 0.082851075618374
-    from math import factorial
 
     def pts(p):
         a1, w1, a2, w2, b3, c3, w3 = p

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import os
 
+import meshio
 import numpy as np
 
 from ..atomic import atomic_path
@@ -60,7 +61,6 @@ def surface_mesh(surface, data: bool = True):
     holding one in ``.surface``): points ``X`` (nv, 3), one ``"triangle"``
     block ``F`` (nf, 3) and, with ``data``, the point and cell data of
     :func:`pyevolver.io.fields.surface_fields`."""
-    import meshio
     s = _surface(surface)
     if s is None:
         raise CommandError("export: no surface is loaded")
@@ -134,7 +134,6 @@ def write_fe(filename: str, mesh, **kwargs) -> None:
 
 def file_format(path) -> str:
     """The meshio format of ``path``, from its extension."""
-    import meshio
     name = os.path.basename(os.fspath(path)).lower()
     parts = name.split(".")
     for k in range(1, len(parts)):
@@ -168,7 +167,6 @@ def export(surface, path: str, fmt: str | None = None, data: bool = True,
 def write_mesh(path, mesh, fmt: str | None = None) -> str:
     """Write a meshio mesh atomically in ``fmt`` (default: by the extension;
     ``evolver`` for ``.fe``) with :data:`WRITE_OPTIONS`."""
-    import meshio
     fmt = fmt or file_format(path)
     if fmt == "xdmf":
         try:
@@ -192,6 +190,5 @@ def write_mesh(path, mesh, fmt: str | None = None) -> str:
 
 def register() -> None:
     """Register the ``.fe`` reader and writer with meshio (idempotent)."""
-    import meshio
     if FORMAT not in meshio.extension_to_filetypes.get(".fe", []):
         meshio.register_format(FORMAT, [".fe"], read_fe, {FORMAT: write_fe})

@@ -260,7 +260,8 @@ class Totals:
         """``{"inst.value": value}`` of the method instances a FUNCTION reads."""
         s = self.surface
         return {f"{n}.value": self.quantity_value(s.quantities[n])
-                for n in (v[:-6] for v in q.function.node.names() if v.endswith(".value"))}
+                for n in (v[:-6] for v in q.function.node.names()  # type: ignore[attr-defined]
+                          if v.endswith(".value"))}
 
     def quantity_value(self, q: Quantity, magnitude: bool = False) -> float:
         """Value of a named quantity; with ``magnitude=True`` the sum of the
@@ -271,7 +272,7 @@ class Totals:
             return self._quantity_value(q, magnitude)
         except PyEvolverError as exc:
             if getattr(exc, "line", None) is None:     # say which quantity failed, where
-                exc.line = q.line
+                exc.line = q.line  # type: ignore[attr-defined]
                 exc.args = (f"quantity {q.name}: {exc}",)
             raise
 

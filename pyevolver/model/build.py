@@ -13,6 +13,7 @@ from ..geometry import kernels as G
 from .formulas import located
 from .ids import IdMap, Lazy
 from .records import first_facets_on_load, record_edge_first_facet
+from .scene import Scene
 from .string import STRING_METHODS, init_rings
 from .surface import HOOKS, Quantity, Surface
 
@@ -756,7 +757,7 @@ class _Builder:
 
 
 
-def build_surface(scene) -> Surface:
+def build_surface(scene: Scene) -> Surface:
     """Build a :class:`Surface` from a :class:`~pyevolver.model.scene.Scene`.
 
     Parameters

@@ -132,7 +132,7 @@ class Surface:
         the string model, the triangles otherwise."""
         return len(self.sf_ptr) - 1 if self.string else len(self.FE)
 
-    def topology(self):
+    def topology(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Topology-derived arrays, cached while ``E`` and ``FE`` are the same
         array objects: ``(idx, sgn, F)`` = edge index (nf, 3), orientation
         sign (nf, 3) and facet vertices (nf, 3).  Operations that change the
@@ -151,7 +151,7 @@ class Surface:
         """(nf, 3) vertices of each facet (tails of its oriented edges)."""
         return self.topology()[2]
 
-    def facet_corners(self):
+    def facet_corners(self) -> np.ndarray:
         """(3, nf) contiguous copy of ``F.T`` (cached with the topology), for
         gathering one coordinate of every facet corner at once."""
         topo = self.topology()
@@ -162,7 +162,7 @@ class Surface:
         self._corners = (topo, Fc)
         return Fc
 
-    def ids(self, kind):
+    def ids(self, kind: str) -> np.ndarray:
         """(n,) element ids of ``kind`` ("vertex", "edge", "facet"): 1..n
         after loading; deletions (``t``, ``w``, ...) leave gaps, as in the
         Evolver, and new elements take ids above the largest."""
@@ -179,13 +179,15 @@ class Surface:
     def edge_tension(self):
         return self.eattr.get("tension", np.zeros(self.ne))
 
-    def wrap_shift(self):
+    def wrap_shift(self) -> np.ndarray | None:
+        """(ne, 3) period shift of each edge of a torus-model surface (None otherwise)."""
         w = self.eattr.get("wrap")
         if w is None or self.periods is None:
             return None
         return w @ self.periods
 
-    def param_env(self):
+    def param_env(self) -> N.MapEnv:
+        """The datafile's parameters (and ``g``, the gravity constant) for formulas."""
         env = dict(self.params)
         env.setdefault("g", self.gravity_constant)
         return N.MapEnv(env)
@@ -218,7 +220,7 @@ class Surface:
         return HOOKS.require("from_arrays")(vertices, facets, **options)
 
     # -- evaluation --------------------------------------------------------
-    def evaluate(self):
+    def evaluate(self) -> Any:
         """Energy, area, volumes and quantity values at the current coordinates.
 
         Returns

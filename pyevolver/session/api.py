@@ -18,6 +18,7 @@ text output of the commands.
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 from ..datafile.writer import DumpSettings
 from ..errors import UnsupportedError
@@ -51,6 +52,15 @@ def progress_bar(total, progress=None, desc=None):
 
 class SessionAPI:
     """Files and pictures of :class:`pyevolver.Session` (a mixin)."""
+
+    # the Session state these methods read (set by Session.__init__)
+    surface: Any
+    filename: str
+    settings: dict[str, Any]
+    toggles: dict[str, Any]
+    attr_types: dict[tuple, str]
+    arrays: dict[str, Any]
+    history: list[tuple]
 
     def export(self, path: str, fmt: str | None = None, data: bool = True) -> str:
         """Write the surface to ``path`` in a meshio format chosen by the

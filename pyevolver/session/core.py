@@ -14,6 +14,7 @@ import signal
 import sys
 import threading
 import time
+from typing import Any, Callable, TextIO
 
 import numpy as np
 
@@ -77,32 +78,32 @@ class Session(SessionAPI):
     ``plot_history``.
     """
 
-    def __init__(self, out=None, err=None):
+    def __init__(self, out: TextIO | None = None, err: TextIO | None = None) -> None:
         self.out = out or sys.stdout
         self.err = err or sys.stderr
-        self.surface = None
-        self.totals = None
-        self.variables = {}
-        self.commands = {}                     # name -> interpreter.Proc
-        self.letters = {}                      # single letters redefined with :::=
-        self.arrays = {}                       # array variables (define name real[n])
-        self.array_types = {}
-        self.attr_types = {}                   # (kind, name) -> 'integer' / 'real' / ...
-        self.toggles = {}
+        self.surface: Any = None               # pyevolver.model.surface.Surface
+        self.totals: Any = None                # pyevolver.methods.totals.Totals
+        self.variables: dict[str, Any] = {}
+        self.commands: dict[str, Any] = {}     # name -> interpreter.Proc
+        self.letters: dict[str, Any] = {}      # single letters redefined with :::=
+        self.arrays: dict[str, Any] = {}       # array variables (define name real[n])
+        self.array_types: dict[str, Any] = {}
+        self.attr_types: dict[tuple, str] = {}  # (kind, name) -> 'integer' / 'real' / ...
+        self.toggles: dict[str, Any] = {}
         self.settings = dict(DEFAULTS)
         self.filename = ""
         self.start_time = time.time()
         self.interp = I.Interpreter(self)
         self._iterator = None
-        self.counts = {}                       # equi_count, refine_count, ... (spec §9.7)
+        self.counts: dict[str, int] = {}       # equi_count, refine_count, ... (spec §9.7)
         self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
         self.iteration_counter = 0
         self.total_time = 0.0
         # seconds one top-level command may run (None: no limit); a command
         # that runs longer stops with an error and leaves the surface as it was
         self.time_limit = None
-        self.history = []                      # (iteration, energy, area) of each g step
-        self.command_history = []              # (number, text) of `history`, `!!` (REF: last 100)
+        self.history: list[tuple] = []         # (iteration, energy, area) of each g step
+        self.command_history: list = []       # (number, text) of `history`, `!!` (REF: last 100)
         self.command_count = 0
         # REF reports some counts once per command, summed, at its end
         # ("Fixed: N", "Unfixed: N" first, then "Edges refined: N", ...)
@@ -110,7 +111,8 @@ class Session(SessionAPI):
 
     # -- loading ---------------------------------------------------------------
     @classmethod
-    def load(cls, filename: str, out=None, err=None, run_read: bool = True,
+    def load(cls, filename: str, out: TextIO | None = None, err: TextIO | None = None,
+             run_read: bool = True,
              text: str | None = None) -> "Session":
         """A session on a datafile.
 
@@ -224,7 +226,7 @@ class Session(SessionAPI):
             raise CommandError(f"dump: cannot write '{name}': {exc.strerror}") from None
 
     # -- output -----------------------------------------------------------------
-    def note(self, text):
+    def note(self, text: str) -> None:
         """A message that ``quiet`` suppresses (REF: counts after r, v, toggle
         messages, mesh operation reports, the header of list)."""
         if not self.toggles.get("quiet"):
@@ -364,12 +366,12 @@ class Session(SessionAPI):
                     return text
         raise CommandError("Command not found in history.")          # REF's ERROR 1588
 
-    def show_history(self):
+    def show_history(self) -> None:
         """``history``: the saved commands, ``n) text``."""
         for num, text in self.command_history:
             self.write(f"{num}) {text}\n")
 
-    def report(self, word, n):
+    def report(self, word: str, n: int) -> None:
         """Add ``n`` to the count REF prints as ``word: total`` when the
         current command ends."""
         self.pending[word] = self.pending.get(word, 0) + n
@@ -389,7 +391,8 @@ class Session(SessionAPI):
         undo.restore(self, snap)
 
     # -- evaluation ------------------------------------------------------------------
-    def recalc(self, keep_cg: bool = False, reposition: bool = False, totals=None) -> None:
+    def recalc(self, keep_cg: bool = False, reposition: bool = False,
+               totals: Any = None) -> None:
         """Recompute energies, areas and volumes (and reset the CG history,
         as the Evolver's recalc does, unless ``keep_cg``).
 
@@ -464,7 +467,8 @@ class Session(SessionAPI):
         if self._iterator is not None:
             self._iterator.cg_history = None
 
-    def g(self, n: int = 1, callback=None, echo: bool = False, progress=None) -> list:
+    def g(self, n: int = 1, callback: Callable[[Any], Any] | None = None, echo: bool = False,
+          progress: Any = None) -> list:
         """Run ``n`` iteration steps; returns the list of step results.
 
         ``callback(result)`` is called after each step; returning True stops
@@ -481,7 +485,7 @@ class Session(SessionAPI):
             # keyword EFFECTIVE_AREA changes only the squared curvature)
             raise UnsupportedError("g with effective_area on", "the effective-area motion "
                                    "is not implemented")
-        results = []
+        results: list = []
         if self.surface.nv == 0:                # e.g. after `t` removed everything (REF)
             self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")
             return results
@@ -556,7 +560,8 @@ class Session(SessionAPI):
             # surface is the one after the last complete iteration
             raise I.Interrupted("Interrupted: stopped after a complete iteration.")
 
-    def bfgs(self, n: int, echo: bool = True, callback=None, progress=None):
+    def bfgs(self, n: int, echo: bool = True, callback: Callable[[Any], Any] | None = None,
+             progress: Any = None) -> Any:
         """``bfgs n``: at most ``n`` iterations of BFGS with a weak Wolfe line
         search (:mod:`pyevolver.evolve.bfgs`; Lewis & Overton 2013), the
         minimizer for nonsmooth energies such as ``circle_willmore``.  Free
@@ -598,7 +603,8 @@ class Session(SessionAPI):
         self.recalc()
         return r
 
-    def newton(self, n: int, echo: bool = True, callback=None):
+    def newton(self, n: int, echo: bool = True,
+               callback: Callable[[Any], Any] | None = None) -> Any:
         """``newton n``: at most ``n`` damped Newton (Levenberg–Marquardt)
         steps with the exact Hessian on all free coordinates
         (:mod:`pyevolver.evolve.newton`); fixed volumes, FIXED quantities
@@ -631,7 +637,8 @@ class Session(SessionAPI):
         self.recalc()
         return r
 
-    def hessian(self, seek: bool = False, max_scale: float | None = None, echo: bool = True):
+    def hessian(self, seek: bool = False, max_scale: float | None = None,
+                echo: bool = True) -> Any:
         """``hessian``: one Newton step on the constrained problem;
         ``hessian_seek [max]``: a line search along the Newton direction
         (scale at most ``max``, default 1).  Returns a :class:`StepResult`
@@ -663,7 +670,7 @@ class Session(SessionAPI):
         self.surface = new
         self.recalc()
 
-    def no_string(self, what: str, surface=None) -> None:
+    def no_string(self, what: str, surface: Any = None) -> None:
         """Refuse ``what`` by name on a string-model surface."""
         s = self.surface if surface is None else surface
         if s is not None and s.string:
@@ -721,20 +728,20 @@ class Session(SessionAPI):
         ``"facet"``, ``"body"``)."""
         return elements.count(self, kind)
 
-    def internal(self, name: str):
+    def internal(self, name: str) -> Any:
         """The value of a built-in name (``vertex_count``, a setting, a toggle)."""
         return variables.internal(self, name)
 
-    def get_attr(self, base, name: str, idx=None):
+    def get_attr(self, base: Any, name: str, idx: Any = None) -> Any:
         """``base.name[idx]`` of an element or quantity reference
         (:func:`pyevolver.commands.element_attrs.get_attr`)."""
         return element_attrs.get_attr(self, base, name, idx)
 
-    def set_attr(self, base, name: str, idx, value) -> None:
+    def set_attr(self, base: Any, name: str, idx: Any, value: Any) -> None:
         """``base.name[idx] := value`` (:func:`pyevolver.commands.element_attrs.set_attr`)."""
         element_attrs.set_attr(self, base, name, idx, value)
 
-    def set_variable(self, name: str, value) -> None:
+    def set_variable(self, name: str, value: Any) -> None:
         """``name := value`` (settings, parameters and user variables)."""
         variables.set_variable(self, name, value)
 
@@ -747,7 +754,7 @@ class Session(SessionAPI):
         """``u``: one equiangulation sweep; returns the number of flips."""
         return remesh.equiangulate(self, echo)
 
-    def edgeswap(self, edges, echo: bool = True) -> int:
+    def edgeswap(self, edges: Any, echo: bool = True) -> int:
         """``edgeswap``: flip the given edges (0-based indices, shape (k,));
         returns the number flipped."""
         return remesh.edgeswap(self, edges, echo)

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import os
 
+import meshio
+
 from ...errors import PyEvolverError
 from ...io.meshio_plugin import file_format, write_mesh
 
@@ -20,7 +22,6 @@ def add_args(parser):
 
 
 def run(args):
-    import meshio
     if not os.path.isfile(args.input):
         raise PyEvolverError(f"convert: cannot open '{args.input}': no such file")
     fmt = file_format(args.output)
