@@ -83,7 +83,7 @@ def render() -> str:
             if not ms:
                 continue
             big = max(ms, key=lambda m: mods[m])
-            uses = sorted((b for (a, b) in edges if a == p), key=lambda b: pos.get(b, 99))
+            uses = sorted((b for (a, b) in edges if a == p), key=lambda b: (pos.get(b, 99), b))
             out.append(f"| {i + 1} | `{p}` | {len(ms)} | {sum(mods[m] for m in ms)} | "
                        f"`{big}` ({mods[big]}) | {', '.join(uses) or '—'} |")
     out += ["", f"{len(mods)} modules, {sum(mods.values())} lines.", "", END]
