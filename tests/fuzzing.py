@@ -1,4 +1,4 @@
-"""Mutation fuzzing helpers shared by tests/test_fuzz.py.
+"""Mutation fuzzing helpers shared by tests/robustness/test_fuzz.py.
 
 Inputs are the shipped examples mutated the way a careless edit or a broken
 transfer would: tokens deleted, duplicated, swapped or replaced, the text

@@ -4,7 +4,7 @@ w.r.t. the vertices.
 Every term of :class:`pyevolver.methods.totals.Totals` has its gradient here
 or, for the named quantities, in the method's registry entry
 (:mod:`pyevolver.methods.registry`); all are checked against central finite
-differences in ``tests/test_gradient.py``.  Shapes: gradients are
+differences in ``tests/evolve/test_gradient.py``.  Shapes: gradients are
 ``(nv, 3)`` arrays.  The discretisations of the built-in methods are stated
 in :mod:`pyevolver.methods.basic`.
 """

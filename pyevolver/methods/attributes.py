@@ -8,7 +8,7 @@ attribute here is computed for the whole surface at once, and
 generator over n elements costs one O(n) evaluation, not n.
 
 The values follow the Surface Evolver 2.70 manual ("Element attributes")
-and what evolver-nox-d prints (checked in tests/test_attributes.py):
+and what evolver-nox-d prints (checked in tests/commands/test_attributes.py):
 
 * vertex ``mean_curvature``: ``h = 3 F·N / (2 N·N)`` with ``F`` the area
   gradient at the vertex and ``N`` the sum of its facets' area vectors

@@ -221,7 +221,7 @@ def moebius_radius_ratio(X: np.ndarray, starts: int = 16,
     (|b| ≈ 0.3); similarities do not change the fit, and with these
     transformations they give every orientation-preserving Möbius
     transformation.  Returns ``(R/r, dev, b)``; checked on inverted tori
-    (tests/test_fig3_torus.py).
+    (tests/studies/test_fig3_torus.py).
     """
 
     Y = X - X.mean(axis=0)

@@ -1,4 +1,4 @@
-// Language features checked against evolver-nox-d (tests/test_language.py)
+// Language features checked against evolver-nox-d (tests/commands/test_language.py)
 // history and its recall
 print 1
 aa := 5

@@ -16,7 +16,7 @@ of x is linear in the control points (``D = B P``), so the gradient is
 control mesh was subdivided first.
 
 Default rule: n = 6 (36 points per regular sub-patch), from a convergence
-test (``tests/test_loop.py::test_quadrature_order_converges``): relative
+test (``tests/geometry/test_loop.py::test_quadrature_order_converges``): relative
 change of W from n to n + 1 on the 5×9 torus (R = 2, r = 1, a coarse and
 strongly curved control mesh) 9e-4 (n = 4), 1.3e-5 (5), 4.8e-6 (6),
 1.2e-7 (7); on the twice-refined icosahedron 8e-6, 5e-8, 1.3e-9, 3e-11.

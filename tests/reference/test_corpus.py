@@ -1,0 +1,113 @@
+"""The third-party corpus (``../shared/corpus``, see its README.md): each
+datafile runs the corpus SCRIPT.txt in pyevolver, in the corpus files folder
+as the reference transcripts were made, and every printed value must agree
+with ``reference/<name>.out`` (the Evolver's own transcript) within 1e-6
+relative.
+
+The generated elastic sheets use energies pyevolver does not have yet: until
+they land, loading them must be refused by name (the whole file read first);
+once a sheet loads, its numbers are compared like the others.  The Evolver
+dumps (``.dmp``) are compared like the datafiles.
+
+Skipped only when the corpus folder is absent.  The corpus files are never
+copied into the repository.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import os
+import re
+
+import numpy as np
+import pytest
+
+from pyevolver.cli import main as cli
+from pyevolver.commands import interpreter as I
+from pyevolver.errors import DatafileError
+from pyevolver.session.core import Session
+
+_HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+_CANDIDATES = [os.path.join(_HERE, "..", "..", "shared", "corpus"),
+               os.environ.get("PYEVOLVER_CORPUS", "")]
+CORPUS = next((os.path.normpath(c) for c in _CANDIDATES
+               if c and os.path.isfile(os.path.join(c, "INDEX.tsv"))), None)
+
+# features the generated elastic sheets use that pyevolver refuses today
+ELASTIC_FEATURES = ("linear_elastic", "star_perp_sq_mean_curvature", "star_gauss_curvature",
+                    "OPTIMIZING_PARAMETER")
+# values printed by SCRIPT.txt (one per line, after a 'STAGE name' line)
+_VALUE = re.compile(r"(?:Enter command: )?(total_energy|total_area|vertex_count|edge_count|"
+                    r"facet_count|body_count) (\S+)")
+
+
+def _rows():
+    if CORPUS is None:
+        return []
+    with open(os.path.join(CORPUS, "INDEX.tsv"), newline="") as fh:
+        rows = list(csv.reader(fh, delimiter="\t"))[1:]
+    return [(r[0], r[4]) for r in rows if r[4] != "companion"]
+
+
+def _params():
+    out = []
+    for name, kind in _rows():
+        out.append(pytest.param(name, kind, id=name.split("__")[-1]))
+    if not out:
+        out.append(pytest.param(None, None, id="corpus-absent",
+                                marks=pytest.mark.skip(reason="no third-party corpus")))
+    return out
+
+
+def printed_values(text):
+    """``{(stage, name): value}`` of the values the corpus script prints."""
+    got = {}
+    stage = None
+    for line in text.splitlines():
+        m = re.search(r"STAGE (\w+)", line)
+        if m:
+            stage = m.group(1)
+            continue
+        m = _VALUE.match(line)
+        if m and stage:
+            got[(stage, m.group(1))] = float(m.group(2))
+    return got
+
+
+def run_script(name, monkeypatch):
+    """Load ``name`` in the corpus files folder and feed SCRIPT.txt as the
+    Evolver's standard input; returns what was printed."""
+    with open(os.path.join(CORPUS, "SCRIPT.txt"), encoding="latin-1") as fh:
+        script = fh.read()
+    monkeypatch.chdir(os.path.join(CORPUS, "files"))
+    out, err = io.StringIO(), io.StringIO()
+    with np.errstate(all="ignore"):
+        ses = Session.load(name, out=out, err=err)
+        ses.time_limit = 120
+        try:
+            cli.repl(ses, stdin=io.StringIO(script))
+        except I.Quit:
+            pass
+    return out.getvalue()
+
+
+@pytest.mark.parametrize("name,kind", _params())
+def test_corpus_datafile(name, kind, monkeypatch):
+    with open(os.path.join(CORPUS, "reference", name + ".out"), encoding="latin-1") as fh:
+        ref = printed_values(fh.read())
+    assert ref, "the reference transcript has no values"
+    try:
+        text = run_script(name, monkeypatch)
+    except DatafileError as exc:
+        if kind == "elastic-sheet":
+            # refused by name, located, after the whole file was read
+            msg = str(exc)
+            assert "not supported in pyevolver" in msg, msg
+            assert any(f.lower() in msg.lower() for f in ELASTIC_FEATURES), msg
+            assert exc.line, msg
+            return
+        raise
+    got = printed_values(text)
+    bad = [(k, v, got.get(k)) for k, v in ref.items()
+           if got.get(k) is None or abs(got[k] - v) > 1e-6 * max(1.0, abs(v))]
+    assert not bad, f"{len(bad)} values differ from the Evolver's, first: {bad[:3]}"
