@@ -13,7 +13,7 @@ import pytest
 
 from conftest import example
 from reference import run_reference
-from test_commands_reference import _same, run_pyevolver
+from comparison import _same, run_pyevolver
 
 import pyevolver
 from pyevolver.errors import CommandError

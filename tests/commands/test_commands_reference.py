@@ -1,50 +1,16 @@
 """The command language prints what evolver-nox-d prints (reference check 18,
 run live through both programs)."""
 import os
-import subprocess
-import sys
 
 import pytest
 
 from conftest import example
+from comparison import _same, run_pyevolver
 from reference import run_reference
 
 # reference check 18 (copied from shared/reference-checks/scripts)
 SCRIPT18 = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "18_language.cmd")
 ROOT = os.path.join(os.path.dirname(os.path.dirname(__file__)), "..")
-
-
-def run_pyevolver(datafile, commands, cwd=None):
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.path.abspath(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
-    p = subprocess.run([sys.executable, "-m", "pyevolver", datafile], input=commands,
-                       capture_output=True, text=True, timeout=120, env=env, cwd=cwd)
-    return p.returncode, p.stdout.rstrip("\n").split("\n"), p.stderr
-
-
-def _tokens(lines):
-    return [l.split() for l in lines if l.strip()]
-
-
-def _same(out, ref, rtol=1e-12):
-    """Token-wise equality, numbers within ``rtol`` (round-off differs)."""
-    a, b = _tokens(out), _tokens(ref)
-    if len(a) != len(b):
-        return False
-    for la, lb in zip(a, b):
-        if len(la) != len(lb):
-            return False
-        for x, y in zip(la, lb):
-            if x == y:
-                continue
-            try:
-                fx = float(x.strip("/*").replace("*/", ""))
-                fy = float(y.strip("/*").replace("*/", ""))
-            except ValueError:
-                return False
-            if abs(fx - fy) > rtol * max(abs(fx), abs(fy)) + 1e-15:
-                return False
-    return True
 
 
 def test_check18_language(evolver, tmp_path):

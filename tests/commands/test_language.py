@@ -4,17 +4,13 @@ Every comparison runs evolver-nox-d live on the same input; the expected
 output is never pasted in.  Exporter scripts shipped with the Evolver
 (off.cmd, stl.cmd, ...) must write byte-identical files.
 """
-import glob
 import os
-import shutil
-import subprocess
-import sys
 
 import pytest
 
-from conftest import EXAMPLES, example
+from conftest import example
 from reference import run_reference
-from test_commands_reference import ROOT, _same, run_pyevolver
+from comparison import _run_both, _same, run_pyevolver
 
 HERE = os.path.dirname(os.path.dirname(__file__))
 MEMORY = ("Element memory", "Total data memory")
@@ -60,19 +56,6 @@ EXPORTERS = [("off", "do_off"), ("stl", "stl"), ("dxf", "dxf"), ("obj", "obj"),
              ("dxf_thick", "dxf_thick")]
 # lines that hold the time of the run (date_and_time)
 TIMESTAMPED = ("// Date:", "    <created>", "    <modified>")
-
-
-def _run_both(evolver, datafile, script, tmp_path):
-    dirs = {}
-    for who in ("ref", "ours"):
-        d = tmp_path / who
-        d.mkdir()
-        for f in glob.glob(os.path.join(EXAMPLES, "*.cmd")):
-            shutil.copy(f, d)
-        dirs[who] = d
-    ref = run_reference(evolver, datafile, script, cwd=str(dirs["ref"]), timeout=120)
-    code, out, err = run_pyevolver(datafile, script + "q\n", cwd=str(dirs["ours"]))
-    return dirs, ref, out, err
 
 
 def _read(path):

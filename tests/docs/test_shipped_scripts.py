@@ -10,8 +10,8 @@ import shutil
 import pytest
 
 from conftest import EXAMPLES, example
-from test_commands_reference import _same
-from test_language import _run_both
+from comparison import _same
+from comparison import _run_both
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
 MEMORY = ("Element memory", "Total data memory")

@@ -156,7 +156,7 @@ def test_ade_vesicle_first_steps_match_reference(evolver, tmp_path):
     REF's lines to 1e-9 (the whole run is compared as reference check 14 in
     test_reference_checks.py)."""
     from reference import run_reference
-    from test_commands_reference import run_pyevolver
+    from comparison import run_pyevolver
     path = os.path.join(CHECKS, "vesicle_ade.fe")
     with open(os.path.join(CHECKS, "14_vesicle_ade.cmd")) as fh:
         script = fh.read().rsplit("q\nq", 1)[0]
@@ -389,7 +389,7 @@ def test_every_method_matches_reference_on_blob0_and_its_refinement(evolver, tmp
     def results(lines):
         return [[float(x) for x in l.split()[1:]] for l in lines if l.startswith("RESULT")]
     ref = results(run_reference(evolver, str(path), script, cwd=str(tmp_path)))
-    from test_commands_reference import run_pyevolver
+    from comparison import run_pyevolver
     code, out, err = run_pyevolver(str(path), script + "q\n", cwd=str(tmp_path))
     assert code == 0, err
     mine = results(out)

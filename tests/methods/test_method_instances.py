@@ -36,7 +36,7 @@ def _progress(lines):
 def test_energy_functions_match_reference(evolver, tmp_path, quantity):
     """The value at load and three ``g`` steps within 1e-9 (scale 1e-4)."""
     from reference import run_reference
-    from test_commands_reference import run_pyevolver
+    from comparison import run_pyevolver
     path = _file(tmp_path, quantity + "\nquantity combo info_only function 3*aa.value - bb.value")
     script = 'printf "RESULT %.15g %.15g\\n", bend.value, combo.value\ng 3\n'
     ref = run_reference(evolver, path, script, cwd=str(tmp_path))

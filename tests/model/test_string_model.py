@@ -15,7 +15,7 @@ import pytest
 
 from conftest import EXAMPLES, example
 from reference import run_reference
-from test_commands_reference import _same, run_pyevolver
+from comparison import _same, run_pyevolver
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
 MEMORY = ("Element memory", "Total data memory")

@@ -18,7 +18,7 @@ import pytest
 
 from conftest import example
 from reference import run_reference
-from test_commands_reference import run_pyevolver
+from comparison import run_pyevolver
 
 LINE = re.compile(r"^\s*(\d+)\. (?:area|length):\s*(\S+) energy:\s*(\S+)\s+scale:\s*(\S+)")
 

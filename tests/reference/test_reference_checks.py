@@ -21,7 +21,7 @@ import pytest
 
 from conftest import example
 from reference import run_reference
-from test_commands_reference import run_pyevolver
+from comparison import run_pyevolver
 
 CHECKS = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "checks")
 

@@ -10,36 +10,9 @@ import numpy as np
 import pytest
 
 from conftest import example
+from comparison import consistent
 from reference import run_reference
 from pyevolver import Session
-from pyevolver.geometry import kernels as G
-
-
-def consistent(s):
-    """Assert the invariants every operation must keep."""
-    assert s.E.shape == (s.ne, 2) and s.FE.shape == (s.nf, 3)
-    idx, sgn = G.edge_index(s.FE)
-    assert s.nf == 0 or (idx.min() >= 0 and idx.max() < s.ne)
-    tails = np.where(sgn > 0, s.E[idx, 0], s.E[idx, 1])
-    heads = np.where(sgn > 0, s.E[idx, 1], s.E[idx, 0])
-    assert np.array_equal(heads, np.roll(tails, -1, axis=1)), "facet edge loops must close"
-    assert not np.any(s.E[:, 0] == s.E[:, 1]), "no edge may join a vertex to itself"
-    for arr in s.vattr.values():
-        assert len(arr) == s.nv
-    for arr in s.eattr.values():
-        assert len(arr) == s.ne
-    for arr in s.fattr.values():
-        assert len(arr) == s.nf
-    for m in s.vcon.values():
-        assert len(m) == s.nv
-    for m in s.econ.values():
-        assert len(m) == s.ne
-    if s.bodies.n:
-        assert s.bodies.facet_matrix.shape == (s.bodies.n, s.nf)
-    for q in s.quantities.values():
-        for m, etype, idx_, sg in q.methods:
-            n = {"vertex": s.nv, "edge": s.ne, "facet": s.nf}[etype]
-            assert len(idx_) == 0 or idx_.max() < n
 
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")

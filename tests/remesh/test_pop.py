@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from conftest import example
 from reference import run_reference
-from test_mesh import consistent
+from comparison import consistent
 
 from pyevolver import Session
 from pyevolver.errors import PyEvolverError

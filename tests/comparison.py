@@ -1,0 +1,92 @@
+"""Helpers the tests share: running pyevolver like a user, comparing its
+transcript with the Evolver's, the invariants every mesh operation keeps.
+
+The tolerances of the comparisons are named in one place,
+:mod:`tolerances`."""
+import glob as _glob
+import os
+import shutil as _shutil
+import subprocess
+import sys
+
+import numpy as np
+
+from conftest import EXAMPLES
+from pyevolver.geometry import kernels as G
+from reference import run_reference
+from tolerances import PRINTED
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+
+
+def run_pyevolver(datafile, commands, cwd=None):
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.path.abspath(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
+    p = subprocess.run([sys.executable, "-m", "pyevolver", datafile], input=commands,
+                       capture_output=True, text=True, timeout=120, env=env, cwd=cwd)
+    return p.returncode, p.stdout.rstrip("\n").split("\n"), p.stderr
+
+
+def _tokens(lines):
+    return [l.split() for l in lines if l.strip()]
+
+
+def _same(out, ref, rtol=PRINTED):
+    """Token-wise equality, numbers within ``rtol`` (round-off differs)."""
+    a, b = _tokens(out), _tokens(ref)
+    if len(a) != len(b):
+        return False
+    for la, lb in zip(a, b):
+        if len(la) != len(lb):
+            return False
+        for x, y in zip(la, lb):
+            if x == y:
+                continue
+            try:
+                fx = float(x.strip("/*").replace("*/", ""))
+                fy = float(y.strip("/*").replace("*/", ""))
+            except ValueError:
+                return False
+            if abs(fx - fy) > rtol * max(abs(fx), abs(fy)) + 1e-15:
+                return False
+    return True
+
+
+def _run_both(evolver, datafile, script, tmp_path):
+    dirs = {}
+    for who in ("ref", "ours"):
+        d = tmp_path / who
+        d.mkdir()
+        for f in _glob.glob(os.path.join(EXAMPLES, "*.cmd")):
+            _shutil.copy(f, d)
+        dirs[who] = d
+    ref = run_reference(evolver, datafile, script, cwd=str(dirs["ref"]), timeout=120)
+    code, out, err = run_pyevolver(datafile, script + "q\n", cwd=str(dirs["ours"]))
+    return dirs, ref, out, err
+
+
+def consistent(s):
+    """Assert the invariants every operation must keep."""
+    assert s.E.shape == (s.ne, 2) and s.FE.shape == (s.nf, 3)
+    idx, sgn = G.edge_index(s.FE)
+    assert s.nf == 0 or (idx.min() >= 0 and idx.max() < s.ne)
+    tails = np.where(sgn > 0, s.E[idx, 0], s.E[idx, 1])
+    heads = np.where(sgn > 0, s.E[idx, 1], s.E[idx, 0])
+    assert np.array_equal(heads, np.roll(tails, -1, axis=1)), "facet edge loops must close"
+    assert not np.any(s.E[:, 0] == s.E[:, 1]), "no edge may join a vertex to itself"
+    for arr in s.vattr.values():
+        assert len(arr) == s.nv
+    for arr in s.eattr.values():
+        assert len(arr) == s.ne
+    for arr in s.fattr.values():
+        assert len(arr) == s.nf
+    for m in s.vcon.values():
+        assert len(m) == s.nv
+    for m in s.econ.values():
+        assert len(m) == s.ne
+    if s.bodies.n:
+        assert s.bodies.facet_matrix.shape == (s.bodies.n, s.nf)
+    for q in s.quantities.values():
+        for m, etype, idx_, sg in q.methods:
+            n = {"vertex": s.nv, "edge": s.ne, "facet": s.nf}[etype]
+            assert len(idx_) == 0 or idx_.max() < n
