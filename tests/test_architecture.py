@@ -174,3 +174,53 @@ def test_architecture_doc_is_current():
     spec.loader.exec_module(mod)
     text = (ROOT / "docs" / "architecture.md").read_text()
     assert mod.updated(text) == text, "run python docs/make_architecture.py"
+
+
+def _test_imports() -> dict[str, set[pathlib.Path]]:
+    """module -> the test files that import it by name."""
+    mods = _module_names()
+    out: dict[str, set[pathlib.Path]] = {}
+    for t in (ROOT / "tests").rglob("test_*.py"):
+        for node in ast.walk(ast.parse(t.read_text())):
+            names = []
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("pyevolver"):
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            for n in names:
+                if n in mods:
+                    out.setdefault(n, set()).add(t)
+    return out
+
+
+def _bare_packages() -> set[str]:
+    """Packages whose ``__init__`` defines no function or class (nothing to test)."""
+    out = set()
+    for p in PKG.rglob("__init__.py"):
+        tree = ast.parse(p.read_text())
+        if not any(isinstance(n, (ast.FunctionDef, ast.ClassDef)) for n in tree.body):
+            out.add(".".join(p.parent.relative_to(ROOT).parts))
+    return out
+
+
+def _module_names() -> set[str]:
+    out = set()
+    for p in PKG.rglob("*.py"):
+        name = ".".join(p.relative_to(ROOT).with_suffix("").parts)
+        out.add(name[: -len(".__init__")] if name.endswith(".__init__") else name)
+    return out
+
+
+def test_tests_mirror_the_package_and_every_module_has_direct_tests():
+    """Each module pyevolver.PKG.x is imported by a test in tests/PKG/ (the
+    leaf modules pyevolver.x by one in tests/): tests/ mirrors the package."""
+    imports = _test_imports()
+    missing = []
+    for m in sorted(_module_names() - {"pyevolver", "pyevolver.__main__"} - _bare_packages()):
+        parts = m.split(".")
+        package = (PKG / parts[1]).is_dir()
+        folder = ROOT / "tests" / parts[1] if package else ROOT / "tests"
+        if not any(f.parent == folder or folder in f.parents and package
+                   for f in imports.get(m, ())):
+            missing.append(m)
+    assert not missing, missing

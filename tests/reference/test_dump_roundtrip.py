@@ -21,6 +21,7 @@ from pyevolver.errors import DatafileError, PyEvolverError
 
 from conftest import example
 from reference import run_reference
+from tolerances import PRINTED, STEPS
 
 # the examples pyevolver runs, and those it refuses by name; crystal.fe is not dumped by REF (no
 # Wulff file) and simplex3.fe only after r
@@ -69,13 +70,13 @@ def _messages(lines):
 
 def _agree(ref, ours):
     (rr, rv, rg), (orr, ov, og) = _pick(ref), _pick(ours)
-    assert _rel(rr[0], orr[0]) <= 1e-9, ("energy", rr[0], orr[0])
-    assert _rel(rr[1], orr[1]) <= 1e-9, ("area", rr[1], orr[1])
+    assert _rel(rr[0], orr[0]) <= STEPS, ("energy", rr[0], orr[0])
+    assert _rel(rr[1], orr[1]) <= STEPS, ("area", rr[1], orr[1])
     assert rr[2:] == orr[2:], ("counts", rr[2:], orr[2:])
-    assert len(rv) == len(ov) and all(_rel(a, b) <= 1e-9 for a, b in zip(rv, ov)), (rv, ov)
+    assert len(rv) == len(ov) and all(_rel(a, b) <= STEPS for a, b in zip(rv, ov)), (rv, ov)
     assert len(rg) == len(og) == 5, (rg, og)
     for (ra, re_), (oa, oe) in zip(rg, og):
-        assert _rel(ra, oa) <= 1e-9 and _rel(re_, oe) <= 1e-9, (rg, og)
+        assert _rel(ra, oa) <= STEPS and _rel(re_, oe) <= STEPS, (rg, og)
 
 
 def _ref_dump(evolver, name, pre, tmp_path):
@@ -144,8 +145,8 @@ def test_our_string_dump_loads_in_reference(evolver, name, tmp_path):
     s.run(SCRIPT.replace("g 5\n", ""))
     ref = run_reference(evolver, out, SCRIPT.replace("g 5\n", ""), cwd=str(tmp_path))
     (rr, rv, _), (orr, ov, _) = _pick(ref), _pick(s.out.getvalue().split("\n"))
-    assert all(_rel(a, b) <= 1e-9 for a, b in zip(rr[:2], orr[:2])) and rr[2:] == orr[2:]
-    assert len(rv) == len(ov) and all(_rel(a, b) <= 1e-9 for a, b in zip(rv, ov))
+    assert all(_rel(a, b) <= STEPS for a, b in zip(rr[:2], orr[:2])) and rr[2:] == orr[2:]
+    assert len(rv) == len(ov) and all(_rel(a, b) <= STEPS for a, b in zip(rv, ov))
     if name == "100grain":
         text = open(out).read()
         for line in ("AUTOCHOP 0.0149", "autochop on", "area_normalization on", "autopop on"):
@@ -254,7 +255,7 @@ def test_scale_fixed_is_fixed_scale_mode(evolver, tmp_path):
     assert len(ours) == len(ref) == 3
     for a, b in zip(ours, ref):
         assert a.split()[-1] == b.split()[-1] == "0.0500000"      # the scale stays
-        assert _rel(a.split()[4], b.split()[4]) <= 1e-9
+        assert _rel(a.split()[4], b.split()[4]) <= STEPS
 
 
 def test_view_transform_generators_skipped(tmp_path):
@@ -514,7 +515,7 @@ def test_run_time_state_of_a_reference_dump(evolver, tmp_path):
     got = s.out.getvalue().split()
     want = next(ln for ln in run_reference(evolver, dmp, show, cwd=str(tmp_path))
                 if ln.startswith("S ")).split()
-    assert got[:6] == want[:6] and _rel(got[6], want[6]) <= 1e-12, (got, want)
+    assert got[:6] == want[:6] and _rel(got[6], want[6]) <= PRINTED, (got, want)
 
 
 @pytest.mark.parametrize("top,word", [
@@ -541,7 +542,7 @@ def test_effective_area_keyword_and_command(evolver, tmp_path):
     ours, ref = _g_lines_both(evolver, s, tmp_path, "g 2")
     assert len(ours) == len(ref) == 2
     for a, b in zip(ours, ref):
-        assert _rel(a.split()[4], b.split()[4]) <= 1e-9, (ours, ref)
+        assert _rel(a.split()[4], b.split()[4]) <= STEPS, (ours, ref)
     s.run("effective_area on")
     with pytest.raises(PyEvolverError, match="not supported in pyevolver: g with effective_area"):
         s.run("g 1")

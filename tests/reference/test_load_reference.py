@@ -11,12 +11,13 @@ from pyevolver import Session
 
 from conftest import example
 from reference import numbers
+from tolerances import PRINTED
 
 FILES = ["cube", "quad", "sphere", "octa", "mound", "qmound", "catbody", "cat", "catman",
          "column", "tankex", "twointor"]
 
 
-def _close(a, b, rtol=1e-12, atol=1e-14):
+def _close(a, b, rtol=PRINTED, atol=1e-14):
     return abs(a - b) <= rtol * max(abs(a), abs(b)) + atol
 
 
