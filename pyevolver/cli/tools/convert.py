@@ -29,6 +29,8 @@ def run(args):
         mesh = meshio.read(args.input)
     except (meshio.ReadError, ValueError, KeyError) as exc:
         raise PyEvolverError(f"convert: meshio cannot read '{args.input}': {exc}") from None
+    except SystemExit:          # meshio exits on some unreadable files (e.g. a broken .vtu)
+        raise PyEvolverError(f"convert: meshio cannot read '{args.input}'") from None
     write_mesh(args.output, mesh, fmt)
     nf = sum(len(c.data) for c in mesh.cells)
     print(f"{args.input} -> {args.output} ({fmt}): {len(mesh.points)} vertices, {nf} cells")

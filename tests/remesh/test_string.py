@@ -1,0 +1,77 @@
+"""Direct tests of pyevolver.remesh.string (string model): ``split_edges``
+(r) and ``vertex_average`` (V, rawv, rawestv)."""
+import numpy as np
+import pytest
+
+import pyevolver
+from pyevolver.remesh.string import split_edges, vertex_average
+from tolerances import ROUNDOFF
+
+
+def _string(tmp_path, pts, fixed_ends=True):
+    lines = ["STRING", "vertices"]
+    for i, p in enumerate(pts):
+        fx = " fixed" if fixed_ends and i in (0, len(pts) - 1) else ""
+        lines.append(f"{i + 1} {p[0]!r} {p[1]!r} 0{fx}")
+    lines.append("edges")
+    for i in range(len(pts) - 1):
+        lines.append(f"{i + 1} {i + 1} {i + 2}")
+    f = tmp_path / "s.fe"
+    f.write_text("\n".join(lines) + "\n")
+    s = pyevolver.load(str(f)).surface
+    assert s.string
+    return s
+
+
+def _length(s):
+    return float(np.linalg.norm(s.X[s.E[:, 1]] - s.X[s.E[:, 0]], axis=1).sum())
+
+
+def test_split_all_edges(tmp_path):
+    s = _string(tmp_path, [(0, 0), (1, 0.5), (2, 0), (3, 1)])
+    L = _length(s)
+    R = np.arange(s.ne)
+    t = split_edges(s, R)
+    assert (t.nv, t.ne) == (s.nv + s.ne, 2 * s.ne)
+    mids = 0.5 * (s.X[s.E[:, 0]] + s.X[s.E[:, 1]])
+    assert np.allclose(t.X[s.nv:], mids, atol=ROUNDOFF)
+    assert _length(t) == pytest.approx(L, rel=ROUNDOFF)
+    # tail half keeps the edge, head half is new and ends at the old head
+    assert np.array_equal(t.E[:s.ne, 0], s.E[:, 0])
+    assert np.array_equal(t.E[:s.ne, 1], s.nv + R)
+    assert np.array_equal(t.E[s.ne:, 1], s.E[:, 1])
+    # still one chain: every inner vertex has two edges, the two ends one
+    deg = np.bincount(t.E.ravel(), minlength=t.nv)
+    assert sorted(deg.tolist()) == [1, 1] + [2] * (t.nv - 2)
+    # the input is untouched
+    assert (s.nv, s.ne) == (4, 3)
+
+
+def test_split_some_edges(tmp_path):
+    s = _string(tmp_path, [(0, 0), (1, 0), (2, 0)])
+    t = split_edges(s, [1])
+    assert (t.nv, t.ne) == (4, 3)
+    assert np.allclose(t.X[3], [1.5, 0, 0])
+    assert _length(t) == pytest.approx(2.0, rel=ROUNDOFF)
+
+
+def test_vertex_average_straight_even_string_does_not_move(tmp_path):
+    s = _string(tmp_path, [(0, 0), (1, 0), (2, 0), (3, 0)])
+    for mode in ("V", "raw", "rawest"):
+        assert np.allclose(vertex_average(s, mode).X, s.X, atol=ROUNDOFF)
+
+
+def test_vertex_average_moves(tmp_path):
+    # middle vertex (0.5, 0.5) between fixed (0,0) and (2,0):
+    # D = mean of (x_e - x_v) = (0.5, -0.5); x += D/4
+    s = _string(tmp_path, [(0, 0), (0.5, 0.5), (2, 0)])
+    raw = vertex_average(s, "raw")
+    assert np.allclose(raw.X[1], [0.625, 0.375, 0], atol=ROUNDOFF)
+    assert np.array_equal(raw.X[[0, 2]], s.X[[0, 2]])            # FIXED ends
+    # V keeps only the part of D along the chord (2,0)-(0,0): (0.5, 0)
+    v = vertex_average(s, "V")
+    assert np.allclose(v.X[1], [0.625, 0.5, 0], atol=ROUNDOFF)
+    assert np.allclose(s.X[1], [0.5, 0.5, 0])                     # input unchanged
+    # free ends do not move either (one edge)
+    f = _string(tmp_path, [(0, 0), (0.5, 0.5), (2, 0)], fixed_ends=False)
+    assert np.allclose(vertex_average(f, "raw").X, raw.X, atol=ROUNDOFF)
