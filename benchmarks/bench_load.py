@@ -47,7 +47,7 @@ REL_TOL = 1e-12
 PYEVOLVER_CODE = (
     "import sys\n"
     "from pyevolver.datafile.reader import read_datafile\n"
-    "from pyevolver.model.surface import build_surface\n"
+    "from pyevolver.model.build import build_surface\n"
     "s = build_surface(read_datafile(sys.argv[1]))\n"
     "t = s.evaluate()\n"
     "print(repr(t.energy), repr(t.total_area), s.nv, s.ne, s.nf)\n"

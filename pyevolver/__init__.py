@@ -16,8 +16,10 @@ from .model.build import build_surface  # noqa: E402
 from . import methods as _methods  # noqa: E402,F401  (installs the model's evaluate/method hooks)
 from .session.core import Session  # noqa: E402
 from .io.meshio_plugin import register as _register_meshio  # noqa: E402
+from .memory import tune_allocator as _tune_allocator  # noqa: E402
 
 _register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)
+_tune_allocator()           # large numpy temporaries stay in the heap (pyevolver.memory)
 
 
 def load(filename: str, **kwargs: Any) -> Session:

@@ -1,0 +1,32 @@
+"""pyevolver.memory: glibc's allocator thresholds are set at import, once,
+and not when the user says otherwise."""
+import os
+import subprocess
+import sys
+
+import pytest
+
+from pyevolver import memory
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _child(env_extra):
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PYEVOLVER_MALLOC", "MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_")}
+    env.update(env_extra, PYTHONPATH=ROOT)
+    p = subprocess.run([sys.executable, "-c", "import pyevolver, pyevolver.memory as m; "
+                        "print(m._done)"], capture_output=True, text=True, env=env, timeout=120)
+    assert p.returncode == 0, p.stderr
+    return p.stdout.strip()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
+def test_thresholds_are_set_at_import_on_glibc():
+    assert _child({}) == "True"
+    assert memory.tune_allocator() is memory.tune_allocator()       # once, then remembered
+
+
+def test_the_user_can_keep_the_defaults():
+    assert _child({"PYEVOLVER_MALLOC": "0"}) == "False"
+    assert _child({"MALLOC_TRIM_THRESHOLD_": "131072"}) == "False"
