@@ -12,7 +12,6 @@ import math
 from typing import Any
 
 import numpy as np
-from scipy.special import ellipe, ellipeinc, ellipk, ellipkinc
 
 from ..errors import ExpressionError
 
@@ -52,12 +51,14 @@ def _ellipk(m):
     """Complete elliptic integral of the first kind K(m), parameter m
     (Abramowitz & Stegun 17.3.1; the Evolver's convention)."""
     _domain(np.asarray(m) >= 1, "ellipticK domain violation, parameter >= 1.")
+    from scipy.special import ellipk      # 0.4 s to import: only when used
     return ellipk(m)
 
 
 def _ellipe(m):
     """Complete elliptic integral of the second kind E(m) (A&S 17.3.3)."""
     _domain(np.asarray(m) > 1, "ellipticE domain violation, parameter > 1.")
+    from scipy.special import ellipe
     return ellipe(m)
 
 
@@ -65,6 +66,7 @@ def _ellipf(phi, m):
     """Incomplete elliptic integral of the first kind F(phi|m) (A&S 17.2.7)."""
     _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
             "incompleteEllipticF domain violation, m*sin(phi)^2 > 1.")
+    from scipy.special import ellipkinc
     return ellipkinc(phi, m)
 
 
@@ -72,6 +74,7 @@ def _ellipeinc(phi, m):
     """Incomplete elliptic integral of the second kind E(phi|m) (A&S 17.2.8)."""
     _domain(np.asarray(m) * np.sin(phi) ** 2 > 1,
             "incompleteEllipticE domain violation, m*sin(phi)^2 > 1.")
+    from scipy.special import ellipeinc
     return ellipeinc(phi, m)
 
 

@@ -34,7 +34,6 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-from scipy.special import roots_jacobi
 
 from .patches import HalfEdges, gather_ring, limit_weights, loop_subdivide, template
 
@@ -141,6 +140,7 @@ def triangle_rule(n):
     ``u, v >= 0, u + v <= 1`` (Duffy: u = ξ, v = (1 − ξ) η; Gauss–Jacobi with
     weight (1 − ξ) in ξ, Gauss–Legendre in η): exact for polynomials of
     degree 2n − 1.  Returns ``(u (n²,), v (n²,), w (n²,))``, Σ w = 1/2."""
+    from scipy.special import roots_jacobi     # 0.4 s to import: only when used
     xj, wj = roots_jacobi(n, 1.0, 0.0)            # weight (1 - x) on [-1, 1]
     xi = (1 + xj) / 2
     wxi = wj / 4                                   # ∫0^1 (1-ξ) g dξ
