@@ -11,6 +11,7 @@ import sys
 
 import numpy as np
 
+import pyevolver
 from conftest import EXAMPLES
 from pyevolver.geometry import kernels as G
 from reference import run_reference
@@ -90,3 +91,28 @@ def consistent(s):
         for m, etype, idx_, sg in q.methods:
             n = {"vertex": s.nv, "edge": s.ne, "facet": s.nf}[etype]
             assert len(idx_) == 0 or idx_.max() < n
+
+
+def octasphere(seed=0, jiggle=0.03, scale=1.0, shift=(0.0, 0.0, 0.0)):
+    """The octahedron split once (18 vertices, 32 facets) on a sphere of radius
+    ``scale`` about ``shift``, each coordinate jiggled by ``jiggle`` times a
+    standard normal (generator seeded ``seed``); one body."""
+    X = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
+    F0 = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
+    X = [np.array(x, float) for x in X]
+    mid = {}
+
+    def m(a, b):
+        k = (min(a, b), max(a, b))
+        if k not in mid:
+            mid[k] = len(X)
+            X.append((X[a] + X[b]) / 2)
+        return mid[k]
+    F = []
+    for a, b, c in F0:
+        ab, bc, ca = m(a, b), m(b, c), m(c, a)
+        F += [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+    X = np.array(X)
+    X /= np.linalg.norm(X, axis=1)[:, None]
+    X += jiggle * np.random.default_rng(seed).standard_normal(X.shape)
+    return pyevolver.Surface.from_arrays(scale * X + np.asarray(shift), np.array(F), body=True)

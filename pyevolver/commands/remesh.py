@@ -45,14 +45,29 @@ def counts_line(session: SessionLike):
             f"Facetedges: {variables.internal(session, 'facetedge_count'):.0f}\n")
 
 
+def _replaced(session: SessionLike, result, count=None, note=None, echo=True):
+    """Install the ``(new surface, n)`` a remesh operation returned; add
+    ``n`` to the count ``count`` and print ``note`` (``{n}`` filled in)."""
+    new, n = result
+    session._replace_surface(new)
+    if count is not None:
+        bump_count(session, count, n)
+    if echo and note is not None:
+        session.note(note.format(n=n))
+    return n
+
+
+def _divide(session: SessionLike, edges):
+    """Bisect ``edges`` (the string model splits them); returns how many."""
+    if session.surface.string:
+        return session._string_split(np.asarray(edges, np.int64))
+    return _replaced(session, ED.edge_divide(session.surface, edges))
+
+
 def refine_edges(session: SessionLike, edges, echo=True):
     """``refine edges where ...``: bisect the given edges (spec §8)."""
     edges = np.asarray(edges, np.int64)
-    if session.surface.string:
-        n = session._string_split(np.unique(edges))
-    else:
-        new, n = ED.edge_divide(session.surface, edges)
-        session._replace_surface(new)
+    n = _divide(session, np.unique(edges) if session.surface.string else edges)
     if echo:
         session.report("Edges refined", n)
 
@@ -71,11 +86,9 @@ def equiangulate(session: SessionLike, echo=True):
     """``u``: one equiangulation sweep (spec §8.2)."""
     if session.surface.string:
         raise CommandError("Cannot equiangulate string model.")      # REF's ERROR 2200
-    new, n = EQ.equiangulate(session.surface)
-    session._replace_surface(new)
+    n = _replaced(session, EQ.equiangulate(session.surface),
+                  note="Edges switched in equiangulation: {n}\n", echo=echo)
     session.counts["equi"] = n                 # REF: the last sweep's flips
-    if echo:
-        session.note(f"Edges switched in equiangulation: {n}\n")
     return n
 
 
@@ -85,19 +98,14 @@ def edgeswap(session: SessionLike, edges, echo=True):
     session.no_string("edgeswap")
     only = np.zeros(session.surface.ne, bool)
     only[np.asarray(edges, np.int64)] = True
-    new, n = EQ.equiangulate(session.surface, threshold=np.inf, only=only)
-    session._replace_surface(new)
+    n = _replaced(session, EQ.equiangulate(session.surface, threshold=np.inf, only=only))
     if echo:
         session.report("Edges swapped", n)
     return n
 
 
 def _bisect(session: SessionLike, edges, echo):
-    if session.surface.string:
-        n = session._string_split(np.asarray(edges, np.int64))
-    else:
-        new, n = ED.edge_divide(session.surface, edges)
-        session._replace_surface(new)
+    n = _divide(session, edges)
     bump_count(session, "refine", n)                # REF: l and K accumulate, r does not
     if echo:
         session.note(f"New edges: {n}\n")
@@ -120,21 +128,15 @@ def skinny(session: SessionLike, angle, echo=True):
 def notch(session: SessionLike, angle, echo=True):
     """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""
     session.no_string("notch")
-    new, n = NO.notch(session.surface, angle)
-    session._replace_surface(new)
-    bump_count(session, "notch", n)
-    if echo:
-        session.note(f"Number of edges notched: {n}\n")
-    return n
+    return _replaced(session, NO.notch(session.surface, angle), "notch",
+                     "Number of edges notched: {n}\n", echo)
 
 
 def pop_edges(session: SessionLike, echo=True):
     """``O``: pop the edges with four facets (pyevolver.remesh.pop)."""
-    new, n = POP.pop_edges(session.surface)
-    session._replace_surface(new)
+    n = _replaced(session, POP.pop_edges(session.surface), note="Edges popped: {n}\n",
+                  echo=echo)
     session.counts["edge_pop"] = n             # REF: a later O with no pops prints 0
-    if echo:
-        session.note(f"Edges popped: {n}\n")
     return n
 
 
@@ -146,12 +148,8 @@ def bump_count(session: SessionLike, key, n):
 def delete_short_edges(session: SessionLike, length, echo=True):
     """``t L`` / ``edgeweed L``: delete edges shorter than ``L`` (spec §8.4)."""
     session.no_string("t (edge weeding)")
-    new, n = DEL.delete_short_edges(session.surface, length)
-    session._replace_surface(new)
-    bump_count(session, "edge_delete", n)
-    if echo:
-        session.note(f"Deleted edges: {n}\n")
-    return n
+    return _replaced(session, DEL.delete_short_edges(session.surface, length), "edge_delete",
+                     "Deleted edges: {n}\n", echo)
 
 
 def delete_elements(session: SessionLike, kind, items, echo=True):
@@ -159,10 +157,7 @@ def delete_elements(session: SessionLike, kind, items, echo=True):
     per facet, its shortest deletable side) as ``t`` / ``w`` do."""
     session.no_string("delete")
     fn = DEL.delete_edges if kind == "edge" else DEL.delete_facets
-    new, n = fn(session.surface, items)
-    session._replace_surface(new)
-    bump_count(session, "edge_delete", n)
-    return n
+    return _replaced(session, fn(session.surface, items), "edge_delete")
 
 
 def jiggle(session: SessionLike, temperature=None, echo=True):
@@ -196,12 +191,8 @@ def weed(session: SessionLike, area, echo=True):
     deleting one of their edges, shortest first (spec §8.4)."""
     if session.surface.string:
         raise CommandError("Can only do area weed on soapfilm model.")   # REF's ERROR 1339
-    new, n = DEL.weed_small_facets(session.surface, area)
-    session._replace_surface(new)
-    bump_count(session, "edge_delete", n)
-    if echo:
-        session.note(f"Skinny triangles weeded: {n}\n")
-    return n
+    return _replaced(session, DEL.weed_small_facets(session.surface, area), "edge_delete",
+                     "Skinny triangles weeded: {n}\n", echo)
 
 
 def vertex_average(session: SessionLike, mode="V", echo=True):

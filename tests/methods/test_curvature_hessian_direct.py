@@ -6,34 +6,11 @@ registry entries of the family point at these functions."""
 import numpy as np
 import pytest
 
+from comparison import octasphere
 from tolerances import FD, ROUNDOFF
-import pyevolver
 from pyevolver.methods import curvature_hessian as CH
 from pyevolver.methods.registry import lookup
 from pyevolver.model.scene import MethodDecl
-
-
-def _sphere(seed=0):
-    """The octahedron split once (18 vertices, 32 facets), on the unit sphere, jiggled."""
-    X = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
-    F0 = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
-    X = [np.array(x, float) for x in X]
-    mid = {}
-
-    def m(a, b):
-        k = (min(a, b), max(a, b))
-        if k not in mid:
-            mid[k] = len(X)
-            X.append((X[a] + X[b]) / 2)
-        return mid[k]
-    F = []
-    for a, b, c in F0:
-        ab, bc, ca = m(a, b), m(b, c), m(c, a)
-        F += [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
-    X = np.array(X)
-    X /= np.linalg.norm(X, axis=1)[:, None]
-    X += 0.03 * np.random.default_rng(seed).standard_normal(X.shape)
-    return pyevolver.Surface.from_arrays(X, np.array(F), body=True)
 
 
 CASES = [("star_sq_mean_curvature", CH.vertex_hessian),
@@ -46,7 +23,7 @@ CASES = [("star_sq_mean_curvature", CH.vertex_hessian),
 
 @pytest.mark.parametrize("name,hess", CASES)
 def test_hessian_symmetric_and_equal_to_gradient_differences(name, hess):
-    s = _sphere(1)
+    s = octasphere(1)
     m = lookup(name)
     assert m.hessian is hess
     decl = MethodDecl(method=name)
@@ -71,7 +48,7 @@ def test_hessian_symmetric_and_equal_to_gradient_differences(name, hess):
 
 def test_translation_leaves_the_energy_unchanged():
     """A rigid translation is in the kernel of every Hessian."""
-    s = _sphere(4)
+    s = octasphere(4)
     T = np.tile([0.3, -1.0, 0.7], s.nv)
     for name, hess in CASES:
         m = lookup(name)

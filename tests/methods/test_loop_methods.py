@@ -6,34 +6,11 @@ differences."""
 import numpy as np
 import pytest
 
+from comparison import octasphere
 from tolerances import FD, ROUNDOFF
-import pyevolver
 from pyevolver.methods import loop as L
 from pyevolver.methods.registry import lookup
 from pyevolver.model.scene import MethodDecl
-
-
-def _sphere(seed=0, scale=1.0, shift=(0.0, 0.0, 0.0)):
-    """The octahedron split once (18 vertices), on a sphere, jiggled."""
-    X = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
-    F0 = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
-    X = [np.array(x, float) for x in X]
-    mid = {}
-
-    def m(a, b):
-        k = (min(a, b), max(a, b))
-        if k not in mid:
-            mid[k] = len(X)
-            X.append((X[a] + X[b]) / 2)
-        return mid[k]
-    F = []
-    for a, b, c in F0:
-        ab, bc, ca = m(a, b), m(b, c), m(c, a)
-        F += [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
-    X = np.array(X)
-    X /= np.linalg.norm(X, axis=1)[:, None]
-    X += 0.05 * np.random.default_rng(seed).standard_normal(X.shape)
-    return pyevolver.Surface.from_arrays(scale * X + np.asarray(shift), np.array(F), body=True)
 
 
 def _totals(s):
@@ -43,7 +20,7 @@ def _totals(s):
 
 
 def test_vertex_shares_add_up_to_the_facet_totals():
-    s = _sphere(0)
+    s = octasphere(0, jiggle=0.05)
     t = s.evaluate()
     per_facet = L.evaluator(s).values(s.X)
     for name, kind in L.KIND.items():
@@ -58,9 +35,9 @@ def test_vertex_shares_add_up_to_the_facet_totals():
 
 
 def test_scaling_and_translation():
-    a = _totals(_sphere(1))
+    a = _totals(octasphere(1, jiggle=0.05))
     lam = 1.7
-    b = _totals(_sphere(1, scale=lam, shift=(0.4, -2.0, 1.1)))
+    b = _totals(octasphere(1, jiggle=0.05, scale=lam, shift=(0.4, -2.0, 1.1)))
     assert abs(b["loop_area"] - lam ** 2 * a["loop_area"]) <= 1e-10 * b["loop_area"]
     assert abs(b["loop_volume"] - lam ** 3 * a["loop_volume"]) <= 1e-10 * b["loop_volume"]
     w = "loop_sq_mean_curvature"
@@ -70,13 +47,13 @@ def test_scaling_and_translation():
 
 
 def test_evaluator_is_cached_with_the_topology():
-    s = _sphere(2)
+    s = octasphere(2, jiggle=0.05)
     assert L.evaluator(s) is L.evaluator(s)
 
 
 @pytest.mark.parametrize("name", sorted(L.KIND))
 def test_gradient_matches_central_differences(name):
-    s = _sphere(3)
+    s = octasphere(3, jiggle=0.05)
     decl = MethodDecl(method=name)
     idx = np.arange(s.nv)
     w = np.random.default_rng(4).uniform(0.5, 1.5, s.nv)
