@@ -58,8 +58,11 @@ class NewtonResult:
 
 def _factor(M):
     """Solve function for the symmetric matrix ``M`` when it is positive
-    definite, None when it is not.  Without CHOLMOD a sparse LU factorization
-    is returned unchecked (the ratio test then rejects non-descent steps)."""
+    definite, None when it is not.  Without CHOLMOD, SuperLU in symmetric mode
+    (symmetric fill-reducing order, no pivoting off the diagonal): then
+    ``P M Pᵀ = L U`` with ``U = D Lᵀ``, and by Sylvester's law of inertia M is
+    positive definite exactly when every pivot ``U_ii`` is positive — the
+    test CHOLMOD's Cholesky makes, so both solvers damp the same steps."""
     chol = _cholmod()
     if chol is not None:
         try:
@@ -68,11 +71,15 @@ def _factor(M):
                 return chol.cholesky(M.tocsc(), mode="supernodal")
         except chol.CholmodNotPositiveDefiniteError:
             return None
+    import scipy.sparse.linalg as spla   # 0.1 s and 8 MB at start-up: when first used
     try:
-        import scipy.sparse.linalg as spla   # 0.1 s and 8 MB at start-up: when first used
-        return spla.splu(M.tocsc()).solve
-    except RuntimeError:
+        lu = spla.splu(M.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:                      # exactly singular
         return None
+    if np.array_equal(lu.perm_r, lu.perm_c) and np.any(lu.U.diagonal() <= 0):
+        return None
+    return lu.solve
 
 
 def _solve(f, B, r, d):

@@ -121,3 +121,24 @@ def test_torus_offset_is_regular_and_on_the_torus():
     assert np.allclose(np.hypot(rho - R, X[:, 2]), r)
     with pytest.raises(ValueError):
         torus_offset(10, 15)
+
+
+def test_factor_without_cholmod_refuses_indefinite_matrices_as_cholmod_does(monkeypatch):
+    """The SuperLU fallback of the damped Newton step answers "not positive
+    definite" exactly when the smallest eigenvalue is not positive (inertia of
+    the symmetric LU pivots), and otherwise solves."""
+    import numpy as np
+    import scipy.sparse as sp
+    from pyevolver.evolve import newton as NW
+    monkeypatch.setattr(NW, "_cholmod", lambda: None)
+    A = sp.random(120, 120, density=0.03, random_state=3)
+    A = A + A.T
+    lam = np.linalg.eigvalsh(A.toarray())
+    b = np.arange(120, dtype=float)
+    for shift in (-lam.min() + 0.1, -lam.min() - 0.1, 0.0):
+        M = (A + shift * sp.eye(120)).tocsc()
+        f = NW._factor(M)
+        if lam.min() + shift > 0:
+            assert f is not None and np.allclose(M @ f(b), b)
+        else:
+            assert f is None
