@@ -1,5 +1,5 @@
 """Commands refused by name: Evolver commands pyevolver does not have yet
-(``e``, ``saddle``, ``detorus``, ...), ``abort``, and the statements the
+(``e``, ``hessian_menu``, ``detorus``, ...), ``abort``, and the statements the
 grammar marks unsupported (``system``, ``permload``, ...).  They fail with
 an :class:`~pyevolver.errors.UnsupportedError` (or ``abort``'s message)
 rather than as unknown words.
@@ -21,7 +21,7 @@ LETTER_LATER = {
     "Z": "Z (zoom)", "M": "M (model order)", "J": "J (jiggle toggle)",
 }
 WORD_LATER = {
-    "saddle", "ritz", "eigenprobe", "lanczos", "hessian_menu",
+    "hessian_menu",
     "vertex_average", "raw_vertex_average", "rawest_vertex_average",
     "pop",
     "t1_edgeswap", "dissolve", "optimize", "optimise", "lagrange", "quadratic",

@@ -22,13 +22,14 @@ READ_ONLY = {
     "vertex_pop_count", "edge_pop_count", "notch_count", "refine_count", "where_count",
     "iteration_counter", "total_time", "random", "quantity_count", "symmetry_group",
     "simplex_representation", "lagrange_order", "date_and_time", "linear", "quadratic",
-    "clock",
+    "clock", "last_eigenvalue",
 }
 DEFAULTS = {
     "scale": 0.1, "scale_limit": 1.0, "scale_scale": 1.0, "target_tolerance": 1e-4,
     "constraint_tolerance": 1e-12, "jiggle_temperature": 0.05, "random_seed": 1.0,
     "autochop_length": 0.0, "integral_order_1d": 3.0, "integral_order_2d": 6.0,
-    "hessian_epsilon": 1e-8, "sq_mean_mix": 0.0,
+    "hessian_epsilon": 1e-10, "sq_mean_mix": 0.0,
+    "last_eigenvalue": 0.0,
 }
 
 

@@ -471,13 +471,30 @@ def solve_bordered(K, B, r, d, method=None, points=None):
                                f"the bordered Hessian could not be factored ({exc})") from None
 
 
-def newton_direction(it, normal: bool = True):
-    """The Newton motion (nv, 3) and new multipliers for the surface of the
-    :class:`~pyevolver.evolve.iterate.Iterator` ``it``.
+class HessianSystem:
+    """The constrained Hessian of :func:`hessian_system`.
 
-    ``normal``: move each vertex along its normal only (``hessian_normal``).
-    Returns ``(dx, lam_new, cons, mobile)``.  The move restores the fixed
-    values along the constraint gradients at the moved positions.
+    ``K`` (n, n) sparse: the Hessian of the Lagrangian on the free
+    coordinates ``dy`` (``dx = T dy``, ``T`` (3nv, n) of ``basis``); ``B``
+    (n, k) the gradients of the k fixed values in those coordinates (None
+    when k = 0); ``rhs`` (n,) = −Tᵀ∇E; ``d`` (k,) the target defects;
+    ``lam`` (k,) the multipliers in ``K``; ``cons``, ``mobile`` as in
+    :func:`newton_direction`.
+    """
+
+    def __init__(self, K, B, rhs, d, T, basis, lam, cons, mobile, X):
+        self.K, self.B, self.rhs, self.d, self.T = K, B, rhs, d, T
+        self.basis, self.lam, self.cons, self.mobile = basis, lam, cons, mobile
+        self.points = np.repeat(X, basis.ndof, axis=0)   # (n, 3) where each unknown sits
+
+
+def hessian_system(it, normal: bool = True) -> HessianSystem:
+    """The Hessian of the Lagrangian on the free motions of the surface of
+    the :class:`~pyevolver.evolve.iterate.Iterator` ``it`` and its border
+    (the bordered system in this module's docstring).
+
+    ``normal``: each vertex moves along its normal only (``hessian_normal``).
+    The multipliers are those stored by the last ``g`` or ``hessian``.
     """
     s = it.surface
     mobile = it._mobile()
@@ -516,8 +533,21 @@ def newton_direction(it, normal: bool = True):
         Cm = np.stack([g.ravel() for g in gs], axis=1)          # (3nv, k)
         B = np.asarray(T.T @ Cm)
         d = cons.targets(s) - cons.values(t)
-    sol = solve_bordered(K, B, rhs, d, points=np.repeat(s.X, basis.ndof, axis=0))
+    return HessianSystem(K, B, rhs, d, T, basis, lam, cons, mobile, s.X)
+
+
+def newton_direction(it, normal: bool = True):
+    """The Newton motion (nv, 3) and new multipliers for the surface of the
+    :class:`~pyevolver.evolve.iterate.Iterator` ``it``.
+
+    ``normal``: move each vertex along its normal only (``hessian_normal``).
+    Returns ``(dx, lam_new, cons, mobile)``.  The move restores the fixed
+    values along the constraint gradients at the moved positions.
+    """
+    hs = hessian_system(it, normal)
+    K = hs.K
+    sol = solve_bordered(K, hs.B, hs.rhs, hs.d, points=hs.points)
     dy = sol[:K.shape[0]]
-    lam_new = -sol[K.shape[0]:] if len(cons) else lam
-    dx = (T @ dy).reshape(-1, 3)
-    return dx, lam_new, cons, mobile
+    lam_new = -sol[K.shape[0]:] if len(hs.cons) else hs.lam
+    dx = (hs.T @ dy).reshape(-1, 3)
+    return dx, lam_new, hs.cons, hs.mobile

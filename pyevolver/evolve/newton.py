@@ -38,8 +38,9 @@ import scipy.sparse as sp
 
 from ..constraints import restore_state, state
 from . import gradient as GR
-from .hessian import (_cholmod, constraint_curvature, lagrangian_hessian, newton_direction,
-                      tangent_basis)
+from .eigen import ShiftedFactor
+from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
+                      solve_bordered, tangent_basis)
 from .iterate import Iterator, StepResult, _Constraints
 
 
@@ -221,7 +222,7 @@ def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
 
 
 def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = None,
-                 normal: bool = True) -> StepResult:
+                 normal: bool = True, eps: float = 1e-10) -> StepResult:
     """The ``hessian`` command: one Newton step on the constrained problem
     (the bordered system of :mod:`.hessian`); with ``seek`` (``hessian_seek``)
     a line search along the Newton direction, scale at most ``max_scale``
@@ -230,7 +231,10 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     The multipliers of the last ``g`` or ``hessian`` step enter the Hessian
     of the Lagrangian; the new ones are stored as the pressures.  A step to
     a non-finite energy is undone: ``message`` "infinite", ``printed``
-    False.
+    False.  When the constrained Hessian has eigenvalues below ``−eps``
+    (``hessian_epsilon``) the step is still taken and ``warnings`` starts
+    with REF's "WARNING 1825: Hessian not positive definite. Index: N"
+    (N their number, from the inertia of :func:`.eigen.inertia`).
 
     Returns
     -------
@@ -238,7 +242,17 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         ``totals`` the evaluation after the step.
     """
     s = it.surface
-    dx, lam, cons, mobile = newton_direction(it, normal=normal)
+    hs = hessian_system(it, normal)
+    n = hs.K.shape[0]
+    sol = solve_bordered(hs.K, hs.B, hs.rhs, hs.d, points=hs.points)
+    cons, mobile = hs.cons, hs.mobile
+    lam = -sol[n:] if len(cons) else hs.lam
+    dx = (hs.T @ sol[:n]).reshape(-1, 3)
+    report: list[str] = []
+    if n:
+        index = ShiftedFactor(hs.K, hs.B, -eps, 0.0).inertia().below
+        if index:
+            report.append(f"WARNING 1825: Hessian not positive definite. Index: {index}\n")
     targets = cons.targets(s)
     X0 = state(s)
 
@@ -249,7 +263,6 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     if seek:
         smax = 1.0 if max_scale is None else max_scale
         scale, _, _ = it._line_search(E, smax, smax)
-    report: list[str] = []
     t = it._move(X0, dx, scale, cons, None, None, mobile, targets, report)
     if not math.isfinite(t.energy):
         restore_state(s, X0)

@@ -652,7 +652,8 @@ class Session(SessionAPI):
         if not it.pressures_valid and len(_Constraints(self.surface)):
             raise CommandError("Pressures invalid. Do regular iteration before Hessian "
                                "to set pressures.")
-        r = hessian_step(it, seek, max_scale, normal=it.settings.hessian_normal)
+        r = hessian_step(it, seek, max_scale, normal=it.settings.hessian_normal,
+                         eps=float(self.settings.get("hessian_epsilon", 1e-10)))
         self.recalc(totals=r.totals)
         if r.message == "infinite":
             raise CommandError("hessian: the Newton step gives a non-finite energy; "
@@ -660,9 +661,15 @@ class Session(SessionAPI):
         r.energy, r.area = self.totals.energy, self.totals.total_area
         if echo:
             for w in r.warnings:
-                self.write(w + "\n")
+                if w.startswith("WARNING 1825"):
+                    self.write_err(w + "\n")          # REF: to stderr, then a blank line
+                else:
+                    self.write(w + "\n")
             if not self.toggles.get("quiet"):
-                self.write("%3d. area: %#17.15g energy: %#17.15g\n" % (1, r.area, r.energy))
+                # hessian_seek adds its scale, as REF does
+                tail = "  scale: %#g" % r.scale if seek else ""
+                self.write("%3d. area: %#17.15g energy: %#17.15g%s\n"
+                           % (1, r.area, r.energy, tail))
         return r
 
     # -- mesh upkeep ------------------------------------------------------------------

@@ -1,0 +1,177 @@
+"""The eigenvalue commands of the Hessian: ``eigenprobe λ``,
+``eigenprobe(λ, n)``, ``ritz(λ, n)``, ``lanczos λ``, ``lanczos(λ, n)`` and
+``saddle [max]`` (the numbers are :mod:`pyevolver.evolve.eigen`'s; these
+handlers read the arguments and print REF's lines).  ``last_eigenvalue``
+and the ``eigenvalues`` array are set as in REF; ``hessian_menu``, an
+interactive menu, stays refused.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import CommandError
+from ..evolve import eigen as EG
+from ..evolve.hessian import hessian_system
+from ..evolve.iterate import _Constraints
+from . import registry
+from .registry import Command
+from .values import as_float, as_int
+
+FAMILY = "eigen"
+RITZ_SYNTAX = "Syntax: RITZ(probe_value, number_of_eigenvalues)"
+
+
+def _system(session: Any, what: str):
+    """The constrained Hessian of the session's surface (hessian_system),
+    after REF's checks: not on strings, vertices, valid pressures."""
+    session.no_string(what)
+    s = session.surface
+    if s is None or s.nv == 0:
+        raise CommandError(f"{what}: the surface has no vertices")
+    it = session.iterator
+    if not it.pressures_valid and len(_Constraints(s)):
+        raise CommandError("Pressures invalid. Do regular iteration before Hessian "
+                           "to set pressures.")
+    return it, hessian_system(it, normal=it.settings.hessian_normal)
+
+
+def _eps(session: Any) -> float:
+    return float(session.settings.get("hessian_epsilon", 1e-10))
+
+
+def _store(session: Any, values) -> None:
+    vals = np.asarray(values, float)
+    if len(vals):
+        session.settings["last_eigenvalue"] = float(vals[0])
+    session.arrays["eigenvalues"] = vals.copy()
+
+
+def _number(session: Any, v: Any, what: str) -> float:
+    return as_float(v, what)
+
+
+def eigenprobe(session: Any, shift: float, iterations: int | None = None) -> Any:
+    """``eigenprobe λ``: print the inertia of the Hessian relative to λ;
+    ``eigenprobe(λ, n)``: then at most n inverse iterations towards the
+    eigenvalue nearest λ (stored in ``last_eigenvalue``)."""
+    _, hs = _system(session, "eigenprobe")
+    eps = _eps(session)
+    if iterations is None:
+        inert = EG.inertia(hs, shift, eps)
+        session.write(inert.line())
+        return inert
+    r = EG.inverse_iteration(hs, shift, max(iterations, 0), eps)
+    session.write(r.inertia.line())
+    for line in r.lines:
+        session.write(line)
+    if math.isfinite(r.value):
+        session.settings["last_eigenvalue"] = r.value
+    session.last_eigenvector = r
+    return r
+
+
+def ritz(session: Any, shift: float, count: int, lanczos: bool = False) -> Any:
+    """``ritz(λ, n)`` (and ``lanczos``): the inertia relative to λ and the n
+    eigenvalues nearest λ, nearest first."""
+    what = "lanczos" if lanczos else "ritz"
+    _, hs = _system(session, what)
+    if count < 0:
+        raise CommandError(f"{what}: the number of eigenvalues must not be negative")
+    r = EG.nearest(hs, shift, count, _eps(session))
+    session.write(r.inertia.line())
+    for j, v in enumerate(r.values, 1):
+        if lanczos:
+            session.write("%d  %20.15f\n" % (j, v))
+        else:
+            session.write("%3d. %20.15f\n" % (j, v))
+    _store(session, r.values)
+    session.last_eigenvector = r
+    return r
+
+
+def saddle(session: Any, max_step: float | None = None) -> Any:
+    """``saddle [max]``: move down along the eigenvector of the lowest
+    eigenvalue when it is negative."""
+    it, _ = _system(session, "saddle")
+    r = EG.saddle_step(it, normal=it.settings.hessian_normal, max_step=max_step,
+                       eps=_eps(session))
+    if not math.isfinite(r.value):
+        session.write("No degrees of freedom.\n")
+        return r
+    session.settings["last_eigenvalue"] = r.value
+    if r.step is None:
+        session.write("Lowest eigenvalue %.15g. Not a saddle point.\n" % r.value)
+        return r
+    session.write("Lowest eigenvalue %.15g\n" % r.value)
+    session.recalc(totals=r.totals)
+    for w in r.warnings:
+        session.write(w + "\n")
+    session.write("stepsize %g\n" % r.step)
+    t = session.totals
+    session.write("1. area: %#17.15g energy: %#17.15g \n" % (t.total_area, t.energy))
+    return r
+
+
+# -- the registered commands: NAME expr and NAME(expr, expr) ---------------------------
+def _bare_eigenprobe(interp, raw, arg):
+    if arg is None:
+        raise CommandError("eigenprobe needs a probe value (usage: eigenprobe value)")
+    eigenprobe(interp.session, as_float(interp.value(arg), "the probe value of eigenprobe"))
+
+
+def _call_eigenprobe(session, args):
+    if not args:
+        raise CommandError("eigenprobe needs a probe value (usage: eigenprobe value)")
+    shift = as_float(args[0], "the probe value of eigenprobe")
+    n = as_int(args[1], "the iteration limit of eigenprobe") if len(args) > 1 else None
+    eigenprobe(session, shift, n)
+
+
+def _bare_ritz(interp, raw, arg):
+    raise CommandError(RITZ_SYNTAX)
+
+
+def _call_ritz(session, args):
+    if len(args) != 2:
+        raise CommandError(RITZ_SYNTAX)
+    ritz(session, as_float(args[0], "the probe value of ritz"),
+         as_int(args[1], "the number of eigenvalues of ritz"))
+
+
+def _bare_lanczos(interp, raw, arg):
+    if arg is None:
+        raise CommandError("lanczos needs a probe value (usage: lanczos value)")
+    ritz(interp.session, as_float(interp.value(arg), "the probe value of lanczos"), 15,
+         lanczos=True)
+
+
+def _call_lanczos(session, args):
+    if not args:
+        raise CommandError("lanczos needs a probe value (usage: lanczos value)")
+    n = as_int(args[1], "the number of eigenvalues of lanczos") if len(args) > 1 else 15
+    ritz(session, as_float(args[0], "the probe value of lanczos"), n, lanczos=True)
+
+
+def _bare_saddle(interp, raw, arg):
+    saddle(interp.session, None if arg is None else
+           as_float(interp.value(arg), "the step limit of saddle"))
+
+
+def _call_saddle(session, args):
+    saddle(session, as_float(args[0], "the step limit of saddle") if args else None)
+
+
+for _names, _bare, _call, _usage, _help, _max in (
+        (("eigenprobe",), _bare_eigenprobe, _call_eigenprobe,
+         "eigenprobe value | eigenprobe(value, iterations)",
+         "eigenvalue counts of the Hessian below, at and above value", 2),
+        (("ritz",), _bare_ritz, _call_ritz, "ritz(value, n)",
+         "the n eigenvalues of the Hessian nearest value", 2),
+        (("lanczos",), _bare_lanczos, _call_lanczos, "lanczos value | lanczos(value, n)",
+         "the eigenvalues of the Hessian nearest value (15 or n)", 2),
+        (("saddle",), _bare_saddle, _call_saddle, "saddle [max]",
+         "move down the eigenvector of a negative Hessian eigenvalue", 1)):
+    registry.add(Command(_names, _bare, _usage, _help, FAMILY, call=_call, max_args=_max))

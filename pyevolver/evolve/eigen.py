@@ -1,0 +1,360 @@
+"""Eigenvalues of the constrained Hessian: the inertia of ``eigenprobe``,
+the eigenvalues of ``ritz`` and ``lanczos``, the inverse iteration of
+``eigenprobe(λ, n)``, the ``saddle`` move and the inertia warning of
+``hessian``.
+
+The Hessian is the one ``hessian`` steps with (:func:`.hessian.hessian_system`):
+``K`` (n, n), the Hessian of the Lagrangian on the free coordinates ``y``
+of the vertices (with ``hessian_normal`` one per vertex: the motion along
+its unit normal; otherwise three, or the tangent space of its constraints),
+bordered by the gradients ``B`` (n, k) of the k fixed volumes and quantities.
+The eigenproblem is the Evolver's (eigentut.htm §3, §5, §6): the metric is
+the identity on ``y`` (no ``linear_metric``), restricted to the motions that
+keep the fixed values, ``Bᵀ y = 0``.  With ``Z`` (n, n − k) an orthonormal
+basis of that subspace the eigenvalues are those of ``Zᵀ K Z``; measured:
+cube.fe after ``g 10`` and catbody.fe give evolver-nox-d's eigenvalues to
+1e-12.
+
+The inertia relative to λ (the counts below, at and above λ) comes from a
+sparse LDLᵀ factorization of ``A = K − λI`` (Sylvester's law of inertia;
+CHOLMOD's simplicial LDLᵀ when scikit-sparse is installed, SuperLU in
+symmetric mode otherwise, as :func:`.newton._factor`) and the Haynsworth
+inertia additivity of the bordered matrix,
+``In([[A, B], [Bᵀ, 0]]) = In(A) + In(−Bᵀ A⁻¹ B)``, from which the k pairs
+of the border are removed.  A pivot of magnitude below ``eps``
+(``hessian_epsilon``) counts as zero, as in the Evolver.
+
+The eigenvalues nearest λ use the shift-inverted operator
+``OP = Z (Zᵀ (K − λI) Z)⁻¹ Zᵀ``, one bordered solve per application
+(ARPACK's implicitly restarted Lanczos, ``scipy.sparse.linalg.eigsh``;
+eigenvalue θ of OP ↔ μ = λ + 1/θ), or the dense ``Zᵀ K Z`` when the
+problem is small.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..constraints import restore_state, state
+from ..errors import UnsupportedError
+from .hessian import HessianSystem, _cholmod, hessian_system
+
+#: below this many unknowns the eigenvalues come from the dense matrix
+DENSE_MAX = 800
+
+
+@dataclass
+class Inertia:
+    """Counts of eigenvalues below, equal to and above a probe value."""
+    below: int
+    equal: int
+    above: int
+
+    def line(self) -> str:
+        """The Evolver's ``Eigencounts:`` line (with its trailing space)."""
+        return "Eigencounts:    %d <,  %d ==,  %d > \n" % (self.below, self.equal, self.above)
+
+
+@dataclass
+class EigenResult:
+    """Eigenvalues near a probe value, with their inertia.
+
+    ``values`` (m,) in the order of their distance from ``shift``;
+    ``vectors`` (n, m) the eigenvectors on the free coordinates (unit
+    length, ``Bᵀ v = 0``); ``motions`` maps one to vertex motions (nv, 3).
+    """
+    shift: float
+    inertia: Inertia
+    values: np.ndarray
+    vectors: np.ndarray
+    system: Any = None
+    lines: list = field(default_factory=list)
+
+    def motion(self, j: int) -> np.ndarray:
+        """The vertex motion (nv, 3) of eigenvector ``j``."""
+        return np.asarray(self.system.T @ self.vectors[:, j]).reshape(-1, 3)
+
+
+class ShiftedFactor:
+    """A factorization of ``A = K − σI`` (n, n): its solve, the inertia of
+    its LDLᵀ pivots and the bordered solve with ``B``.
+
+    Raises :class:`UnsupportedError` when ``A`` is singular (σ an
+    eigenvalue of K to machine precision) and too large for the dense
+    fallback.
+    """
+
+    def __init__(self, K, B, sigma: float, eps: float):
+        n = K.shape[0]
+        A = (K - sigma * sp.identity(n, format="csc")).tocsc()
+        self.n, self.B, self.eps = n, B, eps
+        self.solve: Callable
+        self.pivots = None
+        chol = _cholmod()
+        if chol is not None:
+            try:
+                with np.errstate(all="ignore"), warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    f = chol.cholesky(A, mode="simplicial")
+                    d = f.D()
+                if np.all(np.isfinite(d)) and np.all(d != 0):
+                    self.solve, self.pivots = f, np.asarray(d)
+            except chol.CholmodError:
+                pass
+        if self.pivots is None:
+            import scipy.sparse.linalg as spla   # when first used (start-up time)
+            try:
+                lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                               options={"SymmetricMode": True})
+                if np.array_equal(lu.perm_r, lu.perm_c):
+                    self.solve, self.pivots = lu.solve, lu.U.diagonal()
+            except RuntimeError:                  # exactly singular
+                pass
+        if self.pivots is None:
+            if n > 3 * DENSE_MAX:
+                raise UnsupportedError(f"eigenvalues at the probe value {sigma:g}",
+                                       "the shifted Hessian is singular there; "
+                                       "probe slightly off the eigenvalue")
+            w, V = np.linalg.eigh(A.toarray())
+            self.pivots = w
+            inv = np.where(np.abs(w) > eps, 1.0 / np.where(w == 0, 1.0, w), 0.0)
+            self.solve = lambda R: V @ (inv[:, None] * (V.T @ R)) if np.ndim(R) == 2 \
+                else V @ (inv * (V.T @ R))
+        self.ZB = None
+        if B is not None:
+            self.ZB = np.asarray(self.solve(np.asarray(B, float)))
+            self.S = B.T @ self.ZB                      # (k, k) Bᵀ A⁻¹ B
+
+    def inertia(self) -> Inertia:
+        """The inertia of ``A`` on the subspace ``Bᵀ y = 0``."""
+        d = np.asarray(self.pivots)
+        below = int(np.sum(d < -self.eps))
+        equal = int(np.sum(np.abs(d) <= self.eps))
+        above = len(d) - below - equal
+        if self.B is not None:
+            s = np.linalg.eigvalsh(-0.5 * (self.S + self.S.T))
+            k = len(s)
+            below += int(np.sum(s < -self.eps)) - k
+            equal += int(np.sum(np.abs(s) <= self.eps))
+            above += int(np.sum(s > self.eps)) - k
+            if below < 0 or above < 0:        # a degenerate border: count what is left
+                below, above = max(below, 0), max(above, 0)
+        return Inertia(below, equal, above)
+
+    def op(self, x: np.ndarray) -> np.ndarray:
+        """``y = OP x``: the solution of ``[[A, B], [Bᵀ, 0]] [y; μ] = [x; 0]``."""
+        z = np.asarray(self.solve(x))
+        if self.ZB is None:
+            return z
+        mu = np.linalg.lstsq(self.S, self.B.T @ z, rcond=None)[0]
+        return z - self.ZB @ mu
+
+
+def _null_basis(B, n):
+    """(n, n − k) orthonormal basis of the vectors ``y`` with ``Bᵀ y = 0``."""
+    if B is None:
+        return None
+    Q, R = np.linalg.qr(np.asarray(B, float), mode="complete")
+    rank = int(np.sum(np.abs(np.diag(R)) > 1e-12 * max(np.abs(R).max(), 1e-300)))
+    return Q[:, rank:]
+
+
+def inertia(hs: HessianSystem, shift: float, eps: float = 1e-10) -> Inertia:
+    """Counts of the eigenvalues μ of the constrained Hessian of ``hs``
+    below, equal to and above ``shift``: "equal" means ``|μ − shift| ≤ eps``
+    (``hessian_epsilon``), counted as the difference of the inertias at
+    ``shift ± eps`` (two factorizations; with ``eps`` 0 one, and only
+    exactly zero pivots are equal)."""
+    n = hs.K.shape[0]
+    if n == 0:
+        return Inertia(0, 0, 0)
+    if eps <= 0:
+        return ShiftedFactor(hs.K, hs.B, shift, 0.0).inertia()
+    lo = ShiftedFactor(hs.K, hs.B, shift - eps, 0.0).inertia()
+    hi = ShiftedFactor(hs.K, hs.B, shift + eps, 0.0).inertia()
+    below = lo.below
+    equal = max(hi.below + hi.equal - below, 0)
+    dim = lo.below + lo.equal + lo.above
+    return Inertia(below, equal, max(dim - below - equal, 0))
+
+
+def _order(values, vectors, shift, m):
+    key = np.lexsort((values, np.abs(values - shift)))[:m]
+    return values[key], vectors[:, key]
+
+
+def nearest(hs: HessianSystem, shift: float, m: int, eps: float = 1e-10,
+            dense_max: int = DENSE_MAX, seed: int = 0) -> EigenResult:
+    """The ``m`` eigenvalues of the constrained Hessian nearest ``shift``.
+
+    Parameters
+    ----------
+    hs : HessianSystem
+        From :func:`.hessian.hessian_system`.
+    shift : float
+        The probe value λ.
+    m : int
+        How many (at most the dimension n − k).
+    eps : float
+        Pivot magnitude regarded as zero in the inertia.
+    dense_max : int
+        Up to this dimension the dense ``Zᵀ K Z`` (LAPACK ``eigh``);
+        above it shift-and-invert ARPACK with the bordered solve.
+
+    Returns
+    -------
+    EigenResult
+        Values sorted by their distance from ``shift`` (ties: ascending).
+    """
+    n = hs.K.shape[0]
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps) if n else None
+    inert = inertia(hs, shift, eps)
+    k = 0 if hs.B is None else hs.B.shape[1]
+    dim = n - k
+    m = max(0, min(int(m), dim))
+    if m == 0:
+        return EigenResult(shift, inert, np.zeros(0), np.zeros((n, 0)), hs)
+    if dim <= dense_max or m >= dim - 1:
+        Z = _null_basis(hs.B, n)
+        Kd = hs.K.toarray()
+        if Z is not None:
+            Kd = Z.T @ Kd @ Z
+        w, V = np.linalg.eigh(0.5 * (Kd + Kd.T))
+        if Z is not None:
+            V = Z @ V
+        vals, vecs = _order(w, V, shift, m)
+        return EigenResult(shift, inert, vals, vecs, hs)
+    import scipy.sparse.linalg as spla
+    rng = np.random.default_rng(seed)
+    v0 = fac.op(rng.standard_normal(n))
+    op = spla.LinearOperator((n, n), matvec=fac.op, dtype=float)
+    theta, V = spla.eigsh(op, k=m, which="LM", v0=v0, tol=1e-14)
+    vals = shift + 1.0 / theta
+    return EigenResult(shift, inert, *_order(vals, V, shift, m), system=hs)
+
+
+def lowest(hs: HessianSystem, eps: float = 1e-10, dense_max: int = DENSE_MAX) -> EigenResult:
+    """The lowest eigenvalue of the constrained Hessian and its eigenvector
+    (a shift below Gershgorin's bound, so that ``K − σI`` is positive
+    definite and the lowest eigenvalue is the nearest)."""
+    K = hs.K.tocsr()
+    if K.shape[0] == 0:
+        return EigenResult(0.0, Inertia(0, 0, 0), np.zeros(0), np.zeros((0, 0)), hs)
+    diag = K.diagonal()
+    off = np.asarray(abs(K).sum(axis=1)).ravel() - np.abs(diag)
+    lb = float(np.min(diag - off))
+    sigma = lb - 1e-3 * max(abs(lb), 1.0)
+    r = nearest(hs, sigma, 1, eps, dense_max)
+    r.inertia = inertia(hs, 0.0, eps)
+    return r
+
+
+@dataclass
+class ProbeResult:
+    """``eigenprobe(λ, n)``: the inertia, the eigenvalue the inverse
+    iteration converged to (or its last estimate) and its eigenvector
+    (n,), pointed downhill; ``lines`` the progress REF prints."""
+    inertia: Inertia
+    value: float
+    vector: np.ndarray
+    iterations: int
+    lines: list
+    system: Any = None
+
+    def motion(self) -> np.ndarray:
+        """The vertex motion (nv, 3) of the eigenvector."""
+        return np.asarray(self.system.T @ self.vector).reshape(-1, 3)
+
+
+def inverse_iteration(hs: HessianSystem, shift: float, maxit: int, eps: float = 1e-10,
+                      seed: int = 0, rtol: float = 1e-14) -> ProbeResult:
+    """Inverse power iteration with ``(K − λI)⁻¹`` on the constrained
+    subspace from a random start (the manual's ``eigenprobe(λ, n)``), at
+    most ``maxit`` iterations after the first.  The estimate is
+    ``λ + 1/(xᵀ OP x)`` for the unit iterate x; REF's progress lines
+    ``k  ev = ...`` are made at k = 0, every tenth and the last."""
+    n = hs.K.shape[0]
+    if n == 0:
+        return ProbeResult(Inertia(0, 0, 0), math.nan, np.zeros(0), 0, [], hs)
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps)
+    inert = inertia(hs, shift, eps)
+    rng = np.random.default_rng(seed)
+    x = fac.op(rng.standard_normal(n))
+    x /= np.linalg.norm(x)
+    lines = []
+    ev_old = math.nan
+    ev = math.nan
+    k = 0
+    for k in range(int(maxit) + 1):
+        y = fac.op(x)
+        q = float(x @ y)
+        ev = shift + 1.0 / q if q != 0 else shift
+        ny = np.linalg.norm(y)
+        x = y / ny if ny > 0 else x
+        done = abs(ev - ev_old) <= rtol * max(1.0, abs(ev))
+        if k % 10 == 0 or done or k == int(maxit):
+            lines.append("%d  ev = %20.15f\n" % (k, ev))
+        if done:
+            break
+        ev_old = ev
+    if float(x @ hs.rhs) < 0:          # rhs = −∇E: point downhill
+        x = -x
+    return ProbeResult(inert, ev, x, k, lines, hs)
+
+
+@dataclass
+class SaddleResult:
+    """``saddle``: the lowest eigenvalue, the step along its eigenvector
+    (None when it is not negative: no move) and the energy after."""
+    value: float
+    step: float | None = None
+    energy: float = math.nan
+    area: float = math.nan
+    totals: Any = None
+    warnings: list = field(default_factory=list)
+
+
+def saddle_step(it, normal: bool = True, max_step: float | None = None,
+                eps: float = 1e-10) -> SaddleResult:
+    """The ``saddle`` command on the surface of the
+    :class:`~pyevolver.evolve.iterate.Iterator` ``it``: when the lowest
+    eigenvalue of the constrained Hessian is negative, a line search for
+    the lowest energy along its unit eigenvector, both ways, the step at
+    most ``max_step`` in size (the optimizing search of ``g``, starting at
+    scale 1); the fixed values are restored after the move as in ``g``.
+    """
+    hs = hessian_system(it, normal)
+    low = lowest(hs, eps)
+    if not len(low.values):
+        return SaddleResult(math.nan)
+    value = float(low.values[0])
+    if not value < 0:
+        return SaddleResult(value)
+    s = it.surface
+    dx = low.motion(0)
+    cons, mobile = hs.cons, hs.mobile
+    targets = cons.targets(s)
+    X0 = state(s)
+    smax = math.inf if max_step is None else abs(float(max_step))
+    best = (math.inf, 0.0)
+    for sign in (1.0, -1.0):
+        def E(scale, sign=sign):
+            e = it._move(X0, dx, sign * scale, cons, None, None, mobile, targets, None,
+                         trial=True).energy
+            return e if math.isfinite(e) else math.inf
+        scale = it._line_search(E, min(1.0, smax), min(smax, 1e6))[0]
+        e = E(scale)
+        if e < best[0]:
+            best = (e, sign * scale)
+    report: list[str] = []
+    t = it._move(X0, dx, best[1], cons, None, None, mobile, targets, report)
+    if not math.isfinite(t.energy):
+        restore_state(s, X0)
+        t = s.evaluate()
+    it.cg_history = None
+    return SaddleResult(value, best[1], t.energy, t.total_area, t, report)
