@@ -21,7 +21,9 @@ from .registry import Command
 from .values import as_float, as_int
 
 FAMILY = "eigen"
-RITZ_SYNTAX = "Syntax: RITZ(probe_value, number_of_eigenvalues)"
+RITZ_SYNTAX = "Syntax: RITZ(probe_value, number_of_eigenvalues)"        # REF's messages
+PROBE_SYNTAX = "Syntax: EIGENPROBE probe_value   or  EIGENPROBE(probe_value, iterationmax)"
+LANCZOS_SYNTAX = "Syntax: lanczos rexpr   or   lanczos(expr,count)"
 
 
 def _system(session: Any, what: str):
@@ -118,13 +120,13 @@ def saddle(session: Any, max_step: float | None = None) -> Any:
 # -- the registered commands: NAME expr and NAME(expr, expr) ---------------------------
 def _bare_eigenprobe(interp, raw, arg):
     if arg is None:
-        raise CommandError("eigenprobe needs a probe value (usage: eigenprobe value)")
+        raise CommandError(PROBE_SYNTAX)
     eigenprobe(interp.session, as_float(interp.value(arg), "the probe value of eigenprobe"))
 
 
 def _call_eigenprobe(session, args):
-    if not args:
-        raise CommandError("eigenprobe needs a probe value (usage: eigenprobe value)")
+    if len(args) not in (1, 2):
+        raise CommandError(PROBE_SYNTAX)
     shift = as_float(args[0], "the probe value of eigenprobe")
     n = as_int(args[1], "the iteration limit of eigenprobe") if len(args) > 1 else None
     eigenprobe(session, shift, n)
@@ -143,14 +145,14 @@ def _call_ritz(session, args):
 
 def _bare_lanczos(interp, raw, arg):
     if arg is None:
-        raise CommandError("lanczos needs a probe value (usage: lanczos value)")
+        raise CommandError(LANCZOS_SYNTAX)
     ritz(interp.session, as_float(interp.value(arg), "the probe value of lanczos"), 15,
          lanczos=True)
 
 
 def _call_lanczos(session, args):
-    if not args:
-        raise CommandError("lanczos needs a probe value (usage: lanczos value)")
+    if len(args) not in (1, 2):
+        raise CommandError(LANCZOS_SYNTAX)
     n = as_int(args[1], "the number of eigenvalues of lanczos") if len(args) > 1 else 15
     ritz(session, as_float(args[0], "the probe value of lanczos"), n, lanczos=True)
 

@@ -126,9 +126,21 @@ class ShiftedFactor:
             self.solve = lambda R: V @ (inv[:, None] * (V.T @ R)) if np.ndim(R) == 2 \
                 else V @ (inv * (V.T @ R))
         self.ZB = None
+        self._bordered = None
         if B is not None:
             self.ZB = np.asarray(self.solve(np.asarray(B, float)))
             self.S = B.T @ self.ZB                      # (k, k) Bᵀ A⁻¹ B
+            d = np.abs(np.asarray(self.pivots))
+            if len(d) and d.min() <= 1e-10 * d.max():
+                # A (nearly) singular, the bordered matrix perhaps not (a mode of
+                # K that the constraints remove): solve with the bordered matrix
+                import scipy.sparse.linalg as spla
+                M = sp.bmat([[A, sp.csc_matrix(B)], [sp.csc_matrix(B.T), None]],
+                            format="csc")
+                try:
+                    self._bordered = spla.splu(M)
+                except RuntimeError:
+                    pass
 
     def inertia(self) -> Inertia:
         """The inertia of ``A`` on the subspace ``Bᵀ y = 0``."""
@@ -148,6 +160,8 @@ class ShiftedFactor:
 
     def op(self, x: np.ndarray) -> np.ndarray:
         """``y = OP x``: the solution of ``[[A, B], [Bᵀ, 0]] [y; μ] = [x; 0]``."""
+        if self._bordered is not None:
+            return self._bordered.solve(np.concatenate([x, np.zeros(self.B.shape[1])]))[:self.n]
         z = np.asarray(self.solve(x))
         if self.ZB is None:
             return z
@@ -164,28 +178,81 @@ def _null_basis(B, n):
     return Q[:, rank:]
 
 
-def inertia(hs: HessianSystem, shift: float, eps: float = 1e-10) -> Inertia:
-    """Counts of the eigenvalues μ of the constrained Hessian of ``hs``
-    below, equal to and above ``shift``: "equal" means ``|μ − shift| ≤ eps``
-    (``hessian_epsilon``), counted as the difference of the inertias at
-    ``shift ± eps`` (two factorizations; with ``eps`` 0 one, and only
-    exactly zero pivots are equal)."""
-    n = hs.K.shape[0]
-    if n == 0:
-        return Inertia(0, 0, 0)
-    if eps <= 0:
-        return ShiftedFactor(hs.K, hs.B, shift, 0.0).inertia()
-    lo = ShiftedFactor(hs.K, hs.B, shift - eps, 0.0).inertia()
-    hi = ShiftedFactor(hs.K, hs.B, shift + eps, 0.0).inertia()
-    below = lo.below
-    equal = max(hi.below + hi.equal - below, 0)
-    dim = lo.below + lo.equal + lo.above
-    return Inertia(below, equal, max(dim - below - equal, 0))
+def _dim(hs: HessianSystem) -> int:
+    return hs.K.shape[0] - (0 if hs.B is None else hs.B.shape[1])
 
 
 def _order(values, vectors, shift, m):
     key = np.lexsort((values, np.abs(values - shift)))[:m]
     return values[key], vectors[:, key]
+
+
+def _dense(hs: HessianSystem):
+    """All eigenvalues (ascending) and eigenvectors (n, n − k) of ``Zᵀ K Z``."""
+    Z = _null_basis(hs.B, hs.K.shape[0])
+    Kd = hs.K.toarray()
+    if Z is not None:
+        Kd = Z.T @ Kd @ Z
+    w, V = np.linalg.eigh(0.5 * (Kd + Kd.T))
+    return w, (V if Z is None else Z @ V)
+
+
+def _near(hs: HessianSystem, shift: float, m: int, eps: float, dense_max: int, seed: int = 0):
+    """The m eigenpairs nearest ``shift`` (values ordered by distance)."""
+    n, dim = hs.K.shape[0], _dim(hs)
+    m = max(0, min(int(m), dim))
+    if m == 0:
+        return np.zeros(0), np.zeros((n, 0))
+    if dim <= dense_max or m >= dim - 1:
+        return _order(*_dense(hs), shift, m)
+    import scipy.sparse.linalg as spla   # when first used (start-up time)
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps)
+    v0 = fac.op(np.random.default_rng(seed).standard_normal(n))
+    op = spla.LinearOperator((n, n), matvec=fac.op, dtype=float)
+    theta, V = spla.eigsh(op, k=m, which="LM", v0=v0, tol=1e-14)
+    return _order(shift + 1.0 / theta, V, shift, m)
+
+
+def inertia(hs: HessianSystem, shift: float, eps: float = 1e-10,
+            dense_max: int = DENSE_MAX) -> Inertia:
+    """Counts of the eigenvalues μ of the constrained Hessian of ``hs``
+    below, equal to and above ``shift``; "equal" means ``|μ − shift| ≤ eps``
+    (``hessian_epsilon``).
+
+    Small problems (dimension ≤ ``dense_max``) count the dense eigenvalues.
+    Otherwise the eigenvalues nearest the shift (shift-and-invert) give the
+    equal ones, and the count below is the inertia of one LDLᵀ
+    factorization at a shift σ in the widest gap between them below the
+    window (so that no eigenvalue is near σ: the signs of the pivots of an
+    LDLᵀ without pivoting are not reliable within ~1e-8 of an eigenvalue),
+    plus the nearest eigenvalues between σ and the window.
+    """
+    dim = _dim(hs)
+    if dim <= 0:
+        return Inertia(0, 0, 0)
+    if dim <= dense_max:
+        w = _dense(hs)[0]
+        below = int(np.sum(w < shift - eps))
+        equal = int(np.sum(np.abs(w - shift) <= eps))
+        return Inertia(below, equal, dim - below - equal)
+    m = min(6, dim)
+    while True:
+        vals = _near(hs, shift, m, eps, dense_max)[0]
+        dist = np.abs(vals - shift)
+        if np.any(dist > eps) or m >= dim:
+            break
+        m = min(2 * m, dim)
+    equal = int(np.sum(dist <= eps))
+    if m >= dim:
+        below = int(np.sum(vals < shift - eps))
+        return Inertia(below, equal, dim - below - equal)
+    rmax = float(dist.max())
+    pts = np.sort(np.concatenate([[shift - rmax, shift - eps], vals[vals < shift - eps]]))
+    gap = int(np.argmax(np.diff(pts)))
+    sigma = 0.5 * (pts[gap] + pts[gap + 1])
+    below = ShiftedFactor(hs.K, hs.B, sigma, 0.0).inertia().below
+    below += int(np.sum((vals >= sigma) & (vals < shift - eps)))
+    return Inertia(below, equal, max(dim - below - equal, 0))
 
 
 def nearest(hs: HessianSystem, shift: float, m: int, eps: float = 1e-10,
@@ -201,7 +268,7 @@ def nearest(hs: HessianSystem, shift: float, m: int, eps: float = 1e-10,
     m : int
         How many (at most the dimension n − k).
     eps : float
-        Pivot magnitude regarded as zero in the inertia.
+        The half width of "equal" in the inertia (``hessian_epsilon``).
     dense_max : int
         Up to this dimension the dense ``Zᵀ K Z`` (LAPACK ``eigh``);
         above it shift-and-invert ARPACK with the bordered solve.
@@ -211,31 +278,9 @@ def nearest(hs: HessianSystem, shift: float, m: int, eps: float = 1e-10,
     EigenResult
         Values sorted by their distance from ``shift`` (ties: ascending).
     """
-    n = hs.K.shape[0]
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps) if n else None
-    inert = inertia(hs, shift, eps)
-    k = 0 if hs.B is None else hs.B.shape[1]
-    dim = n - k
-    m = max(0, min(int(m), dim))
-    if m == 0:
-        return EigenResult(shift, inert, np.zeros(0), np.zeros((n, 0)), hs)
-    if dim <= dense_max or m >= dim - 1:
-        Z = _null_basis(hs.B, n)
-        Kd = hs.K.toarray()
-        if Z is not None:
-            Kd = Z.T @ Kd @ Z
-        w, V = np.linalg.eigh(0.5 * (Kd + Kd.T))
-        if Z is not None:
-            V = Z @ V
-        vals, vecs = _order(w, V, shift, m)
-        return EigenResult(shift, inert, vals, vecs, hs)
-    import scipy.sparse.linalg as spla
-    rng = np.random.default_rng(seed)
-    v0 = fac.op(rng.standard_normal(n))
-    op = spla.LinearOperator((n, n), matvec=fac.op, dtype=float)
-    theta, V = spla.eigsh(op, k=m, which="LM", v0=v0, tol=1e-14)
-    vals = shift + 1.0 / theta
-    return EigenResult(shift, inert, *_order(vals, V, shift, m), system=hs)
+    inert = inertia(hs, shift, eps, dense_max)
+    vals, vecs = _near(hs, shift, m, eps, dense_max, seed)
+    return EigenResult(shift, inert, vals, vecs, hs)
 
 
 def lowest(hs: HessianSystem, eps: float = 1e-10, dense_max: int = DENSE_MAX) -> EigenResult:
@@ -249,9 +294,8 @@ def lowest(hs: HessianSystem, eps: float = 1e-10, dense_max: int = DENSE_MAX) ->
     off = np.asarray(abs(K).sum(axis=1)).ravel() - np.abs(diag)
     lb = float(np.min(diag - off))
     sigma = lb - 1e-3 * max(abs(lb), 1.0)
-    r = nearest(hs, sigma, 1, eps, dense_max)
-    r.inertia = inertia(hs, 0.0, eps)
-    return r
+    vals, vecs = _near(hs, sigma, 1, eps, dense_max)
+    return EigenResult(sigma, inertia(hs, 0.0, eps, dense_max), vals, vecs, hs)
 
 
 @dataclass

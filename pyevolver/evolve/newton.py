@@ -38,7 +38,7 @@ import scipy.sparse as sp
 
 from ..constraints import restore_state, state
 from . import gradient as GR
-from .eigen import ShiftedFactor
+from .eigen import ShiftedFactor, inertia
 from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
                       solve_bordered, tangent_basis)
 from .iterate import Iterator, StepResult, _Constraints
@@ -250,7 +250,11 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     dx = (hs.T @ sol[:n]).reshape(-1, 3)
     report: list[str] = []
     if n:
+        # one factorization; its pivots' signs can err within ~1e-8 of an
+        # eigenvalue, so a count of negatives is confirmed by eigen.inertia
         index = ShiftedFactor(hs.K, hs.B, -eps, 0.0).inertia().below
+        if index:
+            index = inertia(hs, 0.0, eps).below
         if index:
             report.append(f"WARNING 1825: Hessian not positive definite. Index: {index}\n")
     targets = cons.targets(s)

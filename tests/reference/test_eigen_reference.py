@@ -1,0 +1,136 @@
+"""The eigenvalue commands against evolver-nox-d, run live: ``eigenprobe``
+(its counts exactly), ``ritz`` (every eigenvalue within 1e-6),
+``eigenprobe(λ, n)`` and ``lanczos`` (the converged value, the nearest
+one), ``saddle``, and the warning of ``hessian`` when the Hessian is not
+positive definite.
+
+Cases: cube.fe after ``g 10`` (a triple eigenvalue: the translations seen
+through normal motion; with ``hessian_normal off`` six zero eigenvalues,
+translations and rotations), mound.fe after ``g 10`` (constraint and
+volume; with ``hessian_normal off`` a negative and two zero eigenvalues),
+catbody.fe grown to volume 8 (two negative eigenvalues: ``hessian`` warns,
+``saddle`` moves).
+"""
+import re
+import subprocess
+
+import pytest
+
+from comparison import run_pyevolver
+from conftest import example
+from reference import run_reference
+from tolerances import LOOSE
+
+COUNTS = re.compile(r"^Eigencounts:\s+(\d+) <,\s+(\d+) ==,\s+(\d+) > $")
+RITZ = re.compile(r"^\s*(\d+)\.\s+(-?\d+\.\d+)$")
+LANCZOS = re.compile(r"^(\d+)\s+(-?\d+\.\d+)$")
+PROBE = re.compile(r"^(\d+)  ev =\s+(-?\d+\.\d+)$")
+
+CATBODY8 = "u\nbody[1].target := 8\ng 5\nr\ng 5\nV\nV\nr\ng 10\n"
+
+
+def _blocks(lines):
+    """[(counts, [values])] of each Eigencounts line and the ritz values after it."""
+    out = []
+    for ln in lines:
+        m = COUNTS.match(ln)
+        if m:
+            out.append((tuple(int(x) for x in m.groups()), []))
+            continue
+        m = RITZ.match(ln)
+        if m and out:
+            out[-1][1].append(float(m.group(2)))
+    return out
+
+
+def _compare(evolver, name, script, tmp_path):
+    ref = run_reference(evolver, example(name), script, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(example(name), script + "q\n", cwd=str(tmp_path))
+    assert code == 0, err
+    b_ref, b_out = _blocks(ref), _blocks(out)
+    assert b_ref and len(b_out) == len(b_ref), (ref, out)
+    for (c_ref, v_ref), (c_out, v_out) in zip(b_ref, b_out):
+        assert c_out == c_ref, (ref, out)
+        assert len(v_out) == len(v_ref), (ref, out)
+        for a, b in zip(v_out, v_ref):
+            assert abs(a - b) < LOOSE, (v_out, v_ref)
+    return ref, out
+
+
+@pytest.mark.parametrize("name,script", [
+    ("cube", "g 10\neigenprobe 1\neigenprobe 0\nritz(1,5)\nritz(0,20)\n"
+             "hessian_normal off\neigenprobe 0\neigenprobe 1e-9\nritz(-0.01,10)\n"),
+    ("mound", "g 10\neigenprobe 0\neigenprobe 1\nritz(0,6)\n"
+              "hessian_normal off\neigenprobe 0\nritz(-0.1,4)\n"),
+    ("catbody", CATBODY8 + "eigenprobe 0\neigenprobe -0.05\nritz(-1,3)\n"),
+])
+def test_eigenprobe_and_ritz_match_reference(evolver, tmp_path, name, script):
+    _compare(evolver, name, script, tmp_path)
+
+
+def test_probe_iteration_lanczos_and_last_eigenvalue(evolver, tmp_path):
+    """``eigenprobe(λ, n)`` converges (near λ) to REF's eigenvalue and sets
+    last_eigenvalue; ``ritz`` sets eigenvalues[]; ``lanczos``'s first value
+    (REF: "usually very accurate") is REF's."""
+    script = ("g 10\neigenprobe(0.3,50)\nprint last_eigenvalue\nritz(0,3)\n"
+              "print eigenvalues[3]\nlanczos 1\n")
+    ref, out = _compare(evolver, "cube", script, tmp_path)
+    for lines in (ref, out):
+        assert next(x for x in lines if PROBE.match(x)).startswith("0  ev =")
+    last = [float(PROBE.match(x).group(2)) for x in (ref, out)
+            for x in [[y for y in x if PROBE.match(y)][-1]]]
+    assert abs(last[0] - last[1]) < LOOSE
+    printed = [[float(y) for y in x if re.fullmatch(r"\s*-?\d+\.\d+", y)] for x in (ref, out)]
+    assert len(printed[0]) == len(printed[1]) == 2
+    assert all(abs(a - b) < LOOSE for a, b in zip(*printed))
+    lz = [[float(LANCZOS.match(y).group(2)) for y in x if LANCZOS.match(y)] for x in (ref, out)]
+    assert abs(lz[0][0] - lz[1][0]) < LOOSE
+
+
+def test_hessian_warns_and_saddle_moves_down(evolver, tmp_path):
+    """Two negative eigenvalues: ``hessian`` prints REF's warning (to
+    stderr, with the index) and still steps; ``saddle`` reports REF's lowest
+    eigenvalue and lowers the energy.  The eigenvalue is double (the shape
+    is symmetric), so the direction within its eigenspace, the step and the
+    energy after it are not REF's: the decrease must be at least half of
+    REF's."""
+    script = CATBODY8 + "hessian\nsaddle\n"
+    proc = subprocess.run([evolver, "-p1", example("catbody")], input=script + "q\nq\n",
+                          capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(example("catbody"), script + "q\n", cwd=str(tmp_path))
+    want = "WARNING 1825: Hessian not positive definite. Index: 2\n\n"
+    assert want in proc.stderr
+    assert want in err
+    ref = run_reference(evolver, example("catbody"), script, cwd=str(tmp_path))
+
+    def parse(lines):
+        i = next(k for k, x in enumerate(lines) if x.startswith("Lowest eigenvalue"))
+        e0 = float([x for x in lines[:i] if "energy:" in x][-1].split()[4])   # hessian's
+        low = float(lines[i].split()[2])
+        assert re.fullmatch(r"stepsize -?[\d.e+-]+", lines[i + 1])
+        m = re.fullmatch(r"1\. area:\s+(\S+) energy:\s+(\S+) ", lines[i + 2])
+        return e0, low, float(m.group(2))
+    e0_ref, low_ref, e1_ref = parse(ref)
+    e0, low, e1 = parse(out)
+    assert abs(e0 - e0_ref) < LOOSE
+    assert abs(low - low_ref) < LOOSE and low < 0
+    assert e0 - e1 > 0.5 * (e0_ref - e1_ref) > 0
+
+
+def test_saddle_at_a_minimum_and_ritz_syntax(evolver, tmp_path):
+    """No negative eigenvalue: REF's "Not a saddle point." and no move;
+    ``ritz 1``, ``lanczos`` and ``eigenprobe`` without arguments are refused
+    with REF's syntax lines."""
+    script = "g 10\nsaddle\nritz 1\nlanczos\neigenprobe\n"
+    ref = run_reference(evolver, example("cube"), script, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(example("cube"), script + "q\n", cwd=str(tmp_path))
+    pick = [x for x in ref if x.startswith("Lowest")]
+    mine = [x for x in out if x.startswith("Lowest")]
+    assert len(pick) == len(mine) == 1 and mine[0].endswith(". Not a saddle point.")
+    assert abs(float(mine[0].split()[2].rstrip(".")) - float(pick[0].split()[2].rstrip("."))) \
+        < LOOSE
+    proc = subprocess.run([evolver, "-p1", example("cube")], input=script + "q\nq\n",
+                          capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
+    for word in ("RITZ(", "lanczos rexpr", "EIGENPROBE probe_value"):
+        line = next(x for x in proc.stderr.split("\n") if word in x)
+        assert line.split(": ", 1)[1].strip() in err
