@@ -204,7 +204,8 @@ def _near(hs: HessianSystem, shift: float, m: int, eps: float, dense_max: int, s
     if m == 0:
         return np.zeros(0), np.zeros((n, 0))
     if dim <= dense_max or m >= dim - 1:
-        return _order(*_dense(hs), shift, m)
+        w, V = _dense(hs)
+        return _order(w, V, shift, m)
     import scipy.sparse.linalg as spla   # when first used (start-up time)
     fac = ShiftedFactor(hs.K, hs.B, shift, eps)
     v0 = fac.op(np.random.default_rng(seed).standard_normal(n))
