@@ -37,7 +37,18 @@ def _system(session: Any, what: str):
     if not it.pressures_valid and len(_Constraints(s)):
         raise CommandError("Pressures invalid. Do regular iteration before Hessian "
                            "to set pressures.")
+    note_beyond(session)
     return it, hessian_system(it, normal=it.settings.hessian_normal)
+
+
+def note_beyond(session: Any) -> None:
+    """Say once per session and reason (stderr) where the Hessian commands go
+    further than the Evolver (:func:`pyevolver.evolve.eigen.beyond_reference`)."""
+    seen = session.__dict__.setdefault("_beyond_noted", set())
+    for note in EG.beyond_reference(session.surface):
+        if note not in seen:
+            seen.add(note)
+            session.write_err(note + "\n")
 
 
 def _eps(session: Any) -> float:

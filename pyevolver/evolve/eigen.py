@@ -378,7 +378,7 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
     if not len(low.values):
         return SaddleResult(math.nan)
     value = float(low.values[0])
-    if not value < 0:
+    if not value < -eps:
         return SaddleResult(value)
     s = it.surface
     dx = low.motion(0)
@@ -396,6 +396,8 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
         e = E(scale)
         if e < best[0]:
             best = (e, sign * scale)
+    if not best[0] < E(0.0):
+        best = (math.inf, 0.0)                 # no lower energy along the eigenvector
     report: list[str] = []
     t = it._move(X0, dx, best[1], cons, None, None, mobile, targets, report)
     if not math.isfinite(t.energy):
@@ -403,3 +405,20 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
         t = s.evaluate()
     it.cg_history = None
     return SaddleResult(value, best[1], t.energy, t.total_area, t, report)
+
+
+def beyond_reference(surface) -> list[str]:
+    """Notes for the Hessian commands where the Evolver 2.70 refuses and
+    pyevolver goes on on purpose: gap energy (REF's ERROR 1604: "Cannot do
+    gap energy Hessian") and FIXED quantities of GLOBAL methods (REF's
+    ERROR 3362: "Fixed quantity ... is not connected to any mobile
+    vertices")."""
+    notes = []
+    if "gap" in surface.evaluate().terms:
+        notes.append("pyevolver: gap energy in the Hessian by differences of its gradient "
+                     "(the Evolver refuses: ERROR 1604)")
+    for q in surface.quantities.values():
+        if q.kind == "fixed" and any(getattr(m, "is_global", False) for m, *_ in q.methods):
+            notes.append(f"pyevolver: the fixed quantity {q.name} of a global method in the "
+                         f"Hessian (the Evolver refuses: ERROR 3362)")
+    return notes

@@ -31,6 +31,7 @@ from ..datafile.writer import DumpSettings, dump as write_dump
 from ..errors import (CommandError, DatafileError, InternalError, PyEvolverError,
                       UnsupportedError)
 from ..evolve.bfgs import check_free, minimize_surface
+from ..evolve.eigen import beyond_reference
 from ..evolve.iterate import IterateSettings, Iterator, _Constraints, progress_line
 from ..evolve.newton import damped_newton, hessian_step
 from ..expr import nodes as N
@@ -652,6 +653,11 @@ class Session(SessionAPI):
         if not it.pressures_valid and len(_Constraints(self.surface)):
             raise CommandError("Pressures invalid. Do regular iteration before Hessian "
                                "to set pressures.")
+        seen = self.__dict__.setdefault("_beyond_noted", set())
+        for note in beyond_reference(self.surface) if echo else ():
+            if note not in seen:            # where REF refuses (once per session)
+                seen.add(note)
+                self.write_err(note + "\n")
         r = hessian_step(it, seek, max_scale, normal=it.settings.hessian_normal,
                          eps=float(self.settings.get("hessian_epsilon", 1e-10)))
         self.recalc(totals=r.totals)

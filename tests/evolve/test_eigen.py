@@ -12,6 +12,7 @@ cases with a known spectrum.
 """
 import io
 import math
+import os
 
 import numpy as np
 import pytest
@@ -147,3 +148,17 @@ def test_factor_inertia_with_and_without_cholmod(monkeypatch, cholmod):
     assert abs(y.sum()) < 1e-10
     r = K @ y - 0.7 * y - x
     assert np.allclose(r - r.mean(), 0, atol=1e-10)
+
+
+def test_beyond_reference_names_fixed_global_quantities(tmp_path):
+    text = open(os.path.join(os.path.dirname(__file__), "..", "..", "datafiles",
+                             "cube.fe")).read()
+    path = tmp_path / "cubeq.fe"
+    path.write_text(text.replace("vertices", "quantity qa fixed = 6 method facet_area global"
+                                 "\n\nvertices", 1))
+    s = Session.load(str(path), out=io.StringIO())
+    notes = EG.beyond_reference(s.surface)
+    assert len(notes) == 1 and "qa" in notes[0] and "ERROR 3362" in notes[0]
+    assert EG.beyond_reference(Session.load(os.path.join(
+        os.path.dirname(__file__), "..", "..", "datafiles", "cube.fe"),
+        out=io.StringIO()).surface) == []

@@ -134,3 +134,15 @@ def test_saddle_at_a_minimum_and_ritz_syntax(evolver, tmp_path):
     for word in ("RITZ(", "lanczos rexpr", "EIGENPROBE probe_value"):
         line = next(x for x in proc.stderr.split("\n") if word in x)
         assert line.split(": ", 1)[1].strip() in err
+
+
+def test_where_the_evolver_refuses_the_hessian_we_say_so(evolver, tmp_path):
+    """sphere.fe has gap energy: REF refuses its Hessian (ERROR 1604);
+    pyevolver goes on with differences of the gradient and says so once."""
+    script = "r\ng 5\neigenprobe 0\nhessian\n"
+    proc = subprocess.run([evolver, "-p1", example("sphere")], input=script + "q\nq\n",
+                          capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
+    assert "ERROR 1604" in proc.stdout + proc.stderr
+    code, out, err = run_pyevolver(example("sphere"), script + "q\n", cwd=str(tmp_path))
+    assert err.count("(the Evolver refuses: ERROR 1604)") == 1
+    assert COUNTS.match(next(x for x in out if x.startswith("Eigencounts")))
