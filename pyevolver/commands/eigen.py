@@ -38,7 +38,21 @@ def _system(session: Any, what: str):
         raise CommandError("Pressures invalid. Do regular iteration before Hessian "
                            "to set pressures.")
     note_beyond(session)
-    return it, hessian_system(it, normal=it.settings.hessian_normal)
+    hs = hessian_system(it, normal=it.settings.hessian_normal)
+    mix = _mix(session)
+    if mix is not None:
+        EG.metric(hs, s, mix)
+    return it, hs
+
+
+def _mix(session: Any) -> float | None:
+    """``linear_metric_mix`` when ``linear_metric`` is on, else None."""
+    if not session.toggles.get("linear_metric"):
+        return None
+    mix = as_float(session.settings.get("linear_metric_mix", 0.5), "linear_metric_mix")
+    if not 0.0 <= mix <= 1.0:
+        raise CommandError(f"linear_metric_mix must be between 0 and 1 (it is {mix:g})")
+    return mix
 
 
 def note_beyond(session: Any) -> None:
@@ -88,7 +102,7 @@ def eigenprobe(session: Any, shift: float, iterations: int | None = None) -> Any
 
 def ritz(session: Any, shift: float, count: int, lanczos: bool = False) -> Any:
     """``ritz(λ, n)`` (and ``lanczos``): the inertia relative to λ and the n
-    eigenvalues nearest λ, nearest first."""
+    eigenvalues nearest λ, ascending (as REF prints them)."""
     what = "lanczos" if lanczos else "ritz"
     _, hs = _system(session, what)
     if count < 0:
@@ -110,7 +124,7 @@ def saddle(session: Any, max_step: float | None = None) -> Any:
     eigenvalue when it is negative."""
     it, _ = _system(session, "saddle")
     r = EG.saddle_step(it, normal=it.settings.hessian_normal, max_step=max_step,
-                       eps=_eps(session))
+                       eps=_eps(session), mix=_mix(session))
     if not math.isfinite(r.value):
         session.write("No degrees of freedom.\n")
         return r

@@ -64,7 +64,7 @@ class Inertia:
 class EigenResult:
     """Eigenvalues near a probe value, with their inertia.
 
-    ``values`` (m,) in the order of their distance from ``shift``;
+    ``values`` (m,) the ones nearest ``shift``, ascending;
     ``vectors`` (n, m) the eigenvectors on the free coordinates (unit
     length, ``Bᵀ v = 0``); ``motions`` maps one to vertex motions (nv, 3).
     """
@@ -81,7 +81,7 @@ class EigenResult:
 
 
 class ShiftedFactor:
-    """A factorization of ``A = K − σI`` (n, n): its solve, the inertia of
+    """A factorization of ``A = K − σI`` (n, n) (``K − σM`` with a metric ``M``): its solve, the inertia of
     its LDLᵀ pivots and the bordered solve with ``B``.
 
     Raises :class:`UnsupportedError` when ``A`` is singular (σ an
@@ -89,9 +89,9 @@ class ShiftedFactor:
     fallback.
     """
 
-    def __init__(self, K, B, sigma: float, eps: float):
+    def __init__(self, K, B, sigma: float, eps: float, M=None):
         n = K.shape[0]
-        A = (K - sigma * sp.identity(n, format="csc")).tocsc()
+        A = (K - sigma * (sp.identity(n, format="csc") if M is None else M)).tocsc()
         self.n, self.B, self.eps = n, B, eps
         self.solve: Callable
         self.pivots = None
@@ -183,22 +183,28 @@ def _dim(hs: HessianSystem) -> int:
 
 
 def _order(values, vectors, shift, m):
+    """The m values nearest ``shift``, in ascending order (as REF prints them)."""
     key = np.lexsort((values, np.abs(values - shift)))[:m]
+    key = key[np.argsort(values[key], kind="stable")]
     return values[key], vectors[:, key]
 
 
 def _dense(hs: HessianSystem):
-    """All eigenvalues (ascending) and eigenvectors (n, n − k) of ``Zᵀ K Z``."""
+    """All eigenvalues (ascending) and eigenvectors (n, n − k) of ``Zᵀ K Z``
+    (with a metric: of ``Zᵀ K Z w = μ Zᵀ M Z w``, the vectors M-orthonormal)."""
+    import scipy.linalg as sla
     Z = _null_basis(hs.B, hs.K.shape[0])
     Kd = hs.K.toarray()
+    Md = None if hs.M is None else hs.M.toarray()
     if Z is not None:
         Kd = Z.T @ Kd @ Z
-    w, V = np.linalg.eigh(0.5 * (Kd + Kd.T))
+        Md = None if Md is None else Z.T @ Md @ Z
+    w, V = sla.eigh(0.5 * (Kd + Kd.T), None if Md is None else 0.5 * (Md + Md.T))
     return w, (V if Z is None else Z @ V)
 
 
 def _near(hs: HessianSystem, shift: float, m: int, eps: float, dense_max: int, seed: int = 0):
-    """The m eigenpairs nearest ``shift`` (values ordered by distance)."""
+    """The m eigenpairs nearest ``shift`` (values ascending)."""
     n, dim = hs.K.shape[0], _dim(hs)
     m = max(0, min(int(m), dim))
     if m == 0:
@@ -207,11 +213,17 @@ def _near(hs: HessianSystem, shift: float, m: int, eps: float, dense_max: int, s
         w, V = _dense(hs)
         return _order(w, V, shift, m)
     import scipy.sparse.linalg as spla   # when first used (start-up time)
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps)
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M)
     v0 = fac.op(np.random.default_rng(seed).standard_normal(n))
     op = spla.LinearOperator((n, n), matvec=fac.op, dtype=float)
-    theta, V = spla.eigsh(op, k=m, which="LM", v0=v0, tol=1e-14)
-    return _order(shift + 1.0 / theta, V, shift, m)
+    if hs.M is None:
+        theta, V = spla.eigsh(op, k=m, which="LM", v0=v0, tol=1e-14)
+        return _order(shift + 1.0 / theta, V, shift, m)
+    # generalized shift-invert mode: OP = (K − σM)⁻¹ M on the subspace,
+    # self-adjoint in the M inner product
+    mu, V = spla.eigsh(hs.K, k=m, M=hs.M, sigma=shift, OPinv=op, which="LM", v0=v0,
+                       tol=1e-14)
+    return _order(mu, V, shift, m)
 
 
 def inertia(hs: HessianSystem, shift: float, eps: float = 1e-10,
@@ -251,7 +263,7 @@ def inertia(hs: HessianSystem, shift: float, eps: float = 1e-10,
     pts = np.sort(np.concatenate([[shift - rmax, shift - eps], vals[vals < shift - eps]]))
     gap = int(np.argmax(np.diff(pts)))
     sigma = 0.5 * (pts[gap] + pts[gap + 1])
-    below = ShiftedFactor(hs.K, hs.B, sigma, 0.0).inertia().below
+    below = ShiftedFactor(hs.K, hs.B, sigma, 0.0, hs.M).inertia().below
     below += int(np.sum((vals >= sigma) & (vals < shift - eps)))
     return Inertia(below, equal, max(dim - below - equal, 0))
 
@@ -277,7 +289,7 @@ def nearest(hs: HessianSystem, shift: float, m: int, eps: float = 1e-10,
     Returns
     -------
     EigenResult
-        Values sorted by their distance from ``shift`` (ties: ascending).
+        The m values nearest ``shift``, ascending.
     """
     inert = inertia(hs, shift, eps, dense_max)
     vals, vecs = _near(hs, shift, m, eps, dense_max, seed)
@@ -293,7 +305,10 @@ def lowest(hs: HessianSystem, eps: float = 1e-10, dense_max: int = DENSE_MAX) ->
         return EigenResult(0.0, Inertia(0, 0, 0), np.zeros(0), np.zeros((0, 0)), hs)
     diag = K.diagonal()
     off = np.asarray(abs(K).sum(axis=1)).ravel() - np.abs(diag)
-    lb = float(np.min(diag - off))
+    lb = float(np.min(diag - off))                 # λ_min(K) ≥ lb (Gershgorin)
+    if hs.M is not None:
+        # μ_min ≥ min(lb, 0) / λ_min(M), with λ_min(M) ≥ hs.M_floor > 0
+        lb = min(lb, 0.0) / hs.M_floor
     sigma = lb - 1e-3 * max(abs(lb), 1.0)
     vals, vecs = _near(hs, sigma, 1, eps, dense_max)
     return EigenResult(sigma, inertia(hs, 0.0, eps, dense_max), vals, vecs, hs)
@@ -326,20 +341,22 @@ def inverse_iteration(hs: HessianSystem, shift: float, maxit: int, eps: float = 
     n = hs.K.shape[0]
     if n == 0:
         return ProbeResult(Inertia(0, 0, 0), math.nan, np.zeros(0), 0, [], hs)
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps)
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M)
     inert = inertia(hs, shift, eps)
+    Mx = (lambda v: v) if hs.M is None else (lambda v: hs.M @ v)
     rng = np.random.default_rng(seed)
     x = fac.op(rng.standard_normal(n))
-    x /= np.linalg.norm(x)
+    x /= math.sqrt(float(x @ Mx(x)))
     lines = []
     ev_old = math.nan
     ev = math.nan
     k = 0
     for k in range(int(maxit) + 1):
-        y = fac.op(x)
-        q = float(x @ y)
+        Mxk = Mx(x)
+        y = fac.op(Mxk)
+        q = float(Mxk @ y)                        # xᵀ M OP M x, x M-unit
         ev = shift + 1.0 / q if q != 0 else shift
-        ny = np.linalg.norm(y)
+        ny = math.sqrt(max(float(y @ Mx(y)), 0.0))
         x = y / ny if ny > 0 else x
         done = abs(ev - ev_old) <= rtol * max(1.0, abs(ev))
         if k % 10 == 0 or done or k == int(maxit):
@@ -365,15 +382,18 @@ class SaddleResult:
 
 
 def saddle_step(it, normal: bool = True, max_step: float | None = None,
-                eps: float = 1e-10) -> SaddleResult:
+                eps: float = 1e-10, mix: float | None = None) -> SaddleResult:
     """The ``saddle`` command on the surface of the
     :class:`~pyevolver.evolve.iterate.Iterator` ``it``: when the lowest
     eigenvalue of the constrained Hessian is negative, a line search for
     the lowest energy along its unit eigenvector, both ways, the step at
     most ``max_step`` in size (the optimizing search of ``g``, starting at
     scale 1); the fixed values are restored after the move as in ``g``.
+    ``mix``: the eigenvector of the ``linear_metric`` with that mix.
     """
     hs = hessian_system(it, normal)
+    if mix is not None:
+        metric(hs, it.surface, mix)
     low = lowest(hs, eps)
     if not len(low.values):
         return SaddleResult(math.nan)
@@ -382,6 +402,7 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
         return SaddleResult(value)
     s = it.surface
     dx = low.motion(0)
+    dx /= max(float(np.linalg.norm(dx)), 1e-300)          # a unit motion
     cons, mobile = hs.cons, hs.mobile
     targets = cons.targets(s)
     X0 = state(s)
@@ -422,3 +443,44 @@ def beyond_reference(surface) -> list[str]:
             notes.append(f"pyevolver: the fixed quantity {q.name} of a global method in the "
                          f"Hessian (the Evolver refuses: ERROR 3362)")
     return notes
+
+
+def metric(hs: HessianSystem, surface, mix: float = 0.5) -> HessianSystem:
+    """Install the metric of ``linear_metric`` in ``hs`` (``hs.M``, (n, n)
+    sparse, and ``hs.M_floor``, a lower bound of its eigenvalues) and
+    return it.
+
+    On the vertex values the metric is ``(1 − mix) M_star + mix M_lin``
+    with ``M_star = diag(A_v / 3)`` (a third of the area of the facets at
+    each vertex) and ``M_lin`` the integral of the linear interpolation,
+    ``A_f / 12 · (1 + δ_ij)`` per facet (eigentut.htm §8, "Hessian with
+    metric"; ``mix`` is ``linear_metric_mix``); on the free coordinates
+    ``Tᵀ (M ⊗ I₃) T``.  Measured: cube.fe after ``g 10`` gives REF's
+    eigenvalues for mix 0, 0.5 and 1 (0.6464353000714, 0.796433510134711,
+    1.036886946140311).
+    """
+    s = surface
+    if getattr(s, "string", False):
+        raise UnsupportedError("linear_metric in the string model")
+    if getattr(s, "quadratic", False) or getattr(s, "order", 1) != 1:
+        raise UnsupportedError("linear_metric in the quadratic model",
+                               "REF uses the quadratic interpolation metric there")
+    t = s.evaluate()
+    A = np.asarray(t.facet_area, float)
+    F = s.F
+    star = np.bincount(F.ravel(), weights=np.repeat(A / 3.0, 3), minlength=s.nv)
+    i, j = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
+    rows = F[:, i.ravel()].ravel()
+    cols = F[:, j.ravel()].ravel()
+    vals = (A[:, None] / 12.0 * np.where(i == j, 2.0, 1.0).ravel()[None, :]).ravel()
+    Mv = (1.0 - mix) * sp.diags(star) + mix * sp.csr_matrix((vals, (rows, cols)),
+                                                              shape=(s.nv, s.nv))
+    T = hs.T
+    hs.M = (T.T @ sp.kron(Mv, sp.identity(3)) @ T).tocsc()
+    # M_lin ≥ diag(A_v/12) = M_star/4 (each facet's mass matrix A/12·(I + 11ᵀ) ≥ A/12·I)
+    used = star[np.repeat(np.arange(s.nv), hs.basis.ndof)]
+    hs.M_floor = float(((1.0 - mix) + mix / 4.0) * used.min()) if len(used) else 1.0
+    if not hs.M_floor > 0:
+        raise UnsupportedError("linear_metric with a mobile vertex on no facet",
+                               "its mass is zero")
+    return hs

@@ -486,6 +486,8 @@ class HessianSystem:
         self.K, self.B, self.rhs, self.d, self.T = K, B, rhs, d, T
         self.basis, self.lam, self.cons, self.mobile = basis, lam, cons, mobile
         self.points = np.repeat(X, basis.ndof, axis=0)   # (n, 3) where each unknown sits
+        self.M = None               # the eigenvalue metric (n, n); None: the identity
+        self.M_floor = 1.0          # a lower bound of the eigenvalues of M
 
 
 def hessian_system(it, normal: bool = True) -> HessianSystem:

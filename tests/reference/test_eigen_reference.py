@@ -8,7 +8,7 @@ Cases: cube.fe after ``g 10`` (a triple eigenvalue: the translations seen
 through normal motion; with ``hessian_normal off`` six zero eigenvalues,
 translations and rotations), mound.fe after ``g 10`` (constraint and
 volume; with ``hessian_normal off`` a negative and two zero eigenvalues),
-catbody.fe grown to volume 8 (two negative eigenvalues: ``hessian`` warns,
+cube.fe with ``linear_metric`` (mix 0.5, 0 and 1), catbody.fe grown to volume 8 (two negative eigenvalues: ``hessian`` warns,
 ``saddle`` moves).
 """
 import re
@@ -63,6 +63,10 @@ def _compare(evolver, name, script, tmp_path):
     ("mound", "g 10\neigenprobe 0\neigenprobe 1\nritz(0,6)\n"
               "hessian_normal off\neigenprobe 0\nritz(-0.1,4)\n"),
     ("catbody", CATBODY8 + "eigenprobe 0\neigenprobe -0.05\nritz(-1,3)\n"),
+    # linear_metric: the mix of the star and linear interpolation metrics
+    ("cube", "g 10\nlinear_metric\nritz(0,5)\neigenprobe 1\nlinear_metric_mix := 0\n"
+             "ritz(0,5)\nlinear_metric_mix := 1\nritz(0,5)\nhessian_normal off\n"
+             "ritz(0.1,5)\n"),
 ])
 def test_eigenprobe_and_ritz_match_reference(evolver, tmp_path, name, script):
     _compare(evolver, name, script, tmp_path)
