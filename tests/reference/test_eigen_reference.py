@@ -46,7 +46,6 @@ def _blocks(lines):
 def _compare(evolver, name, script, tmp_path):
     ref = run_reference(evolver, example(name), script, cwd=str(tmp_path))
     code, out, err = run_pyevolver(example(name), script + "q\n", cwd=str(tmp_path))
-    assert code == 0, err
     b_ref, b_out = _blocks(ref), _blocks(out)
     assert b_ref and len(b_out) == len(b_ref), (ref, out)
     for (c_ref, v_ref), (c_out, v_out) in zip(b_ref, b_out):
@@ -54,19 +53,18 @@ def _compare(evolver, name, script, tmp_path):
         assert len(v_out) == len(v_ref), (ref, out)
         for a, b in zip(v_out, v_ref):
             assert abs(a - b) < LOOSE, (v_out, v_ref)
-    return ref, out
+    return ref, out, err
 
 
 @pytest.mark.parametrize("name,script", [
     ("cube", "g 10\neigenprobe 1\neigenprobe 0\nritz(1,5)\nritz(0,20)\n"
-             "hessian_normal off\neigenprobe 0\neigenprobe 1e-9\nritz(-0.01,10)\n"),
+             "hessian_normal off\neigenprobe 0\neigenprobe 1e-9\nritz(-0.01,10)\n"
+             # linear_metric: the mix of the star and linear interpolation metrics
+             "hessian_normal on\nlinear_metric\nritz(0,5)\neigenprobe 1\n"
+             "linear_metric_mix := 0\nritz(0,5)\nlinear_metric_mix := 1\nritz(0,5)\n"
+             "hessian_normal off\nritz(0.1,5)\n"),
     ("mound", "g 10\neigenprobe 0\neigenprobe 1\nritz(0,6)\n"
               "hessian_normal off\neigenprobe 0\nritz(-0.1,4)\n"),
-    ("catbody", CATBODY8 + "eigenprobe 0\neigenprobe -0.05\nritz(-1,3)\n"),
-    # linear_metric: the mix of the star and linear interpolation metrics
-    ("cube", "g 10\nlinear_metric\nritz(0,5)\neigenprobe 1\nlinear_metric_mix := 0\n"
-             "ritz(0,5)\nlinear_metric_mix := 1\nritz(0,5)\nhessian_normal off\n"
-             "ritz(0.1,5)\n"),
 ])
 def test_eigenprobe_and_ritz_match_reference(evolver, tmp_path, name, script):
     _compare(evolver, name, script, tmp_path)
@@ -75,10 +73,12 @@ def test_eigenprobe_and_ritz_match_reference(evolver, tmp_path, name, script):
 def test_probe_iteration_lanczos_and_last_eigenvalue(evolver, tmp_path):
     """``eigenprobe(λ, n)`` converges (near λ) to REF's eigenvalue and sets
     last_eigenvalue; ``ritz`` sets eigenvalues[]; ``lanczos``'s first value
-    (REF: "usually very accurate") is REF's."""
+    (REF: "usually very accurate") is REF's.  No negative eigenvalue:
+    ``saddle`` prints REF's "Not a saddle point." line; ``ritz 1``, ``lanczos``
+    and ``eigenprobe`` without arguments are refused with REF's syntax lines."""
     script = ("g 10\neigenprobe(0.3,50)\nprint last_eigenvalue\nritz(0,3)\n"
-              "print eigenvalues[3]\nlanczos 1\n")
-    ref, out = _compare(evolver, "cube", script, tmp_path)
+              "print eigenvalues[3]\nlanczos 1\nsaddle\nritz 1\nlanczos\neigenprobe\n")
+    ref, out, err = _compare(evolver, "cube", script, tmp_path)
     for lines in (ref, out):
         assert next(x for x in lines if PROBE.match(x)).startswith("0  ev =")
     last = [float(PROBE.match(x).group(2)) for x in (ref, out)
@@ -89,23 +89,32 @@ def test_probe_iteration_lanczos_and_last_eigenvalue(evolver, tmp_path):
     assert all(abs(a - b) < LOOSE for a, b in zip(*printed))
     lz = [[float(LANCZOS.match(y).group(2)) for y in x if LANCZOS.match(y)] for x in (ref, out)]
     assert abs(lz[0][0] - lz[1][0]) < LOOSE
+    pick = [x for x in ref if x.startswith("Lowest")]
+    mine = [x for x in out if x.startswith("Lowest")]
+    assert len(pick) == len(mine) == 1 and mine[0].endswith(". Not a saddle point.")
+    assert abs(float(mine[0].split()[2].rstrip(".")) - float(pick[0].split()[2].rstrip("."))) \
+        < LOOSE
+    proc = subprocess.run([evolver, "-p1", example("cube")], input=script + "q\nq\n",
+                          capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
+    for word in ("RITZ(", "lanczos rexpr", "EIGENPROBE probe_value"):
+        line = next(x for x in proc.stderr.split("\n") if word in x)
+        assert line.split(": ", 1)[1].strip() in err
 
 
 def test_hessian_warns_and_saddle_moves_down(evolver, tmp_path):
-    """Two negative eigenvalues: ``hessian`` prints REF's warning (to
-    stderr, with the index) and still steps; ``saddle`` reports REF's lowest
+    """Two negative eigenvalues: ``eigenprobe`` and ``ritz`` as REF;
+    ``hessian`` prints REF's warning (to stderr, with the index) and still steps; ``saddle`` reports REF's lowest
     eigenvalue and lowers the energy.  The eigenvalue is double (the shape
     is symmetric), so the direction within its eigenspace, the step and the
     energy after it are not REF's: the decrease must be at least half of
     REF's."""
-    script = CATBODY8 + "hessian\nsaddle\n"
+    script = CATBODY8 + "eigenprobe 0\neigenprobe -0.05\nritz(-1,3)\nhessian\nsaddle\n"
     proc = subprocess.run([evolver, "-p1", example("catbody")], input=script + "q\nq\n",
                           capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
-    code, out, err = run_pyevolver(example("catbody"), script + "q\n", cwd=str(tmp_path))
+    ref, out, err = _compare(evolver, "catbody", script, tmp_path)
     want = "WARNING 1825: Hessian not positive definite. Index: 2\n\n"
     assert want in proc.stderr
     assert want in err
-    ref = run_reference(evolver, example("catbody"), script, cwd=str(tmp_path))
 
     def parse(lines):
         i = next(k for k, x in enumerate(lines) if x.startswith("Lowest eigenvalue"))
@@ -121,29 +130,10 @@ def test_hessian_warns_and_saddle_moves_down(evolver, tmp_path):
     assert e0 - e1 > 0.5 * (e0_ref - e1_ref) > 0
 
 
-def test_saddle_at_a_minimum_and_ritz_syntax(evolver, tmp_path):
-    """No negative eigenvalue: REF's "Not a saddle point." and no move;
-    ``ritz 1``, ``lanczos`` and ``eigenprobe`` without arguments are refused
-    with REF's syntax lines."""
-    script = "g 10\nsaddle\nritz 1\nlanczos\neigenprobe\n"
-    ref = run_reference(evolver, example("cube"), script, cwd=str(tmp_path))
-    code, out, err = run_pyevolver(example("cube"), script + "q\n", cwd=str(tmp_path))
-    pick = [x for x in ref if x.startswith("Lowest")]
-    mine = [x for x in out if x.startswith("Lowest")]
-    assert len(pick) == len(mine) == 1 and mine[0].endswith(". Not a saddle point.")
-    assert abs(float(mine[0].split()[2].rstrip(".")) - float(pick[0].split()[2].rstrip("."))) \
-        < LOOSE
-    proc = subprocess.run([evolver, "-p1", example("cube")], input=script + "q\nq\n",
-                          capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
-    for word in ("RITZ(", "lanczos rexpr", "EIGENPROBE probe_value"):
-        line = next(x for x in proc.stderr.split("\n") if word in x)
-        assert line.split(": ", 1)[1].strip() in err
-
-
 def test_where_the_evolver_refuses_the_hessian_we_say_so(evolver, tmp_path):
     """sphere.fe has gap energy: REF refuses its Hessian (ERROR 1604);
     pyevolver goes on with differences of the gradient and says so once."""
-    script = "r\ng 5\neigenprobe 0\nhessian\n"
+    script = "g 5\neigenprobe 0\nhessian\n"
     proc = subprocess.run([evolver, "-p1", example("sphere")], input=script + "q\nq\n",
                           capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
     assert "ERROR 1604" in proc.stdout + proc.stderr
