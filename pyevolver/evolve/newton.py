@@ -234,7 +234,9 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     False.  When the constrained Hessian has eigenvalues below ``−eps``
     (``hessian_epsilon``) the step is still taken and ``warnings`` starts
     with REF's "WARNING 1825: Hessian not positive definite. Index: N"
-    (N their number, from the inertia of :func:`.eigen.inertia`).
+    (N their number, from the inertia of :func:`.eigen.inertia`).  With
+    ``check_increase`` a ``hessian`` step that raises the energy is undone
+    (REF's WARNING 1596; ``message`` "increase").
 
     Returns
     -------
@@ -259,6 +261,7 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
             report.append(f"WARNING 1825: Hessian not positive definite. Index: {index}\n")
     targets = cons.targets(s)
     X0 = state(s)
+    e0 = s.evaluate().energy
 
     def E(scale, report=None):
         e = it._move(X0, dx, scale, cons, None, None, mobile, targets, report).energy
@@ -273,6 +276,15 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         it.cg_history = None
         t = s.evaluate()
         return StepResult(t.energy, t.total_area, scale, lam, {}, False, message="infinite",
+                          warnings=report, totals=t)
+    if not seek and it.settings.check_increase and t.energy > e0:
+        # check_increase: REF undoes a Newton step that raises the energy
+        restore_state(s, X0)
+        it.cg_history = None
+        t = s.evaluate()
+        report.append("WARNING 1596: Hessian move would have raised energy.  "
+                      "Restoring coords.\n")
+        return StepResult(t.energy, t.total_area, 0.0, lam, {}, True, message="increase",
                           warnings=report, totals=t)
     b = s.bodies
     qp = {}

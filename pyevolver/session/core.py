@@ -667,7 +667,7 @@ class Session(SessionAPI):
         r.energy, r.area = self.totals.energy, self.totals.total_area
         if echo:
             for w in r.warnings:
-                if w.startswith("WARNING 1825"):
+                if w.startswith(("WARNING 1825", "WARNING 1596")):
                     self.write_err(w + "\n")          # REF: to stderr, then a blank line
                 else:
                     self.write(w + "\n")

@@ -140,3 +140,16 @@ def test_where_the_evolver_refuses_the_hessian_we_say_so(evolver, tmp_path):
     code, out, err = run_pyevolver(example("sphere"), script + "q\n", cwd=str(tmp_path))
     assert err.count("(the Evolver refuses: ERROR 1604)") == 1
     assert COUNTS.match(next(x for x in out if x.startswith("Eigencounts")))
+
+
+def test_check_increase_undoes_a_hessian_step(evolver, tmp_path):
+    """cube.fe after ``g 2``: the Newton step raises the area; with
+    ``check_increase`` REF warns (stderr) and restores, as pyevolver does."""
+    script = "g 2\ncheck_increase\nhessian\n"
+    proc = subprocess.run([evolver, "-p1", example("cube")], input=script + "q\nq\n",
+                          capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(example("cube"), script + "q\n", cwd=str(tmp_path))
+    want = "WARNING 1596: Hessian move would have raised energy.  Restoring coords.\n\n"
+    assert want in proc.stderr and want in err
+    ref = run_reference(evolver, example("cube"), script, cwd=str(tmp_path))
+    assert [x for x in out if "area:" in x][-1] == [x for x in ref if "area:" in x][-1]
