@@ -80,41 +80,64 @@ class EigenResult:
         return np.asarray(self.system.T @ self.vectors[:, j]).reshape(-1, 3)
 
 
+def _ldl(A):
+    """``(solve, pivots)`` of an LDLᵀ factorization of the symmetric sparse
+    ``A`` without off-diagonal pivoting (CHOLMOD's simplicial LDLᵀ, or
+    SuperLU in symmetric mode as :func:`.newton._factor`), or None when a
+    pivot is zero."""
+    chol = _cholmod()
+    if chol is not None:
+        try:
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                f = chol.cholesky(A, mode="simplicial")
+                d = f.D()
+            if np.all(np.isfinite(d)) and np.all(d != 0):
+                return f, np.asarray(d)
+        except chol.CholmodError:
+            pass
+    import scipy.sparse.linalg as spla   # when first used (start-up time)
+    try:
+        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:                  # exactly singular
+        return None
+    if np.array_equal(lu.perm_r, lu.perm_c):
+        return lu.solve, lu.U.diagonal()
+    return None
+
+
 class ShiftedFactor:
     """A factorization of ``A = K − σI`` (n, n) (``K − σM`` with a metric ``M``): its solve, the inertia of
     its LDLᵀ pivots and the bordered solve with ``B``.
 
     Raises :class:`UnsupportedError` when ``A`` is singular (σ an
     eigenvalue of K to machine precision) and too large for the dense
-    fallback.
+    fallback, unless ``nudge``: then σ is moved by up to 1e-4 of K's mean
+    diagonal until it factors (``self.sigma``), for shift-and-invert.
     """
 
-    def __init__(self, K, B, sigma: float, eps: float, M=None):
+    def __init__(self, K, B, sigma: float, eps: float, M=None, nudge: bool = False):
         n = K.shape[0]
-        A = (K - sigma * (sp.identity(n, format="csc") if M is None else M)).tocsc()
+        Mm = sp.identity(n, format="csc") if M is None else M
         self.n, self.B, self.eps = n, B, eps
         self.solve: Callable
         self.pivots = None
-        chol = _cholmod()
-        if chol is not None:
-            try:
-                with np.errstate(all="ignore"), warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    f = chol.cholesky(A, mode="simplicial")
-                    d = f.D()
-                if np.all(np.isfinite(d)) and np.all(d != 0):
-                    self.solve, self.pivots = f, np.asarray(d)
-            except chol.CholmodError:
-                pass
-        if self.pivots is None:
-            import scipy.sparse.linalg as spla   # when first used (start-up time)
-            try:
-                lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                               options={"SymmetricMode": True})
-                if np.array_equal(lu.perm_r, lu.perm_c):
-                    self.solve, self.pivots = lu.solve, lu.U.diagonal()
-            except RuntimeError:                  # exactly singular
-                pass
+        A = (K - sigma * Mm).tocsc()
+        got = _ldl(A)
+        if got is None and nudge and n:
+            # σ an eigenvalue to machine precision (a rigid motion at 0): for
+            # shift-and-invert any shift this near does, so move it a little
+            scale = max(float(np.abs(K.diagonal()).mean()), 1e-300)
+            for k in range(1, 4):
+                sigma += 1e-10 * 100 ** k * scale
+                A = (K - sigma * Mm).tocsc()
+                got = _ldl(A)
+                if got is not None:
+                    break
+        self.sigma = sigma
+        if got is not None:
+            self.solve, self.pivots = got
         if self.pivots is None:
             if n > 3 * DENSE_MAX:
                 raise UnsupportedError(f"eigenvalues at the probe value {sigma:g}",
@@ -213,15 +236,15 @@ def _near(hs: HessianSystem, shift: float, m: int, eps: float, dense_max: int, s
         w, V = _dense(hs)
         return _order(w, V, shift, m)
     import scipy.sparse.linalg as spla   # when first used (start-up time)
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M)
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True)
     v0 = fac.op(np.random.default_rng(seed).standard_normal(n))
     op = spla.LinearOperator((n, n), matvec=fac.op, dtype=float)
     if hs.M is None:
         theta, V = spla.eigsh(op, k=m, which="LM", v0=v0, tol=1e-14)
-        return _order(shift + 1.0 / theta, V, shift, m)
+        return _order(fac.sigma + 1.0 / theta, V, shift, m)
     # generalized shift-invert mode: OP = (K − σM)⁻¹ M on the subspace,
     # self-adjoint in the M inner product
-    mu, V = spla.eigsh(hs.K, k=m, M=hs.M, sigma=shift, OPinv=op, which="LM", v0=v0,
+    mu, V = spla.eigsh(hs.K, k=m, M=hs.M, sigma=fac.sigma, OPinv=op, which="LM", v0=v0,
                        tol=1e-14)
     return _order(mu, V, shift, m)
 
@@ -263,7 +286,7 @@ def inertia(hs: HessianSystem, shift: float, eps: float = 1e-10,
     pts = np.sort(np.concatenate([[shift - rmax, shift - eps], vals[vals < shift - eps]]))
     gap = int(np.argmax(np.diff(pts)))
     sigma = 0.5 * (pts[gap] + pts[gap + 1])
-    below = ShiftedFactor(hs.K, hs.B, sigma, 0.0, hs.M).inertia().below
+    below = ShiftedFactor(hs.K, hs.B, sigma, 0.0, hs.M, nudge=True).inertia().below
     below += int(np.sum((vals >= sigma) & (vals < shift - eps)))
     return Inertia(below, equal, max(dim - below - equal, 0))
 
@@ -341,7 +364,7 @@ def inverse_iteration(hs: HessianSystem, shift: float, maxit: int, eps: float = 
     n = hs.K.shape[0]
     if n == 0:
         return ProbeResult(Inertia(0, 0, 0), math.nan, np.zeros(0), 0, [], hs)
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M)
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True)
     inert = inertia(hs, shift, eps)
     Mx = (lambda v: v) if hs.M is None else (lambda v: hs.M @ v)
     rng = np.random.default_rng(seed)
@@ -355,7 +378,7 @@ def inverse_iteration(hs: HessianSystem, shift: float, maxit: int, eps: float = 
         Mxk = Mx(x)
         y = fac.op(Mxk)
         q = float(Mxk @ y)                        # xᵀ M OP M x, x M-unit
-        ev = shift + 1.0 / q if q != 0 else shift
+        ev = fac.sigma + 1.0 / q if q != 0 else fac.sigma
         ny = math.sqrt(max(float(y @ Mx(y)), 0.0))
         x = y / ny if ny > 0 else x
         done = abs(ev - ev_old) <= rtol * max(1.0, abs(ev))
