@@ -319,10 +319,12 @@ def nearest(hs: HessianSystem, shift: float, m: int, eps: float = 1e-10,
     return EigenResult(shift, inert, vals, vecs, hs)
 
 
-def lowest(hs: HessianSystem, eps: float = 1e-10, dense_max: int = DENSE_MAX) -> EigenResult:
-    """The lowest eigenvalue of the constrained Hessian and its eigenvector
-    (a shift below Gershgorin's bound, so that ``K − σI`` is positive
-    definite and the lowest eigenvalue is the nearest)."""
+def lowest(hs: HessianSystem, eps: float = 1e-10, dense_max: int = DENSE_MAX,
+           m: int = 1) -> EigenResult:
+    """The ``m`` lowest eigenvalues of the constrained Hessian and their
+    eigenvectors, ascending (a shift below Gershgorin's bound, so that
+    ``K − σM`` is positive definite and the lowest eigenvalues are the
+    nearest)."""
     K = hs.K.tocsr()
     if K.shape[0] == 0:
         return EigenResult(0.0, Inertia(0, 0, 0), np.zeros(0), np.zeros((0, 0)), hs)
@@ -333,7 +335,7 @@ def lowest(hs: HessianSystem, eps: float = 1e-10, dense_max: int = DENSE_MAX) ->
         # μ_min ≥ min(lb, 0) / λ_min(M), with λ_min(M) ≥ hs.M_floor > 0
         lb = min(lb, 0.0) / hs.M_floor
     sigma = lb - 1e-3 * max(abs(lb), 1.0)
-    vals, vecs = _near(hs, sigma, 1, eps, dense_max)
+    vals, vecs = _near(hs, sigma, m, eps, dense_max)
     return EigenResult(sigma, inertia(hs, 0.0, eps, dense_max), vals, vecs, hs)
 
 
@@ -404,27 +406,67 @@ class SaddleResult:
     warnings: list = field(default_factory=list)
 
 
+def _seek(E: Callable[[float], float], smax: float) -> float:
+    """The step in [0, smax] of least ``E``: scale 1 doubled while E falls
+    (halved until it falls), then Brent's bounded search in the bracket
+    (the energy along an unstable mode is far from a parabola, so the
+    parabolic step of ``g``'s search falls short)."""
+    from scipy.optimize import minimize_scalar
+    e0 = E(0.0)
+    s = min(1.0, smax)
+    e = E(s)
+    if e < e0:
+        while True:
+            if s >= smax:
+                return s
+            s2 = min(2.0 * s, smax)
+            e2 = E(s2)
+            if not e2 < e:
+                hi = s2
+                break
+            s, e = s2, e2
+    else:
+        for _ in range(40):
+            s /= 2.0
+            e = E(s)
+            if e < e0:
+                break
+        else:
+            return 0.0
+        hi = 2.0 * s
+    r = minimize_scalar(E, bounds=(0.0, hi), method="bounded",
+                        options={"xatol": 1e-6 * hi, "maxiter": 60})
+    return float(r.x) if r.fun < e else s
+
+
 def saddle_step(it, normal: bool = True, max_step: float | None = None,
                 eps: float = 1e-10, mix: float | None = None) -> SaddleResult:
     """The ``saddle`` command on the surface of the
     :class:`~pyevolver.evolve.iterate.Iterator` ``it``: when the lowest
     eigenvalue of the constrained Hessian is negative, a line search for
-    the lowest energy along its unit eigenvector, both ways, the step at
-    most ``max_step`` in size (the optimizing search of ``g``, starting at
-    scale 1); the fixed values are restored after the move as in ``g``.
+    the lowest energy along its unit eigenvector (for a multiple eigenvalue
+    the one along the force's part in the eigenspace), both ways, the step at
+    most ``max_step`` in size (:func:`_seek`); the fixed values are
+    restored after the move as in ``g``.
     ``mix``: the eigenvector of the ``linear_metric`` with that mix.
     """
     hs = hessian_system(it, normal)
     if mix is not None:
         metric(hs, it.surface, mix)
-    low = lowest(hs, eps)
+    low = lowest(hs, eps, m=4)
     if not len(low.values):
         return SaddleResult(math.nan)
     value = float(low.values[0])
     if not value < -eps:
         return SaddleResult(value)
     s = it.surface
-    dx = low.motion(0)
+    # a multiple lowest eigenvalue (a symmetric shape): within its eigenspace
+    # the direction of the force −∇E (any vector of it when there is none)
+    same = np.abs(low.values - value) <= 1e-8 * max(1.0, abs(value))
+    V = low.vectors[:, same]
+    c = V.T @ hs.rhs
+    v = V @ c if np.linalg.norm(c) > 1e-12 * max(np.linalg.norm(hs.rhs), 1e-300) else V[:, 0]
+    dx = np.asarray(hs.T @ v).reshape(-1, 3)
     dx /= max(float(np.linalg.norm(dx)), 1e-300)          # a unit motion
     cons, mobile = hs.cons, hs.mobile
     targets = cons.targets(s)
@@ -436,7 +478,7 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
             e = it._move(X0, dx, sign * scale, cons, None, None, mobile, targets, None,
                          trial=True).energy
             return e if math.isfinite(e) else math.inf
-        scale = it._line_search(E, min(1.0, smax), min(smax, 1e6))[0]
+        scale = _seek(E, min(smax, 1e6))
         e = E(scale)
         if e < best[0]:
             best = (e, sign * scale)

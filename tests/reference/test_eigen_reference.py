@@ -105,9 +105,10 @@ def test_hessian_warns_and_saddle_moves_down(evolver, tmp_path):
     """Two negative eigenvalues: ``eigenprobe`` and ``ritz`` as REF;
     ``hessian`` prints REF's warning (to stderr, with the index) and still steps; ``saddle`` reports REF's lowest
     eigenvalue and lowers the energy.  The eigenvalue is double (the shape
-    is symmetric), so the direction within its eigenspace, the step and the
-    energy after it are not REF's: the decrease must be at least half of
-    REF's."""
+    is symmetric), so the direction within its eigenspace (REF: random;
+    pyevolver: the force's part in it) and the step are not REF's: the
+    decrease must be at least 90% of REF's (measured: 0.0958 against
+    0.0928)."""
     script = CATBODY8 + "eigenprobe 0\neigenprobe -0.05\nritz(-1,3)\nhessian\nsaddle\n"
     proc = subprocess.run([evolver, "-p1", example("catbody")], input=script + "q\nq\n",
                           capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
@@ -127,7 +128,7 @@ def test_hessian_warns_and_saddle_moves_down(evolver, tmp_path):
     e0, low, e1 = parse(out)
     assert abs(e0 - e0_ref) < LOOSE
     assert abs(low - low_ref) < LOOSE and low < 0
-    assert e0 - e1 > 0.5 * (e0_ref - e1_ref) > 0
+    assert e0 - e1 > 0.9 * (e0_ref - e1_ref) > 0
 
 
 def test_where_the_evolver_refuses_the_hessian_we_say_so(evolver, tmp_path):
