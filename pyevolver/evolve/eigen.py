@@ -215,14 +215,21 @@ def _order(values, vectors, shift, m):
 def _dense(hs: HessianSystem):
     """All eigenvalues (ascending) and eigenvectors (n, n − k) of ``Zᵀ K Z``
     (with a metric: of ``Zᵀ K Z w = μ Zᵀ M Z w``, the vectors M-orthonormal)."""
-    import scipy.linalg as sla
     Z = _null_basis(hs.B, hs.K.shape[0])
     Kd = hs.K.toarray()
     Md = None if hs.M is None else hs.M.toarray()
     if Z is not None:
         Kd = Z.T @ Kd @ Z
         Md = None if Md is None else Z.T @ Md @ Z
-    w, V = sla.eigh(0.5 * (Kd + Kd.T), None if Md is None else 0.5 * (Md + Md.T))
+    Kd = 0.5 * (Kd + Kd.T)
+    if Md is None:
+        w, V = np.linalg.eigh(Kd)
+    else:
+        # K v = μ M v with M = L Lᵀ: (L⁻¹ K L⁻ᵀ) u = μ u, v = L⁻ᵀ u (M-orthonormal)
+        L = np.linalg.cholesky(0.5 * (Md + Md.T))
+        C = np.linalg.solve(L, np.linalg.solve(L, Kd).T)
+        w, U = np.linalg.eigh(0.5 * (C + C.T))
+        V = np.linalg.solve(L.T, U)
     return w, (V if Z is None else Z @ V)
 
 
@@ -408,10 +415,9 @@ class SaddleResult:
 
 def _seek(E: Callable[[float], float], smax: float) -> float:
     """The step in [0, smax] of least ``E``: scale 1 doubled while E falls
-    (halved until it falls), then Brent's bounded search in the bracket
+    (halved until it falls), then a golden-section search in the bracket
     (the energy along an unstable mode is far from a parabola, so the
     parabolic step of ``g``'s search falls short)."""
-    from scipy.optimize import minimize_scalar
     e0 = E(0.0)
     s = min(1.0, smax)
     e = E(s)
@@ -434,9 +440,22 @@ def _seek(E: Callable[[float], float], smax: float) -> float:
         else:
             return 0.0
         hi = 2.0 * s
-    r = minimize_scalar(E, bounds=(0.0, hi), method="bounded",
-                        options={"xatol": 1e-6 * hi, "maxiter": 60})
-    return float(r.x) if r.fun < e else s
+    # golden-section search on [0, hi] (its minimum bracketed by s)
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = 0.0, hi
+    x1, x2 = b - g * (b - a), a + g * (b - a)
+    f1, f2 = E(x1), E(x2)
+    while b - a > 1e-6 * hi:
+        if f1 < f2:
+            b, x2, f2 = x2, x1, f1
+            x1 = b - g * (b - a)
+            f1 = E(x1)
+        else:
+            a, x1, f1 = x1, x2, f2
+            x2 = a + g * (b - a)
+            f2 = E(x2)
+    x, f = (x1, f1) if f1 < f2 else (x2, f2)
+    return x if f < e else s
 
 
 def saddle_step(it, normal: bool = True, max_step: float | None = None,
@@ -465,7 +484,8 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
     same = np.abs(low.values - value) <= 1e-8 * max(1.0, abs(value))
     V = low.vectors[:, same]
     c = V.T @ hs.rhs
-    v = V @ c if np.linalg.norm(c) > 1e-12 * max(np.linalg.norm(hs.rhs), 1e-300) else V[:, 0]
+    small = 1e-12 * max(float(np.linalg.norm(hs.rhs)), 1e-300)
+    v = V @ c if float(np.linalg.norm(c)) > small else V[:, 0]
     dx = np.asarray(hs.T @ v).reshape(-1, 3)
     dx /= max(float(np.linalg.norm(dx)), 1e-300)          # a unit motion
     cons, mobile = hs.cons, hs.mobile
