@@ -76,8 +76,12 @@ def _store(session: Any, values) -> None:
     session.arrays["eigenvalues"] = vals.copy()
 
 
-def _number(session: Any, v: Any, what: str) -> float:
-    return as_float(v, what)
+def _shift(v: Any, what: str) -> float:
+    """A finite probe value."""
+    x = as_float(v, what)
+    if not math.isfinite(x):
+        raise CommandError(f"{what} must be finite (it is {x})")
+    return x
 
 
 def eigenprobe(session: Any, shift: float, iterations: int | None = None) -> Any:
@@ -122,6 +126,8 @@ def ritz(session: Any, shift: float, count: int, lanczos: bool = False) -> Any:
 def saddle(session: Any, max_step: float | None = None) -> Any:
     """``saddle [max]``: move down along the eigenvector of the lowest
     eigenvalue when it is negative."""
+    if max_step is not None and math.isnan(max_step):
+        raise CommandError("the step limit of saddle is not a number")
     it, _ = _system(session, "saddle")
     r = EG.saddle_step(it, normal=it.settings.hessian_normal, max_step=max_step,
                        eps=_eps(session), mix=_mix(session))
@@ -146,13 +152,13 @@ def saddle(session: Any, max_step: float | None = None) -> Any:
 def _bare_eigenprobe(interp, raw, arg):
     if arg is None:
         raise CommandError(PROBE_SYNTAX)
-    eigenprobe(interp.session, as_float(interp.value(arg), "the probe value of eigenprobe"))
+    eigenprobe(interp.session, _shift(interp.value(arg), "the probe value of eigenprobe"))
 
 
 def _call_eigenprobe(session, args):
     if len(args) not in (1, 2):
         raise CommandError(PROBE_SYNTAX)
-    shift = as_float(args[0], "the probe value of eigenprobe")
+    shift = _shift(args[0], "the probe value of eigenprobe")
     n = as_int(args[1], "the iteration limit of eigenprobe") if len(args) > 1 else None
     eigenprobe(session, shift, n)
 
@@ -164,14 +170,14 @@ def _bare_ritz(interp, raw, arg):
 def _call_ritz(session, args):
     if len(args) != 2:
         raise CommandError(RITZ_SYNTAX)
-    ritz(session, as_float(args[0], "the probe value of ritz"),
+    ritz(session, _shift(args[0], "the probe value of ritz"),
          as_int(args[1], "the number of eigenvalues of ritz"))
 
 
 def _bare_lanczos(interp, raw, arg):
     if arg is None:
         raise CommandError(LANCZOS_SYNTAX)
-    ritz(interp.session, as_float(interp.value(arg), "the probe value of lanczos"), 15,
+    ritz(interp.session, _shift(interp.value(arg), "the probe value of lanczos"), 15,
          lanczos=True)
 
 
@@ -179,7 +185,7 @@ def _call_lanczos(session, args):
     if len(args) not in (1, 2):
         raise CommandError(LANCZOS_SYNTAX)
     n = as_int(args[1], "the number of eigenvalues of lanczos") if len(args) > 1 else 15
-    ritz(session, as_float(args[0], "the probe value of lanczos"), n, lanczos=True)
+    ritz(session, _shift(args[0], "the probe value of lanczos"), n, lanczos=True)
 
 
 def _bare_saddle(interp, raw, arg):

@@ -73,3 +73,18 @@ def test_saddle_function_reports_no_move_at_a_minimum():
     assert r.step is None and r.value > 0
     assert np.array_equal(s.surface.X, X)
     assert out.getvalue().endswith("Not a saddle point.\n")
+
+
+def test_bad_arguments_are_refused():
+    s, _ = session()
+    s.run("g 5")
+    X = s.surface.X.copy()
+    for cmd, msg in (("ritz(1e308*10, 2)", "must be finite"), ("ritz(0, -1)", "negative"),
+                     ("eigenprobe 1e308*10", "must be finite"),
+                     ("saddle sqrt(1e308*10) - sqrt(1e308*10)", "not a number"),
+                     ("ritz(1, 2, 3)", "at most 2")):
+        with pytest.raises(CommandError, match=msg):
+            s.run(cmd)
+    assert np.array_equal(s.surface.X, X)
+    s.run("ritz(0, 100)")                     # more than there are: all 13
+    assert len(s.arrays["eigenvalues"]) == 13
