@@ -407,7 +407,7 @@ def _cholmod():
     return cholmod
 
 
-def solve_bordered(K, B, r, d, method=None, points=None):
+def solve_bordered(K, B, r, d, method=None, points=None, pivots=None):
     """Solve ``[[K, B], [Bᵀ, 0]] [y; μ] = [r; d]``.
 
     K : sparse symmetric (n, n); B : (n, k) dense or None; r : (n,); d : (k,).
@@ -420,6 +420,9 @@ def solve_bordered(K, B, r, d, method=None, points=None):
     eliminate in the geometric nested-dissection order of
     :func:`~pyevolver.evolve.ordering.nested_dissection` instead of its
     own AMD order (about half the factorization time on large surfaces).
+    ``pivots``, a list: when CHOLMOD solved, it receives the LDLᵀ pivots of
+    K and the Schur complement ``Bᵀ K⁻¹ B`` (None without a border), from
+    which :mod:`.eigen` reads the inertia at no extra cost.
     """
     chol = _cholmod() if method in (None, "cholmod") else None
     if method == "cholmod" and chol is None:
@@ -449,6 +452,8 @@ def solve_bordered(K, B, r, d, method=None, points=None):
                     y = Z[:, 0] - Z[:, 1:] @ mu
                     sol = np.concatenate([y, mu])
             if np.all(np.isfinite(sol)):
+                if pivots is not None:
+                    pivots.extend([f.D(), None if B is None else S])
                 return sol
         except (chol.CholmodError, np.linalg.LinAlgError):
             pass

@@ -39,7 +39,7 @@ import scipy.sparse as sp
 from ..constraints import restore_state, state
 from ..errors import UnsupportedError
 from . import gradient as GR
-from .eigen import ShiftedFactor, inertia
+from .eigen import ShiftedFactor
 from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
                       solve_bordered, tangent_basis)
 from .iterate import Iterator, StepResult, _Constraints
@@ -222,6 +222,26 @@ def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
     return res
 
 
+def _index(hs, piv, eps):
+    """The number of negative eigenvalues of the constrained Hessian, for
+    REF's warning 1825.  The pivots of the step's own LDLᵀ (CHOLMOD) count
+    them at no cost; when they find some (their signs can err for
+    eigenvalues within round-off of 0: rigid motions) the count is that of
+    one factorization at −δ, δ = max(eps, 1e-8 × the mean |diagonal|)."""
+    if piv:
+        d, S = piv
+        below = int(np.sum(np.asarray(d) < 0))
+        if S is not None:
+            below += int(np.sum(np.linalg.eigvalsh(-0.5 * (S + S.T)) < 0)) - S.shape[0]
+        if below <= 0:
+            return 0
+    delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
+    try:
+        return ShiftedFactor(hs.K, hs.B, -delta, 0.0, nudge=True).inertia().below
+    except UnsupportedError:       # (singular where it cannot be resolved: no warning)
+        return 0
+
+
 def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = None,
                  normal: bool = True, eps: float = 1e-10) -> StepResult:
     """The ``hessian`` command: one Newton step on the constrained problem
@@ -235,7 +255,7 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     False.  When the constrained Hessian has eigenvalues below ``−eps``
     (``hessian_epsilon``) the step is still taken and ``warnings`` starts
     with REF's "WARNING 1825: Hessian not positive definite. Index: N"
-    (N their number, from the inertia of :func:`.eigen.inertia`).  With
+    (N their number, from the inertia: :func:`_index`).  With
     ``check_increase`` a ``hessian`` step that raises the energy is undone
     (REF's WARNING 1596; ``message`` "increase").
 
@@ -247,20 +267,14 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     s = it.surface
     hs = hessian_system(it, normal)
     n = hs.K.shape[0]
-    sol = solve_bordered(hs.K, hs.B, hs.rhs, hs.d, points=hs.points)
+    piv: list = []
+    sol = solve_bordered(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, pivots=piv)
     cons, mobile = hs.cons, hs.mobile
     lam = -sol[n:] if len(cons) else hs.lam
     dx = (hs.T @ sol[:n]).reshape(-1, 3)
     report: list[str] = []
     if n:
-        # one factorization; its pivots' signs can err within ~1e-8 of an
-        # eigenvalue, so a count of negatives is confirmed by eigen.inertia
-        try:
-            index = ShiftedFactor(hs.K, hs.B, -eps, 0.0, nudge=True).inertia().below
-            if index:
-                index = inertia(hs, 0.0, eps).below
-        except UnsupportedError:       # (singular where it cannot be resolved: no warning)
-            index = 0
+        index = _index(hs, piv, eps)
         if index:
             report.append(f"WARNING 1825: Hessian not positive definite. Index: {index}\n")
     targets = cons.targets(s)
