@@ -181,3 +181,23 @@ def test_linear_metric_on_the_uniform_grid(tmp_path):
     assert EG.inertia(hs, 1.0) == EG.inertia(hs, 1.0, dense_max=0)
     low = EG.lowest(hs, dense_max=0)
     assert abs(low.values[0] - EG.nearest(hs, -1.0, 1).values[0]) < 1e-9
+
+
+@pytest.mark.parametrize("cholmod", [True, False])
+def test_hessian_index_with_and_without_the_steps_pivots(monkeypatch, cholmod):
+    """newton._index, REF's "Index" of warning 1825: from the solve's LDLᵀ
+    pivots (CHOLMOD) or, without them, one factorization; the constrained
+    circulant shifted by −c has as many negative eigenvalues as exact < c."""
+    from pyevolver.evolve import newton
+    from pyevolver.evolve.hessian import solve_bordered
+    if not cholmod:
+        monkeypatch.setattr(EG, "_cholmod", lambda: None)
+        monkeypatch.setattr(newton, "_cholmod", lambda: None)
+    K, B, exact = _circulant(30)
+    for c in (0.05, 0.5, 1.7):
+        hs = _system(K - c * sp.identity(30), B)
+        piv: list = []
+        if cholmod:
+            solve_bordered(hs.K, hs.B, np.zeros(30), np.zeros(1), pivots=piv)
+            assert piv
+        assert newton._index(hs, piv, 1e-10) == int(np.sum(exact < c))
