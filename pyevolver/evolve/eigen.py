@@ -43,6 +43,7 @@ import scipy.sparse as sp
 from ..constraints import restore_state, state
 from ..errors import UnsupportedError
 from .hessian import HessianSystem, _cholmod, hessian_system
+from .iterate import _Constraints
 
 #: below this many unknowns the eigenvalues come from the dense matrix
 DENSE_MAX = 800
@@ -523,6 +524,14 @@ def beyond_reference(surface) -> list[str]:
     if "gap" in surface.evaluate().terms:
         notes.append("pyevolver: gap energy in the Hessian by differences of its gradient "
                      "(the Evolver refuses: ERROR 1604)")
+    fixed_bodies = len(_Constraints(surface).bodies) > 0
+    contents = [c for c in list(surface.constraints.values()) +
+                list((getattr(surface, "boundaries", None) or {}).values())
+                if getattr(c, "content", None)]
+    if fixed_bodies and (surface.periods is not None or contents):
+        why = "on a torus" if surface.periods is not None else "with content integrals"
+        notes.append(f"pyevolver: the fixed body volumes {why} in the Hessian (the Evolver "
+                     f"makes them global quantities and refuses: ERROR 3362)")
     for q in surface.quantities.values():
         if q.kind == "fixed" and any(getattr(m, "is_global", False) for m, *_ in q.methods):
             notes.append(f"pyevolver: the fixed quantity {q.name} of a global method in the "

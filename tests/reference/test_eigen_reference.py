@@ -131,15 +131,17 @@ def test_hessian_warns_and_saddle_moves_down(evolver, tmp_path):
     assert e0 - e1 > 0.9 * (e0_ref - e1_ref) > 0
 
 
-def test_where_the_evolver_refuses_the_hessian_we_say_so(evolver, tmp_path):
+@pytest.mark.parametrize("name,error", [("sphere", "ERROR 1604"), ("column", "ERROR 3362")])
+def test_where_the_evolver_refuses_the_hessian_we_say_so(evolver, tmp_path, name, error):
     """sphere.fe has gap energy: REF refuses its Hessian (ERROR 1604);
-    pyevolver goes on with differences of the gradient and says so once."""
-    script = "g 5\neigenprobe 0\nhessian\n"
-    proc = subprocess.run([evolver, "-p1", example("sphere")], input=script + "q\nq\n",
+    column.fe's body volume with content integrals becomes a global quantity
+    REF refuses (ERROR 3362).  pyevolver goes on and says so once."""
+    script = "g 2\neigenprobe 0\nhessian\n"
+    proc = subprocess.run([evolver, "-p1", example(name)], input=script + "q\nq\n",
                           capture_output=True, text=True, timeout=120, cwd=str(tmp_path))
-    assert "ERROR 1604" in proc.stdout + proc.stderr
-    code, out, err = run_pyevolver(example("sphere"), script + "q\n", cwd=str(tmp_path))
-    assert err.count("(the Evolver refuses: ERROR 1604)") == 1
+    assert error in proc.stdout + proc.stderr
+    code, out, err = run_pyevolver(example(name), script + "q\n", cwd=str(tmp_path))
+    assert err.count(f"(the Evolver refuses: {error})") == 1
     assert COUNTS.match(next(x for x in out if x.startswith("Eigencounts")))
 
 
