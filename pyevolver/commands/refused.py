@@ -21,7 +21,7 @@ LETTER_LATER = {
     "Z": "Z (zoom)", "M": "M (model order)", "J": "J (jiggle toggle)",
 }
 WORD_LATER = {
-    "hessian_menu",
+    "hessian_menu", "move",
     "vertex_average", "raw_vertex_average", "rawest_vertex_average",
     "pop",
     "t1_edgeswap", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
