@@ -8,27 +8,30 @@ The Hessian is the one ``hessian`` steps with (:func:`.hessian.hessian_system`):
 of the vertices (with ``hessian_normal`` one per vertex: the motion along
 its unit normal; otherwise three, or the tangent space of its constraints),
 bordered by the gradients ``B`` (n, k) of the k fixed volumes and quantities.
-The eigenproblem is the Evolver's (eigentut.htm §3, §5, §6): the metric is
-the identity on ``y`` (no ``linear_metric``), restricted to the motions that
-keep the fixed values, ``Bᵀ y = 0``.  With ``Z`` (n, n − k) an orthonormal
-basis of that subspace the eigenvalues are those of ``Zᵀ K Z``; measured:
-cube.fe after ``g 10`` and catbody.fe give evolver-nox-d's eigenvalues to
-1e-12.
+The eigenproblem is the Evolver's (eigentut.htm §3, §5, §6, §8): the metric
+is the identity on ``y``, or with ``linear_metric`` the mass matrix of
+:func:`metric`, restricted to the motions that keep the fixed values,
+``Bᵀ y = 0``.  With ``Z`` (n, n − k) an orthonormal basis of that subspace
+the eigenvalues are those of ``Zᵀ K Z`` (``Zᵀ K Z w = μ Zᵀ M Z w``);
+measured: cube.fe, mound.fe after ``g 10`` and catbody.fe give
+evolver-nox-d's eigenvalues to 1e-9 or better.
 
-The inertia relative to λ (the counts below, at and above λ) comes from a
-sparse LDLᵀ factorization of ``A = K − λI`` (Sylvester's law of inertia;
-CHOLMOD's simplicial LDLᵀ when scikit-sparse is installed, SuperLU in
-symmetric mode otherwise, as :func:`.newton._factor`) and the Haynsworth
-inertia additivity of the bordered matrix,
-``In([[A, B], [Bᵀ, 0]]) = In(A) + In(−Bᵀ A⁻¹ B)``, from which the k pairs
-of the border are removed.  A pivot of magnitude below ``eps``
-(``hessian_epsilon``) counts as zero, as in the Evolver.
+Inertia (the counts below, at and above λ; "at" means within ``eps``,
+``hessian_epsilon``): Sylvester's law of inertia on a sparse LDLᵀ
+factorization of ``A = K − σM`` (CHOLMOD's simplicial LDLᵀ when
+scikit-sparse is installed, SuperLU in symmetric mode otherwise, as
+:func:`.newton._factor`) and the Haynsworth inertia additivity of the
+bordered matrix, ``In([[A, B], [Bᵀ, 0]]) = In(A) + In(−Bᵀ A⁻¹ B)``, from
+which the k pairs of the border are removed.  The pivots' signs are not
+reliable within round-off of an eigenvalue, so :func:`inertia` counts the
+dense eigenvalues of small problems and otherwise factors at a shift in a
+gap between the eigenvalues nearest λ.
 
 The eigenvalues nearest λ use the shift-inverted operator
-``OP = Z (Zᵀ (K − λI) Z)⁻¹ Zᵀ``, one bordered solve per application
+``OP = Z (Zᵀ (K − λM) Z)⁻¹ Zᵀ``, one bordered solve per application
 (ARPACK's implicitly restarted Lanczos, ``scipy.sparse.linalg.eigsh``;
 eigenvalue θ of OP ↔ μ = λ + 1/θ), or the dense ``Zᵀ K Z`` when the
-problem is small.
+problem is small (at most ``DENSE_MAX`` unknowns).
 """
 from __future__ import annotations
 
