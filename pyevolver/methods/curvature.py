@@ -105,17 +105,83 @@ def _h_zero(s, method):
 def _check_supported(s):
     if s.periods is not None:
         raise UnsupportedError("curvature methods in the torus model")
+
+
+def _check_closed(s, what):
+    """Refuse ``what`` at constrained vertices and on surfaces with a free edge."""
+    _check_supported(s)
     if s.vcon and any(np.any(m) for m in s.vcon.values()):
-        raise UnsupportedError("curvature methods at vertices on level-set constraints",
-                               "REF projects F and N onto the constraints there")
+        raise UnsupportedError(f"{what} at vertices on level-set constraints")
+    if _edge_valence_one_vertices(s).any():
+        raise UnsupportedError(f"{what} on surfaces with a free boundary",
+                               "the partial stars of boundary vertices")
+
+
+def _edge_valence_one_vertices(s):
+    """(nv,) bool: the vertices on an edge with exactly one facet (cached per topology)."""
     topo = s.topology()
     c = s.__dict__.get("_free_boundary")
     if c is None or c[0] is not topo:
-        c = (topo, bool(np.any(np.bincount(topo[0].ravel(), minlength=s.ne) == 1)))
+        ev = np.bincount(topo[0].ravel(), minlength=s.ne) == 1
+        on = np.zeros(s.nv, bool)
+        on[s.E[ev].ravel()] = True
+        c = (topo, on)
         s._free_boundary = c
-    if c[1]:
-        raise UnsupportedError("curvature methods on surfaces with a free boundary",
-                               "the partial stars of boundary vertices")
+    return c[1]
+
+
+def _wall_vertices(s):
+    """(nv,) bool: vertices on a level-set constraint that acts as a mirror
+    (not NONWALL; a one-sided constraint only where the vertex hits it)."""
+    on = np.zeros(s.nv, bool)
+    for cid, mask in (s.vcon or {}).items():
+        if "nonwall" not in s.constraints[cid].flags:
+            on |= np.asarray(mask, bool)
+    return on
+
+
+def mirror_projector(s, m):
+    """The vertices whose ``F`` and ``N`` REF projects onto their constraints'
+    tangent space (the constraints as mirror planes) and the projectors there.
+
+    Old-style methods (``sq_mean_curvature``, ``eff_area_…``, ``normal_…``) project
+    at every vertex on a level-set constraint; the ``star_…`` methods only at
+    those that also lie on an edge with one facet (an incomplete star).
+    ``ignore_constraints`` in the declaration turns it off.  Measured against
+    evolver-nox-d 2.70 on a mound (free edge on z = 0) and a closed cube with
+    its bottom vertices on z = 0 (docs/supported.md).
+
+    Returns
+    -------
+    rows : (k,) int
+        The projected vertices (empty: none).
+    P : (k, 3, 3)
+        ``I − G (GᵀG)⁻¹ Gᵀ`` of each, G the gradients of its constraints.
+    """
+    from ..constraints.levelset import project_tangent
+    empty = (np.zeros(0, np.int64), np.zeros((0, 3, 3)))
+    if not s.vcon or getattr(m, "ignore_constraints", False):
+        return empty
+    on = _wall_vertices(s)
+    if not VERTEX_METHODS.get(m.method, ("", "", True))[2]:
+        on &= _edge_valence_one_vertices(s)
+    rows = np.nonzero(on)[0]
+    if not len(rows):
+        return empty
+    eye = [np.zeros((s.nv, 3)) for _ in range(3)]
+    for k in range(3):
+        eye[k][rows, k] = 1.0
+    cols = project_tangent(s, eye)
+    return rows, np.stack([c[rows] for c in cols], axis=2)
+
+
+def _project(rows, P, v):
+    """``v`` (nv, 3) with the rows ``rows`` multiplied by their projectors."""
+    if not len(rows):
+        return v
+    v = v.copy()
+    v[rows] = np.einsum("nij,nj->ni", P, v[rows])
+    return v
 
 
 def _kind(s, name):
@@ -128,15 +194,16 @@ def _kind(s, name):
     return kind, h0, old
 
 
-def _skipped(s):
-    """(nv,) bool: vertices where the old-style methods are zero."""
-    skip = s.vattr["fixed"].copy()
+def _skipped(s, m=None):
+    """(nv,) bool: vertices where the old-style methods are zero (FIXED ones
+    unless the declaration says ``ignore_fixed``, parametric-boundary ones)."""
+    skip = np.zeros(s.nv, bool) if getattr(m, "ignore_fixed", False) else s.vattr["fixed"].copy()
     if "boundary" in s.vattr:
         skip |= s.vattr["boundary"] != 0
     return skip
 
 
-def _vertex_energy(s, A, F, N, name):
+def _vertex_energy(s, A, F, N, name, m=None):
     """``E`` (nv,) and its partial derivatives ``dF``, ``dN`` (nv, 3), ``dA``."""
     kind, h0, old = _kind(s, name)
     nv = s.nv
@@ -176,7 +243,7 @@ def _vertex_energy(s, A, F, N, name):
     E, dA = np.nan_to_num(E), np.nan_to_num(dA)
     dF, dN = np.nan_to_num(dF), np.nan_to_num(dN)
     if old:
-        skip = _skipped(s)
+        skip = _skipped(s, m)
         E[skip] = 0.0
         dF[skip] = 0.0
         dN[skip] = 0.0
@@ -189,7 +256,9 @@ def vertex_values(ctx, m, idx):
     s = ctx.surface
     _check_supported(s)
     A, F, N = star_sums(ctx)
-    E, _, _, _ = _vertex_energy(s, A, F, N, m.method)
+    rows, P = mirror_projector(s, m)
+    F, N = _project(rows, P, F), _project(rows, P, N)
+    E, _, _, _ = _vertex_energy(s, A, F, N, m.method, m)
     return E[idx]
 
 
@@ -210,7 +279,10 @@ def vertex_gradient(t, m, idx, w):
     s = t.surface
     _check_supported(s)
     A, F, N = star_sums(t)
-    _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method)
+    rows, Pm = mirror_projector(s, m)
+    F, N = _project(rows, Pm, F), _project(rows, Pm, N)
+    _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method, m)
+    dF, dN = _project(rows, Pm, dF), _project(rows, Pm, dN)   # projectors held constant
     P = facet_points(t)
     L = 2.0 * t.facet_area
     with np.errstate(all="ignore"):
@@ -332,21 +404,21 @@ def _gauss(t):
 
 def star_gauss_values(ctx, m, idx):
     """``star_gauss_curvature``: the angle defect 2π − Σ angles at a vertex."""
-    _check_supported(ctx.surface)
+    _check_closed(ctx.surface, "star_gauss_curvature")
     K, _, _, _ = _gauss(ctx)
     return K[idx]
 
 
 def sq_gauss_values(ctx, m, idx):
     """``sq_gauss_curvature``: K²/(A/3) at a vertex (closed surfaces)."""
-    _check_supported(ctx.surface)
+    _check_closed(ctx.surface, "sq_gauss_curvature")
     K, A, _, _ = _gauss(ctx)
     return (K * K / (A / 3.0))[idx]
 
 
 def _gauss_grad(t, idx, w, square):
     s = t.surface
-    _check_supported(s)
+    _check_closed(s, "sq_gauss_curvature/star_gauss_curvature")
     K, A, P, dang = _gauss(t)
     wv = vertex_weights(s.nv, idx, w)
     if square:
@@ -455,7 +527,7 @@ def cotan_values(ctx, m, idx):
     curvature normal K = S/(2A) = 2H n and mixed areas A (MDSB 2003), i.e.
     ``|S_v|² / (16 A_v)``; pyevolver's own method (paper's W_MDSB)."""
     s = ctx.surface
-    _check_supported(s)
+    _check_closed(s, "cotan_sq_mean_curvature")
     _, _, _, _, _, Sv, Av = _cotan_parts(ctx)
     with np.errstate(all="ignore"):
         E = np.nan_to_num(np.einsum("ij,ij->i", Sv, Sv) / (16.0 * Av))
@@ -464,7 +536,7 @@ def cotan_values(ctx, m, idx):
 
 def cotan_gradient(t, m, idx, w):
     s = t.surface
-    _check_supported(s)
+    _check_closed(s, "cotan_sq_mean_curvature")
     P, cot, cg, Am, Amg, Sv, Av = _cotan_parts(t)
     wv = vertex_weights(s.nv, idx, w)
     with np.errstate(all="ignore"):
@@ -541,7 +613,7 @@ def circle_willmore_values(ctx, m, idx):
     ½ Σ_{e∋v} β_e − π (REF: 0 on polyhedra inscribed in a sphere, 1.1430603354544
     on blob0.fe).  Not differentiable where some β = 0 or π."""
     s = ctx.surface
-    _check_supported(s)
+    _check_closed(s, "circle_willmore")
     e, i, j, k, l_ = _edge_quads(s)
     beta = _bobenko_beta(s.X, i, j, k, l_)
     per_v = 0.5 * (np.bincount(i, weights=beta, minlength=s.nv)
@@ -551,7 +623,7 @@ def circle_willmore_values(ctx, m, idx):
 
 def circle_willmore_gradient(t, m, idx, w):
     s = t.surface
-    _check_supported(s)
+    _check_closed(s, "circle_willmore")
     wv = vertex_weights(s.nv, idx, w)
     e, i, j, k, l_ = _edge_quads(s)
     _, (gi, gj, gk, gl) = _bobenko_beta(s.X, i, j, k, l_, grad=True)

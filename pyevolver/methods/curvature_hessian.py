@@ -109,7 +109,7 @@ def _ratio(P, gP, HP, Q, gQ, HQ):
     return g, H
 
 
-def vertex_energy_hessian(s, A, F, N, name):
+def vertex_energy_hessian(s, A, F, N, name, m=None):
     """Hessian (nv, 7, 7) of the vertex energies ``E_v`` of method ``name`` in
     the variables ``(A, F, N)`` (see :func:`curvature._vertex_energy`)."""
     kind, h0, old = C._kind(s, name)
@@ -165,7 +165,7 @@ def vertex_energy_hessian(s, A, F, N, name):
             M[~ok] = 0.0
     M = np.nan_to_num(M)
     if old:
-        M[C._skipped(s)] = 0.0
+        M[C._skipped(s, m)] = 0.0
     return M
 
 
@@ -202,9 +202,17 @@ def vertex_hessian(t, m, idx, w, basis=None):
     s = t.surface
     C._check_supported(s)
     A, F, N = C.star_sums(t)
-    _, dF, dN, dA = C._vertex_energy(s, A, F, N, m.method)
+    rows, Pm = C.mirror_projector(s, m)
+    F, N = C._project(rows, Pm, F), C._project(rows, Pm, N)
+    _, dF, dN, dA = C._vertex_energy(s, A, F, N, m.method, m)
+    dF, dN = C._project(rows, Pm, dF), C._project(rows, Pm, dN)
     wv = C.vertex_weights(s.nv, idx, w)
-    M = vertex_energy_hessian(s, A, F, N, m.method) * wv[:, None, None]
+    M = vertex_energy_hessian(s, A, F, N, m.method, m) * wv[:, None, None]
+    if len(rows):                      # E(A, P F, P N): M -> Tᵀ M T, T = diag(1, P, P)
+        T = np.zeros((len(rows), 7, 7))
+        T[:, 0, 0] = 1.0
+        T[:, 1:4, 1:4] = T[:, 4:7, 4:7] = Pm
+        M[rows] = np.einsum("nji,njk,nkl->nil", T, M[rows], T)
     return star_hessian(t, M, dA * wv, dF * wv[:, None], dN * wv[:, None], basis)
 
 
@@ -252,7 +260,7 @@ def _angle_jets(x):
 
 def _gauss_hessian(t, idx, w, square, basis):
     s = t.surface
-    C._check_supported(s)
+    C._check_closed(s, "sq_gauss_curvature/star_gauss_curvature")
     K, A, P, _ = C._gauss(t)
     nv, Fc = s.nv, s.F
     nf = len(P)
@@ -298,7 +306,7 @@ def sq_gauss_hessian(t, m, idx, w, basis=None):
 def cotan_hessian(t, m, idx, w, basis=None):
     """Hessian of ``Σ_v w_v |S_v|² / (16 A_v)`` (MDSB; see :func:`curvature.cotan_values`)."""
     s = t.surface
-    C._check_supported(s)
+    C._check_closed(s, "cotan_sq_mean_curvature")
     P, cot, _, _, _, Sv, Av = C._cotan_parts(t)
     nv, Fc = s.nv, s.F
     nf = len(P)
