@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..constraints.levelset import curved_constraints, tangent_projectors
 from ..errors import UnsupportedError
 from ..model.records import edge_facets
 from ._common import corner_scatter, facet_points, n2_grad_dot, scatter
@@ -130,12 +131,12 @@ def _edge_valence_one_vertices(s):
     return c[1]
 
 
-def _wall_vertices(s):
+def _wall_vertices(s, nonwall):
     """(nv,) bool: vertices on a level-set constraint that acts as a mirror
-    (not NONWALL; a one-sided constraint only where the vertex hits it)."""
+    (NONWALL ones too when ``nonwall``)."""
     on = np.zeros(s.nv, bool)
     for cid, mask in (s.vcon or {}).items():
-        if "nonwall" not in s.constraints[cid].flags:
+        if nonwall or "nonwall" not in s.constraints[cid].flags:
             on |= np.asarray(mask, bool)
     return on
 
@@ -158,21 +159,17 @@ def mirror_projector(s, m):
     P : (k, 3, 3)
         ``I − G (GᵀG)⁻¹ Gᵀ`` of each, G the gradients of its constraints.
     """
-    from ..constraints.levelset import project_tangent
     empty = (np.zeros(0, np.int64), np.zeros((0, 3, 3)))
     if not s.vcon or getattr(m, "ignore_constraints", False):
         return empty
-    on = _wall_vertices(s)
-    if not VERTEX_METHODS.get(m.method, ("", "", True))[2]:
+    old = VERTEX_METHODS.get(m.method, ("", "", True))[2]
+    on = _wall_vertices(s, old)
+    if not old:
         on &= _edge_valence_one_vertices(s)
     rows = np.nonzero(on)[0]
     if not len(rows):
         return empty
-    eye = [np.zeros((s.nv, 3)) for _ in range(3)]
-    for k in range(3):
-        eye[k][rows, k] = 1.0
-    cols = project_tangent(s, eye)
-    return rows, np.stack([c[rows] for c in cols], axis=2)
+    return rows, tangent_projectors(s, rows, nonwall=old)
 
 
 def _project(rows, P, v):
@@ -280,6 +277,13 @@ def vertex_gradient(t, m, idx, w):
     _check_supported(s)
     A, F, N = star_sums(t)
     rows, Pm = mirror_projector(s, m)
+    if len(rows) and VERTEX_METHODS.get(m.method, ("", "", True))[2]:
+        curved = curved_constraints(s, rows)
+        if curved:
+            raise UnsupportedError(
+                f"the gradient of {m.method} at vertices on curved constraints ({curved[0]})",
+                "REF's force there is neither the derivative with the projector held "
+                "constant nor the exact one; the star_ methods are supported")
     F, N = _project(rows, Pm, F), _project(rows, Pm, N)
     _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method, m)
     dF, dN = _project(rows, Pm, dF), _project(rows, Pm, dN)   # projectors held constant
