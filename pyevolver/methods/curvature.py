@@ -172,6 +172,40 @@ def mirror_projector(s, m):
     return rows, tangent_projectors(s, rows, nonwall=old)
 
 
+def check_old_gradient(s, m, rows):
+    """Refuse the gradient of an old-style method where REF's force is not the
+    derivative of its energy (measured with ``v_force`` after ``g 1``): at
+    vertices on curved constraints; for the h_zero, ``eff_area`` and
+    ``normal`` estimates also at unskipped vertices on a free edge that are not
+    projected, at projected ones with a complete star (``eff``/``normal``) and
+    at any projected one (with h_zero).  ``sq_mean_curvature`` without
+    h_zero agrees with REF on free edges and plane constraints."""
+    kind0, _, old = VERTEX_METHODS.get(m.method, ("plain", "no", True))
+    if not old:
+        return
+    if len(rows):
+        curved = curved_constraints(s, rows)
+        if curved:
+            raise UnsupportedError(
+                f"the gradient of {m.method} at vertices on curved constraints ({curved[0]})",
+                "REF's force there is neither the derivative with the projector held "
+                "constant nor the exact one; the star_ methods are supported")
+    kind, h0, _ = _kind(s, m.method)
+    if kind == "plain" and h0 is None:
+        return
+    live = ~_skipped(s, m)
+    proj = np.zeros(s.nv, bool)
+    proj[rows] = True
+    edge = _edge_valence_one_vertices(s)
+    bad = live & edge & ~proj
+    bad |= live & proj & (~edge if h0 is None else True)
+    if bad.any():
+        what = "h_zero" if h0 is not None else kind0
+        raise UnsupportedError(
+            f"the gradient of {m.method} ({what}) at vertices on a free edge or a constraint",
+            "REF's force there is not the derivative of its energy; use the star_ methods")
+
+
 def _project(rows, P, v):
     """``v`` (nv, 3) with the rows ``rows`` multiplied by their projectors."""
     if not len(rows):
@@ -277,13 +311,7 @@ def vertex_gradient(t, m, idx, w):
     _check_supported(s)
     A, F, N = star_sums(t)
     rows, Pm = mirror_projector(s, m)
-    if len(rows) and VERTEX_METHODS.get(m.method, ("", "", True))[2]:
-        curved = curved_constraints(s, rows)
-        if curved:
-            raise UnsupportedError(
-                f"the gradient of {m.method} at vertices on curved constraints ({curved[0]})",
-                "REF's force there is neither the derivative with the projector held "
-                "constant nor the exact one; the star_ methods are supported")
+    check_old_gradient(s, m, rows)
     F, N = _project(rows, Pm, F), _project(rows, Pm, N)
     _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method, m)
     dF, dN = _project(rows, Pm, dF), _project(rows, Pm, dN)   # projectors held constant

@@ -203,6 +203,7 @@ def vertex_hessian(t, m, idx, w, basis=None):
     C._check_supported(s)
     A, F, N = C.star_sums(t)
     rows, Pm = C.mirror_projector(s, m)
+    C.check_old_gradient(s, m, rows)
     F, N = C._project(rows, Pm, F), C._project(rows, Pm, N)
     _, dF, dN, dA = C._vertex_energy(s, A, F, N, m.method, m)
     dF, dN = C._project(rows, Pm, dF), C._project(rows, Pm, dN)
