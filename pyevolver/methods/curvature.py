@@ -331,6 +331,10 @@ def vertex_gradient(t, m, idx, w):
 
 # -- mean_curvature_integral ----------------------------------------------------------------
 
+MCI_FLAT = 1e-12
+"""|tan θ| below which an edge counts as flat for REF's gradient of ∫H dA."""
+
+
 def _dihedral(t, idx):
     """For the edges ``idx``: which have two facets (``ok``), those edges
     ``e``, and their facets running along (``f1``) and against (``f2``) them."""
@@ -378,9 +382,12 @@ def mci_gradient(t, m, idx, w):
     C = np.einsum("ij,ij->i", N1, N2)
     theta = np.arctan2(S, C)
     R = S * S + C * C
-    # dθ = (C dS − S dC)/R with S = u·(N1 × N2), C = N1·N2
-    a = (C / R)[:, None]
-    b = (S / R)[:, None]
+    # dθ = (C dS − S dC)/R with S = u·(N1 × N2), C = N1·N2; REF drops dθ at
+    # flat edges (θ = 0 to round-off: its acos form is singular there), which
+    # decides its steps once `r` has made flat edges
+    flat = np.abs(S) <= MCI_FLAT * np.abs(C)
+    a = np.where(flat, 0.0, C / R)[:, None]
+    b = np.where(flat, 0.0, S / R)[:, None]
     # through N1 (facet f1 corners) and N2 (facet f2 corners)
     g1 = n2_grad_dot(P1, a * np.cross(N2, u) - b * N2)
     g2 = n2_grad_dot(P2, a * np.cross(u, N1) - b * N1)

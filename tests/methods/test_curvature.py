@@ -138,14 +138,18 @@ def test_legacy_squared_curvature_energy_has_a_gradient():
         assert _fd_check(S, lambda: S.evaluate().energy, g, np.random.default_rng(2)) <= FD
 
 
-def test_curvature_methods_refuse_partial_stars():
-    """Free boundaries and constrained vertices (REF projects there) are
-    refused by name, not evaluated wrongly."""
+def test_closed_surface_methods_refuse_partial_stars():
+    """The methods defined for closed surfaces only (``sq_gauss_curvature``,
+    pyevolver's ``cotan_sq_mean_curvature``) refuse free boundaries by name;
+    the squared mean curvature family evaluates there (REF's rules, see
+    test_curvature_constrained.py)."""
     from conftest import example
     from pyevolver.errors import UnsupportedError
     s = Session.load(example("quad.fe"), out=io.StringIO())
-    with pytest.raises(UnsupportedError, match="free boundary"):
-        _value(s.surface.evaluate(), "star_perp_sq_mean_curvature")
+    for name in ("sq_gauss_curvature", "cotan_sq_mean_curvature"):
+        with pytest.raises(UnsupportedError, match="free boundary"):
+            _value(s.surface.evaluate(), name)
+    assert np.isfinite(_value(s.surface.evaluate(), "star_perp_sq_mean_curvature"))
 
 
 def test_ade_vesicle_first_steps_match_reference(evolver, tmp_path):
