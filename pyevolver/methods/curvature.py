@@ -443,7 +443,7 @@ def _gauss(t):
 
 def star_gauss_values(ctx, m, idx):
     """``star_gauss_curvature``: the angle defect 2π − Σ angles at a vertex."""
-    _check_closed(ctx.surface, "star_gauss_curvature")
+    _check_supported(ctx.surface)
     K, _, _, _ = _gauss(ctx)
     return K[idx]
 
@@ -457,7 +457,10 @@ def sq_gauss_values(ctx, m, idx):
 
 def _gauss_grad(t, idx, w, square):
     s = t.surface
-    _check_closed(s, "sq_gauss_curvature/star_gauss_curvature")
+    if square:
+        _check_closed(s, "sq_gauss_curvature")
+    else:
+        _check_supported(s)
     K, A, P, dang = _gauss(t)
     wv = vertex_weights(s.nv, idx, w)
     if square:

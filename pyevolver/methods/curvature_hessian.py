@@ -261,7 +261,10 @@ def _angle_jets(x):
 
 def _gauss_hessian(t, idx, w, square, basis):
     s = t.surface
-    C._check_closed(s, "sq_gauss_curvature/star_gauss_curvature")
+    if square:
+        C._check_closed(s, "sq_gauss_curvature")
+    else:
+        C._check_supported(s)
     K, A, P, _ = C._gauss(t)
     nv, Fc = s.nv, s.F
     nf = len(P)
