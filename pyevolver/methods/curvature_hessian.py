@@ -360,8 +360,22 @@ def cotan_hessian(t, m, idx, w, basis=None):
 # the registry entries of the curvature family (values and gradients in
 # :mod:`pyevolver.methods.curvature`, Hessians here)
 
+def plane_constraints_only(s) -> bool:
+    """False where a constrained vertex is on a curved constraint: the
+    gradient holds the mirror projectors constant there (as REF), so its
+    derivative has terms in the projectors' derivatives that
+    :func:`vertex_hessian` leaves out; ``hessian`` then takes differences of
+    the gradient."""
+    if not s.vcon:
+        return True
+    from ..constraints.levelset import constrained_vertices, curved_constraints
+    rows = np.nonzero(constrained_vertices(s))[0]
+    return not (len(rows) and curved_constraints(s, rows))
+
+
 for _name in C.VERTEX_METHODS:
-    register_method(_name, "vertex", C.vertex_values, C.vertex_gradient, vertex_hessian)
+    register_method(_name, "vertex", C.vertex_values, C.vertex_gradient, vertex_hessian,
+                    hessian_applies=plane_constraints_only)
 for _name in ("mean_curvature_integral", "mean_curvature_integral_a"):
     register_method(_name, "edge", C.mci_values, C.mci_gradient, mci_hessian)
 register_method("star_gauss_curvature", "vertex", C.star_gauss_values, C.star_gauss_gradient,

@@ -16,6 +16,7 @@ import pytest
 from pyevolver import Session
 from pyevolver.errors import UnsupportedError
 from pyevolver.methods import curvature as C
+from pyevolver.methods import curvature_hessian as CH
 from pyevolver.methods.registry import lookup
 from pyevolver.model.scene import MethodDecl
 from tolerances import FD
@@ -166,6 +167,13 @@ def test_curved_constraint_old_gradient_refused_star_projector_constant(tmp_path
     g = lookup("star_perp_sq_mean_curvature").gradient(
         S.evaluate(), MethodDecl(method="star_perp_sq_mean_curvature"), idx, np.ones(S.nv))
     assert np.isfinite(g).all()
+    # the analytic Hessian leaves out the projectors' derivatives: hessian
+    # falls back to differences of the gradient there, not on planes
+    entry = lookup("star_perp_sq_mean_curvature")
+    assert entry.hessian_applies is CH.plane_constraints_only
+    assert not entry.hessian_applies(S)
+    flat = Session.load(os.path.join(DATA, "curv_mound.fe"), out=io.StringIO()).surface
+    assert entry.hessian_applies(flat)
 
 
 def test_mix_sq_mean_curvature_is_refused_by_name():
