@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..constraints.levelset import constrained_vertices, curved_constraints
 from . import curvature as C
 from ._common import assemble, facet_points
 from .registry import register_method
@@ -368,7 +369,6 @@ def plane_constraints_only(s) -> bool:
     the gradient."""
     if not s.vcon:
         return True
-    from ..constraints.levelset import constrained_vertices, curved_constraints
     rows = np.nonzero(constrained_vertices(s))[0]
     return not (len(rows) and curved_constraints(s, rows))
 
