@@ -55,10 +55,11 @@ def _compare_run(evolver, path, script, tmp_path, rtol=LOOSE):
     return a, b
 
 
-@pytest.mark.parametrize("base,method", [("curv_mound.fe", "star_perp_sq_mean_curvature"),
-                                         ("curv_vesicle.fe", "sq_mean_curvature"),
-                                         ("curv_mound.fe", "sq_mean_curvature"),
-                                         ("curv_vesicle.fe", "star_perp_sq_mean_curvature")])
+@pytest.mark.parametrize("base,method", [
+    ("curv_mound.fe", "star_perp_sq_mean_curvature"),
+    ("curv_vesicle.fe", "sq_mean_curvature"),
+    pytest.param("curv_mound.fe", "sq_mean_curvature", marks=pytest.mark.slow),
+    pytest.param("curv_vesicle.fe", "star_perp_sq_mean_curvature", marks=pytest.mark.slow)])
 def test_g_and_refined_g_match_reference(evolver, tmp_path, base, method):
     """Acceptance: load, ``g 10``, ``r; g 5`` agree with REF within 1e-6
     (measured: 1e-13 on every line)."""
@@ -103,21 +104,23 @@ def test_nonwall_and_h_zero_star_methods_match_reference(evolver, tmp_path):
     _compare_run(evolver, path, "r\ng 8\n", tmp_path, rtol=STEPS)
 
 
-def test_catenoid_boundary_rings_match_reference(evolver, tmp_path):
+@pytest.mark.parametrize("free,m", [
+    (False, "sq_mean_curvature"), (True, "star_perp_sq_mean_curvature"),
+    pytest.param(True, "sq_mean_curvature", marks=pytest.mark.slow),
+    pytest.param(False, "star_perp_sq_mean_curvature", marks=pytest.mark.slow)])
+def test_catenoid_boundary_rings_match_reference(evolver, tmp_path, free, m):
     """Vertices on parametric boundaries (cat.fe's rings, FIXED or free):
     the old methods are zero there, the star methods use the partial star
     unprojected; ``r; g 5`` as REF."""
     with open(example("cat.fe")) as fh:
         src = fh.read()
     src = src[:src.index("read")]
-    for free in (False, True):
-        for m in ("sq_mean_curvature", "star_perp_sq_mean_curvature"):
-            text = src.replace("vertices   //", f"quantity bend energy method {m} global\n\nvertices //")
-            if free:
-                text = text.replace("fixed", "")
-            path = tmp_path / f"cat_{m}_{free}.fe"
-            path.write_text(text)
-            _compare_run(evolver, str(path), "r\ng 5\n", tmp_path, rtol=STEPS)
+    text = src.replace("vertices   //", f"quantity bend energy method {m} global\n\nvertices //")
+    if free:
+        text = text.replace("fixed", "")
+    path = tmp_path / f"cat_{m}_{free}.fe"
+    path.write_text(text)
+    _compare_run(evolver, str(path), "r\ng 5\n", tmp_path, rtol=STEPS)
 
 
 def test_gauss_curvature_integral_matches_reference(evolver, tmp_path):
