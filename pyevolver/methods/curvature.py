@@ -108,11 +108,13 @@ def _check_supported(s):
         raise UnsupportedError("curvature methods in the torus model")
 
 
-def _check_closed(s, what):
-    """Refuse ``what`` at constrained vertices and on surfaces with a free edge."""
+def _check_closed(s, what, constraints=False):
+    """Refuse ``what`` on surfaces with a free edge and, unless ``constraints``
+    (REF evaluates it there without projection), at constrained vertices."""
     _check_supported(s)
-    if s.vcon and any(np.any(m) for m in s.vcon.values()):
-        raise UnsupportedError(f"{what} at vertices on level-set constraints")
+    if not constraints and s.vcon and any(np.any(m) for m in s.vcon.values()):
+        raise UnsupportedError(f"{what} at vertices on level-set constraints",
+                               "no mirror rule known")
     if _edge_valence_one_vertices(s).any():
         raise UnsupportedError(f"{what} on surfaces with a free boundary",
                                "the partial stars of boundary vertices")
@@ -450,7 +452,7 @@ def star_gauss_values(ctx, m, idx):
 
 def sq_gauss_values(ctx, m, idx):
     """``sq_gauss_curvature``: K²/(A/3) at a vertex (closed surfaces)."""
-    _check_closed(ctx.surface, "sq_gauss_curvature")
+    _check_closed(ctx.surface, "sq_gauss_curvature", True)
     K, A, _, _ = _gauss(ctx)
     return (K * K / (A / 3.0))[idx]
 
@@ -458,7 +460,7 @@ def sq_gauss_values(ctx, m, idx):
 def _gauss_grad(t, idx, w, square):
     s = t.surface
     if square:
-        _check_closed(s, "sq_gauss_curvature")
+        _check_closed(s, "sq_gauss_curvature", True)
     else:
         _check_supported(s)
     K, A, P, dang = _gauss(t)

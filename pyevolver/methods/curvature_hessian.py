@@ -263,7 +263,7 @@ def _angle_jets(x):
 def _gauss_hessian(t, idx, w, square, basis):
     s = t.surface
     if square:
-        C._check_closed(s, "sq_gauss_curvature")
+        C._check_closed(s, "sq_gauss_curvature", True)
     else:
         C._check_supported(s)
     K, A, P, _ = C._gauss(t)

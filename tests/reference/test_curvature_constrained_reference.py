@@ -156,3 +156,10 @@ def test_mean_curvature_integral_steps_on_flat_edges_match_reference(evolver, tm
     path.write_text(src)
     _compare_run(evolver, str(path), "g 3\n", tmp_path, rtol=STEPS)
     _compare_run(evolver, str(path), "r\ng 4\n", tmp_path, rtol=STEPS)
+
+
+def test_sq_gauss_curvature_on_the_vesicle_matches_reference(evolver, tmp_path):
+    """``sq_gauss_curvature`` (closed surfaces) at constrained vertices: no
+    projection in REF; ``r; g 5`` as REF (measured 1e-15)."""
+    path = _variant(tmp_path, "curv_vesicle.fe", "sq_gauss_curvature")
+    _compare_run(evolver, path, "r\ng 5\n", tmp_path, rtol=STEPS)
