@@ -163,3 +163,16 @@ def test_sq_gauss_curvature_on_the_vesicle_matches_reference(evolver, tmp_path):
     projection in REF; ``r; g 5`` as REF (measured 1e-15)."""
     path = _variant(tmp_path, "curv_vesicle.fe", "sq_gauss_curvature")
     _compare_run(evolver, path, "r\ng 5\n", tmp_path, rtol=STEPS)
+
+
+@pytest.mark.parametrize("method", ["star_perp_sq_mean_curvature",
+                                    pytest.param("sq_mean_curvature", marks=pytest.mark.slow)])
+def test_vertices_on_two_mirror_planes_match_reference(evolver, tmp_path, method):
+    """A quarter mound between the planes x = 0, y = 0 and z = 0: F and N
+    projected onto the intersection line at vertices on two constraints;
+    ``g 10; r; g 5`` as REF (measured 3e-15)."""
+    with open(os.path.join(DATA, "curv_quarter.fe")) as fh:
+        src = fh.read().replace("star_perp_sq_mean_curvature", method)
+    path = tmp_path / f"quarter_{method}.fe"
+    path.write_text(src)
+    _compare_run(evolver, str(path), "g 10\nr\ng 5\n", tmp_path, rtol=STEPS)
