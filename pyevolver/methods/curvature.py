@@ -20,6 +20,12 @@ Hessian-vector product, never assembled), ``∂E/∂N`` through
 ``mean_curvature_integral`` is the edge method ``Σ_e ½ L_e θ_e`` with θ_e
 the signed exterior dihedral angle (positive where the surface is convex
 towards its normals), ∫H dA with H = (k1 + k2)/2.
+
+At vertices on level-set constraints F and N are projected onto the
+constraints' tangent space (the constraints act as mirror planes; manual,
+"eff_area_sq_mean_curvature"), by REF's rules found by experiment
+(:func:`mirror_projector`, docs/supported.md); a vertex on a free edge off
+any constraint uses its partial star as it is.
 """
 from __future__ import annotations
 
