@@ -339,10 +339,6 @@ def vertex_gradient(t, m, idx, w):
 
 # -- mean_curvature_integral ----------------------------------------------------------------
 
-MCI_FLAT = 1e-12
-"""|tan θ| below which an edge counts as flat for REF's gradient of ∫H dA."""
-
-
 def _dihedral(t, idx):
     """For the edges ``idx``: which have two facets (``ok``), those edges
     ``e``, and their facets running along (``f1``) and against (``f2``) them."""
@@ -370,7 +366,11 @@ def mci_values(ctx, m, idx):
     Le = np.linalg.norm(d, axis=1)
     S = np.einsum("ij,ij->i", np.cross(N1, N2), d) / Le
     C = np.einsum("ij,ij->i", N1, N2)
-    out[ok] = 0.5 * Le * np.arctan2(S, C)
+    if m.method == "mean_curvature_integral_a":
+        with np.errstate(all="ignore"):
+            out[ok] = 0.5 * Le * S / C          # REF's "_a": ½ L tan θ (blob0: 1e-15)
+    else:
+        out[ok] = 0.5 * Le * np.arctan2(S, C)
     return out
 
 
@@ -391,9 +391,15 @@ def mci_gradient(t, m, idx, w):
     theta = np.arctan2(S, C)
     R = S * S + C * C
     # dθ = (C dS − S dC)/R with S = u·(N1 × N2), C = N1·N2; REF drops dθ at
-    # flat edges (θ = 0 to round-off: its acos form is singular there), which
-    # decides its steps once `r` has made flat edges
-    flat = np.abs(S) <= MCI_FLAT * np.abs(C)
+    # exactly flat edges (its acos form is singular there: cube.fe's faces);
+    # at edges flat only to round-off (a refined curved surface) what REF
+    # does depends on its rounding, and the exact dθ is kept
+    flat = S == 0.0
+    if m.method == "mean_curvature_integral_a":       # ½ L tan θ: d tan θ = (C dS − S dC)/C²
+        flat[:] = False
+        with np.errstate(all="ignore"):
+            theta = S / C
+            R = C * C
     a = np.where(flat, 0.0, C / R)[:, None]
     b = np.where(flat, 0.0, S / R)[:, None]
     # through N1 (facet f1 corners) and N2 (facet f2 corners)

@@ -244,7 +244,10 @@ def mci_hessian(t, m, idx, w, basis=None):
     N2 = J.cross(x[0] - x[1], x[3] - x[1])       # f2 runs head → tail → l
     L = J.norm(d)
     u = d * _inverse(L)
-    theta = J.atan2(J.dot(u, J.cross(N1, N2)), J.dot(N1, N2))
+    if m.method == "mean_curvature_integral_a":           # ½ L tan θ (REF's "_a")
+        theta = J.dot(u, J.cross(N1, N2)) * _inverse(J.dot(N1, N2))
+    else:
+        theta = J.atan2(J.dot(u, J.cross(N1, N2)), J.dot(N1, N2))
     E = (L * theta) * (0.5 * w)
     return _elements(s.nv, verts, E.H, basis)
 

@@ -87,7 +87,8 @@ def _fd_check(S, value, grad, rng, h=1e-6, n=12):
     return worst
 
 
-@pytest.mark.parametrize("name", WILLMORE + ["mean_curvature_integral", "sq_gauss_curvature",
+@pytest.mark.parametrize("name", WILLMORE + ["mean_curvature_integral", "mean_curvature_integral_a",
+                                             "sq_gauss_curvature",
                                              "star_gauss_curvature", "circle_willmore",
                                              "harmonic_energy"])
 @pytest.mark.parametrize("h_zero", [None, 0.7])

@@ -182,7 +182,7 @@ def test_mix_sq_mean_curvature_is_refused_by_name():
 
 
 def test_mean_curvature_integral_drops_dtheta_at_flat_edges(tmp_path):
-    """REF's gradient of ∫H dA leaves out dθ at flat edges.  On cube.fe the
+    """REF's gradient of ∫H dA leaves out dθ at exactly flat edges.  On cube.fe the
     centre of a face is a wing of the four cube edges, whose θ = π/2 falls
     by 2 dz per unit lift (the facets tilt by dz/½), so the force there is
     4 outward (closed form; REF's v_force after ``g 1``), while the exact

@@ -144,7 +144,7 @@ def test_gauss_curvature_integral_matches_reference(evolver, tmp_path):
 
 
 def test_mean_curvature_integral_steps_on_flat_edges_match_reference(evolver, tmp_path):
-    """∫H dA on cube.fe: REF drops dθ at flat edges (the faces' diagonals,
+    """∫H dA on cube.fe: REF drops dθ at exactly flat edges (the faces' diagonals,
     and after ``r`` the refined faces), so its steps are not those of the
     exact gradient; ``g 3`` and ``r; g 4`` as REF (measured: equal to the last
     printed digit; the exact gradient differed by 7e-5 in the first step)."""
@@ -176,3 +176,26 @@ def test_vertices_on_two_mirror_planes_match_reference(evolver, tmp_path, method
     path = tmp_path / f"quarter_{method}.fe"
     path.write_text(src)
     _compare_run(evolver, str(path), "g 10\nr\ng 5\n", tmp_path, rtol=STEPS)
+
+
+def test_mean_curvature_integral_a_is_half_length_times_tan(evolver, tmp_path):
+    """REF's ``mean_curvature_integral_a`` is Σ_e ½ L_e tan θ_e (found from
+    its per-edge values on blob0.fe, 1e-15), not ∫H dA: value, ``g 3``,
+    ``r`` and ``g 3`` on blob0 as REF (measured: every digit)."""
+    with open(os.path.join(DATA, "checks", "blob0.fe")) as fh:
+        lines = [l for l in fh.read().split("\n") if not l.startswith("quantity")]
+    src = "\n".join(lines).replace(
+        "vertices", "quantity mcia energy method mean_curvature_integral_a global\n\nvertices", 1)
+    path = tmp_path / "blob_mcia.fe"
+    path.write_text(src)
+    script = "print mcia.value\ng 3\nr\nprint mcia.value\ng 3\n"
+    ref = run_reference(evolver, str(path), script, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(str(path), script + "q\n", cwd=str(tmp_path))
+    assert code == 0, err
+    nums = [float(l) for l in ref if re.fullmatch(r"\s*-?[\d.]+\s*", l)]
+    ours = [float(l) for l in out if re.fullmatch(r"\s*-?[\d.]+\s*", l)]
+    assert len(nums) == len(ours) == 2
+    assert all(abs(a - b) <= PRINTED * 10 * abs(b) for a, b in zip(ours, nums))
+    a, b = _steps(out), _steps(ref)
+    assert len(a) == len(b) == 6
+    assert all(abs(x[1] - y[1]) <= STEPS * abs(y[1]) for x, y in zip(a, b))
