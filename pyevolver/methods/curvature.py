@@ -156,7 +156,8 @@ def mirror_projector(s, m):
     Old-style methods (``sq_mean_curvature``, ``eff_area_…``, ``normal_…``) project
     at every vertex on a level-set constraint; the ``star_…`` methods only at
     those that also lie on an edge with one facet (an incomplete star).
-    ``ignore_constraints`` in the declaration turns it off.  Measured against
+    ``ignore_constraints`` in the declaration turns it off for the old
+    methods only (REF: no effect on the star methods).  Measured against
     evolver-nox-d 2.70 on a mound (free edge on z = 0) and a closed cube with
     its bottom vertices on z = 0 (docs/supported.md).
 
@@ -168,9 +169,9 @@ def mirror_projector(s, m):
         ``I − G (GᵀG)⁻¹ Gᵀ`` of each, G the gradients of its constraints.
     """
     empty = (np.zeros(0, np.int64), np.zeros((0, 3, 3)))
-    if not s.vcon or getattr(m, "ignore_constraints", False):
-        return empty
     old = VERTEX_METHODS.get(m.method, ("", "", True))[2]
+    if not s.vcon or (old and getattr(m, "ignore_constraints", False)):
+        return empty
     on = _wall_vertices(s, old)
     if not old:
         on &= _edge_valence_one_vertices(s)

@@ -126,6 +126,8 @@ def test_projection_rules(dome, vesicle):
         assert (len(rows) > 0) == star_rows
         ign = MethodDecl(method="sq_mean_curvature", ignore_constraints=True)
         assert len(C.mirror_projector(S, ign)[0]) == 0
+        ign = MethodDecl(method="star_perp_sq_mean_curvature", ignore_constraints=True)
+        assert (len(C.mirror_projector(S, ign)[0]) > 0) == star_rows     # no effect (REF)
 
 
 def test_old_method_gradients_refused_where_ref_differs(vesicle):

@@ -124,8 +124,8 @@ def test_catenoid_boundary_rings_match_reference(evolver, tmp_path, free, m):
 
 
 def test_gauss_curvature_integral_matches_reference(evolver, tmp_path):
-    """``gauss_curvature_integral`` on cat.fe (boundary rings) and on the
-    mound with a FIXED base: value after ``r`` and the ``g 5`` steps."""
+    """``gauss_curvature_integral`` on cat.fe (boundary rings): the ``g 5``
+    steps after ``r`` (the mound with a FIXED base in the slow run)."""
     with open(example("cat.fe")) as fh:
         cat = fh.read()
     cat = cat[:cat.index("read")].replace(
@@ -133,6 +133,11 @@ def test_gauss_curvature_integral_matches_reference(evolver, tmp_path):
     p1 = tmp_path / "cat_gci.fe"
     p1.write_text(cat)
     _compare_run(evolver, str(p1), "r\ng 5\n", tmp_path, rtol=STEPS)
+
+
+@pytest.mark.slow
+def test_gauss_curvature_integral_on_a_fixed_base_matches_reference(evolver, tmp_path):
+    """The mound with a FIXED base: boundary corners and sides counted."""
     with open(os.path.join(DATA, "curv_mound.fe")) as fh:
         mound = fh.read()
     mound = mound.replace("method star_perp_sq_mean_curvature", "method gauss_curvature_integral")
@@ -158,6 +163,7 @@ def test_mean_curvature_integral_steps_on_flat_edges_match_reference(evolver, tm
     _compare_run(evolver, str(path), "r\ng 4\n", tmp_path, rtol=STEPS)
 
 
+@pytest.mark.slow
 def test_sq_gauss_curvature_on_the_vesicle_matches_reference(evolver, tmp_path):
     """``sq_gauss_curvature`` (closed surfaces) at constrained vertices: no
     projection in REF; ``r; g 5`` as REF (measured 1e-15)."""
@@ -199,3 +205,12 @@ def test_mean_curvature_integral_a_is_half_length_times_tan(evolver, tmp_path):
     a, b = _steps(out), _steps(ref)
     assert len(a) == len(b) == 6
     assert all(abs(x[1] - y[1]) <= STEPS * abs(y[1]) for x, y in zip(a, b))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["star_perp_sq_mean_curvature", "sq_mean_curvature"])
+def test_ignore_constraints_matches_reference(evolver, tmp_path, method):
+    """IGNORE_CONSTRAINTS turns the projection off for the old methods and
+    has no effect on the star methods (REF); ``r; g 5`` as REF."""
+    path = _variant(tmp_path, "curv_mound.fe", method, " ignore_constraints")
+    _compare_run(evolver, path, "r\ng 5\n", tmp_path, rtol=STEPS)
