@@ -140,6 +140,10 @@ class QuadTotals(Totals):
                                    "the Evolver has no curvature in the quadratic model")
         self.facet_nodes = facet_nodes(s)
         self.facet_P = s.X[self.facet_nodes]
+        # the corner triangles (facet_x0, facet_S on demand): REF's facet
+        # normal attribute uses the three corners in the quadratic model
+        self._corner_xyz = tuple(np.ascontiguousarray(self.facet_P[:, :3, k].T)
+                                 for k in range(3))
         X, Xu, Xv = Q.patch_frames(self.facet_P)
         N = np.cross(Xu, Xv)
         self.facet_area = np.linalg.norm(N, axis=2) @ _W7

@@ -189,16 +189,33 @@ class _Builder:
         n = len(blk.ids)
         self.eid = IdMap(blk.ids, "edge", sc.filename, blk.lines)
         E = np.zeros((n, 2), np.int64)
-        if isinstance(blk.data, np.ndarray):
-            bad = [0] if blk.data.shape[1] != 2 else []
+        data = blk.data
+        if "quadratic" in sc.flags and n and not isinstance(data, np.ndarray):
+            # the quadratic model: an edge may list its midpoint third
+            # (manual: "Quadratic declaration"); kept for the conversion
+            # (pyevolver.remesh.quadratic.from_listed) as s.listed_midpoints
+            mids = np.array([d[2] if len(d) == 3 else 0 for d in data], np.int64)
+            data = [d[:2] if len(d) == 3 else d for d in data]
+            has = mids != 0
+            listed = np.full(n, -1, np.int64)
+            if has.any():
+                listed[has] = self.vid.lookup(mids[has], [blk.lines[k] for k in
+                                                          np.nonzero(has)[0]],
+                                              "edge", [blk.ids[k] for k in np.nonzero(has)[0]])
+            s.listed_midpoints = listed
+        elif "quadratic" in sc.flags and isinstance(data, np.ndarray) and data.shape[1] == 3:
+            s.listed_midpoints = self.vid.lookup(data[:, 2:], blk.lines, "edge", blk.ids)[:, 0]
+            data = data[:, :2]
+        if isinstance(data, np.ndarray):
+            bad = [0] if data.shape[1] != 2 else []
         else:
-            bad = [k for k, d in enumerate(blk.data) if len(d) != 2]
+            bad = [k for k, d in enumerate(data) if len(d) != 2]
         if bad:
             k = bad[0]
             raise self.error(f"edge {blk.ids[k]}: expected two vertex ids, got "
-                             f"{len(blk.data[k])}", blk.lines[k])
+                             f"{len(data[k])}", blk.lines[k])
         if n:
-            raw = np.array(blk.data, dtype=np.int64)
+            raw = np.array(data, dtype=np.int64)
             E[:] = self.vid.lookup(raw, blk.lines, "edge", blk.ids)
         fixed = np.zeros(n, bool)
         tension = np.ones(n) if s.string else None     # string edges: tension 1

@@ -16,7 +16,7 @@ from ..constraints import constrained_vertices, project_to_constraints
 from ..errors import UnsupportedError
 from ..geometry import quadratic as Q
 from ..model.surface import Surface
-from .grow import grow
+from .grow import grow, remap_quantities
 from .refine import boundary_midpoints, split_edges
 from .shrink import subset
 
@@ -152,3 +152,57 @@ def refine_quadratic(s: Surface) -> Surface:
     P[ne:ne + len(R)] = halves[:, 1]
     P[ne + len(R):] = _inner_midpoints(s, ref, patches)
     return _add_midpoints(t, P)
+
+
+def _permute_vertices(s: Surface, perm: np.ndarray) -> Surface:
+    """A copy of ``s`` whose vertex ``i`` is ``s``'s vertex ``perm[i]`` (ids kept)."""
+    perm = np.asarray(perm, np.int64)
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(len(perm))
+    keep = np.ones(s.nv, bool)
+    t = subset(s, s.E, s.FE, keep, np.ones(s.ne, bool), np.ones(s.nf, bool))
+    t.X = s.X[perm].copy()
+    t.E = inv[s.E]
+    t.vattr = {k: a[perm].copy() for k, a in t.vattr.items()}
+    t.vcon = {c: a[perm].copy() for c, a in t.vcon.items()}
+    t.extra = {(et, n): (a[perm].copy() if et == "vertex" else a) for (et, n), a in t.extra.items()}
+
+    def move(etype, idx, sgn):
+        return (inv[idx], sgn) if etype == "vertex" else (idx, sgn)
+    t.quantities = remap_quantities(t, t, move)
+    t.__dict__.pop("_topo", None)
+    return t
+
+
+def from_listed(s: Surface) -> Surface:
+    """The quadratic surface of a datafile with ``QUADRATIC`` in its top
+    section: the edges' listed midpoints (``s.listed_midpoints``, -1 where an
+    edge lists none) move to the end in edge order; an edge without one
+    gets a new midpoint as with ``M 2``.
+
+    Raises
+    ------
+    UnsupportedError
+        When a listed midpoint is also an edge's end or two edges share one.
+    """
+    mids = np.asarray(s.__dict__.pop("listed_midpoints"), np.int64)
+    _check(s)
+    listed = mids[mids >= 0]
+    if len(np.unique(listed)) != len(listed) or np.isin(listed, s.E).any():
+        raise UnsupportedError("a midpoint vertex shared by two edges or also an edge's end")
+    missing = np.nonzero(mids < 0)[0]
+    if len(missing):
+        nv = s.nv
+        s = grow(s, v_from_edge=missing)
+        new = np.arange(nv, nv + len(missing))
+        s.X[new] = 0.5 * (s.X[s.E[missing, 0]] + s.X[s.E[missing, 1]])
+        boundary_midpoints(s, s.E[missing, 0], s.E[missing, 1], new)
+        sel = new[constrained_vertices(s)[new]]
+        if len(sel):
+            project_to_constraints(s, sel)
+        mids = mids.copy()
+        mids[missing] = new
+    corners = np.setdiff1d(np.arange(s.nv), mids)
+    t = _permute_vertices(s, np.concatenate([corners, mids]))
+    t.order = 2
+    return t
