@@ -36,8 +36,11 @@ def _add_midpoints(s: Surface, P: np.ndarray | None = None) -> Surface:
     t = grow(s, v_from_edge=np.arange(ne))
     new = np.arange(nv, nv + ne)
     t.X[new] = 0.5 * (s.X[s.E[:, 0]] + s.X[s.E[:, 1]]) if P is None else P
-    # on a boundary: the curve point nearest the chord's midpoint
-    boundary_midpoints(t, s.E[:, 0], s.E[:, 1], new)
+    # on a boundary: the curve point nearest the chord's midpoint (after r:
+    # nearest the point of the old curve), by the Gauss-Newton of
+    # remesh.refine started from the tail's parameters (REF's p1 after M 2
+    # on catbody.fe: 0.5235693, below pi/6 as from the tail)
+    boundary_midpoints(t, s.E[:, 1], s.E[:, 0], new, target=P)
     sel = new[constrained_vertices(t)[new]]
     if len(sel):
         project_to_constraints(t, sel)
@@ -125,11 +128,6 @@ def refine_quadratic(s: Surface) -> Surface:
         midpoint per edge: ``V' = V + E + (2E + 3F)``, ``E' = 2E + 3F``,
         ``F' = 4F`` without NO_REFINE.
     """
-    if "boundary" in s.vattr and s.vattr["boundary"].any():
-        # catbody.fe: the area after M 2; r differs from REF's by 6e-6
-        # relative; the new boundary midpoints are not placed as REF does
-        raise UnsupportedError("r on boundaries in the quadratic model",
-                               "the new midpoints on boundaries are not matched yet")
     ne = s.ne
     midv = s.midv
     assert midv is not None
