@@ -393,6 +393,12 @@ def _edge_scalar_integral(t, m, idx):
     return (f * np.linalg.norm(Et, axis=2)) @ Q.GL3_W
 
 
+def _vertex_scalar_integral(t, m, idx):
+    # the midpoints are vertices: REF sums them too (M 2 on a tetrahedron:
+    # 12.0575 = the 4 corners' 5.09 + the 6 midpoints')
+    return t.eval_points(m.scalar, t.surface.X[idx], "vertex", idx)
+
+
 def _edge_vector_integral(t, m, idx):
     return t.edge_vector_integral(m.vector or [], idx)
 
@@ -410,6 +416,7 @@ for _name, _et, _v, _g in (
         ("edge_tension", "edge", _edge_tension, _edge_tension_gradient),
         ("facet_vector_integral", "facet", _facet_vector_integral, _facet_vector_gradient),
         ("facet_scalar_integral", "facet", _facet_scalar_integral, None),
+        ("vertex_scalar_integral", "vertex", _vertex_scalar_integral, None),
         ("edge_scalar_integral", "edge", _edge_scalar_integral, None),
         ("edge_vector_integral", "edge", _edge_vector_integral, _edge_vector_gradient)):
     register_method(_name, _et, _v, _g, no_hessian=_NO, model="quadratic")
