@@ -11,7 +11,7 @@ from ..expr.nodes import Formula
 from ..limits import MAX_ARRAY_ENTRIES
 from ..geometry import kernels as G
 from .formulas import located
-from .ids import IdMap, Lazy
+from .ids import IdMap, Lazy, split_midpoints
 from .records import first_facets_on_load, record_edge_first_facet
 from .scene import Scene
 from .string import STRING_METHODS, init_rings
@@ -190,22 +190,8 @@ class _Builder:
         self.eid = IdMap(blk.ids, "edge", sc.filename, blk.lines)
         E = np.zeros((n, 2), np.int64)
         data = blk.data
-        if "quadratic" in sc.flags and n and not isinstance(data, np.ndarray):
-            # the quadratic model: an edge may list its midpoint third
-            # (manual: "Quadratic declaration"); kept for the conversion
-            # (pyevolver.remesh.quadratic.from_listed) as s.listed_midpoints
-            mids = np.array([d[2] if len(d) == 3 else 0 for d in data], np.int64)
-            data = [d[:2] if len(d) == 3 else d for d in data]
-            has = mids != 0
-            listed = np.full(n, -1, np.int64)
-            if has.any():
-                listed[has] = self.vid.lookup(mids[has], [blk.lines[k] for k in
-                                                          np.nonzero(has)[0]],
-                                              "edge", [blk.ids[k] for k in np.nonzero(has)[0]])
-            s.listed_midpoints = listed
-        elif "quadratic" in sc.flags and isinstance(data, np.ndarray) and data.shape[1] == 3:
-            s.listed_midpoints = self.vid.lookup(data[:, 2:], blk.lines, "edge", blk.ids)[:, 0]
-            data = data[:, :2]
+        if "quadratic" in sc.flags and n:     # (pyevolver.remesh.quadratic.from_listed)
+            data, s.listed_midpoints = split_midpoints(data, self.vid, blk.lines, blk.ids)
         if isinstance(data, np.ndarray):
             bad = [0] if data.shape[1] != 2 else []
         else:
