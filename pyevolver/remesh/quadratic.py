@@ -184,6 +184,8 @@ def from_listed(s: Surface) -> Surface:
         When a listed midpoint is also an edge's end or two edges share one.
     """
     mids = np.asarray(s.__dict__.pop("listed_midpoints"), np.int64)
+    # the edges of triangulated faces (spokes) come after the listed ones
+    mids = np.concatenate([mids, np.full(s.ne - len(mids), -1, np.int64)])
     _check(s)
     listed = mids[mids >= 0]
     if len(np.unique(listed)) != len(listed) or np.isin(listed, s.E).any():
