@@ -100,3 +100,14 @@ def test_refusals():
     with pytest.raises(UnsupportedError, match="midpoint"):
         from_listed(s)
     assert ROUNDOFF > 0
+
+
+def test_refine_refuses_partly_split_facets(tmp_path):
+    # REF places the midpoints of the edges cutting such facets elsewhere
+    text = open(example("cube.fe")).read().replace("\n1   1 2   \n", "\n1   1 2 no_refine\n")
+    p = tmp_path / "c.fe"
+    p.write_text(text)
+    s = to_quadratic(pyevolver.load(str(p)).surface)
+    assert s.eattr["no_refine"].sum() == 1
+    with pytest.raises(UnsupportedError, match="NO_REFINE"):
+        refine_quadratic(s)
