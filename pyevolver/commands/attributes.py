@@ -138,7 +138,7 @@ ATTRIBUTES = [
      "to 4 entries; empty when no element of the kind is on a constraint"),
     ("vertex, edge, facet", "v_/e_/f_method_list, f_body_list, f_next_bfacet, wrap_list, "
      "raw_velocity", "refused by name (the Evolver's internal data structure)"),
-    ("edge", "midv", "REF's error: only in the quadratic model"),
+    ("edge", "midv", "the midpoint's id in the quadratic model; REF's error in the linear one"),
     ("edge", "frontbody, backbody", "string model: the bodies of the facets along and "
      "against the edge; soapfilm model: REF's error"),
     ("facet, edge", "set frontbody / backbody / wrap, unset frontbody / backbody / bodies",
@@ -249,6 +249,8 @@ def element_attr(session, base, name, idx):
     if (k, name) in GRAPHICS:
         key = (k, _GRAPHICS_ALIAS.get(name, name))
         return float(_session_store(session).get(key, {}).get(i, GRAPHICS[(k, name)]))
+    if (k, name) == ("vertex", "mid_edge") and s.order == 2:
+        return float(i >= s.nv - s.ne)           # the midpoints are the last ne vertices
     if (k, name) in FLAGS_DEFAULT:
         return FLAGS_DEFAULT[(k, name)]
     only = _ONLY.get(name)
@@ -320,7 +322,9 @@ def element_attr(session, base, name, idx):
         if name == "length":
             return float(geometry(session).edge_length[i])
         if name == "midv":
-            raise ExpressionError("Cannot do MIDV except in QUADRATIC model.")
+            if s.order != 2:
+                raise ExpressionError("Cannot do MIDV except in QUADRATIC model.")
+            return float(s.ids("vertex")[s.midv[i]])
         if name in ("frontbody", "backbody"):
             if not s.string:
                 raise ExpressionError("Frontbody or backbody only for facets, or string "

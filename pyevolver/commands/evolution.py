@@ -94,11 +94,6 @@ def _recalc(interp, raw, arg):
     interp.session.recalc(reposition=True)
 
 
-@register("linear", usage="linear", help="the linear model (a no-op here)", family=FAMILY)
-def _linear(interp, raw, arg):
-    return        # a no-op on a linear surface, as in REF
-
-
 @register("convert_to_quantities", usage="convert_to_quantities", arg="none",
           help="compute energies as named quantities (the numbers are the same)",
           family=FAMILY)

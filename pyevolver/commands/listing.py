@@ -91,6 +91,8 @@ def _list_edge(session: SessionLike, i):
     vid, eid = s.ids("vertex"), s.ids("edge")
     a, b = vid[s.E[i]]
     line = f"{eid[i]:3d}   {a:5d} {b:4d}    "
+    if s.order == 2:                      # REF: "/*midpt*/  16" in the quadratic model
+        line += f"  /*midpt*/ {vid[s.midv[i]]:3d} "
     w = s.eattr.get("wrap")
     if w is not None:
         line += " " + " ".join({0: "*", 1: "+", -1: "-"}.get(int(x), "?")

@@ -18,13 +18,13 @@ LETTER_LATER = {
     "e": "e (extrapolation)", "i": "i (information)", "Q": "Q (quantities)",
     "C": "C (consistency check)", "c": "c (counts)", "N": "N",
     "b": "b (interactive body targets)", "p": "p (ideal gas)", "y": "y (torus duplication)",
-    "Z": "Z (zoom)", "M": "M (model order)", "J": "J (jiggle toggle)",
+    "Z": "Z (zoom)", "J": "J (jiggle toggle)",
 }
 WORD_LATER = {
     "hessian_menu", "move",
     "vertex_average", "raw_vertex_average", "rawest_vertex_average",
     "pop",
-    "t1_edgeswap", "dissolve", "optimize", "optimise", "lagrange", "quadratic",
+    "t1_edgeswap", "dissolve", "optimize", "optimise",
     "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
     "conj_grad_later", "fix", "unfix", "burchard", "zoom",
 }
@@ -37,7 +37,7 @@ def _x_abort(interp, node):
 
 
 @register("system", "shell", "exec", "permload", "define boundary", "define quantity",
-          "define method_instance", "quadratic", "detorus", "dissolve", "binary_printf",
+          "define method_instance", "detorus", "dissolve", "binary_printf",
           "binary_off_file", "postscript", "reorder_storage", "renumber_all",
           usage="(refused)", statement="unsupported", help="refused by name",
           family="refused")

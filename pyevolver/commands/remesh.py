@@ -16,6 +16,7 @@ from ..errors import CommandError, UnsupportedError
 from ..remesh import string as SM
 from ..remesh import delete_edges as DEL, edge_divide as ED, equiangulate as EQ
 from ..remesh import notch as NO, pop as POP, vertex_average as VA
+from ..remesh.quadratic import refine_quadratic
 from ..remesh.refine import refine as _refine_all
 from . import element_attrs, elements, variables
 from .registry import register
@@ -27,6 +28,8 @@ def refine(session: SessionLike, echo=True):
     s = session.surface
     if s.string:
         session._string_split(np.nonzero(~s.eattr["no_refine"])[0])
+    elif s.order == 2:
+        session._replace_surface(refine_quadratic(s))
     else:
         session._replace_surface(_refine_all(s))
     if "edge_divide_length" in session.settings:
@@ -209,6 +212,14 @@ def vertex_average(session: SessionLike, mode="V", echo=True):
 FAMILY = "remesh"
 
 
+def linear_only(session: SessionLike, what: str) -> None:
+    """Refuse ``what`` by name in the quadratic model (pyevolver's mesh
+    operations other than ``r`` do not carry the edge midpoints)."""
+    if getattr(session.surface, "order", 1) == 2:
+        raise UnsupportedError(f"{what} in the quadratic model",
+                               "only r is implemented there; M 1 returns to the linear model")
+
+
 @register("r", usage="r [n]", help="refine every edge and facet (n times)", family=FAMILY)
 def _r(interp, raw, arg):
     for _ in range(1 if arg is None else interp.count(arg)):
@@ -218,6 +229,7 @@ def _r(interp, raw, arg):
 
 @register("j", usage="j [temperature]", help="jiggle the vertices", family=FAMILY)
 def _j(interp, raw, arg):
+    linear_only(interp.session, "j (jiggle)")
     jiggle(interp.session,
            None if arg is None else as_float(interp.value(arg), f"the argument of {raw}"))
 
@@ -231,51 +243,60 @@ def _needs_value(interp, raw, arg, example):
 @register("t", "edgeweed", usage="t length", help="delete edges shorter than length",
           family=FAMILY)
 def _t(interp, raw, arg):
+    linear_only(interp.session, "t (edge weeding)")
     delete_short_edges(interp.session, _needs_value(interp, raw, arg, "0.01"))
 
 
 @register("w", "areaweed", usage="w area", help="weed facets smaller than area",
           family=FAMILY)
 def _w(interp, raw, arg):
+    linear_only(interp.session, "w (area weeding)")
     weed(interp.session, _needs_value(interp, raw, arg, "0.01"))
 
 
 @register("l", "edge_divide", usage="l length", help="bisect edges longer than length",
           family=FAMILY)
 def _l(interp, raw, arg):
+    linear_only(interp.session, "l (edge division)")
     edge_divide_long(interp.session, _needs_value(interp, raw, arg, "0.3"))
 
 
 @register("K", usage="K angle", help="bisect skinny triangles", family=FAMILY)
 def _k(interp, raw, arg):
+    linear_only(interp.session, "K (skinny triangles)")
     skinny(interp.session, _needs_value(interp, raw, arg, "0.3"))
 
 
 @register("n", "notch", usage="n angle", help="notch edges sharper than angle",
           family=FAMILY)
 def _n(interp, raw, arg):
+    linear_only(interp.session, "n (notching)")
     notch(interp.session, _needs_value(interp, raw, arg, "0.3"))
 
 
 @register("V", "rawv", "rawestv", usage="V | rawv | rawestv", help="vertex averaging",
           family=FAMILY)
 def _v_average(interp, raw, arg):
+    linear_only(interp.session, "vertex averaging")
     vertex_average(interp.session, {"V": "V", "rawv": "raw", "rawestv": "rawest"}[raw])
 
 
 @register("O", usage="O", help="pop edges with four facets", family=FAMILY)
 def _o(interp, raw, arg):
+    linear_only(interp.session, "O (popping)")
     pop_edges(interp.session)
 
 
 @register("u", "equiangulate", usage="u", help="one equiangulation sweep", family=FAMILY)
 def _u(interp, raw, arg):
+    linear_only(interp.session, "u (equiangulation)")
     equiangulate(interp.session)
 
 
 @register("refine", usage="refine edges|facets [where ...]", statement="refine",
           help="bisect the edges, or split the facets at their centres", family=FAMILY)
 def _x_refine(interp, node):
+    linear_only(interp.session, "refine")
     s = interp.session
     els = elements.generate(s, node[1], interp.env)
     kinds = {el.kind for el in els}
@@ -291,6 +312,7 @@ def _x_refine(interp, node):
 @register("edgeswap", usage="edgeswap edges [where ...]", statement="edgeswap",
           help="flip the edges that are quadrilateral diagonals", family=FAMILY)
 def _x_edgeswap(interp, node):
+    linear_only(interp.session, "edgeswap")
     s = interp.session
     els = elements.generate(s, node[1], interp.env)
     if {el.kind for el in els} - {"edge"}:
@@ -301,6 +323,7 @@ def _x_edgeswap(interp, node):
 @register("delete", usage="delete edges|facets [where ...]", statement="delete",
           help="delete edges (facets: their shortest side)", family=FAMILY)
 def _x_delete(interp, node):
+    linear_only(interp.session, "delete")
     s = interp.session
     gen = node[1]
     if gen.kind not in ("edge", "facet"):

@@ -115,7 +115,8 @@ def internal(session: SessionLike, name):
         "random": lambda: float(session.rng.random()),
         "quantity_count": lambda: len(s.quantities),
         "symmetry_group": lambda: 0, "simplex_representation": lambda: 0,
-        "lagrange_order": lambda: 1, "linear": lambda: 1, "quadratic": lambda: 0,
+        "lagrange_order": lambda: s.order, "linear": lambda: int(s.order == 1),
+        "quadratic": lambda: int(s.order == 2),
         "lagrange": lambda: 0,
         "date_and_time": lambda: time.strftime("%a %b %d %H:%M:%S %Y"),
         # REF: "total elapsed Evolver execution time in seconds"; here the

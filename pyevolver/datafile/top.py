@@ -263,6 +263,8 @@ class TopSection:
                 sc.values[name + "_fixed"] = 1.0
             # the quadrature orders: pyevolver has REF's default rules only
             default = {"integral_order_1d": 3.0, "integral_order_2d": 6.0}.get(name)
+            if "quadratic" in sc.flags:     # REF's dump of the quadratic model writes 5 and 3
+                default = {"integral_order_1d": 5.0, "integral_order_2d": 3.0}.get(name)
             if name == "integral_order" or (default is not None and
                                             sc.values[name] != default):
                 raise self.error(f"not supported in pyevolver: {name.upper()} "

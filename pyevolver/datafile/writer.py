@@ -190,6 +190,8 @@ class _FeWriter:
                 self.w(" ".join(num(v) for v in row))
         if s.symmetric_content:
             self.w("SYMMETRIC_CONTENT")
+        if s.order == 2:
+            self.w("QUADRATIC")
         mode = getattr(s, "curvature_mode", "plain")
         if mode == "eff":
             self.w("EFFECTIVE_AREA")
@@ -385,6 +387,8 @@ class _FeWriter:
         for k in range(s.ne):
             a, b = s.E[k]
             parts = [str(a + 1), str(b + 1)]
+            if s.order == 2:               # the midpoint third (REF's dump)
+                parts.append(str(s.midv[k] + 1))
             if wrap is not None:
                 parts += [{0: "*", 1: "+", -1: "-"}[int(v)] for v in wrap[k]]
             if ea.get("fixed") is not None and ea["fixed"][k]:

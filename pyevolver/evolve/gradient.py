@@ -38,6 +38,8 @@ def energy_gradient(t):
     s = t.surface
     if s.string:
         return _string_energy_gradient(t)
+    if hasattr(t, "energy_gradient"):       # a model's own (the quadratic model's)
+        return t.energy_gradient()
     g = corner_scatter(t, facet_area_grad(t), s.facet_tension)
     et = s.eattr.get("tension")
     if et is not None and np.any(et):
@@ -127,6 +129,8 @@ def body_volume_gradients(t):
     s = t.surface
     if s.string:
         return SM.volume_gradients(t)
+    if hasattr(t, "body_volume_gradients"):  # a model's own (the quadratic model's)
+        return t.body_volume_gradients()
     b = s.bodies
     vg = facet_volume_grad(t, s.symmetric_content)
     out = np.zeros((b.n, s.nv, 3))
@@ -174,7 +178,7 @@ def quantity_gradient(t, q):
     for m, etype, idx, sign in q.methods:
         w = np.ones(len(idx)) if sign is None else np.asarray(sign, float)
         w = w * m.modulus * q.modulus
-        fn = lookup(m.method).gradient
+        fn = lookup(m.method, getattr(t, "model", "linear")).gradient
         if fn is None:
             raise UnsupportedError(f"the gradient of method {m.method}")
         g += fn(t, m, np.asarray(idx, np.int64), w)

@@ -255,6 +255,10 @@ def _quantity_hessian(t, q, weight):
 def lagrangian_hessian(s, cons, lam, grad_fn, basis=None):
     """Sparse Hessian of E − Σ λ_i g_i (level-set terms excluded): (3nv, 3nv),
     or ``Tᵀ H T`` on a :class:`Basis`."""
+    if getattr(s, "order", 1) == 2:         # the quadratic model's hook
+        raise UnsupportedError("the Hessian in the quadratic model",
+                               "REF fails there too (cube.fe: M 2; g 5; hessian gives "
+                               "ERROR 3362); M 1 returns to the linear model")
     t = s.evaluate()
     H, _, complete = _analytic_parts(s, t, cons, lam, basis, gradient=False)
     if complete:

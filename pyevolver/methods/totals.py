@@ -42,6 +42,8 @@ class Totals:
         (ne, 3), (ne,), (nf, 3), (nf, 2, 3): computed on first use.
     """
 
+    model = "linear"        # the element order whose method variants apply
+
     def __init__(self, s: Surface):
         self.surface = s
         X = s.X
@@ -290,7 +292,7 @@ class Totals:
                 for di, n in zip(d, names)))
         total = 0.0
         for m, etype, idx, sign in q.methods:
-            fn = lookup(m.method).value
+            fn = lookup(m.method, self.model).value
             vals = fn(self, m, idx)
             if magnitude:
                 total += abs(m.modulus) * float(np.sum(np.abs(vals)))
@@ -331,7 +333,10 @@ def evaluate(surface: Surface) -> Totals:
         Of the class :data:`MODEL_TOTALS` gives the surface's model (a
         :class:`pyevolver.methods.string.StringTotals` in the string model).
     """
-    return MODEL_TOTALS["string" if surface.string else "soapfilm"](surface)
+    model = "string" if surface.string else "soapfilm"
+    if getattr(surface, "order", 1) == 2:
+        model = "quadratic"
+    return MODEL_TOTALS[model](surface)
 
 
 HOOKS.evaluate = evaluate

@@ -11,7 +11,7 @@ from ..expr.nodes import Formula
 from ..limits import MAX_ARRAY_ENTRIES
 from ..geometry import kernels as G
 from .formulas import located
-from .ids import IdMap, Lazy
+from .ids import IdMap, Lazy, split_midpoints
 from .records import first_facets_on_load, record_edge_first_facet
 from .scene import Scene
 from .string import STRING_METHODS, init_rings
@@ -189,16 +189,19 @@ class _Builder:
         n = len(blk.ids)
         self.eid = IdMap(blk.ids, "edge", sc.filename, blk.lines)
         E = np.zeros((n, 2), np.int64)
-        if isinstance(blk.data, np.ndarray):
-            bad = [0] if blk.data.shape[1] != 2 else []
+        data = blk.data
+        if "quadratic" in sc.flags and n:     # (pyevolver.remesh.quadratic.from_listed)
+            data, s.listed_midpoints = split_midpoints(data, self.vid, blk.lines, blk.ids)
+        if isinstance(data, np.ndarray):
+            bad = [0] if data.shape[1] != 2 else []
         else:
-            bad = [k for k, d in enumerate(blk.data) if len(d) != 2]
+            bad = [k for k, d in enumerate(data) if len(d) != 2]
         if bad:
             k = bad[0]
             raise self.error(f"edge {blk.ids[k]}: expected two vertex ids, got "
-                             f"{len(blk.data[k])}", blk.lines[k])
+                             f"{len(data[k])}", blk.lines[k])
         if n:
-            raw = np.array(blk.data, dtype=np.int64)
+            raw = np.array(data, dtype=np.int64)
             E[:] = self.vid.lookup(raw, blk.lines, "edge", blk.ids)
         fixed = np.zeros(n, bool)
         tension = np.ones(n) if s.string else None     # string edges: tension 1

@@ -51,3 +51,21 @@ class IdMap:
             raise DatafileError(f"{user} {user_ids[flat]} refers to {self.what} {bad}, "
                                 f"which is not defined", self.filename, lines[flat])
         return self.order[pos_c]
+
+
+def split_midpoints(data, vid: IdMap, lines, ids) -> tuple[list, np.ndarray]:
+    """The edge rows of a QUADRATIC datafile: an edge may list its midpoint
+    vertex third (manual, "Quadratic declaration").
+
+    Returns
+    -------
+    rows : list of the (tail, head) ids of each edge
+    mids : (ne,) int array, the midpoint's vertex index, -1 where none is listed
+    """
+    rows = [list(d) for d in data]
+    raw = np.array([d[2] if len(d) == 3 else 0 for d in rows], np.int64)
+    mids = np.full(len(rows), -1, np.int64)
+    has = np.nonzero(raw)[0]
+    if len(has):
+        mids[has] = vid.lookup(raw[has], [lines[k] for k in has], "edge", [ids[k] for k in has])
+    return [d[:2] if len(d) == 3 else d for d in rows], mids

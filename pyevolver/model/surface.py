@@ -110,6 +110,9 @@ class Surface:
         # the string model (surface dimension 1): facets are edge chains kept in
         # sf_ptr / sf_enc (pyevolver.model.string) and FE stays empty
         self.string = False
+        # the element order: 1 linear, 2 the quadratic model, in which the
+        # edge midpoints are the last ne vertices, in edge order (see midv)
+        self.order = 1
         self.sf_ptr = np.zeros(1, np.int64)
         self.sf_enc = np.zeros(0, np.int64)
 
@@ -125,6 +128,14 @@ class Surface:
     @property
     def nf(self):
         return len(self.FE)
+
+    @property
+    def midv(self) -> np.ndarray | None:
+        """(ne,) the midpoint vertex of each edge in the quadratic model
+        (the last ``ne`` vertices, in edge order); None in the linear model."""
+        if self.order != 2:
+            return None
+        return np.arange(self.nv - self.ne, self.nv)
 
     @property
     def n_facets(self):
@@ -194,6 +205,8 @@ class Surface:
 
     def __repr__(self) -> str:
         model = "string" if self.string else "soapfilm"
+        if self.order == 2:
+            model += ", quadratic"
         torus = ", torus" if self.periods is not None else ""
         return (f"<Surface {model}{torus}, space dimension {self.sdim}: {self.nv} vertices, "
                 f"{self.ne} edges, {self.n_facets} facets, {self.bodies.n} bodies, "

@@ -22,12 +22,12 @@ def _enc(e, forward):
     return np.where(forward, e, ~e)
 
 
-def boundary_midpoints(s, tails, heads, vnew):
+def boundary_midpoints(s, tails, heads, vnew, target=None):
     """Place the new vertices ``vnew`` (midpoints of ``edges``) on their
-    parametric boundary: the curve point nearest the chord midpoint, by
-    damped Gauss-Newton in parameter space started from the head vertex's
-    parameters (at most 5 outer steps, spec §6.3).  Vertices not on a
-    boundary are left as they are."""
+    parametric boundary: the curve point nearest the chord midpoint (or
+    nearest ``target (len(vnew), 3)`` when given), by damped Gauss-Newton in
+    parameter space started from the head vertex's parameters (at most 5
+    outer steps, spec §6.3).  Vertices not on a boundary are left as they are."""
     if "boundary" not in s.vattr:
         return
     bnd = s.vattr["boundary"]
@@ -37,7 +37,7 @@ def boundary_midpoints(s, tails, heads, vnew):
         if not len(sel):
             continue
         v, head, tail = vnew[sel], heads[sel], tails[sel]
-        target = 0.5 * (s.X[tail] + s.X[head])
+        goal = 0.5 * (s.X[tail] + s.X[head]) if target is None else target[sel]
         names = tuple(f"p{k + 1}" for k in range(b.nparams))
 
         def curve(P):
@@ -48,7 +48,7 @@ def boundary_midpoints(s, tails, heads, vnew):
 
         P = s.vattr["params"][head][:, :b.nparams].copy()
         X, J = curve(P)
-        r = X - target
+        r = X - goal
         for _ in range(5):
             JtJ = np.einsum("nik,nil->nkl", J, J)
             Jtr = np.einsum("nik,ni->nk", J, r)
@@ -60,7 +60,7 @@ def boundary_midpoints(s, tails, heads, vnew):
             for _ in range(10):               # damping: halve until the distance drops
                 Pn = P + lam[:, None] * dp
                 Xn, Jn = curve(Pn)
-                rn = Xn - target
+                rn = Xn - goal
                 worse = np.einsum("ni,ni->n", rn, rn) > cur * (1 + 1e-15) + 1e-300
                 if not worse.any():
                     break

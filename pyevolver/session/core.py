@@ -37,6 +37,7 @@ from ..evolve.newton import damped_newton, hessian_step
 from ..expr import nodes as N
 from ..limits import MAX_EXPANDED_LINE
 from ..model.build import build_surface
+from ..remesh.quadratic import from_listed
 from ..remesh.edge_divide import edge_divide, long_edges
 from ..remesh.string import split_edges
 
@@ -137,6 +138,8 @@ class Session(SessionAPI):
         """Load a datafile into this session (see :meth:`load`)."""
         scene = read_datafile(filename, text)
         surface = build_surface(scene)
+        if "listed_midpoints" in surface.__dict__:     # QUADRATIC in the datafile
+            surface = from_listed(surface)
         return self._install(filename, scene, surface, run_read)
 
     def _install(self, filename, scene, surface, run_read):

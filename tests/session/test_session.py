@@ -25,7 +25,7 @@ def test_failing_command_leaves_state():
 
 
 @pytest.mark.parametrize("cmd,word", [("o", "o"),
-                                      ("lagrange 2", "lagrange"), ("quadratic", "quadratic"),
+                                      ("lagrange 2", "lagrange"), ("M 3", "M 3"),
                                       ("refine vertex[1]", "refine")])
 def test_later_features_refused_by_name(cmd, word):
     s = session()
