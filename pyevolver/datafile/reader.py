@@ -168,11 +168,11 @@ class Reader(TopSection, ElementSections):
             if (name in allowed or name in self.scene.parameters or name in N.CONSTANTS
                     or any(name == a[1] for a in self.scene.attributes)):
                 continue
-            line = None
-            for node in _walk(expr):
-                if isinstance(node, N.Var) and node.name == name:
-                    line = node.line
-                    col = node.column
+            line = col = None
+            for node in _walk(expr):       # a Var, or an indexed name such as a[1]
+                if getattr(node, "name", None) == name:
+                    line = getattr(node, "line", None)
+                    col = getattr(node, "column", None)
                     break
             raise _LocatedName(name, line, col)
 

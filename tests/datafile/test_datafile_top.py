@@ -125,6 +125,8 @@ def test_periods_by_expressions_and_procedures_cut_out():
     ("space_dimension 4", 1, 1, "SPACE_DIMENSION 4"),
     ("integral_order_2d 8", 1, None, "INTEGRAL_ORDER_2D 8"),
     ("parameter a = 1\nconstraint 1 formula: x + q = a", 2, 27, "undefined parameter 'q'"),
+    # an undefined indexed name (an UnboundLocalError the fuzzer found)
+    ("constraint 1 formula: qq[1]*x = 0", 1, 23, "undefined parameter 'qq'"),
     ("parameter a = 1\nfoo bar", 2, 1, "unexpected 'foo'"),
 ])
 def test_refusals_are_located(top, line, col, words):
