@@ -17,8 +17,10 @@ actually uses (tests/methods/test_springs.py):
 * ``hooke3_energy``: ``½ |L − s|^p / s`` with ``s = hooke_size`` and
   ``p = hooke3_power``; ``p = 0`` gives ``−log|L − s|``; with
   ``frickenhaus_flag`` nonzero, edges shorter than ``s`` cost nothing.
-* ``dihedral_hooke``: ``(1 − cos θ) L`` per edge with exactly two facets,
-  ``θ`` the angle between their normals (oriented alike across the edge).
+* ``dihedral_hooke``: ``(1 − cos θ) L`` per edge with two facets, ``θ`` the
+  angle between their normals (oriented alike across the edge); an edge with
+  one facet counts ``2 L`` (θ = π) as in evolver-nox-d; edges with more than
+  two facets are refused.
 
 Gradients are analytic.  ``hooke_energy`` has its analytic Hessian; the others
 use the registry's finite differences of the gradient.
@@ -27,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import UnsupportedError
 from ..model.records import edge_facets
 from ._common import assemble, facet_points, n2_grad_dot, scatter
 from .registry import register_method
@@ -177,13 +180,26 @@ def _dihedral_parts(t, idx):
     return k, e, fa, fb, sig, Na, Nb, la, lb, c
 
 
+def _valence(t, idx):
+    """(len(idx),) facets per edge; edges with more than two are refused."""
+    s = t.surface
+    val = np.bincount(s.topology()[0].ravel(), minlength=s.ne)[np.asarray(idx, np.int64)]
+    if (val > 2).any():
+        raise UnsupportedError("dihedral_hooke on edges with more than two facets")
+    return val
+
+
 def dihedral_hooke(t, m, idx):
-    """Per-edge ``(1 − cos θ) L`` (0 on edges without exactly two facets)."""
+    """Per-edge ``(1 − cos θ) L``; ``2 L`` on an edge with one facet (the
+    Evolver's value), 0 on an edge with none."""
     out = np.zeros(len(idx))
     if t.surface.nf == 0:
         return out
+    val = _valence(t, idx)
     k, e, _, _, _, _, _, _, _, c = _dihedral_parts(t, idx)
     out[k] = (1.0 - c) * t.edge_length[e]
+    one = val == 1
+    out[one] = 2.0 * t.edge_length[np.asarray(idx, np.int64)[one]]
     return out
 
 
@@ -195,6 +211,8 @@ def dihedral_hooke_gradient(t, m, idx, w):
     if s.nf == 0:
         return g
     w = np.asarray(w, float)
+    one = _valence(t, idx) == 1
+    g += _edge_grad(t, np.asarray(idx, np.int64)[one], 2.0 * w[one])
     k, e, fa, fb, sig, Na, Nb, la, lb, c = _dihedral_parts(t, idx)
     L = t.edge_length[e]
     we = w[k]
