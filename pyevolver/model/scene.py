@@ -104,6 +104,8 @@ class Scene:
     boundary_names: dict = field(default_factory=dict)    # id -> name (named boundaries)
     on_assign: dict = field(default_factory=dict)         # parameter -> procedure
                                                           # (ON_ASSIGN_CALL)
+    optimizing: dict = field(default_factory=dict)        # OPTIMIZING_PARAMETER name ->
+                                                          # (pdelta, pscale)
     unsupported: list = field(default_factory=list)       # (feature, line, column): refused
                                                           # once the whole file is read
     warnings: list = field(default_factory=list)          # (message, line, column): the

@@ -153,6 +153,8 @@ class Session(SessionAPI):
             surface.boundary_names = dict(scene.boundary_names)
         if scene.values.get("_period_exprs") is not None and surface.periods is not None:
             surface.period_exprs = scene.values["_period_exprs"]
+        # OPTIMIZING_PARAMETERs: moved by g (pyevolver.evolve.optparams)
+        surface.optimizing = dict(scene.optimizing)
         self._iterator = None                  # no CG history, pressures not yet valid
         # REF's gravity flag (reported by G): on when the datafile declares a
         # nonzero gravity_constant or a body has a density (mound.fe: on with
