@@ -1,0 +1,102 @@
+"""pyevolver.evolve.optparams: OPTIMIZING_PARAMETER moved by ``g``.
+
+A hexagonal film whose boundary circle has the optimizing radius ``rr``
+(small scales, so that the shrinking circle stays well away from 0):
+the parameter values after ``g`` steps (fixed and optimizing scale, after
+``r``) against evolver-nox-d run live, its numerical gradient against the
+closed form, the dump round trip and the refusals by name."""
+import numpy as np
+import pytest
+from comparison import _run_both, _same
+from tolerances import STEPS
+
+import pyevolver
+from pyevolver.evolve import optparams as OP
+
+HEXAGON = """optimizing_parameter rr = 1.2 {opts}
+boundary 1 parameters 1
+x1: rr*cos(p1)
+x2: rr*sin(p1)
+x3: 0
+vertices
+1 0 0 {z}
+2 0 boundary 1 fixed
+3 1.0471975511965976 boundary 1 fixed
+4 2.0943951023931953 boundary 1 fixed
+5 3.141592653589793 boundary 1 fixed
+6 4.1887902047863905 boundary 1 fixed
+7 5.235987755982989 boundary 1 fixed
+edges
+1 2 3 boundary 1 fixed
+2 3 4 boundary 1 fixed
+3 4 5 boundary 1 fixed
+4 5 6 boundary 1 fixed
+5 6 7 boundary 1 fixed
+6 7 2 boundary 1 fixed
+7 1 2
+8 1 3
+9 1 4
+10 1 5
+11 1 6
+12 1 7
+faces
+1 7 1 -8
+2 8 2 -9
+3 9 3 -10
+4 10 4 -11
+5 11 5 -12
+6 12 6 -7
+{bodies}
+"""
+
+
+def _hexagon(tmp_path, opts="pscale = 0.3", z=0.1, bodies=""):
+    p = tmp_path / "hexagon.fe"
+    p.write_text(HEXAGON.format(opts=opts, z=z, bodies=bodies))
+    return str(p)
+
+
+def _numbers(lines):
+    return [ln for ln in lines if ln.strip() and (ln.strip()[0] in "-0123456789")]
+
+
+@pytest.mark.parametrize("opts", ["pscale = 0.3", "pdelta = 0.001", ""])
+def test_parameter_moves_as_in_the_evolver(evolver, tmp_path, opts):
+    f = _hexagon(tmp_path, opts)
+    pr = 'printf "%.15g %.15g\\n", rr, vertex[1].z\n'
+    script = ("m 0.05\ng 1\n" + pr + "g 1\n" + pr + "optimize 0.04\ng 3\n" + pr
+              + "r\ng 2\n" + pr)
+    _, ref, out, err = _run_both(evolver, f, script, tmp_path)
+    ref = [ln for ln in _numbers(ref) if len(ln.split()) == 2]
+    out = [ln for ln in _numbers(out) if len(ln.split()) == 2]
+    assert len(ref) == 4, ref
+    assert _same(out, ref, STEPS), (out, ref, err)
+
+
+def test_gradient_is_the_derivative_of_the_hexagon_area(tmp_path):
+    # flat regular hexagon of radius rr: E = (3√3/2) rr², dE/drr = 3√3 rr
+    sess = pyevolver.load(_hexagon(tmp_path, "", z=0.0))
+    s = sess.surface
+    assert OP.names(s) == ["rr"]
+    g = OP.gradient(s)
+    assert abs(g[0] - 3 * np.sqrt(3) * 1.2) <= 1e-7
+    assert s.params["rr"] == 1.2          # left as it was
+    OP.set_values(s, np.array([1.5]))
+    assert abs(s.evaluate().energy - 1.5 * np.sqrt(3) * 1.5 ** 2) <= 1e-12
+
+
+def test_dump_keeps_the_declaration(tmp_path):
+    sess = pyevolver.load(_hexagon(tmp_path, "pdelta = 0.001 pscale = 0.3"))
+    out = tmp_path / "d.fe"
+    sess.run(f'dump "{out}"')
+    line = next(ln for ln in out.read_text().splitlines() if " rr " in ln)
+    assert line.startswith("OPTIMIZING_PARAMETER rr = 1.2 pdelta = 0.001 pscale = 0.")
+    assert pyevolver.load(str(out)).surface.optimizing["rr"] == pytest.approx((0.001, 0.3))
+
+
+@pytest.mark.parametrize("cmd", ["hessian", "newton", "bfgs", "U; g"])
+def test_unsupported_combinations_are_refused_by_name(tmp_path, cmd):
+    sess = pyevolver.load(_hexagon(tmp_path))
+    with pytest.raises(pyevolver.errors.PyEvolverError,
+                       match="not supported in pyevolver: OPTIMIZING_PARAMETER with"):
+        sess.run(cmd)
