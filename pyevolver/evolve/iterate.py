@@ -352,7 +352,7 @@ class Iterator:
                 OP.refuse(s, "fixed volumes or FIXED quantities")
             if settings.conj_grad:
                 OP.refuse(s, "conj_grad")
-            self._pbase = OP.values(s)
+            self._pbase: np.ndarray | None = OP.values(s)
             pvel = -OP.scales(s) ** 2 * OP.gradient(s)
         else:
             self._pbase = None
