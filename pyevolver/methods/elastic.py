@@ -1,5 +1,7 @@
-"""Elastic stretching energies of facets: ``linear_elastic`` and the
-``relaxed_elastic_A`` family (``relaxed_elastic1_A``, ``relaxed_elastic2_A``).
+"""Elastic stretching energies of facets: ``linear_elastic``, the
+``relaxed_elastic_A`` family (``relaxed_elastic1_A``, ``relaxed_elastic2_A``)
+and ``dirichlet_elastic`` (``A0 Tr(FQ)`` per facet, as evolver-nox-d computes
+it; it needs only ``form_factors``).
 
 Surface Evolver 2.70 manual, "Quantities and methods", linear_elastic and
 relaxed_elastic_A.  The unstrained shape of a facet is its Gram matrix
@@ -197,7 +199,35 @@ def _register_relaxed(name: str, which: int) -> None:
     register_method(name, "facet", values, gradient)
 
 
+def _ff_strain(t, idx, name):
+    """:func:`_strain` for methods that need only ``form_factors``."""
+    s = t.surface
+    if ("facet", "poisson_ratio") in s.extra:
+        return _strain(t, idx, name)
+    s.extra[("facet", "poisson_ratio")] = np.zeros(s.nf)
+    try:
+        return _strain(t, idx, name)
+    finally:
+        del s.extra[("facet", "poisson_ratio")]
+
+
+def dirichlet_elastic(t, m, idx):
+    """Per-facet ``dirichlet_elastic`` energy ``A0 Tr(FQ)`` (evolver-nox-d's
+    value; the manual's ``Tr(CCᵀ)`` of the deformation C), shape (len(idx),)."""
+    P = _ff_strain(t, idx, "dirichlet_elastic")
+    return P["A0"] * np.einsum("nij,nji->n", P["F"], P["Q"])
+
+
+def dirichlet_elastic_gradient(t, m, idx, w):
+    """Gradient (nv, 3) of ``Σ w_f A0 Tr(F Q)``: ``M = w A0 Q``."""
+    idx = np.asarray(idx, np.int64)
+    P = _ff_strain(t, idx, "dirichlet_elastic")
+    M = P["Q"] * (np.asarray(w, float) * P["A0"])[:, None, None]
+    return _gradient_from_M(t, idx, P, M)
+
+
 register_method("linear_elastic", "facet", linear_elastic, linear_elastic_gradient)
+register_method("dirichlet_elastic", "facet", dirichlet_elastic, dirichlet_elastic_gradient)
 _register_relaxed("relaxed_elastic_a", 0)
 _register_relaxed("relaxed_elastic1_a", 1)
 _register_relaxed("relaxed_elastic2_a", 2)

@@ -58,7 +58,8 @@ def _numbers(lines):
 
 
 @pytest.mark.parametrize("method,leb", [("linear_elastic", False), ("relaxed_elastic_A", False),
-                                        ("relaxed_elastic_A", True)])
+                                        ("relaxed_elastic_A", True),
+                                        ("dirichlet_elastic", False)])
 def test_values_and_steps_agree_with_the_evolver(evolver, tmp_path, method, leb):
     f = _sheet(tmp_path, method, leb)
     script = ("foreach facet ff do printf \"%.15g %.15g %.15g\\n\", ff.st, ff.st1, ff.st2\n"
@@ -110,7 +111,7 @@ def test_degenerate_form_factors_give_zero_and_missing_attributes_stop(tmp_path)
 
 
 @pytest.mark.parametrize("name", ["linear_elastic", "relaxed_elastic_a", "relaxed_elastic1_a",
-                                  "relaxed_elastic2_a"])
+                                  "relaxed_elastic2_a", "dirichlet_elastic"])
 def test_gradient_matches_central_differences(tmp_path, name):
     # a random 3x3-vertex sheet, form factors from a random reference shape, so
     # that facets fall in all three branches of the relaxed energy
