@@ -100,3 +100,59 @@ def test_unsupported_combinations_are_refused_by_name(tmp_path, cmd):
     with pytest.raises(pyevolver.errors.PyEvolverError,
                        match="not supported in pyevolver: OPTIMIZING_PARAMETER with"):
         sess.run(cmd)
+
+
+def _torus_sheet(n=3):
+    """A 3x3 elastic sheet in a torus cell whose x period is the optimizing
+    parameter ``ll`` (1.2; the form factors are those of the cell with ll = 1)."""
+    h = 1.0 / n
+    lines = ["optimizing_parameter ll = 1.2 pscale = 0.5",
+             "define facet attribute poisson_ratio real",
+             "define facet attribute form_factors real[3]",
+             "quantity st energy modulus 20 method linear_elastic global",
+             "torus", "periods", "ll 0 0", "0 1 0", "0 0 1", "", "vertices"]
+
+    def vid(i, j):
+        return (j % n) * n + (i % n) + 1
+    for j in range(n):
+        for i in range(n):
+            z = float(0.05 * np.sin(2 * np.pi * i / n + 1) * np.cos(2 * np.pi * j / n))
+            lines.append(f"{vid(i, j)} {i * 1.2 / n!r} {j / n!r} {z!r}")
+    lines.append("\nedges")
+    edges = {}
+    k = 0
+    for j in range(n):
+        for i in range(n):
+            for di, dj in [(1, 0), (0, 1), (1, 1)]:
+                k += 1
+                edges[(i, j, di, dj)] = k
+                wx = "+" if i + di >= n else "*"
+                wy = "+" if j + dj >= n else "*"
+                lines.append(f"{k} {vid(i, j)} {vid(i + di, j + dj)} {wx} {wy} *")
+    lines.append("\nfaces")
+    f = 0
+    for j in range(n):
+        for i in range(n):
+            e10, e11, e01 = edges[(i, j, 1, 0)], edges[(i, j, 1, 1)], edges[(i, j, 0, 1)]
+            eup, etop = edges[((i + 1) % n, j, 0, 1)], edges[(i, (j + 1) % n, 1, 0)]
+            f += 1
+            lines.append(f"{f} {e10} {eup} -{e11} tension 0 poisson_ratio 0.3 "
+                         f"form_factors {{{h * h!r}, {h * h!r}, {2 * h * h!r}}}")
+            f += 1
+            lines.append(f"{f} {e11} -{etop} -{e01} tension 0 poisson_ratio 0.3 "
+                         f"form_factors {{{2 * h * h!r}, {h * h!r}, {h * h!r}}}")
+    return "\n".join(lines) + "\n"
+
+
+def test_torus_period_parameter_with_an_elastic_sheet(evolver, tmp_path):
+    p = tmp_path / "tor.fe"
+    p.write_text(_torus_sheet())
+    pr = 'printf "%.15g %.15g\\n", ll, total_energy\n'
+    _, ref, out, err = _run_both(evolver, str(p), pr + "g 5\n" + pr + "m 0.01\ng 2\n" + pr,
+                                 tmp_path)
+    def keep(lines):
+        return [ln for ln in lines
+                if "area:" in ln or (_numbers([ln]) and len(ln.split()) == 2)]
+    ref, out = keep(ref), keep(out)
+    assert len(ref) == 10, ref
+    assert _same(out, ref, STEPS), (out, ref, err)
