@@ -12,9 +12,12 @@ parametric boundaries are put where their boundary parameters now say and
 PERIODS given by expressions are re-evaluated.
 
 Not done here (refused by name where they are used): optimizing parameters
-together with fixed volumes or FIXED quantities (the Evolver projects the
-parameters' motion on those constraints too), with ``conj_grad`` and in
-``hessian`` / ``newton``.
+together with fixed volumes or FIXED quantities (even a parameter that no
+fixed value depends on changes how evolver-nox-d restores the volumes: on
+cube.fe with an optimizing parameter in a constraint's energy integrand, REF's
+``m 0.2; g 1`` ends 2.5e-5 away in vertex[5].z from the same run with a plain
+parameter, which pyevolver reproduces), with ``conj_grad`` and in
+``hessian`` / ``newton`` / ``bfgs``.
 """
 from __future__ import annotations
 
