@@ -35,15 +35,17 @@ zero energy.
 
 Gradients are analytic: ``dw = tr(M dF)`` with ``M = (QC + k Tr C Q) / (2(1+ν))``,
 ``k = ν/(1−ν)``, and for the uniaxial branch ``d(λ₁²/2) = (λ₁/2) yᵀ dF y`` with
-``y = L r``, ``Q = L Lᵀ`` and ``r`` the unit eigenvector of ``Lᵀ F L``.  Hessians
-are taken by finite differences of the gradient (the registry's fallback).
+``y = L r``, ``Q = L Lᵀ`` and ``r`` the unit eigenvector of ``Lᵀ F L``.
+``linear_elastic`` and ``dirichlet_elastic`` have analytic Hessians; the
+relaxed ones are taken by finite differences of the gradient (the registry's
+fallback).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import PyEvolverError
-from ._common import corner_scatter
+from ._common import assemble, corner_scatter
 from .registry import register_method
 
 
@@ -226,8 +228,65 @@ def dirichlet_elastic_gradient(t, m, idx, w):
     return _gradient_from_M(t, idx, P, M)
 
 
-register_method("linear_elastic", "facet", linear_elastic, linear_elastic_gradient)
-register_method("dirichlet_elastic", "facet", dirichlet_elastic, dirichlet_elastic_gradient)
+_E = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]]])
+
+
+def _hessian_from_f(t, idx, P, gf, Hf, basis):
+    """Assemble ``Σ_f [Jᵀ Hf J + Σ_j gf_j ∂²f_j]`` over the facets, with
+    ``f = (F11, F12, F22)`` the Gram entries, ``gf`` (n, 3) and ``Hf``
+    (n, 3, 3) the derivatives of the facet energy w.r.t. them."""
+    a, b = P["a"], P["b"]
+    n = len(a)
+    # J: (n, 3 entries, 2 sides, 3 coords); dF11 = 2a·da, dF12 = a·db + b·da, dF22 = 2b·db
+    J = np.zeros((n, 3, 2, 3))
+    J[:, 0, 0] = 2 * a
+    J[:, 1, 0] = b
+    J[:, 1, 1] = a
+    J[:, 2, 1] = 2 * b
+    Hs = np.einsum("njsc,njk,nktd->nsctd", J, Hf, J)           # (n, 2, 3, 2, 3)
+    eye = np.eye(3)
+    Hs[:, 0, :, 0, :] += 2 * gf[:, 0, None, None] * eye
+    Hs[:, 0, :, 1, :] += gf[:, 1, None, None] * eye
+    Hs[:, 1, :, 0, :] += gf[:, 1, None, None] * eye
+    Hs[:, 1, :, 1, :] += 2 * gf[:, 2, None, None] * eye
+    T = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])        # vertex <- sides
+    blocks = np.einsum("is,nsctd,jt->nijcd", T, Hs, T)            # (n, 3, 3, 3, 3)
+    s = t.surface
+    return assemble(s.nv, s.F[idx], blocks, basis)
+
+
+def linear_elastic_hessian(t, m, idx, w, basis=None):
+    """Analytic Hessian of ``Σ w_f E_f`` for ``linear_elastic``: the density's
+    second derivative ``(tr(dF₁Q dF₂Q) + k tr(dF₁Q) tr(dF₂Q)) / (4(1+ν))`` and
+    its first derivative times the Gram entries' second derivatives."""
+    idx = np.asarray(idx, np.int64)
+    P = _strain(t, idx, "linear_elastic")
+    c = np.asarray(w, float) * P["A0"]
+    M = _linear_M(P) * c[:, None, None]
+    gf = np.stack([M[:, 0, 0], M[:, 0, 1] + M[:, 1, 0], M[:, 1, 1]], 1)
+    EQ = np.einsum("jab,nbc->njac", _E, P["Q"])                  # (n, 3, 2, 2)
+    tr2 = np.einsum("niab,njba->nij", EQ, EQ)
+    tr1 = np.einsum("niaa->ni", EQ)
+    nu = P["nu"]
+    k = nu / (1.0 - nu)
+    Hf = (tr2 + k[:, None, None] * tr1[:, :, None] * tr1[:, None, :]) \
+        * (c / (4.0 * (1.0 + nu)))[:, None, None]
+    return _hessian_from_f(t, idx, P, gf, Hf, basis)
+
+
+def dirichlet_elastic_hessian(t, m, idx, w, basis=None):
+    """Analytic Hessian of ``Σ w_f A0 Tr(FQ)`` (linear in F)."""
+    idx = np.asarray(idx, np.int64)
+    P = _ff_strain(t, idx, "dirichlet_elastic")
+    M = P["Q"] * (np.asarray(w, float) * P["A0"])[:, None, None]
+    gf = np.stack([M[:, 0, 0], M[:, 0, 1] + M[:, 1, 0], M[:, 1, 1]], 1)
+    return _hessian_from_f(t, idx, P, gf, np.zeros((len(idx), 3, 3)), basis)
+
+
+register_method("linear_elastic", "facet", linear_elastic, linear_elastic_gradient,
+                linear_elastic_hessian)
+register_method("dirichlet_elastic", "facet", dirichlet_elastic, dirichlet_elastic_gradient,
+                dirichlet_elastic_hessian)
 _register_relaxed("relaxed_elastic_a", 0)
 _register_relaxed("relaxed_elastic1_a", 1)
 _register_relaxed("relaxed_elastic2_a", 2)

@@ -22,8 +22,8 @@ actually uses (tests/methods/test_springs.py):
   one facet counts ``2 L`` (θ = π) as in evolver-nox-d; edges with more than
   two facets are refused.
 
-Gradients are analytic.  ``hooke_energy`` has its analytic Hessian; the others
-use the registry's finite differences of the gradient.
+Gradients are analytic; so are the Hessians of the three ``hooke`` methods
+(``dihedral_hooke`` uses the registry's finite differences of the gradient).
 """
 from __future__ import annotations
 
@@ -87,13 +87,19 @@ def hooke_gradient(t, m, idx, w):
 
 
 def hooke_hessian(t, m, idx, w, basis=None):
-    """Per-edge blocks ``[[K, −K], [−K, K]]`` with
-    ``K = f'' u uᵀ + (f'/L)(I − u uᵀ)``, ``u`` the unit edge vector."""
+    """Analytic Hessian of ``Σ w_e |L_e − L₀|^p`` (:func:`_spring_hessian`)."""
     s = t.surface
     idx = np.asarray(idx, np.int64)
-    L = t.edge_length[idx]
-    d = L - _param(s, "hooke_length", 0.0)
+    d = t.edge_length[idx] - _param(s, "hooke_length", 0.0)
     _, f1, f2 = _power_law(d, _param(s, "hooke_power", 2.0))
+    return _spring_hessian(t, idx, w, f1, f2, basis)
+
+
+def _spring_hessian(t, idx, w, f1, f2, basis):
+    """Per-edge blocks ``[[K, −K], [−K, K]]`` of ``Σ w_e f(L_e)`` with
+    ``K = f'' u uᵀ + (f'/L)(I − u uᵀ)``, ``u`` the unit edge vector."""
+    s = t.surface
+    L = t.edge_length[idx]
     w = np.asarray(w, float)
     with np.errstate(divide="ignore", invalid="ignore"):
         u = np.nan_to_num(t.edge_vec[idx] / L[:, None])
@@ -123,6 +129,14 @@ def hooke2(t, m, idx):
     return _power_law(d, _param(t.surface, "hooke2_power", 2.0))[0]
 
 
+def hooke2_hessian(t, m, idx, w, basis=None):
+    """Analytic Hessian of ``Σ w_e |L_e − s_e|^p`` (:func:`_spring_hessian`)."""
+    idx = np.asarray(idx, np.int64)
+    d = t.edge_length[idx] - hooke_size(t)[idx]
+    _, f1, f2 = _power_law(d, _param(t.surface, "hooke2_power", 2.0))
+    return _spring_hessian(t, idx, w, f1, f2, basis)
+
+
 def hooke2_gradient(t, m, idx, w):
     """Gradient (nv, 3) of ``Σ w_e |L_e − s_e|^p``."""
     idx = np.asarray(idx, np.int64)
@@ -136,14 +150,13 @@ def _hooke3_parts(t, idx):
     size = hooke_size(t)[idx]
     d = t.edge_length[idx] - size
     p = _param(s, "hooke3_power", 2.0)
-    f, f1, _ = _power_law(d, p)
+    f, f1, f2 = _power_law(d, p)
     if p != 0:
         with np.errstate(divide="ignore", invalid="ignore"):
-            f, f1 = 0.5 * f / size, 0.5 * f1 / size
+            f, f1, f2 = 0.5 * f / size, 0.5 * f1 / size, 0.5 * f2 / size
     if _param(s, "frickenhaus_flag", 0.0):
-        f = np.where(d < 0, 0.0, f)
-        f1 = np.where(d < 0, 0.0, f1)
-    return f, f1
+        f, f1, f2 = (np.where(d < 0, 0.0, x) for x in (f, f1, f2))
+    return f, f1, f2
 
 
 def hooke3(t, m, idx):
@@ -155,6 +168,13 @@ def hooke3_gradient(t, m, idx, w):
     """Gradient (nv, 3) of ``Σ w_e ½ |L_e − s_e|^p / s_e``."""
     idx = np.asarray(idx, np.int64)
     return _edge_grad(t, idx, np.asarray(w, float) * _hooke3_parts(t, idx)[1])
+
+
+def hooke3_hessian(t, m, idx, w, basis=None):
+    """Analytic Hessian of ``Σ w_e ½ |L_e − s_e|^p / s_e`` (:func:`_spring_hessian`)."""
+    idx = np.asarray(idx, np.int64)
+    _, f1, f2 = _hooke3_parts(t, idx)
+    return _spring_hessian(t, idx, w, f1, f2, basis)
 
 
 # ---- dihedral_hooke ------------------------------------------------------------------
@@ -233,6 +253,6 @@ def dihedral_hooke_gradient(t, m, idx, w):
 
 
 register_method("hooke_energy", "edge", hooke, hooke_gradient, hooke_hessian)
-register_method("hooke2_energy", "edge", hooke2, hooke2_gradient)
-register_method("hooke3_energy", "edge", hooke3, hooke3_gradient)
+register_method("hooke2_energy", "edge", hooke2, hooke2_gradient, hooke2_hessian)
+register_method("hooke3_energy", "edge", hooke3, hooke3_gradient, hooke3_hessian)
 register_method("dihedral_hooke", "edge", dihedral_hooke, dihedral_hooke_gradient)

@@ -162,3 +162,30 @@ def test_mylarcube_agrees_with_the_evolver(evolver, tmp_path):
     out = [ln for ln in out if "area:" in ln or ln[:1].isdigit() or ln[:1] == "-"]
     assert len(ref) == 7, ref
     assert _same(out, ref, 1e-6), (out, ref, err)
+
+
+@pytest.mark.parametrize("name", ["linear_elastic", "dirichlet_elastic"])
+def test_hessian_matches_differences_of_the_gradient(name):
+    rng = np.random.default_rng(6)
+    X = np.array([[0, 0, 0], [1, 0, 0.1], [0.1, 1, 0], [1.1, 1.2, 0.2]]) \
+        + 0.05 * rng.standard_normal((4, 3))
+    s = pyevolver.Surface.from_arrays(X, np.array([[0, 1, 2], [1, 3, 2]]))
+    s.extra[("facet", "form_factors")] = np.array([[1.0, 0.1, 0.9], [1.2, -0.2, 1.1]])
+    s.extra[("facet", "poisson_ratio")] = np.array([0.3, 0.2])
+    m = lookup(name)
+    idx = np.arange(s.nf)
+    w = np.array([1.5, 0.7])
+    D = m.hessian(s.evaluate(), None, idx, w).toarray()
+    assert np.abs(D - D.T).max() <= 1e-12 * max(1.0, np.abs(D).max())
+    X0 = s.X.copy()
+    h = 1e-6
+    for i in range(s.nv):
+        for k in range(3):
+            g = []
+            for sg in (1, -1):
+                s.X = X0.copy()
+                s.X[i, k] += sg * h
+                g.append(m.gradient(s.evaluate(), None, idx, w).ravel())
+            col = (g[0] - g[1]) / (2 * h)
+            assert np.abs(D[:, 3 * i + k] - col).max() <= FD * max(1.0, np.abs(col).max())
+    s.X = X0

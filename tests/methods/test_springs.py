@@ -139,12 +139,19 @@ def test_gradient_matches_central_differences(tmp_path, method, params):
     _fd_check(s, lookup(method), rng.uniform(0.5, 2.0, s.ne))
 
 
-def test_hooke_hessian_matches_differences_of_the_gradient(tmp_path):
-    s = pyevolver.load(_fan(tmp_path, "hooke_energy")).surface
-    s.params.update({"hooke_length": 0.4, "hooke_power": 3})
+@pytest.mark.parametrize("method,params", [
+    ("hooke_energy", {"hooke_length": 0.4, "hooke_power": 3}),
+    ("hooke2_energy", {"hooke2_power": 2}),
+    ("hooke3_energy", {"hooke3_power": 3, "frickenhaus_flag": 1}),
+])
+def test_hooke_hessians_match_differences_of_the_gradient(tmp_path, method, params):
+    s = pyevolver.load(_fan(tmp_path, method)).surface
+    s.params.update(params)
+    s.extra[("edge", "hooke_size")] = np.random.default_rng(7).uniform(0.6, 1.4, s.ne)
+    m = lookup(method)
     idx = np.arange(s.ne)
     w = np.linspace(0.5, 2.0, s.ne)
-    D = SP.hooke_hessian(s.evaluate(), None, idx, w).toarray()
+    D = m.hessian(s.evaluate(), None, idx, w).toarray()
     assert np.abs(D - D.T).max() <= ROUNDOFF * 10
     X0 = s.X.copy()
     h = 1e-6
@@ -154,7 +161,7 @@ def test_hooke_hessian_matches_differences_of_the_gradient(tmp_path):
             for sg in (1, -1):
                 s.X = X0.copy()
                 s.X[i, k] += sg * h
-                g.append(SP.hooke_gradient(s.evaluate(), None, idx, w).ravel())
+                g.append(m.gradient(s.evaluate(), None, idx, w).ravel())
             col = (g[0] - g[1]) / (2 * h)
             assert np.abs(D[:, 3 * i + k] - col).max() <= FD * max(1.0, np.abs(col).max())
     s.X = X0
