@@ -189,3 +189,16 @@ def test_hessian_matches_differences_of_the_gradient(name):
             col = (g[0] - g[1]) / (2 * h)
             assert np.abs(D[:, 3 * i + k] - col).max() <= FD * max(1.0, np.abs(col).max())
     s.X = X0
+
+
+def test_the_evolvers_dump_loads_with_the_same_energy(evolver, tmp_path):
+    # REF writes form_factors and poisson_ratio into its dump; read back here
+    from reference import run_reference
+    dmp = tmp_path / "mylar.dmp"
+    ref = run_reference(evolver, os.path.join(EXAMPLES, "mylarcube.fe"),
+                        f'g 3\ndump "{dmp}"\nprintf "%.15g %.15g\\n", total_energy, '
+                        'stretch.value\n', cwd=str(tmp_path))
+    e_ref, st_ref = (float(v) for v in _numbers(ref)[-1].split())
+    sess = pyevolver.load(str(dmp))
+    assert abs(sess.value("total_energy") - e_ref) <= STEPS * abs(e_ref)
+    assert abs(sess.value("stretch.value") - st_ref) <= STEPS * abs(st_ref)
