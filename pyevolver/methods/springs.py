@@ -36,7 +36,12 @@ from .registry import register_method
 
 
 def _param(s, name: str, default: float) -> float:
-    """A variable's value (the Evolver's internal variables default when unset)."""
+    """A variable's value.  The method's own variables (``hooke_length`` and
+    ``hooke_power``, ``hooke2_power``, ``hooke3_power``) are created with their
+    defaults when the method is first evaluated, as the Evolver does (they can
+    then be printed and assigned); ``frickenhaus_flag`` is read only."""
+    if name != "frickenhaus_flag" and name not in s.params:
+        s.params[name] = default
     v = s.params.get(name)
     try:
         return default if v is None else float(v)
