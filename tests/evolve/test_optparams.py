@@ -5,13 +5,28 @@ A hexagonal film whose boundary circle has the optimizing radius ``rr``
 the parameter values after ``g`` steps (fixed and optimizing scale, after
 ``r``) against evolver-nox-d run live, its numerical gradient against the
 closed form, the dump round trip and the refusals by name."""
+import io
+
 import numpy as np
 import pytest
-from comparison import _run_both, _same
+from comparison import _same
+from reference import run_reference
 from tolerances import STEPS
 
 import pyevolver
 from pyevolver.evolve import optparams as OP
+from pyevolver.session.core import Session
+
+
+def _run_both(evolver, datafile, script, tmp_path):
+    """The Evolver's output lines (subprocess) and pyevolver's (in this
+    process, which saves the interpreter's start-up): ``(None, ref, out, err)``."""
+    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
+    out, err = io.StringIO(), io.StringIO()
+    sess = Session.load(datafile, out=out, err=err)
+    sess.run(script)
+    return None, ref, out.getvalue().rstrip("\n").split("\n"), err.getvalue()
+
 
 HEXAGON = """optimizing_parameter rr = 1.2 {opts}
 boundary 1 parameters 1

@@ -4,17 +4,31 @@ Values against closed forms (a uniformly stretched triangle) and against
 evolver-nox-d run live (per-facet values and ``g`` steps on a small file
 written from the manual, and the shipped mylarcube.fe); analytic gradients
 against central differences on every branch of the relaxed energy."""
+import io
 import os
 
 import numpy as np
 import pytest
-from comparison import _run_both, _same
+from comparison import _same
+from reference import run_reference
 from conftest import EXAMPLES
 from tolerances import FD, PRINTED, ROUNDOFF, STEPS
 
 import pyevolver
 from pyevolver.methods import elastic as EL
 from pyevolver.methods.registry import lookup
+from pyevolver.session.core import Session
+
+
+def _run_both(evolver, datafile, script, tmp_path):
+    """The Evolver's output lines (subprocess) and pyevolver's (in this
+    process, which saves the interpreter's start-up): ``(None, ref, out, err)``."""
+    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
+    out, err = io.StringIO(), io.StringIO()
+    sess = Session.load(datafile, out=out, err=err)
+    sess.run(script)
+    return None, ref, out.getvalue().rstrip("\n").split("\n"), err.getvalue()
+
 
 # two facets sharing an edge, each with its own Poisson ratio and form factors;
 # facet 1 is stretched in one direction only, facet 2 in both
@@ -193,7 +207,6 @@ def test_hessian_matches_differences_of_the_gradient(name):
 
 def test_the_evolvers_dump_loads_with_the_same_energy(evolver, tmp_path):
     # REF writes form_factors and poisson_ratio into its dump; read back here
-    from reference import run_reference
     dmp = tmp_path / "mylar.dmp"
     ref = run_reference(evolver, os.path.join(EXAMPLES, "mylarcube.fe"),
                         f'g 3\ndump "{dmp}"\nprintf "%.15g %.15g\\n", total_energy, '

@@ -2,16 +2,30 @@
 dihedral_hooke against evolver-nox-d run live (values under each power and
 flag, and ``g`` steps), against closed forms, and their gradients (and
 hooke_energy's Hessian) against central differences."""
+import io
 import os
 
 import numpy as np
 import pytest
-from comparison import _run_both, _same
+from comparison import _same
+from reference import run_reference
 from tolerances import FD, PRINTED, ROUNDOFF, STEPS
 
 import pyevolver
 from pyevolver.methods import springs as SP
 from pyevolver.methods.registry import lookup
+from pyevolver.session.core import Session
+
+
+def _run_both(evolver, datafile, script, tmp_path):
+    """The Evolver's output lines (subprocess) and pyevolver's (in this
+    process, which saves the interpreter's start-up): ``(None, ref, out, err)``."""
+    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
+    out, err = io.StringIO(), io.StringIO()
+    sess = Session.load(datafile, out=out, err=err)
+    sess.run(script)
+    return None, ref, out.getvalue().rstrip("\n").split("\n"), err.getvalue()
+
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 
