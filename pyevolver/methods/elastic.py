@@ -42,6 +42,8 @@ fallback).
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..errors import PyEvolverError
@@ -116,14 +118,14 @@ def _gradient_from_M(t, idx, P, M):
     return corner_scatter(t, per)
 
 
-def linear_elastic(t, m, idx):
+def linear_elastic(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
     """Per-facet ``linear_elastic`` energy, shape (len(idx),)."""
     P = _strain(t, idx, "linear_elastic")
     w, _, _ = _linear_density(P["C"], P["nu"])
     return P["A0"] * w
 
 
-def linear_elastic_gradient(t, m, idx, w):
+def linear_elastic_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Gradient (nv, 3) of ``Σ w_f E_f`` for ``linear_elastic``."""
     idx = np.asarray(idx, np.int64)
     P = _strain(t, idx, "linear_elastic")
@@ -213,14 +215,14 @@ def _ff_strain(t, idx, name):
         del s.extra[("facet", "poisson_ratio")]
 
 
-def dirichlet_elastic(t, m, idx):
+def dirichlet_elastic(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
     """Per-facet ``dirichlet_elastic`` energy ``A0 Tr(FQ)`` (evolver-nox-d's
     value; the manual's ``Tr(CCᵀ)`` of the deformation C), shape (len(idx),)."""
     P = _ff_strain(t, idx, "dirichlet_elastic")
     return P["A0"] * np.einsum("nij,nji->n", P["F"], P["Q"])
 
 
-def dirichlet_elastic_gradient(t, m, idx, w):
+def dirichlet_elastic_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Gradient (nv, 3) of ``Σ w_f A0 Tr(F Q)``: ``M = w A0 Q``."""
     idx = np.asarray(idx, np.int64)
     P = _ff_strain(t, idx, "dirichlet_elastic")
@@ -255,7 +257,8 @@ def _hessian_from_f(t, idx, P, gf, Hf, basis):
     return assemble(s.nv, s.F[idx], blocks, basis)
 
 
-def linear_elastic_hessian(t, m, idx, w, basis=None):
+def linear_elastic_hessian(t: Any, m: Any, idx: np.ndarray, w: np.ndarray,
+                           basis: Any = None) -> Any:
     """Analytic Hessian of ``Σ w_f E_f`` for ``linear_elastic``: the density's
     second derivative ``(tr(dF₁Q dF₂Q) + k tr(dF₁Q) tr(dF₂Q)) / (4(1+ν))`` and
     its first derivative times the Gram entries' second derivatives."""
@@ -274,7 +277,8 @@ def linear_elastic_hessian(t, m, idx, w, basis=None):
     return _hessian_from_f(t, idx, P, gf, Hf, basis)
 
 
-def dirichlet_elastic_hessian(t, m, idx, w, basis=None):
+def dirichlet_elastic_hessian(t: Any, m: Any, idx: np.ndarray, w: np.ndarray,
+                              basis: Any = None) -> Any:
     """Analytic Hessian of ``Σ w_f A0 Tr(FQ)`` (linear in F)."""
     idx = np.asarray(idx, np.int64)
     P = _ff_strain(t, idx, "dirichlet_elastic")

@@ -27,6 +27,8 @@ Gradients are analytic; so are the Hessians of the three ``hooke`` methods
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..errors import UnsupportedError
@@ -75,14 +77,14 @@ def _edge_grad(t, idx, dEdL):
 
 
 # ---- hooke_energy ------------------------------------------------------------------
-def hooke(t, m, idx):
+def hooke(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
     """Per-edge ``|L − hooke_length|^hooke_power``, shape (len(idx),)."""
     s = t.surface
     d = t.edge_length[idx] - _param(s, "hooke_length", 0.0)
     return _power_law(d, _param(s, "hooke_power", 2.0))[0]
 
 
-def hooke_gradient(t, m, idx, w):
+def hooke_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Gradient (nv, 3) of ``Σ w_e |L_e − L₀|^p``."""
     s = t.surface
     idx = np.asarray(idx, np.int64)
@@ -91,7 +93,8 @@ def hooke_gradient(t, m, idx, w):
     return _edge_grad(t, idx, np.asarray(w, float) * f1)
 
 
-def hooke_hessian(t, m, idx, w, basis=None):
+def hooke_hessian(t: Any, m: Any, idx: np.ndarray, w: np.ndarray,
+                  basis: Any = None) -> Any:
     """Analytic Hessian of ``Σ w_e |L_e − L₀|^p`` (:func:`_spring_hessian`)."""
     s = t.surface
     idx = np.asarray(idx, np.int64)
@@ -128,13 +131,14 @@ def hooke_size(t) -> np.ndarray:
     return np.asarray(arr, float)
 
 
-def hooke2(t, m, idx):
+def hooke2(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
     """Per-edge ``|L − hooke_size|^hooke2_power``, shape (len(idx),)."""
     d = t.edge_length[idx] - hooke_size(t)[idx]
     return _power_law(d, _param(t.surface, "hooke2_power", 2.0))[0]
 
 
-def hooke2_hessian(t, m, idx, w, basis=None):
+def hooke2_hessian(t: Any, m: Any, idx: np.ndarray, w: np.ndarray,
+                   basis: Any = None) -> Any:
     """Analytic Hessian of ``Σ w_e |L_e − s_e|^p`` (:func:`_spring_hessian`)."""
     idx = np.asarray(idx, np.int64)
     d = t.edge_length[idx] - hooke_size(t)[idx]
@@ -142,7 +146,7 @@ def hooke2_hessian(t, m, idx, w, basis=None):
     return _spring_hessian(t, idx, w, f1, f2, basis)
 
 
-def hooke2_gradient(t, m, idx, w):
+def hooke2_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Gradient (nv, 3) of ``Σ w_e |L_e − s_e|^p``."""
     idx = np.asarray(idx, np.int64)
     d = t.edge_length[idx] - hooke_size(t)[idx]
@@ -164,18 +168,19 @@ def _hooke3_parts(t, idx):
     return f, f1, f2
 
 
-def hooke3(t, m, idx):
+def hooke3(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
     """Per-edge ``½ |L − s|^p / s``, shape (len(idx),)."""
     return _hooke3_parts(t, idx)[0]
 
 
-def hooke3_gradient(t, m, idx, w):
+def hooke3_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Gradient (nv, 3) of ``Σ w_e ½ |L_e − s_e|^p / s_e``."""
     idx = np.asarray(idx, np.int64)
     return _edge_grad(t, idx, np.asarray(w, float) * _hooke3_parts(t, idx)[1])
 
 
-def hooke3_hessian(t, m, idx, w, basis=None):
+def hooke3_hessian(t: Any, m: Any, idx: np.ndarray, w: np.ndarray,
+                   basis: Any = None) -> Any:
     """Analytic Hessian of ``Σ w_e ½ |L_e − s_e|^p / s_e`` (:func:`_spring_hessian`)."""
     idx = np.asarray(idx, np.int64)
     _, f1, f2 = _hooke3_parts(t, idx)
@@ -214,7 +219,7 @@ def _valence(t, idx):
     return val
 
 
-def dihedral_hooke(t, m, idx):
+def dihedral_hooke(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
     """Per-edge ``(1 − cos θ) L``; ``2 L`` on an edge with one facet (the
     Evolver's value), 0 on an edge with none."""
     out = np.zeros(len(idx))
@@ -228,7 +233,7 @@ def dihedral_hooke(t, m, idx):
     return out
 
 
-def dihedral_hooke_gradient(t, m, idx, w):
+def dihedral_hooke_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Gradient (nv, 3) of ``Σ w_e (1 − cos θ_e) L_e``:
     ``−L ∂cos + (1 − cos) ∂L`` with ``∂cos/∂N_a = (n_b − c n_a)/|N_a|``."""
     s = t.surface
