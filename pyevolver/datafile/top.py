@@ -373,6 +373,8 @@ class TopSection:
                 vals[key] = self._const(opts[key][0], line, f"{key} of parameter {name}")
         if opts.get("optimizing"):
             self.scene.optimizing[name] = (vals["pdelta"], vals["pscale"])
+        elif "pdelta" in opts or "pscale" in opts:
+            self.scene.param_deltas[name] = (vals["pdelta"], vals["pscale"])
         if "on_assign_call" in opts:
             # the procedure runs whenever the variable is assigned (manual); it
             # must have been declared before, in the top section

@@ -106,6 +106,8 @@ class Scene:
                                                           # (ON_ASSIGN_CALL)
     optimizing: dict = field(default_factory=dict)        # OPTIMIZING_PARAMETER name ->
                                                           # (pdelta, pscale)
+    param_deltas: dict = field(default_factory=dict)      # every parameter's (pdelta,
+                                                          # pscale) given in the file
     unsupported: list = field(default_factory=list)       # (feature, line, column): refused
                                                           # once the whole file is read
     warnings: list = field(default_factory=list)          # (message, line, column): the

@@ -155,6 +155,7 @@ class Session(SessionAPI):
             surface.period_exprs = scene.values["_period_exprs"]
         # OPTIMIZING_PARAMETERs: moved by g (pyevolver.evolve.optparams)
         surface.optimizing = dict(scene.optimizing)
+        surface.param_deltas = dict(scene.param_deltas)
         self._iterator = None                  # no CG history, pressures not yet valid
         # REF's gravity flag (reported by G): on when the datafile declares a
         # nonzero gravity_constant or a body has a density (mound.fe: on with

@@ -171,3 +171,18 @@ def test_torus_period_parameter_with_an_elastic_sheet(evolver, tmp_path):
     ref, out = keep(ref), keep(out)
     assert len(ref) == 10, ref
     assert _same(out, ref, STEPS), (out, ref, err)
+
+
+def test_fix_and_unfix_toggle_a_parameter(evolver, tmp_path):
+    # manual: "unfix rr" makes a plain parameter optimizing (its PSCALE kept)
+    p = tmp_path / "plain.fe"
+    p.write_text(HEXAGON.format(opts="pscale = 0.3", z=0.1, bodies="")
+                 .replace("optimizing_parameter", "parameter"))
+    pr = 'printf "%.15g\\n", rr\n'
+    script = ("m 0.1\ng 1\n" + pr + "unfix rr\ng 1\n" + pr + "fix rr\ng 1\n" + pr
+              + "unfix rr\ng 1\n" + pr)
+    _, ref, out, err = _run_both(evolver, str(p), script, tmp_path)
+    ref = [ln for ln in _numbers(ref) if len(ln.split()) == 1]
+    out = [ln for ln in _numbers(out) if len(ln.split()) == 1]
+    assert len(ref) == 4 and ref[0].strip() == "1.2" and ref[1] != ref[0], ref
+    assert _same(out, ref, STEPS), (out, ref, err)
