@@ -97,6 +97,65 @@ def project_tangent(s: Surface, vecs: list[np.ndarray]) -> list[np.ndarray]:
     return out
 
 
+def tangent_projectors(s: Surface, rows: np.ndarray, nonwall: bool = True) -> np.ndarray:
+    """The projectors ``I − G (GᵀG)⁻¹ Gᵀ`` onto the tangent spaces of the
+    level-set constraints of the vertices ``rows`` (G their gradients; a
+    one-sided constraint counts where the vertex hits it and is not leaving
+    it this step, as in :func:`project_tangent`; NONWALL constraints only
+    when ``nonwall``).
+
+    Returns
+    -------
+    (len(rows), 3, 3) array
+        The identity at a vertex on none of them.
+    """
+    rows = np.asarray(rows, np.int64)
+    out = np.broadcast_to(np.eye(3), (len(rows), 3, 3)).copy()
+    cids = [c for c in sorted(s.vcon or {})
+            if nonwall or "nonwall" not in s.constraints[c].flags]
+    if not len(rows) or not cids:
+        return out
+    env = s.param_env()
+    on = np.stack([np.asarray(s.vcon[c], bool)[rows] for c in cids], axis=1)
+    on = _hit_one_sided(s, cids, on, env, rows=rows)
+    keys, inv = np.unique(on, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    for gi, key in enumerate(keys):
+        if not key.any():
+            continue
+        sel = np.nonzero(inv == gi)[0]
+        coords = vertex_coords(s, rows[sel])
+        G = np.stack([np.broadcast_to(s.constraints[c].formula.gradient(env, coords, len(sel)),
+                                      (len(sel), 3))
+                      for c, k in zip(cids, key) if k], axis=2)       # (n, 3, k)
+        GtG = np.einsum("nik,nil->nkl", G, G)
+        with np.errstate(all="ignore"):
+            Ginv = np.nan_to_num(np.linalg.pinv(GtG))
+        out[sel] -= np.einsum("nik,nkl,njl->nij", G, Ginv, G)
+    return out
+
+
+def curved_constraints(s: Surface, rows: np.ndarray) -> list[int]:
+    """The level-set constraints of the vertices ``rows`` whose formula has a
+    nonzero second derivative at one of them (not planes there).
+
+    Returns
+    -------
+    list of int
+        Constraint ids.
+    """
+    rows = np.asarray(rows, np.int64)
+    env = s.param_env()
+    out = []
+    for c in sorted(s.vcon or {}):
+        rr = rows[np.asarray(s.vcon[c], bool)[rows]]
+        if len(rr):
+            H = s.constraints[c].formula.hessian(env, vertex_coords(s, rr), len(rr))
+            if np.any(H != 0):
+                out.append(c)
+    return out
+
+
 def _hit_one_sided(s, cids, on, env, tol=1e-10, rows=None, violated=False, hold=None):
     """``on`` with one-sided (NONNEGATIVE / NONPOSITIVE) constraints kept only
     for the vertices that hit them (value 0 within ``tol``), or, with

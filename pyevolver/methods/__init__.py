@@ -15,8 +15,8 @@ integrals), :mod:`~pyevolver.methods.curvature` (+ ``curvature_hessian``),
 """
 from __future__ import annotations
 
-from . import (basic, curvature_hessian, elastic, harmonic, loop,  # noqa: F401  (they register)
-               springs)
+from . import (basic, curvature_hessian, elastic, gauss_integral, harmonic,  # noqa: F401
+               loop, springs)
 from . import string as _string  # noqa: F401  (registers the string model's totals)
 from .registry import (CURVATURE_METHODS, GRADIENTS, HESSIANS, METHODS, NO_HESSIAN, REGISTRY,
                        Method, lookup, method_info, register_method)

@@ -20,11 +20,18 @@ Hessian-vector product, never assembled), ``∂E/∂N`` through
 ``mean_curvature_integral`` is the edge method ``Σ_e ½ L_e θ_e`` with θ_e
 the signed exterior dihedral angle (positive where the surface is convex
 towards its normals), ∫H dA with H = (k1 + k2)/2.
+
+At vertices on level-set constraints F and N are projected onto the
+constraints' tangent space (the constraints act as mirror planes; manual,
+"eff_area_sq_mean_curvature"), by REF's rules found by experiment
+(:func:`mirror_projector`, docs/supported.md); a vertex on a free edge off
+any constraint uses its partial star as it is.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..constraints.levelset import curved_constraints, tangent_projectors
 from ..errors import UnsupportedError
 from ..model.records import edge_facets
 from ._common import corner_scatter, facet_points, n2_grad_dot, scatter
@@ -105,17 +112,116 @@ def _h_zero(s, method):
 def _check_supported(s):
     if s.periods is not None:
         raise UnsupportedError("curvature methods in the torus model")
-    if s.vcon and any(np.any(m) for m in s.vcon.values()):
-        raise UnsupportedError("curvature methods at vertices on level-set constraints",
-                               "REF projects F and N onto the constraints there")
+
+
+def _check_closed(s, what, constraints=False):
+    """Refuse ``what`` on surfaces with a free edge and, unless ``constraints``
+    (REF evaluates it there without projection), at constrained vertices."""
+    _check_supported(s)
+    if not constraints and s.vcon and any(np.any(m) for m in s.vcon.values()):
+        raise UnsupportedError(f"{what} at vertices on level-set constraints",
+                               "no mirror rule known")
+    if _edge_valence_one_vertices(s).any():
+        raise UnsupportedError(f"{what} on surfaces with a free boundary",
+                               "the partial stars of boundary vertices")
+
+
+def _edge_valence_one_vertices(s):
+    """(nv,) bool: the vertices on an edge with exactly one facet (cached per topology)."""
     topo = s.topology()
     c = s.__dict__.get("_free_boundary")
     if c is None or c[0] is not topo:
-        c = (topo, bool(np.any(np.bincount(topo[0].ravel(), minlength=s.ne) == 1)))
+        ev = np.bincount(topo[0].ravel(), minlength=s.ne) == 1
+        on = np.zeros(s.nv, bool)
+        on[s.E[ev].ravel()] = True
+        c = (topo, on)
         s._free_boundary = c
-    if c[1]:
-        raise UnsupportedError("curvature methods on surfaces with a free boundary",
-                               "the partial stars of boundary vertices")
+    return c[1]
+
+
+def _wall_vertices(s, nonwall):
+    """(nv,) bool: vertices on a level-set constraint that acts as a mirror
+    (NONWALL ones too when ``nonwall``)."""
+    on = np.zeros(s.nv, bool)
+    for cid, mask in (s.vcon or {}).items():
+        if nonwall or "nonwall" not in s.constraints[cid].flags:
+            on |= np.asarray(mask, bool)
+    return on
+
+
+def mirror_projector(s, m):
+    """The vertices whose ``F`` and ``N`` REF projects onto their constraints'
+    tangent space (the constraints as mirror planes) and the projectors there.
+
+    Old-style methods (``sq_mean_curvature``, ``eff_area_…``, ``normal_…``) project
+    at every vertex on a level-set constraint; the ``star_…`` methods only at
+    those that also lie on an edge with one facet (an incomplete star).
+    ``ignore_constraints`` in the declaration turns it off for the old
+    methods only (REF: no effect on the star methods).  Measured against
+    evolver-nox-d 2.70 on a mound (free edge on z = 0) and a closed cube with
+    its bottom vertices on z = 0 (docs/supported.md).
+
+    Returns
+    -------
+    rows : (k,) int
+        The projected vertices (empty: none).
+    P : (k, 3, 3)
+        ``I − G (GᵀG)⁻¹ Gᵀ`` of each, G the gradients of its constraints.
+    """
+    empty = (np.zeros(0, np.int64), np.zeros((0, 3, 3)))
+    old = VERTEX_METHODS.get(m.method, ("", "", True))[2]
+    if not s.vcon or (old and getattr(m, "ignore_constraints", False)):
+        return empty
+    on = _wall_vertices(s, old)
+    if not old:
+        on &= _edge_valence_one_vertices(s)
+    rows = np.nonzero(on)[0]
+    if not len(rows):
+        return empty
+    return rows, tangent_projectors(s, rows, nonwall=old)
+
+
+def check_old_gradient(s, m, rows):
+    """Refuse the gradient of an old-style method where REF's force is not the
+    derivative of its energy (measured with ``v_force`` after ``g 1``): at
+    vertices on curved constraints; for the h_zero, ``eff_area`` and
+    ``normal`` estimates also at unskipped vertices on a free edge that are not
+    projected, at projected ones with a complete star (``eff``/``normal``) and
+    at any projected one (with h_zero).  ``sq_mean_curvature`` without
+    h_zero agrees with REF on free edges and plane constraints."""
+    kind0, _, old = VERTEX_METHODS.get(m.method, ("plain", "no", True))
+    if not old:
+        return
+    if len(rows):
+        curved = curved_constraints(s, rows)
+        if curved:
+            raise UnsupportedError(
+                f"the gradient of {m.method} at vertices on curved constraints ({curved[0]})",
+                "REF's force there is neither the derivative with the projector held "
+                "constant nor the exact one; the star_ methods are supported")
+    kind, h0, _ = _kind(s, m.method)
+    if kind == "plain" and h0 is None:
+        return
+    live = ~_skipped(s, m)
+    proj = np.zeros(s.nv, bool)
+    proj[rows] = True
+    edge = _edge_valence_one_vertices(s)
+    bad = live & edge & ~proj
+    bad |= live & proj & (~edge if h0 is None else True)
+    if bad.any():
+        what = "h_zero" if h0 is not None else kind0
+        raise UnsupportedError(
+            f"the gradient of {m.method} ({what}) at vertices on a free edge or a constraint",
+            "REF's force there is not the derivative of its energy; use the star_ methods")
+
+
+def _project(rows, P, v):
+    """``v`` (nv, 3) with the rows ``rows`` multiplied by their projectors."""
+    if not len(rows):
+        return v
+    v = v.copy()
+    v[rows] = np.einsum("nij,nj->ni", P, v[rows])
+    return v
 
 
 def _kind(s, name):
@@ -128,15 +234,16 @@ def _kind(s, name):
     return kind, h0, old
 
 
-def _skipped(s):
-    """(nv,) bool: vertices where the old-style methods are zero."""
-    skip = s.vattr["fixed"].copy()
+def _skipped(s, m=None):
+    """(nv,) bool: vertices where the old-style methods are zero (FIXED ones
+    unless the declaration says ``ignore_fixed``, parametric-boundary ones)."""
+    skip = np.zeros(s.nv, bool) if getattr(m, "ignore_fixed", False) else s.vattr["fixed"].copy()
     if "boundary" in s.vattr:
         skip |= s.vattr["boundary"] != 0
     return skip
 
 
-def _vertex_energy(s, A, F, N, name):
+def _vertex_energy(s, A, F, N, name, m=None):
     """``E`` (nv,) and its partial derivatives ``dF``, ``dN`` (nv, 3), ``dA``."""
     kind, h0, old = _kind(s, name)
     nv = s.nv
@@ -176,7 +283,7 @@ def _vertex_energy(s, A, F, N, name):
     E, dA = np.nan_to_num(E), np.nan_to_num(dA)
     dF, dN = np.nan_to_num(dF), np.nan_to_num(dN)
     if old:
-        skip = _skipped(s)
+        skip = _skipped(s, m)
         E[skip] = 0.0
         dF[skip] = 0.0
         dN[skip] = 0.0
@@ -189,7 +296,9 @@ def vertex_values(ctx, m, idx):
     s = ctx.surface
     _check_supported(s)
     A, F, N = star_sums(ctx)
-    E, _, _, _ = _vertex_energy(s, A, F, N, m.method)
+    rows, P = mirror_projector(s, m)
+    F, N = _project(rows, P, F), _project(rows, P, N)
+    E, _, _, _ = _vertex_energy(s, A, F, N, m.method, m)
     return E[idx]
 
 
@@ -210,7 +319,11 @@ def vertex_gradient(t, m, idx, w):
     s = t.surface
     _check_supported(s)
     A, F, N = star_sums(t)
-    _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method)
+    rows, Pm = mirror_projector(s, m)
+    check_old_gradient(s, m, rows)
+    F, N = _project(rows, Pm, F), _project(rows, Pm, N)
+    _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method, m)
+    dF, dN = _project(rows, Pm, dF), _project(rows, Pm, dN)   # projectors held constant
     P = facet_points(t)
     L = 2.0 * t.facet_area
     with np.errstate(all="ignore"):
@@ -254,7 +367,11 @@ def mci_values(ctx, m, idx):
     Le = np.linalg.norm(d, axis=1)
     S = np.einsum("ij,ij->i", np.cross(N1, N2), d) / Le
     C = np.einsum("ij,ij->i", N1, N2)
-    out[ok] = 0.5 * Le * np.arctan2(S, C)
+    if m.method == "mean_curvature_integral_a":
+        with np.errstate(all="ignore"):
+            out[ok] = 0.5 * Le * S / C          # REF's "_a": ½ L tan θ (blob0: 1e-15)
+    else:
+        out[ok] = 0.5 * Le * np.arctan2(S, C)
     return out
 
 
@@ -274,9 +391,18 @@ def mci_gradient(t, m, idx, w):
     C = np.einsum("ij,ij->i", N1, N2)
     theta = np.arctan2(S, C)
     R = S * S + C * C
-    # dθ = (C dS − S dC)/R with S = u·(N1 × N2), C = N1·N2
-    a = (C / R)[:, None]
-    b = (S / R)[:, None]
+    # dθ = (C dS − S dC)/R with S = u·(N1 × N2), C = N1·N2; REF drops dθ at
+    # exactly flat edges (its acos form is singular there: cube.fe's faces);
+    # at edges flat only to round-off (a refined curved surface) what REF
+    # does depends on its rounding, and the exact dθ is kept
+    flat = S == 0.0
+    if m.method == "mean_curvature_integral_a":       # ½ L tan θ: d tan θ = (C dS − S dC)/C²
+        flat[:] = False
+        with np.errstate(all="ignore"):
+            theta = S / C
+            R = C * C
+    a = np.where(flat, 0.0, C / R)[:, None]
+    b = np.where(flat, 0.0, S / R)[:, None]
     # through N1 (facet f1 corners) and N2 (facet f2 corners)
     g1 = n2_grad_dot(P1, a * np.cross(N2, u) - b * N2)
     g2 = n2_grad_dot(P2, a * np.cross(u, N1) - b * N1)
@@ -339,14 +465,17 @@ def star_gauss_values(ctx, m, idx):
 
 def sq_gauss_values(ctx, m, idx):
     """``sq_gauss_curvature``: K²/(A/3) at a vertex (closed surfaces)."""
-    _check_supported(ctx.surface)
+    _check_closed(ctx.surface, "sq_gauss_curvature", True)
     K, A, _, _ = _gauss(ctx)
     return (K * K / (A / 3.0))[idx]
 
 
 def _gauss_grad(t, idx, w, square):
     s = t.surface
-    _check_supported(s)
+    if square:
+        _check_closed(s, "sq_gauss_curvature", True)
+    else:
+        _check_supported(s)
     K, A, P, dang = _gauss(t)
     wv = vertex_weights(s.nv, idx, w)
     if square:
@@ -455,7 +584,7 @@ def cotan_values(ctx, m, idx):
     curvature normal K = S/(2A) = 2H n and mixed areas A (MDSB 2003), i.e.
     ``|S_v|² / (16 A_v)``; pyevolver's own method (paper's W_MDSB)."""
     s = ctx.surface
-    _check_supported(s)
+    _check_closed(s, "cotan_sq_mean_curvature")
     _, _, _, _, _, Sv, Av = _cotan_parts(ctx)
     with np.errstate(all="ignore"):
         E = np.nan_to_num(np.einsum("ij,ij->i", Sv, Sv) / (16.0 * Av))
@@ -464,7 +593,7 @@ def cotan_values(ctx, m, idx):
 
 def cotan_gradient(t, m, idx, w):
     s = t.surface
-    _check_supported(s)
+    _check_closed(s, "cotan_sq_mean_curvature")
     P, cot, cg, Am, Amg, Sv, Av = _cotan_parts(t)
     wv = vertex_weights(s.nv, idx, w)
     with np.errstate(all="ignore"):
@@ -541,7 +670,7 @@ def circle_willmore_values(ctx, m, idx):
     ½ Σ_{e∋v} β_e − π (REF: 0 on polyhedra inscribed in a sphere, 1.1430603354544
     on blob0.fe).  Not differentiable where some β = 0 or π."""
     s = ctx.surface
-    _check_supported(s)
+    _check_closed(s, "circle_willmore")
     e, i, j, k, l_ = _edge_quads(s)
     beta = _bobenko_beta(s.X, i, j, k, l_)
     per_v = 0.5 * (np.bincount(i, weights=beta, minlength=s.nv)
@@ -551,7 +680,7 @@ def circle_willmore_values(ctx, m, idx):
 
 def circle_willmore_gradient(t, m, idx, w):
     s = t.surface
-    _check_supported(s)
+    _check_closed(s, "circle_willmore")
     wv = vertex_weights(s.nv, idx, w)
     e, i, j, k, l_ = _edge_quads(s)
     _, (gi, gj, gk, gl) = _bobenko_beta(s.X, i, j, k, l_, grad=True)

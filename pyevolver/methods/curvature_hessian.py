@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..constraints.levelset import constrained_vertices, curved_constraints
 from . import curvature as C
 from ._common import assemble, facet_points
 from .registry import register_method
@@ -109,7 +110,7 @@ def _ratio(P, gP, HP, Q, gQ, HQ):
     return g, H
 
 
-def vertex_energy_hessian(s, A, F, N, name):
+def vertex_energy_hessian(s, A, F, N, name, m=None):
     """Hessian (nv, 7, 7) of the vertex energies ``E_v`` of method ``name`` in
     the variables ``(A, F, N)`` (see :func:`curvature._vertex_energy`)."""
     kind, h0, old = C._kind(s, name)
@@ -165,7 +166,7 @@ def vertex_energy_hessian(s, A, F, N, name):
             M[~ok] = 0.0
     M = np.nan_to_num(M)
     if old:
-        M[C._skipped(s)] = 0.0
+        M[C._skipped(s, m)] = 0.0
     return M
 
 
@@ -202,9 +203,18 @@ def vertex_hessian(t, m, idx, w, basis=None):
     s = t.surface
     C._check_supported(s)
     A, F, N = C.star_sums(t)
-    _, dF, dN, dA = C._vertex_energy(s, A, F, N, m.method)
+    rows, Pm = C.mirror_projector(s, m)
+    C.check_old_gradient(s, m, rows)
+    F, N = C._project(rows, Pm, F), C._project(rows, Pm, N)
+    _, dF, dN, dA = C._vertex_energy(s, A, F, N, m.method, m)
+    dF, dN = C._project(rows, Pm, dF), C._project(rows, Pm, dN)
     wv = C.vertex_weights(s.nv, idx, w)
-    M = vertex_energy_hessian(s, A, F, N, m.method) * wv[:, None, None]
+    M = vertex_energy_hessian(s, A, F, N, m.method, m) * wv[:, None, None]
+    if len(rows):                      # E(A, P F, P N): M -> Tᵀ M T, T = diag(1, P, P)
+        T = np.zeros((len(rows), 7, 7))
+        T[:, 0, 0] = 1.0
+        T[:, 1:4, 1:4] = T[:, 4:7, 4:7] = Pm
+        M[rows] = np.einsum("nji,njk,nkl->nil", T, M[rows], T)
     return star_hessian(t, M, dA * wv, dF * wv[:, None], dN * wv[:, None], basis)
 
 
@@ -234,7 +244,10 @@ def mci_hessian(t, m, idx, w, basis=None):
     N2 = J.cross(x[0] - x[1], x[3] - x[1])       # f2 runs head → tail → l
     L = J.norm(d)
     u = d * _inverse(L)
-    theta = J.atan2(J.dot(u, J.cross(N1, N2)), J.dot(N1, N2))
+    if m.method == "mean_curvature_integral_a":           # ½ L tan θ (REF's "_a")
+        theta = J.dot(u, J.cross(N1, N2)) * _inverse(J.dot(N1, N2))
+    else:
+        theta = J.atan2(J.dot(u, J.cross(N1, N2)), J.dot(N1, N2))
     E = (L * theta) * (0.5 * w)
     return _elements(s.nv, verts, E.H, basis)
 
@@ -252,7 +265,10 @@ def _angle_jets(x):
 
 def _gauss_hessian(t, idx, w, square, basis):
     s = t.surface
-    C._check_supported(s)
+    if square:
+        C._check_closed(s, "sq_gauss_curvature", True)
+    else:
+        C._check_supported(s)
     K, A, P, _ = C._gauss(t)
     nv, Fc = s.nv, s.F
     nf = len(P)
@@ -298,7 +314,7 @@ def sq_gauss_hessian(t, m, idx, w, basis=None):
 def cotan_hessian(t, m, idx, w, basis=None):
     """Hessian of ``Σ_v w_v |S_v|² / (16 A_v)`` (MDSB; see :func:`curvature.cotan_values`)."""
     s = t.surface
-    C._check_supported(s)
+    C._check_closed(s, "cotan_sq_mean_curvature")
     P, cot, _, _, _, Sv, Av = C._cotan_parts(t)
     nv, Fc = s.nv, s.F
     nf = len(P)
@@ -348,8 +364,21 @@ def cotan_hessian(t, m, idx, w, basis=None):
 # the registry entries of the curvature family (values and gradients in
 # :mod:`pyevolver.methods.curvature`, Hessians here)
 
+def plane_constraints_only(s) -> bool:
+    """False where a constrained vertex is on a curved constraint: the
+    gradient holds the mirror projectors constant there (as REF), so its
+    derivative has terms in the projectors' derivatives that
+    :func:`vertex_hessian` leaves out; ``hessian`` then takes differences of
+    the gradient."""
+    if not s.vcon:
+        return True
+    rows = np.nonzero(constrained_vertices(s))[0]
+    return not (len(rows) and curved_constraints(s, rows))
+
+
 for _name in C.VERTEX_METHODS:
-    register_method(_name, "vertex", C.vertex_values, C.vertex_gradient, vertex_hessian)
+    register_method(_name, "vertex", C.vertex_values, C.vertex_gradient, vertex_hessian,
+                    hessian_applies=plane_constraints_only)
 for _name in ("mean_curvature_integral", "mean_curvature_integral_a"):
     register_method(_name, "edge", C.mci_values, C.mci_gradient, mci_hessian)
 register_method("star_gauss_curvature", "vertex", C.star_gauss_values, C.star_gauss_gradient,

@@ -71,6 +71,12 @@ CURVATURE_METHODS = {
 }
 
 
+_NOT_YET = {
+    "mix_sq_mean_curvature": "the Evolver 2.70 has no such method (DATAFILE ERROR 1559), "
+                             "so there is no reference for its formula",
+}
+
+
 def register_method(name: str, etype: str, fn: Callable, gradient: Callable | None = None,
                     hessian: Callable | None = None, *, no_hessian: str | None = None,
                     hessian_applies: Callable | None = None) -> Method:
@@ -100,8 +106,8 @@ def lookup(name: str) -> Method:
         return REGISTRY[name]
     except KeyError:
         if name in CURVATURE_METHODS:
-            raise UnsupportedError(f"method {name}",
-                                   "curvature energies come with the Willmore issue") from None
+            raise UnsupportedError(f"method {name}", _NOT_YET.get(
+                name, "curvature energies come with the Willmore issue")) from None
         raise UnsupportedError(f"method {name}") from None
 
 

@@ -115,3 +115,17 @@ def test_integral_edges_skip_fixed_edges():
     assert idx.tolist() == [6]                   # edge 7 (edge 9 is FIXED)
     assert np.array_equal(np.abs(sign), [1.0])
     assert LS.integral_edges(s, "content") == []
+
+
+def test_tangent_projectors_equal_project_tangent_and_find_curved_constraints():
+    """The per-vertex projector matrices act as project_tangent does; the
+    sphere (constraint 1) is curved at its vertices, the planes are not."""
+    s = surface()
+    rows = np.arange(s.nv)
+    P = LS.tangent_projectors(s, rows)
+    v = np.random.default_rng(1).standard_normal((s.nv, 3))
+    (t,) = LS.project_tangent(s, [v])
+    assert np.allclose(np.einsum("nij,nj->ni", P, v), t, atol=ROUNDOFF * 10)
+    assert np.allclose(P, np.swapaxes(P, 1, 2), atol=ROUNDOFF)
+    assert LS.curved_constraints(s, rows) == [1]
+    assert LS.curved_constraints(s, np.array([4, 5, 6])) == []

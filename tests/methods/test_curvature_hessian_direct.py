@@ -16,6 +16,7 @@ from pyevolver.model.scene import MethodDecl
 CASES = [("star_sq_mean_curvature", CH.vertex_hessian),
          ("sq_mean_curvature", CH.vertex_hessian),
          ("mean_curvature_integral", CH.mci_hessian),
+         ("mean_curvature_integral_a", CH.mci_hessian),
          ("star_gauss_curvature", CH.star_gauss_hessian),
          ("sq_gauss_curvature", CH.sq_gauss_hessian),
          ("cotan_sq_mean_curvature", CH.cotan_hessian)]

@@ -30,7 +30,9 @@ def test_views_follow_the_registry():
 
 def test_unknown_and_unimplemented_methods():
     with pytest.raises(UnsupportedError, match="Willmore"):
-        lookup("gauss_curvature_integral")
+        lookup("sqcurve_string")
+    with pytest.raises(UnsupportedError, match="1559"):
+        lookup("mix_sq_mean_curvature")
     with pytest.raises(UnsupportedError):
         lookup("no_such_method")
 

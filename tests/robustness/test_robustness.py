@@ -114,8 +114,9 @@ def test_errors_once_without_a_line():
     assert exc.line == 1
     exc = _load_error("method_instance mm method no_such_method\n" + CUBE_TEXT)
     assert exc.line == 1
-    # a method refused when the surface is first evaluated (an open box)
-    exc = _load_error("\n\nquantity sq energy method star_perp_sq_mean_curvature global\n"
+    # a method refused when the surface is first evaluated (an open box:
+    # sq_gauss_curvature needs a closed surface)
+    exc = _load_error("\n\nquantity sq energy method sq_gauss_curvature global\n"
                       + CUBE_TEXT.replace("1   1 2 3 4 5 6  volume 1", "").replace(
                           "5   5  6  7   8", ""))
     assert exc.line == 3 and "quantity sq" in exc.message
