@@ -536,7 +536,11 @@ class Session(SessionAPI):
                         self._replace_surface(new)
                     r.warnings.append(f"Autochopped {nch} edges.")
             if echo:
+                off = self.__dict__.get("suppressed_warnings") or ()
                 for w in r.warnings:
+                    if any(w.startswith(f"WARNING {n}:") for n in off) or \
+                            ("Total difference" in w and 1055 in off):
+                        continue                    # suppress_warning n
                     if w.startswith(("WARNING 1055", "Total difference", "WARNING 1864")):
                         # REF writes these to stderr, the pair (and 1864) followed by a
                         # blank line
