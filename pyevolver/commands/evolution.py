@@ -7,6 +7,7 @@ arguments and print REF's messages.
 from __future__ import annotations
 
 from ..errors import CommandError
+from ..evolve import optparams as OP
 from .registry import register
 from .values import as_float
 
@@ -43,11 +44,13 @@ def _optimize(interp, raw, arg):
 @register("bfgs", usage="bfgs [n]", help="n BFGS iterations (nonsmooth energies)",
           family=FAMILY)
 def _bfgs(interp, raw, arg):
+    OP.refuse(interp.session.surface, "bfgs")
     interp.session.bfgs(1 if arg is None else interp.count(arg))
 
 
 @register("newton", usage="newton [n]", help="n damped Newton steps", family=FAMILY)
 def _newton(interp, raw, arg):
+    OP.refuse(interp.session.surface, "newton")
     interp.session.newton(1 if arg is None else interp.count(arg))
 
 
@@ -56,6 +59,7 @@ def _newton(interp, raw, arg):
 def _hessian(interp, raw, arg):
     s = interp.session
     name = raw.lower()
+    OP.refuse(s.surface, name)
     if name == "hessian_seek" and arg is not None:
         s.hessian(seek=True, max_scale=as_float(interp.value(arg), f"the argument of {raw}"))
     else:

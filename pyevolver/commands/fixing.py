@@ -33,8 +33,18 @@ def fix_name(session: SessionLike, name, on):
         else:
             q.kind = "info_only" if q.kind == "fixed" else q.kind
         return
+    if name in session.variables and isinstance(session.variables[name], (int, float)):
+        # manual: "unfix radius" makes a parameter optimizing, "fix radius" plain
+        # again; its PDELTA / PSCALE are kept (pyevolver.evolve.optparams)
+        opt = s.__dict__.setdefault("optimizing", {})
+        keep = s.__dict__.setdefault("param_deltas", {})
+        if on and name in opt:
+            keep[name] = opt.pop(name)
+        elif not on and name not in opt:
+            opt[name] = keep.pop(name, (1e-4, 1.0))
+        return
     if name in session.variables:
-        raise UnsupportedError(f"{'fix' if on else 'unfix'} {name} (optimizing parameters)")
+        raise UnsupportedError(f"{'fix' if on else 'unfix'} {name} (a string variable)")
     raise CommandError(f"{'fix' if on else 'unfix'}: '{name}' is not a quantity "
                        f"(expected: fix element_generator or fix quantity_name)")
 

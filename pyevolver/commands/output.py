@@ -137,3 +137,16 @@ def histogram_text(vals, log=False):
         out.append("%10.5g - %10.5g     %d" % (edges[k], edges[k + 1], counts[k]))
     return "\n".join(out + tail) + "\n"
 
+
+
+@register("suppress_warning", "unsuppress_warning", usage="suppress_warning n",
+          help="do not print (print again) the Evolver's warning number n", family=FAMILY)
+def _suppress_warning(interp, raw, arg):
+    if arg is None:
+        raise CommandError(f"{raw} needs a warning number")
+    n = interp.count(arg)
+    off = interp.session.__dict__.setdefault("suppressed_warnings", set())
+    if raw.lower() == "suppress_warning":
+        off.add(n)
+    else:
+        off.discard(n)

@@ -365,14 +365,18 @@ class TopSection:
         self.scene.unsupported.append((feature, line, col))
 
     def _parameter_options(self, name, opts, line):
-        """OPTIMIZING_PARAMETER (refused: the Evolver varies it during
-        iteration), PDELTA / PSCALE (used by optimizing parameters only: no
-        number of a plain parameter changes), ON_ASSIGN_CALL (refused)."""
-        if opts.get("optimizing"):
-            self._defer(f"OPTIMIZING_PARAMETER ({name})", line, opts.get("column"))
+        """OPTIMIZING_PARAMETER (``g`` moves it with the vertices:
+        :mod:`pyevolver.evolve.optparams`), PDELTA / PSCALE (its finite
+        difference and motion scale, defaults 0.0001 and 1; kept for plain
+        parameters too), ON_ASSIGN_CALL."""
+        vals = {"pdelta": 1e-4, "pscale": 1.0}
         for key in ("pdelta", "pscale"):
             if key in opts:
-                self._const(opts[key][0], line, f"{key} of parameter {name}")
+                vals[key] = self._const(opts[key][0], line, f"{key} of parameter {name}")
+        if opts.get("optimizing"):
+            self.scene.optimizing[name] = (vals["pdelta"], vals["pscale"])
+        elif "pdelta" in opts or "pscale" in opts:
+            self.scene.param_deltas[name] = (vals["pdelta"], vals["pscale"])
         if "on_assign_call" in opts:
             # the procedure runs whenever the variable is assigned (manual); it
             # must have been declared before, in the top section

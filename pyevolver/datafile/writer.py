@@ -217,6 +217,12 @@ class _FeWriter:
                 continue            # strings and arrays are not datafile parameters
             if not _NAME.match(pname) or pname in N.CONSTANTS:
                 continue
+            opt = (getattr(s, "optimizing", None) or {}).get(pname)
+            if opt is not None:     # REF: OPTIMIZING_PARAMETER rr = 1.2 pscale = 0.3
+                extra = "".join(f" {k} = {num(x)}" for k, x, d in
+                                (("pdelta", opt[0], 1e-4), ("pscale", opt[1], 1.0)) if x != d)
+                self.w(f"OPTIMIZING_PARAMETER {pname} = {num(v)}{extra}")
+                continue
             self.w(f"PARAMETER {pname} = {num(v)}")
         self.w()
         types = self.opts.attr_types if self.opts is not None else {}

@@ -17,6 +17,7 @@ import numpy as np
 from ..constraints import (displace, project_tangent, project_to_constraints, release_one_sided,
                        restore_state, state)
 from . import gradient as GR
+from . import optparams as OP
 
 
 def _solve(A, d):
@@ -344,6 +345,21 @@ class Iterator:
         cons = _Constraints(s)
         t0 = s.evaluate()
         f = -GR.energy_gradient(t0)
+        # optimizing parameters: moved by -scale * pscale * dE/dp with the vertices
+        popt = bool(OP.names(s))
+        if popt:
+            if len(cons):
+                OP.refuse(s, "fixed volumes or FIXED quantities")
+            if settings.conj_grad:
+                OP.refuse(s, "conj_grad")
+            self._pbase: np.ndarray | None = OP.values(s)
+            pvel = -OP.scales(s) ** 2 * OP.gradient(s)
+        else:
+            self._pbase = None
+
+        def params_at(scale_):
+            if popt:
+                OP.set_values(s, self._pbase + scale_ * pvel)
         # the vertex attributes v_force and v_oldx read the last step's force
         # (REF: FIXED vertices included, not projected onto constraints; +0.0
         # turns -0 into 0) and the moving vertices' starting coordinates
@@ -406,6 +422,7 @@ class Iterator:
 
         def E(scale):
             self._diverged = False
+            params_at(scale)
             t = self._move(X0, vel, scale, cons, us, A, mobile, targets, trial_msgs,
                            trial=True)
             e = math.nan if self._diverged else t.energy
@@ -430,6 +447,7 @@ class Iterator:
         report = trial_msgs
         self._carry = (us, A)
         self._diverged = False
+        params_at(settings.scale_scale * scale)
         t = self._move(X0, vel, settings.scale_scale * scale, cons, us, A,
                        mobile, targets, report)
         t = self._hold_one_sided(t)
@@ -440,6 +458,7 @@ class Iterator:
             E0 = t0.energy
         if settings.check_increase and e > E0:
             restore_state(s, X0)
+            self._restore_params()
             self.cg_history = None
             warnings.append("WARNING 1865: Motion would have increased energy. Restoring "
                             "coordinates.")
@@ -449,6 +468,7 @@ class Iterator:
         if not fixed_scale and e > E0 and scale > 0:
             scale = s1
             us_c, A_c = self._carry
+            params_at(scale)
             t = self._move(X0, vel, scale, cons, us_c, A_c, mobile, targets, report)
             t = self._hold_one_sided(t)
             self.cg_history = None
@@ -479,11 +499,17 @@ class Iterator:
         warning, and no progress line."""
         s = self.surface
         restore_state(s, X0)
+        self._restore_params()
         self.cg_history = None
         return StepResult(t0.energy, t0.total_area, scale, lam, {}, False,
                           message="infinite",
                           warnings=report + [INFINITE_WARNING], totals=s.evaluate(),
                           motion=motion)
+
+    def _restore_params(self):
+        """Put the optimizing parameters back to their values before the step."""
+        if getattr(self, "_pbase", None) is not None:
+            OP.set_values(self.surface, self._pbase)
 
     def _line_search(self, E, scale, smax):
         """The optimizing-scale search of spec §7.6; returns (s, E0, s1)."""

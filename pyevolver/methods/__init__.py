@@ -5,7 +5,9 @@ One entry per method in :mod:`pyevolver.methods.registry` holds its value,
 gradient and Hessian; one module per method family registers its entries
 at import: :mod:`~pyevolver.methods.basic` (areas, volumes, lengths,
 integrals), :mod:`~pyevolver.methods.curvature` (+ ``curvature_hessian``),
-:mod:`~pyevolver.methods.harmonic`, :mod:`~pyevolver.methods.loop`.
+:mod:`~pyevolver.methods.harmonic`, :mod:`~pyevolver.methods.loop`,
+:mod:`~pyevolver.methods.elastic` (stretching energies of facets),
+:mod:`~pyevolver.methods.springs` (``hooke_energy`` and relatives, ``dihedral_hooke``).
 :func:`register_method` is public, so a user can add methods::
 
     from pyevolver.methods import register_method
@@ -13,7 +15,8 @@ integrals), :mod:`~pyevolver.methods.curvature` (+ ``curvature_hessian``),
 """
 from __future__ import annotations
 
-from . import basic, curvature_hessian, gauss_integral, harmonic, loop  # noqa: F401  (they register)
+from . import (basic, curvature_hessian, elastic, gauss_integral, harmonic,  # noqa: F401
+               loop, springs)  # (they register)
 from . import quadratic as _quadratic  # noqa: F401  (the quadratic model's totals and methods)
 from . import string as _string  # noqa: F401  (registers the string model's totals)
 from .registry import (CURVATURE_METHODS, GRADIENTS, HESSIANS, METHODS, NO_HESSIAN, REGISTRY,

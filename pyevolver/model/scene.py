@@ -104,6 +104,10 @@ class Scene:
     boundary_names: dict = field(default_factory=dict)    # id -> name (named boundaries)
     on_assign: dict = field(default_factory=dict)         # parameter -> procedure
                                                           # (ON_ASSIGN_CALL)
+    optimizing: dict = field(default_factory=dict)        # OPTIMIZING_PARAMETER name ->
+                                                          # (pdelta, pscale)
+    param_deltas: dict = field(default_factory=dict)      # every parameter's (pdelta,
+                                                          # pscale) given in the file
     unsupported: list = field(default_factory=list)       # (feature, line, column): refused
                                                           # once the whole file is read
     warnings: list = field(default_factory=list)          # (message, line, column): the

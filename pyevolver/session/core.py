@@ -157,6 +157,9 @@ class Session(SessionAPI):
             surface.boundary_names = dict(scene.boundary_names)
         if scene.values.get("_period_exprs") is not None and surface.periods is not None:
             surface.period_exprs = scene.values["_period_exprs"]
+        # OPTIMIZING_PARAMETERs: moved by g (pyevolver.evolve.optparams)
+        surface.optimizing = dict(scene.optimizing)
+        surface.param_deltas = dict(scene.param_deltas)
         self._iterator = None                  # no CG history, pressures not yet valid
         # REF's gravity flag (reported by G): on when the datafile declares a
         # nonzero gravity_constant or a body has a density (mound.fe: on with
@@ -537,7 +540,11 @@ class Session(SessionAPI):
                         self._replace_surface(new)
                     r.warnings.append(f"Autochopped {nch} edges.")
             if echo:
+                off = self.__dict__.get("suppressed_warnings") or ()
                 for w in r.warnings:
+                    if any(w.startswith(f"WARNING {n}:") for n in off) or \
+                            ("Total difference" in w and 1055 in off):
+                        continue                    # suppress_warning n
                     if w.startswith(("WARNING 1055", "Total difference", "WARNING 1864")):
                         # REF writes these to stderr, the pair (and 1864) followed by a
                         # blank line

@@ -76,3 +76,14 @@ def test_quit_status():
     with pytest.raises(Quit) as exc:
         s.run("quit 257")
     assert exc.value.code == 1
+
+
+def test_suppress_warning_is_a_command(evolver, tmp_path):
+    # REF: read sections call it (suppress the hessian's "not positive definite")
+    s = session()
+    s.run("suppress_warning 1825; suppress_warning 1055; unsuppress_warning 1825")
+    assert s.suppressed_warnings == {1055}
+    with pytest.raises(CommandError, match="needs a warning number"):
+        s.run("suppress_warning")
+    ref = run_reference(evolver, CUBE, "suppress_warning 1825\nprint 7\n", cwd=str(tmp_path))
+    assert [ln.strip() for ln in ref if ln.strip()] == ["7"]

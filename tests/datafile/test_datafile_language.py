@@ -285,6 +285,7 @@ def test_body_pressure(evolver, tmp_path):
 @pytest.mark.parametrize("top", ["merit_factor 2", "zoom_vertex 3", "zoom_radius 2.0",
                                  "suppress_warning 1825", "unsuppress_warning 1825",
                                  "parameter yy = 2 pscale = 2 pdelta = 0.1",
+                                 "optimizing_parameter xx = 1 pdelta = 0.001",
                                  "keep_originals",
                                  "view_transforms 1 color red 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1",
                                  "view_transform_generators 1\n-1 0 0 0\n0 1 0 0\n0 0 1 0\n"
@@ -295,7 +296,6 @@ def test_settings_that_change_no_number(evolver, tmp_path, top):
 
 
 @pytest.mark.parametrize("top,word,line", [
-    ("optimizing_parameter xx = 1 pdelta = 0.001", "OPTIMIZING_PARAMETER", 1),
     ("constraint 1 content_rank 2\nformula: z = 0", "CONTENT_RANK", 1),
     ("square_gaussian_curvature 1", "SQUARE_GAUSSIAN_CURVATURE", 1),
     ("define vertex attribute kk real function { self.kk := 1 }", "FUNCTION", 1),
