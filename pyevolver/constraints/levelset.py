@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..expr.nodes import coord_names
 from ..model.formulas import Integrand, located
 from ..model.surface import Surface
 from .boundary import boundary_eval, boundary_groups, solve_small
@@ -86,7 +87,7 @@ def project_tangent(s: Surface, vecs: list[np.ndarray]) -> list[np.ndarray]:
     for gi, key in enumerate(keys):
         rr = rows[inv == gi]
         coords = vertex_coords(s, rr)
-        Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(rr))
+        Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(rr), _names(s))
                        for c, k in zip(cids, key) if k], axis=2)     # (n, 3, k)
         GtG = np.einsum("nik,nil->nkl", Gm, Gm)
         for v in out:
@@ -110,7 +111,8 @@ def tangent_projectors(s: Surface, rows: np.ndarray, nonwall: bool = True) -> np
         The identity at a vertex on none of them.
     """
     rows = np.asarray(rows, np.int64)
-    out = np.broadcast_to(np.eye(3), (len(rows), 3, 3)).copy()
+    d = s.X.shape[1]
+    out = np.broadcast_to(np.eye(d), (len(rows), d, d)).copy()
     cids = [c for c in sorted(s.vcon or {})
             if nonwall or "nonwall" not in s.constraints[c].flags]
     if not len(rows) or not cids:
@@ -125,8 +127,9 @@ def tangent_projectors(s: Surface, rows: np.ndarray, nonwall: bool = True) -> np
             continue
         sel = np.nonzero(inv == gi)[0]
         coords = vertex_coords(s, rows[sel])
-        G = np.stack([np.broadcast_to(s.constraints[c].formula.gradient(env, coords, len(sel)),
-                                      (len(sel), 3))
+        G = np.stack([np.broadcast_to(s.constraints[c].formula.gradient(env, coords, len(sel),
+                                                                        _names(s)),
+                                      (len(sel), d))
                       for c, k in zip(cids, key) if k], axis=2)       # (n, 3, k)
         GtG = np.einsum("nik,nil->nkl", G, G)
         with np.errstate(all="ignore"):
@@ -150,7 +153,7 @@ def curved_constraints(s: Surface, rows: np.ndarray) -> list[int]:
     for c in sorted(s.vcon or {}):
         rr = rows[np.asarray(s.vcon[c], bool)[rows]]
         if len(rr):
-            H = s.constraints[c].formula.hessian(env, vertex_coords(s, rr), len(rr))
+            H = s.constraints[c].formula.hessian(env, vertex_coords(s, rr), len(rr), _names(s))
             if np.any(H != 0):
                 out.append(c)
     return out
@@ -208,8 +211,8 @@ def release_one_sided(s: Surface, force: np.ndarray) -> None:
         coords = vertex_coords(s, rr)
         phi = np.broadcast_to(_constraint_formula(con, "values", env, coords, len(rr)),
                               (len(rr),))
-        g = np.broadcast_to(_constraint_formula(con, "gradient", env, coords, len(rr)),
-                            (len(rr), 3))
+        g = np.broadcast_to(_constraint_formula(con, "gradient", env, coords, len(rr),
+                                                _names(s)), (len(rr), s.X.shape[1]))
         into = np.einsum("ij,ij->i", np.asarray(force)[rr], g)
         if "nonpositive" in con.flags:
             into = -into
@@ -217,6 +220,11 @@ def release_one_sided(s: Surface, force: np.ndarray) -> None:
         if leave.any():
             out[c] = rr[leave]
     s._one_sided_released = out or None
+
+
+def _names(s: Surface) -> tuple[str, ...]:
+    """The coordinate names of the surface's space (``x y z``, or ``x y z w x5 ...``)."""
+    return coord_names(s.X.shape[1])
 
 
 def vertex_coords(s: Surface, rows: np.ndarray) -> dict[str, np.ndarray]:
@@ -229,7 +237,7 @@ def vertex_coords(s: Surface, rows: np.ndarray) -> dict[str, np.ndarray]:
     dict of str -> (n,) or (n, k) array
     """
     P = s.X[rows]
-    out = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+    out = {nm: P[:, k] for k, nm in enumerate(_names(s))}
     for (etype, name), arr in s.extra.items():
         if etype == "vertex" and name not in out:
             out[name] = arr[rows]
@@ -294,7 +302,8 @@ def project_to_constraints(s: Surface, idx: np.ndarray, tol: float | None = None
                 # (a one-sided constraint here is violated, hit or held: an equality)
                 phi = _constraint_formula(c, "values", env, coords, len(sel))
                 phis.append(phi)
-                grads.append(_constraint_formula(c, "gradient", env, coords, len(sel)))
+                grads.append(_constraint_formula(c, "gradient", env, coords, len(sel),
+                                                 _names(s)))
             phi = np.stack(phis, axis=1)           # (n, k)
             if phi0 is None:
                 phi0 = np.max(np.abs(phi), axis=1)

@@ -166,6 +166,8 @@ class Reader(TopSection, ElementSections):
         # (boundary parametrizations name p1, p2, ... instead: see _decl)
         for name in expr.names():
             if (name in allowed or name in self.scene.parameters or name in N.CONSTANTS
+                    or (name in N.COORD_NAMES[4:] and "x" in allowed
+                        and int(name[1:]) <= self.scene.space_dimension)
                     or any(name == a[1] for a in self.scene.attributes)):
                 continue
             line = col = None

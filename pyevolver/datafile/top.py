@@ -171,7 +171,7 @@ class TopSection:
             col = bad.start() - (text.rfind("\n", 0, bad.start()) + 1) + 1
             raise self.error(f"malformed number '{bad.group(0)}'", self._src(sec, line), col)
         sdm = _SPACE_DIM_RE.search(text)
-        if sdm and int(sdm.group(1)) > 3:
+        if sdm and int(sdm.group(1)) > 3 and re.search(r"^[ \t]*string\b", text, re.I | re.M):
             # the model is refused whatever else the file says: say so before
             # parsing what only that model allows (relaxed.fe's ref_coord[1])
             line = text.count("\n", 0, sdm.start()) + 1
@@ -256,7 +256,8 @@ class TopSection:
             sc.values[name] = self._const(expr, self._src(sec, line), name)
             sc.decl_lines[name] = self._src(sec, line)
             if name in ("space_dimension", "surface_dimension") and \
-                    sc.values[name] not in (1, 2, 3, 4):
+                    sc.values[name] not in ((1, 2, 3, 4, 5, 6, 7, 8, 9)
+                                            if name == "space_dimension" else (1, 2, 3, 4)):
                 raise self.error(f"not supported in pyevolver: {name.upper()} "
                                  f"{sc.values[name]:g}", self._src(sec, line))
             if fixed:

@@ -166,7 +166,7 @@ def quantity_gradient(t, q):
     """Gradient (nv, 3) of a named quantity's value (a FUNCTION quantity's:
     Σ_i ∂f/∂v_i ∇v_i over the method instances it reads)."""
     s = t.surface
-    g = np.zeros((s.nv, 3))
+    g = np.zeros((s.nv, s.X.shape[1]))
     if q.function is not None:
         env = t.instance_values(q)
         names = list(env)

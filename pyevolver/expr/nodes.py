@@ -548,6 +548,19 @@ _DIFF = {
 
 COORD_ALIASES = {"x1": "x", "x2": "y", "x3": "z", "x4": "w"}
 
+# the canonical names of the coordinates x1 .. x9 (SPACE_DIMENSION up to 9)
+COORD_NAMES = ("x", "y", "z", "w", "x5", "x6", "x7", "x8", "x9")
+
+
+def coord_names(n: int) -> tuple[str, ...]:
+    """The canonical names of the first ``n`` coordinates (``x y z w x5 ...``)."""
+    return COORD_NAMES[:n]
+
+
+def coord_dict(P: np.ndarray) -> dict:
+    """``{name: column}`` of the points ``P (n, d)``, by :func:`coord_names`."""
+    return {nm: P[:, k] for k, nm in enumerate(COORD_NAMES[:P.shape[1]])}
+
 
 
 def canonical_coords(node: Node) -> Node:

@@ -87,11 +87,12 @@ def edge_vectors(X, E, wrap_shift=None):
 
 
 def facet_sides(edge_vec, FE, index=None):
-    """Side vectors (nf, 2, 3) of each facet from its first vertex.
+    """Side vectors (nf, 2, d) of each facet from its first vertex (d the
+    edge vectors' dimension, 3 but in SPACE_DIMENSION > 3).
 
     ``index`` optionally gives the precomputed ``edge_index(FE)``."""
     idx, sgn = edge_index(FE) if index is None else index
-    S = np.empty((len(idx), 2, 3))
+    S = np.empty((len(idx), 2, edge_vec.shape[1]))
     np.multiply(edge_vec[idx[:, 0]], sgn[:, 0, None], out=S[:, 0])
     np.multiply(edge_vec[idx[:, 1]], sgn[:, 1, None], out=S[:, 1])
     S[:, 1] += S[:, 0]
@@ -227,3 +228,62 @@ def facet_quadrature_points(x0, S):
 def edge_quadrature_points(x0, d):
     """Gauss points (ne, 2, 3) on straight edges from x0 along d."""
     return x0[:, None, :] + GL2_T[None, :, None] * d[:, None, :]
+
+
+# ---------------------------------------------------------------------------
+# any ambient dimension (SPACE_DIMENSION > 3): Gram determinants
+
+
+def gram_facet_areas(S: np.ndarray) -> np.ndarray:
+    """Facet areas in any dimension: ``½ √(|a|²|b|² − (a·b)²)``.
+
+    Parameters
+    ----------
+    S : (nf, 2, d) array
+        The sides ``a = x1 − x0``, ``b = x2 − x0`` of each facet.
+
+    Returns
+    -------
+    (nf,) array
+        The areas (half the square root of the Gram determinant of the
+        sides; the triangle's area in R^d, as the Evolver's ``area``).
+    """
+    a, b = S[:, 0], S[:, 1]
+    aa = np.einsum("ij,ij->i", a, a)
+    bb = np.einsum("ij,ij->i", b, b)
+    ab = np.einsum("ij,ij->i", a, b)
+    return 0.5 * np.sqrt(np.maximum(aa * bb - ab * ab, 0.0))
+
+
+def gram_facet_area_grad(S: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """Per-corner gradients (nf, 3, d) of the facet areas in any dimension.
+
+    ``∂A/∂a = (|b|² a − (a·b) b) / 4A``, ``∂A/∂b = (|a|² b − (a·b) a) / 4A``
+    (differentiating the Gram determinant), corner 0 gets ``−(∂A/∂a + ∂A/∂b)``;
+    zero for degenerate facets.
+
+    Parameters
+    ----------
+    S : (nf, 2, d) array
+        Sides, as :func:`gram_facet_areas`.
+    area : (nf,) array
+        Their areas.
+    """
+    a, b = S[:, 0], S[:, 1]
+    aa = np.einsum("ij,ij->i", a, a)[:, None]
+    bb = np.einsum("ij,ij->i", b, b)[:, None]
+    ab = np.einsum("ij,ij->i", a, b)[:, None]
+    with np.errstate(all="ignore"):
+        inv = np.where(area > 0, 0.25 / np.where(area > 0, area, 1.0), 0.0)[:, None]
+    ga = (bb * a - ab * b) * inv
+    gb = (aa * b - ab * a) * inv
+    return np.stack([-(ga + gb), ga, gb], axis=1)
+
+
+def scatter_nd(nv: int, idx: np.ndarray, vecs: np.ndarray) -> np.ndarray:
+    """Sum rows ``vecs (m, d)`` into vertices ``idx (m,)``: an (nv, d) array
+    (one ``bincount`` per coordinate)."""
+    out = np.empty((nv, vecs.shape[1]))
+    for k in range(vecs.shape[1]):
+        out[:, k] = np.bincount(idx, weights=vecs[:, k], minlength=nv)
+    return out

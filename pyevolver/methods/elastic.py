@@ -46,7 +46,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import PyEvolverError
+from ..errors import PyEvolverError, UnsupportedError
+from ..geometry.kernels import scatter_nd
 from ._common import assemble, corner_scatter
 from .registry import register_method
 
@@ -71,13 +72,23 @@ def _strain(t, idx, name):
     -------
     dict
         ``a, b`` (n, 3) sides; ``F, Q, C`` (n, 2, 2); ``A0`` (n,) unstrained
-        areas (0 for degenerate form factors); ``nu`` (n,).
+        areas (0 for degenerate form factors); ``nu`` (n,).  For the
+        five-dimensional methods (:func:`_is_b`) the sides are those of
+        x1..x3 and the form factors the Gram matrix of the sides in x4, x5
+        (with ``ra, rb`` (n, 2) those reference sides).
     """
-    nu_all, ff_all = _attrs(t, name)
     idx = np.asarray(idx, np.int64)
     S = t.facet_S[idx]
-    a, b = S[:, 0], S[:, 1]
-    ff = ff_all[idx, :3]
+    if _is_b(name):
+        nu_all = _b_attrs(t, name)
+        a, b = S[:, 0, :3], S[:, 1, :3]
+        ra, rb = S[:, 0, 3:5], S[:, 1, 3:5]
+        ff = np.stack([np.einsum("ij,ij->i", ra, ra), np.einsum("ij,ij->i", ra, rb),
+                       np.einsum("ij,ij->i", rb, rb)], axis=1)
+    else:
+        nu_all, ff_all = _attrs(t, name)
+        a, b = S[:, 0], S[:, 1]
+        ff = ff_all[idx, :3]
     det = ff[:, 0] * ff[:, 2] - ff[:, 1] ** 2
     ok = det > 0
     safe = np.where(ok, det, 1.0)
@@ -91,7 +102,10 @@ def _strain(t, idx, name):
     F[:, 1, 1] = np.einsum("ij,ij->i", b, b)
     C = 0.5 * (F @ Q - np.eye(2))
     A0 = np.where(ok, 0.5 * np.sqrt(safe), 0.0)
-    return {"a": a, "b": b, "F": F, "Q": Q, "C": C, "A0": A0, "nu": nu_all[idx]}
+    P = {"a": a, "b": b, "F": F, "Q": Q, "C": C, "A0": A0, "nu": nu_all[idx]}
+    if _is_b(name):
+        P["ra"], P["rb"] = ra, rb
+    return P
 
 
 def _linear_density(C, nu):
@@ -101,6 +115,76 @@ def _linear_density(C, nu):
     k = nu / (1.0 - nu)
     w = (trcc + k * tr ** 2) / (2.0 * (1.0 + nu))
     return w, tr, k
+
+
+def _is_b(name: str) -> bool:
+    """Whether ``name`` is a five-dimensional method (``linear_elastic_B``,
+    ``relaxed_elastic``, ``relaxed_elastic1``, ``relaxed_elastic2``: the
+    reference shape in the coordinates x4, x5)."""
+    return name in ("linear_elastic_b", "relaxed_elastic", "relaxed_elastic1",
+                    "relaxed_elastic2")
+
+
+def _b_attrs(t, name: str) -> np.ndarray:
+    """``poisson_ratio`` (nf,) of a five-dimensional method, which needs
+    ``SPACE_DIMENSION 5``."""
+    s = t.surface
+    if s.X.shape[1] != 5:
+        raise UnsupportedError(f"{name} in SPACE_DIMENSION {s.sdim}",
+                               "the method needs SPACE_DIMENSION 5: x1..x3 strained, "
+                               "x4, x5 the unstrained plane")
+    nu = s.extra.get(("facet", "poisson_ratio"))
+    if nu is None:
+        raise PyEvolverError(f"Facet extra attribute poisson_ratio missing. Needed by {name}.")
+    return np.asarray(nu, float)
+
+
+def _b_gradient(t, idx, P, M, e):
+    """Gradient (nv, 5) of ``Σ_f E_f`` for a five-dimensional method, with
+    ``M`` (n, 2, 2) = ``∂E/∂F`` (weights and unstrained areas included) and
+    ``e`` (n,) the facet energies (weighted): through the strained sides
+    (x1..x3) as :func:`_gradient_from_M`, and through the reference sides
+    (x4, x5) with ``∂E/∂S = e Q / 2 − M F Q`` (``dA0 = A0 tr(Q dS)/2``, and
+    the density depends on F and S only through ``F Q``, ``dQ = −Q dS Q``)."""
+    s = t.surface
+    MS = 0.5 * e[:, None, None] * P["Q"] - M @ P["F"] @ P["Q"]
+    per = np.zeros((len(idx), 3, 5))
+    for cols, (a, b), Mx in (((0, 3), (P["a"], P["b"]), M), ((3, 5), (P["ra"], P["rb"]), MS)):
+        Ms = 0.5 * (Mx + np.swapaxes(Mx, 1, 2))
+        ga = 2.0 * (Ms[:, 0, 0, None] * a + Ms[:, 0, 1, None] * b)
+        gb = 2.0 * (Ms[:, 0, 1, None] * a + Ms[:, 1, 1, None] * b)
+        per[:, 0, cols[0]:cols[1]] = -(ga + gb)
+        per[:, 1, cols[0]:cols[1]] = ga
+        per[:, 2, cols[0]:cols[1]] = gb
+    return scatter_nd(s.nv, s.F[idx].ravel(), per.reshape(-1, 5))
+
+
+def linear_elastic_b(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
+    """Per-facet ``linear_elastic_B`` energy, shape (len(idx),): the
+    ``linear_elastic`` density of the strain of x1..x3 against the reference
+    shape in x4, x5, times ``LEBweight`` when declared (manual, quants.htm)."""
+    P = _strain(t, idx, "linear_elastic_b")
+    w, _, _ = _linear_density(P["C"], P["nu"])
+    return P["A0"] * w * _lebweight(t, idx)
+
+
+def linear_elastic_b_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Gradient (nv, 5) of ``Σ w_f E_f`` for ``linear_elastic_B``."""
+    idx = np.asarray(idx, np.int64)
+    P = _strain(t, idx, "linear_elastic_b")
+    c = np.asarray(w, float) * P["A0"] * _lebweight(t, idx)
+    dens, _, _ = _linear_density(P["C"], P["nu"])
+    M = _linear_M(P) * c[:, None, None]
+    return _b_gradient(t, idx, P, M, c * dens)
+
+
+def _lebweight(t, idx):
+    """The facet attribute ``LEBweight`` at ``idx`` (ones when not declared)."""
+    weight = t.surface.extra.get(("facet", "lebweight"))
+    if weight is None:
+        weight = t.surface.extra.get(("facet", "LEBweight"))
+    idx = np.asarray(idx, np.int64)
+    return np.ones(len(idx)) if weight is None else np.asarray(weight, float)[idx]
 
 
 def _gradient_from_M(t, idx, P, M):
@@ -162,11 +246,7 @@ def _relaxed(t, idx, name):
     branch[(s1 > 0) & (s2 > 0)] = 2
     branch[~ok] = 0
     y = np.einsum("nij,nj->ni", L, r[:, :, 1])
-    weight = t.surface.extra.get(("facet", "lebweight"))
-    if weight is None:
-        weight = t.surface.extra.get(("facet", "LEBweight"))
-    lw = np.ones(n) if weight is None else np.asarray(weight, float)[np.asarray(idx, np.int64)]
-    return P, branch, l1, y, lw
+    return P, branch, l1, y, _lebweight(t, idx)
 
 
 def _relaxed_values(t, idx, name, which):
@@ -187,7 +267,14 @@ def _relaxed_gradient(t, idx, w, name, which):
                  np.where((branch == 1)[:, None, None], M1, 0.0))
     if which:
         M = np.where((branch == which)[:, None, None], M, 0.0)
-    M = M * (np.asarray(w, float) * P["A0"] * lw)[:, None, None]
+    c = np.asarray(w, float) * P["A0"] * lw
+    M = M * c[:, None, None]
+    if _is_b(name):
+        w_lin, _, _ = _linear_density(P["C"], P["nu"])
+        e = np.where(branch == 2, w_lin, np.where(branch == 1, 0.5 * l1 ** 2, 0.0))
+        if which:
+            e = np.where(branch == which, e, 0.0)
+        return _b_gradient(t, idx, P, M, c * e)
     return _gradient_from_M(t, idx, P, M)
 
 
@@ -294,3 +381,8 @@ register_method("dirichlet_elastic", "facet", dirichlet_elastic, dirichlet_elast
 _register_relaxed("relaxed_elastic_a", 0)
 _register_relaxed("relaxed_elastic1_a", 1)
 _register_relaxed("relaxed_elastic2_a", 2)
+# the five-dimensional variants: reference shape in x4, x5 (no analytic Hessian)
+register_method("linear_elastic_b", "facet", linear_elastic_b, linear_elastic_b_gradient)
+_register_relaxed("relaxed_elastic", 0)
+_register_relaxed("relaxed_elastic1", 1)
+_register_relaxed("relaxed_elastic2", 2)

@@ -36,7 +36,7 @@ class _Builder:
         if sd not in (1, 2):
             raise self.error(f"not supported in pyevolver: SURFACE_DIMENSION {sd} "
                              f"(the simplex model)", sc.decl_lines.get("surface_dimension"))
-        if s.sdim != 3 and not (s.string and s.sdim == 2):
+        if s.sdim < 3 and not (s.string and s.sdim == 2) or s.sdim > 3 and s.string:
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
                              f"(3, or 2 in the string model)",
                              sc.decl_lines.get("space_dimension"))
@@ -90,8 +90,8 @@ class _Builder:
         blk = sc.vertices
         n = len(blk.ids)
         self.vid = IdMap(blk.ids, "vertex", sc.filename, blk.lines)
-        X = np.zeros((n, 3))
         sd = s.sdim                 # 2-d surfaces keep a zero z column
+        X = np.zeros((n, max(3, sd)))
         fixed = np.zeros(n, bool)
         bnd = None
         params = None
