@@ -24,7 +24,7 @@ def list_elements(session: SessionLike, gen, env):
     if fn is None:
         return
     session.note({"vertex": "// Id               X                Y" +
-                ("               Z" if session.surface.sdim == 3 else ""),
+                ("               Z" if session.surface.sdim >= 3 else ""),
                 "edge": "// Id    endpoints", "facet": "// Id    edges",
                 "body": "// Id    facets"}[kind] + "\n")
     for el in els:

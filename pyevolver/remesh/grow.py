@@ -89,7 +89,7 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     t = copy.copy(s)
     for name in ("_lift_cache", "_topo"):
         t.__dict__.pop(name, None)
-    t.X = _append_rows(s.X, np.zeros((nv_new, 3)))
+    t.X = _append_rows(s.X, np.zeros((nv_new, s.X.shape[1])))
     t.E = _append_rows(s.E, np.zeros((ne_new, 2), np.int64))
     t.FE = _append_rows(s.FE, np.zeros((nf_new, 3), np.int64))
     efixed = s.eattr["fixed"]

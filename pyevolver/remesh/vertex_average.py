@@ -82,8 +82,8 @@ def vertex_average(s, mode="V"):
     w2 = np.where(use, w * w, 0.0)
     cnt = np.bincount(v, weights=use.astype(float), minlength=nv)
     W = np.bincount(v, weights=w2, minlength=nv)
-    D = np.zeros((nv, 3))
-    for k in range(3):
+    D = np.zeros((nv, s.X.shape[1]))
+    for k in range(D.shape[1]):
         D[:, k] = np.bincount(v, weights=w2 * vec[:, k], minlength=nv)
     movable = ~s.vattr["fixed"] & (cnt >= 2) & (W > 0)
     bnd = s.vattr.get("boundary")
