@@ -20,6 +20,9 @@ from . import constraints, elements
 from .registry import register
 from .values import _KIND, ElemRef, QRef, SessionLike, as_float, as_int
 
+# the coordinates past the third (SPACE_DIMENSION > 3), by column
+_HIGH_COORDS = {"w": 3, "x4": 3, "x5": 4, "x6": 5, "x7": 6, "x8": 7, "x9": 8}
+
 
 def get_attr(session: SessionLike, base, name, idx):
     """The value of ``base.name`` (``idx``: its index, a number or a tuple)."""
@@ -63,8 +66,12 @@ def get_attr(session: SessionLike, base, name, idx):
     v = A.element_attr(session, base, name, idx)
     if v is not A.MISSING:
         return v
-    if s.sdim == 2 and name in ("z", "x3") and k in ("vertex", "edge", "facet"):
+    if k in ("vertex", "edge", "facet") and _HIGH_COORDS.get(name, 0) >= s.sdim or \
+            s.sdim == 2 and name in ("z", "x3") and k in ("vertex", "edge", "facet"):
         raise ExpressionError("Coordinate dimension exceeds space dimension.")  # REF 2475
+    if name in _HIGH_COORDS and k in ("vertex", "edge"):     # x4 .. x9 (w = x4)
+        j = _HIGH_COORDS[name]
+        return float(s.X[i, j] if k == "vertex" else t.edge_vec[i, j] * base.sign)
     if k == "vertex":
         coords = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}
         if name == "x" and idx is not None:          # x[2] is y
@@ -278,8 +285,10 @@ def set_attr(session: SessionLike, base, name, idx, value):
         else:
             arr[(i,) + attr_pos(k, name, arr, idx)] = value
         return
-    if k == "vertex" and name in ("x", "y", "z", "x1", "x2", "x3"):
-        j = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2}[name]
+    if k == "vertex" and name in ("x", "y", "z", "x1", "x2", "x3", *_HIGH_COORDS):
+        j = {"x": 0, "y": 1, "z": 2, "x1": 0, "x2": 1, "x3": 2, **_HIGH_COORDS}[name]
+        if j >= s.sdim and j >= 3:
+            raise CommandError("Coordinate dimension exceeds space dimension.")
         if name == "x" and idx is not None:
             j = int(idx) - 1 if not isinstance(idx, tuple) else -1
             if j < 0 or j >= s.sdim:

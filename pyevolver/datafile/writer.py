@@ -15,6 +15,8 @@ Writers are registered by format name (``WRITERS``), as meshio does;
 """
 from __future__ import annotations
 
+import contextvars
+
 import math
 import re
 from collections.abc import Mapping
@@ -58,6 +60,10 @@ def _wrap(child, prec, strict=False):
     return f"({text})" if p < prec or (strict and p == prec) else text
 
 
+# whether the surface being written has SPACE_DIMENSION > 3 (formulas name x4)
+_HIGH_DIM: contextvars.ContextVar[bool] = contextvars.ContextVar("_HIGH_DIM", default=False)
+
+
 def _text(node):
     """(text, precedence of its outermost operator)."""
     if isinstance(node, N.Num):
@@ -65,6 +71,9 @@ def _text(node):
         return (f"({t})", 9) if t.startswith("-") else (t, 9)
     if isinstance(node, N.Var):
         # the gravitational constant is G in the Evolver (g alone is its go command)
+        # in SPACE_DIMENSION > 3 the fourth coordinate (canonically w) is x4
+        if node.name == "w" and _HIGH_DIM.get():
+            return "x4", 9
         return ("G" if node.name == "g" else node.name), 9
     if isinstance(node, N.Func):
         return f"{node.name}({', '.join(expr_text(a) for a in node.args)})", 9
@@ -136,8 +145,15 @@ class _FeWriter:
         raise UnsupportedError(f"dump: {what} (a datafile cannot express it)")
 
     def text(self):
+        token = _HIGH_DIM.set(self.s.sdim > 3)
+        try:
+            return self._text()
+        finally:
+            _HIGH_DIM.reset(token)
+
+    def _text(self):
         s = self.s
-        if s.sdim != 3 and not (s.string and s.sdim == 2):
+        if s.sdim < 3 and not (s.string and s.sdim == 2):
             self.refuse(f"space dimension {s.sdim}")
         self._check()
         self._header()
@@ -181,8 +197,8 @@ class _FeWriter:
         self.w()
         if s.string:
             self.w("STRING")
-            if s.sdim != 3:
-                self.w(f"SPACE_DIMENSION {s.sdim}")
+        if s.sdim != 3:
+            self.w(f"SPACE_DIMENSION {s.sdim}")
         if s.periods is not None:
             self.w("TORUS_FILLED" if s.torus_filled else "TORUS")
             self.w("PERIODS")
