@@ -71,6 +71,12 @@ class UnsupportedError(PyEvolverError):
         super().__init__(msg)
 
 
+def dimension_error(sdim: int, what: str, verb: str = "needs") -> UnsupportedError:
+    """The refusal of ``what`` in ``SPACE_DIMENSION sdim`` > 3:
+    ``"not supported in pyevolver: SPACE_DIMENSION 5: the Hessian needs 3 dimensions"``."""
+    return UnsupportedError(f"SPACE_DIMENSION {sdim}: {what} {verb} 3 dimensions")
+
+
 class CommandError(PyEvolverError):
     """A command could not be parsed or executed; the surface is unchanged."""
 

@@ -31,7 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..constraints import boundary_eval, boundary_groups, vertex_coords
-from ..errors import UnsupportedError
+from ..errors import UnsupportedError, dimension_error
 from ..geometry import kernels as G
 from ..methods.basic import (edge_length_hessian, facet_area_hessian,  # noqa: F401
                              facet_gravity_hessian, facet_volume_hessian)
@@ -508,6 +508,8 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
     The multipliers are those stored by the last ``g`` or ``hessian``.
     """
     s = it.surface
+    if s.X.shape[1] > 3:
+        raise dimension_error(s.sdim, "the Hessian")
     mobile = it._mobile()
     cons = _Constraints(s)
     t = s.evaluate()

@@ -32,7 +32,7 @@ from ..atomic import atomic_path
 from ..datafile.reader import read_datafile
 from ..datafile import writer
 from ..datafile.writer import DumpSettings
-from ..errors import CommandError, PyEvolverError, UnsupportedError
+from ..errors import CommandError, PyEvolverError, UnsupportedError, dimension_error
 from ..model.arrays import surface_from_arrays
 from ..model.build import build_surface
 from ..model.surface import Surface
@@ -60,12 +60,15 @@ def surface_mesh(surface, data: bool = True):
     """A :class:`meshio.Mesh` of ``surface`` (a Surface, or an object
     holding one in ``.surface``): points ``X`` (nv, 3), one ``"triangle"``
     block ``F`` (nf, 3) and, with ``data``, the point and cell data of
-    :func:`pyevolver.io.fields.surface_fields`."""
+    :func:`pyevolver.io.fields.surface_fields`.  Refused in SPACE_DIMENSION
+    > 3 (``dump`` writes such a surface)."""
     s = _surface(surface)
     if s is None:
         raise CommandError("export: no surface is loaded")
     if s.nf == 0:
         raise UnsupportedError("export of a surface without facets (the string model)")
+    if s.X.shape[1] > 3:
+        raise dimension_error(s.sdim, "mesh exports", "need")
     if s.periods is not None:
         raise UnsupportedError("export of a torus-model surface",
                                "facets across the periodic wrap would need copies of "

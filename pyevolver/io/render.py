@@ -20,7 +20,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..atomic import atomic_path
-from ..errors import CommandError, UnsupportedError
+from ..errors import CommandError, UnsupportedError, dimension_error
 from ..model.surface import Surface
 from .fields import curvature_method, surface_fields
 
@@ -107,6 +107,8 @@ def snapshot(surface: Surface | None, path: str, field: str | None = "mean_curva
     str
         ``path``.
     """
+    if surface is not None and surface.X.shape[1] > 3:
+        raise dimension_error(surface.sdim, "pictures")
     mpl, Figure, FigureCanvasAgg = _matplotlib()
     from matplotlib.collections import PolyCollection
     s = surface

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..constraints import integral_edges
-from ..errors import UnsupportedError
+from ..errors import UnsupportedError, dimension_error
 from ..geometry import kernels as G
 from ..model.surface import Surface
 from .registry import lookup
@@ -30,7 +30,7 @@ ND_METHODS = frozenset({"linear_elastic_b", "relaxed_elastic", "relaxed_elastic1
 def refuse(s: Surface, what: str, verb: str = "need") -> UnsupportedError:
     """The refusal of ``what`` in the surface's dimension (``"SPACE_DIMENSION 5:
     body volumes need 3 dimensions"``)."""
-    return UnsupportedError(f"SPACE_DIMENSION {s.sdim}: {what} {verb} 3 dimensions")
+    return dimension_error(s.sdim, what, verb)
 
 
 class NDTotals(Totals):

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..constraints import project_to_constraints
 from ..errors import UnsupportedError
+from ..geometry.kernels import gram_facet_areas
 from .shrink import subset
 
 
@@ -239,14 +240,13 @@ def weed_small_facets(s, area):
     Returns ``(new surface, number of facets weeded)``.
     """
     F = s.F
-    A = 0.5 * np.linalg.norm(np.cross(s.X[F[:, 1]] - s.X[F[:, 0]], s.X[F[:, 2]] - s.X[F[:, 0]]),
-                             axis=1)
+    A = gram_facet_areas(np.stack([s.X[F[:, 1]] - s.X[F[:, 0]], s.X[F[:, 2]] - s.X[F[:, 0]]], 1))
     return _weed(s, np.nonzero(A < area)[0], area)
 
 
 def _facet_area(d, f):
     P = d.X[[d.E[_dec(x)][0] if x >= 0 else d.E[_dec(x)][1] for x in d.FE[f]]]
-    return 0.5 * float(np.linalg.norm(np.cross(P[1] - P[0], P[2] - P[0])))
+    return float(gram_facet_areas(np.stack([P[1] - P[0], P[2] - P[0]])[None])[0])
 
 
 def _weed(s, facets, area):

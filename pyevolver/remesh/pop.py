@@ -37,7 +37,7 @@ import math
 
 import numpy as np
 
-from ..errors import UnsupportedError
+from ..errors import UnsupportedError, dimension_error
 from ..model.records import edge_first_facet, record_edge_first_facet
 from .grow import grow, reorder_new_edges
 
@@ -86,6 +86,8 @@ def _check(s, cand, val):
 def _loop(s, e, first):
     """Facets on edge ``e`` in the Evolver's loop order, with their signs on
     ``e``, third corners and unit directions off the edge."""
+    if s.X.shape[1] > 3:
+        raise dimension_error(s.sdim, "edge popping", "needs")
     absFE = np.where(s.FE >= 0, s.FE, ~s.FE)
     fs = np.nonzero((absFE == e).any(axis=1))[0]
     a, b = s.E[e]

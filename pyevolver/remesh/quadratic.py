@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..constraints import constrained_vertices, project_to_constraints
-from ..errors import UnsupportedError
+from ..errors import UnsupportedError, dimension_error
 from ..geometry import quadratic as Q
 from ..model.surface import Surface
 from .grow import grow, remap_quantities
@@ -22,6 +22,8 @@ from .shrink import subset
 
 
 def _check(s: Surface) -> None:
+    if s.X.shape[1] > 3:
+        raise dimension_error(s.sdim, "the quadratic model")
     if s.string:
         raise UnsupportedError("the quadratic model of the string model",
                                "pyevolver has it for soapfilm surfaces only")
