@@ -40,6 +40,10 @@ class _Builder:
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
                              f"(3, or 2 in the string model)",
                              sc.decl_lines.get("space_dimension"))
+        if s.sdim > 3 and (sc.bodies.ids or sc.torus):    # pyevolver.methods.ndim refuses the rest
+            raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim}: "
+                             f"{'the torus model needs' if sc.torus else 'bodies need'} 3 dimensions",
+                             sc.decl_lines.get("space_dimension"))
         if s.string and sc.torus and s.sdim != 2:
             raise self.error("not supported in pyevolver: TORUS in a 3-dimensional string model",
                              sc.decl_lines.get("torus", sc.decl_lines.get("torus_filled")))
