@@ -108,7 +108,7 @@ def snapshot(surface: Surface | None, path: str, field: str | None = "mean_curva
         ``path``.
     """
     if surface is not None and surface.X.shape[1] > 3:
-        raise dimension_error(surface.sdim, "pictures")
+        raise dimension_error(surface.sdim, "pictures", "need")
     mpl, Figure, FigureCanvasAgg = _matplotlib()
     from matplotlib.collections import PolyCollection
     s = surface

@@ -215,3 +215,96 @@ def test_the_evolvers_dump_loads_with_the_same_energy(evolver, tmp_path):
     sess = pyevolver.load(str(dmp))
     assert abs(sess.value("total_energy") - e_ref) <= STEPS * abs(e_ref)
     assert abs(sess.value("stretch.value") - st_ref) <= STEPS * abs(st_ref)
+
+
+def _sheet5d(tmp_path, rng, energy="linear_elastic_B", tension=0.0):
+    """A 3x3-vertex sheet in SPACE_DIMENSION 5: x1..x3 a jiggled grid, x4, x5
+    another (the unstrained plane), random Poisson ratios, every vertex free."""
+    g = np.array([[i, j] for j in range(3) for i in range(3)], float)
+    X = np.concatenate([g + 0.15 * rng.standard_normal(g.shape),
+                        0.1 * rng.standard_normal((9, 1)),
+                        g + 0.15 * rng.standard_normal(g.shape)], axis=1)
+    F = []
+    for j in range(2):
+        for i in range(2):
+            a = 3 * j + i
+            F += [[a, a + 1, a + 4], [a, a + 4, a + 3]]
+    E = sorted({tuple(sorted((f[k], f[(k + 1) % 3]))) for f in F for k in range(3)})
+    eid = {e: k + 1 for k, e in enumerate(E)}
+
+    def fe(a, b):
+        return eid[(a, b)] if (a, b) in eid else -eid[(b, a)]
+    nu = rng.uniform(0.1, 0.45, len(F))
+    text = [f"space_dimension 5\nquantity st energy method {energy} global",
+            "define facet attribute poisson_ratio real\nvertices"]
+    text += [f"{k + 1} " + " ".join(f"{x:.17g}" for x in row) for k, row in enumerate(X)]
+    text += ["edges"] + [f"{k + 1} {a + 1} {b + 1}" for k, (a, b) in enumerate(E)]
+    text += ["faces"] + [f"{k + 1} {fe(a, b)} {fe(b, c)} {fe(c, a)} tension {tension} "
+                         f"poisson_ratio {nu[k]:.17g}" for k, (a, b, c) in enumerate(F)]
+    p = tmp_path / f"sheet5d_{energy}.fe"
+    p.write_text("\n".join(text) + "\n")
+    return pyevolver.load(str(p), out=io.StringIO())
+
+
+@pytest.mark.parametrize("name", ["linear_elastic_b", "relaxed_elastic", "relaxed_elastic1",
+                                  "relaxed_elastic2"])
+def test_five_dimensional_gradient_matches_central_differences(tmp_path, name):
+    # the strained coordinates x1..x3 and the reference plane x4, x5 both move
+    rng = np.random.default_rng(7)
+    sess = _sheet5d(tmp_path, rng)
+    s = sess.surface
+    assert s.X.shape == (9, 5)
+    m = lookup(name)
+    idx = np.arange(s.nf)
+    w = rng.uniform(0.5, 2.0, s.nf)
+    t = s.evaluate()
+    if name.startswith("relaxed"):
+        _, branch, _, _, _ = EL._relaxed(t, idx, name)
+        assert set(branch.tolist()) >= {1, 2}, branch
+    grad = m.gradient(t, None, idx, w)
+    assert grad.shape == (9, 5)
+    X0 = s.X.copy()
+    h = 1e-6
+    num = np.zeros_like(grad)
+    for i in range(s.nv):
+        for k in range(5):
+            e = []
+            for sg in (1, -1):
+                s.X = X0.copy()
+                s.X[i, k] += sg * h
+                e.append(float(w @ m.value(s.evaluate(), None, idx)))
+            num[i, k] = (e[0] - e[1]) / (2 * h)
+    s.X = X0
+    assert np.abs(grad[:, 3:]).max() > 1e-3          # the reference plane is pulled too
+    assert np.abs(grad - num).max() <= FD * max(1.0, np.abs(grad).max())
+
+
+def test_five_dimensional_methods_agree_with_the_three_dimensional_ones(tmp_path):
+    # linear_elastic_B on (x1..x3 | x4, x5) is linear_elastic with the form
+    # factors of the x4, x5 sides; relaxed_elastic{,1,2} the _A variants
+    rng = np.random.default_rng(3)
+    s5 = _sheet5d(tmp_path, rng).surface
+    t5 = s5.evaluate()
+    S = t5.facet_S
+    ra, rb = S[:, 0, 3:], S[:, 1, 3:]
+    s3 = pyevolver.Surface.from_arrays(s5.X[:, :3], s5.F)
+    s3.extra[("facet", "form_factors")] = np.stack(
+        [np.einsum("ij,ij->i", ra, ra), np.einsum("ij,ij->i", ra, rb),
+         np.einsum("ij,ij->i", rb, rb)], 1)
+    s3.extra[("facet", "poisson_ratio")] = s5.extra[("facet", "poisson_ratio")]
+    t3 = s3.evaluate()
+    idx = np.arange(s5.nf)
+    for b, a in [("linear_elastic_b", "linear_elastic"), ("relaxed_elastic", "relaxed_elastic_a"),
+                 ("relaxed_elastic1", "relaxed_elastic1_a"),
+                 ("relaxed_elastic2", "relaxed_elastic2_a")]:
+        v5, v3 = lookup(b).value(t5, None, idx), lookup(a).value(t3, None, idx)
+        assert np.allclose(v5, v3, rtol=ROUNDOFF, atol=0), b
+
+
+def test_five_dimensional_methods_need_space_dimension_5(tmp_path):
+    p = tmp_path / "b3.fe"
+    p.write_text(SHEET.format(extra="", method="linear_elastic_B", w1="", w2="", w3="")
+                 .replace("relaxed_elastic1_A", "relaxed_elastic1"))
+    with pytest.raises(pyevolver.errors.PyEvolverError) as exc:     # located at the quantity
+        pyevolver.load(str(p), out=io.StringIO())
+    assert "not supported in pyevolver: linear_elastic_b in SPACE_DIMENSION 3" in str(exc.value)
