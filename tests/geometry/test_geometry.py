@@ -113,3 +113,44 @@ def test_long_body_line_with_attributes(tmp_path):
     a = 4 / math.sqrt(10 + 2 * math.sqrt(5))
     assert t.volumes[0] == pytest.approx(5 / 12 * (3 + math.sqrt(5)) * a ** 3, rel=1e-13)
     assert s.bodies.target[0] == 2.5
+
+
+@pytest.mark.parametrize("d", [3, 4, 5, 7])
+def test_gram_area_of_a_rotated_unit_square_is_1(d):
+    # the unit square split into two triangles, rotated and moved in R^d
+    q, _ = np.linalg.qr(np.random.default_rng(d).standard_normal((d, d)))
+    P = np.zeros((4, d))
+    P[:, :2] = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    P = P @ q.T + 0.7
+    S = np.stack([np.stack([P[1] - P[0], P[2] - P[0]]), np.stack([P[2] - P[0], P[3] - P[0]])])
+    A = G.gram_facet_areas(S)
+    assert np.allclose(A, 0.5, rtol=1e-14) and abs(A.sum() - 1.0) < 1e-14
+    if d == 3:                       # the cross-product kernel agrees
+        assert np.allclose(G.facet_areas(G.facet_normals(S)), A, rtol=1e-14)
+
+
+def test_gram_area_gradient_matches_central_differences():
+    rng = np.random.default_rng(1)
+    P = rng.standard_normal((6, 3, 5))                     # six triangles in R^5
+    S = np.stack([P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]], axis=1)
+    g = G.gram_facet_area_grad(S, G.gram_facet_areas(S))
+    h = 1e-6
+    num = np.zeros_like(g)
+    for c in range(3):
+        for k in range(5):
+            Pp, Pm = P.copy(), P.copy()
+            Pp[:, c, k] += h
+            Pm[:, c, k] -= h
+            area = [G.gram_facet_areas(np.stack([Q[:, 1] - Q[:, 0], Q[:, 2] - Q[:, 0]], axis=1))
+                    for Q in (Pp, Pm)]
+            num[:, c, k] = (area[0] - area[1]) / (2 * h)
+    assert np.abs(g - num).max() < 1e-8
+    # a degenerate facet has zero area and zero gradient
+    S0 = np.zeros((1, 2, 5))
+    S0[0, 0, 0] = S0[0, 1, 0] = 1.0
+    assert G.gram_facet_areas(S0)[0] == 0.0 and not G.gram_facet_area_grad(S0, np.zeros(1)).any()
+
+
+def test_scatter_nd_sums_rows_into_vertices():
+    out = G.scatter_nd(3, np.array([0, 2, 0]), np.arange(12.0).reshape(3, 4))
+    assert out.tolist() == [[8, 10, 12, 14], [0, 0, 0, 0], [4, 5, 6, 7]]
