@@ -218,7 +218,7 @@ def constraint_value(session, i, cid):
     s = session.surface
     c = s.constraints[cid]
     P = s.X[i:i + 1]
-    coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+    coords = N.coord_dict(P)          # x y z (w x5 .. in SPACE_DIMENSION > 3)
     return float(np.asarray(c.formula.values(s.param_env(), coords, 1)).ravel()[0])
 
 
@@ -227,8 +227,9 @@ def constraint_normal(session, i, cid):
     s = session.surface
     c = s.constraints[cid]
     P = s.X[i:i + 1]
-    coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
-    g = np.asarray(c.formula.gradient(s.param_env(), coords, 1), float).reshape(-1)[:s.sdim]
+    coords = N.coord_dict(P)
+    g = np.asarray(c.formula.gradient(s.param_env(), coords, 1, N.coord_names(P.shape[1])),
+                   float).reshape(-1)[:s.sdim]
     n = np.linalg.norm(g)
     return g / n if n > 0 else g
 

@@ -95,9 +95,12 @@ def vertex_average(s, mode="V"):
     mv = np.nonzero(movable)[0]
     D[mv] /= W[mv, None]
     if mode == "V":
-        n = G.vertex_normals(s.F, t.facet_N2, nv, vertex_facet_rank(s))
+        # in SPACE_DIMENSION > 3 REF's normals are those of x1..x3 and only
+        # those coordinates lose their normal component (measured)
+        N2 = t.facet_N2 if D.shape[1] == 3 else G.facet_normals(t.facet_S[:, :, :3])
+        n = G.vertex_normals(s.F, N2, nv, vertex_facet_rank(s))
         (D,) = project_tangent(s, [D])
-        D = D - np.einsum("ij,ij->i", D, n)[:, None] * n
+        D[:, :3] -= np.einsum("ij,ij->i", D[:, :3], n)[:, None] * n
         (D,) = project_tangent(s, [D])
     new = copy.copy(s)
     new.__dict__.pop("_lift_cache", None)
