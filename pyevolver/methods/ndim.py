@@ -27,10 +27,14 @@ ND_METHODS = frozenset({"linear_elastic_b", "relaxed_elastic", "relaxed_elastic1
                         "relaxed_elastic2"})
 
 
-def refuse(s: Surface, what: str, verb: str = "need") -> UnsupportedError:
+def refuse(s: Surface, what: str, verb: str = "need",
+           line: int | None = None) -> UnsupportedError:
     """The refusal of ``what`` in the surface's dimension (``"SPACE_DIMENSION 5:
-    body volumes need 3 dimensions"``)."""
-    return dimension_error(s.sdim, what, verb)
+    body volumes need 3 dimensions"``), located at ``line`` (default: the
+    SPACE_DIMENSION declaration's)."""
+    exc = dimension_error(s.sdim, what, verb)
+    exc.line = line if line is not None else s.sdim_line  # type: ignore[attr-defined]
+    return exc
 
 
 class NDTotals(Totals):
@@ -142,10 +146,10 @@ def check_supported(s: Surface) -> None:
         raise refuse(s, "constraint energy and content integrals")
     for q in s.quantities.values():
         if q.function is not None:
-            raise refuse(s, f"FUNCTION quantities ({q.name})")
+            raise refuse(s, f"FUNCTION quantities ({q.name})", line=q.line)
         for m, *_ in q.methods:
             if m.method.lower() not in ND_METHODS:
-                raise refuse(s, f"method {m.method} (quantity {q.name})", "needs")
+                raise refuse(s, f"method {m.method} (quantity {q.name})", "needs", q.line)
 
 
 MODEL_TOTALS["ndim"] = NDTotals

@@ -31,6 +31,7 @@ class _Builder:
         self._actual_volume = {}        # body position -> ACTUAL_VOLUME
         s.params = dict(sc.parameters)
         s.sdim = sc.space_dimension
+        s.sdim_line = sc.decl_lines.get("space_dimension")
         s.string = sc.string
         sd = int(sc.values.get("surface_dimension", 1 if s.string else 2))
         if sd not in (1, 2):
@@ -40,7 +41,7 @@ class _Builder:
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim} "
                              f"(3, or 2 in the string model)",
                              sc.decl_lines.get("space_dimension"))
-        if s.sdim > 3 and (sc.bodies.ids or sc.torus):    # pyevolver.methods.ndim refuses the rest
+        if s.sdim > 3 and (len(sc.bodies.ids) or sc.torus):   # methods.ndim refuses the rest
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {s.sdim}: "
                              f"{'the torus model needs' if sc.torus else 'bodies need'} 3 dimensions",
                              sc.decl_lines.get("space_dimension"))

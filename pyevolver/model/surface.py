@@ -84,6 +84,7 @@ class Surface:
 
     def __init__(self):
         self.sdim = 3
+        self.sdim_line: int | None = None   # the datafile line of SPACE_DIMENSION (refusals)
         self.X = np.zeros((0, 3))
         self.E = np.zeros((0, 2), dtype=np.int64)
         self.FE = np.zeros((0, 3), dtype=np.int64)
