@@ -172,8 +172,9 @@ class TopSection:
             raise self.error(f"malformed number '{bad.group(0)}'", self._src(sec, line), col)
         sdm = _SPACE_DIM_RE.search(text)
         if sdm and int(sdm.group(1)) > 3 and re.search(r"^[ \t]*string\b", text, re.I | re.M):
-            # the model is refused whatever else the file says: say so before
-            # parsing what only that model allows (relaxed.fe's ref_coord[1])
+            # a string model above 3 dimensions is refused whatever else the
+            # file says: say so before parsing the rest (the soapfilm model
+            # runs in 4 to 9 dimensions: pyevolver.methods.ndim)
             line = text.count("\n", 0, sdm.start()) + 1
             raise self.error(f"not supported in pyevolver: SPACE_DIMENSION {sdm.group(1)} "
                              f"(3, or 2 in the string model)", self._src(sec, line),
