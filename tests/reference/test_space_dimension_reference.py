@@ -6,7 +6,8 @@ constraints on ``ref_coord``) and tests/data/elastic5d.fe (``linear_elastic_B``
 as the energy, a facet tension, constraints on x4, x5 and a curved one in x4,
 x5, a free vertex): the same script in both programs, ``v``, ``g 5``, ``r``,
 ``g 5``, ``list vertices``, ``u``, ``g 3``; every number printed agrees within
-``STEPS`` (measured: 1e-14 relative or better).  A dump written by each loads
+``STEPS`` (measured: 1e-14 relative or better; a 4-D square with a constraint in x4:
+1e-11 after `r; g 5`).  A dump written by each loads
 in the other with the same energy and quantities.
 """
 import io
@@ -71,6 +72,21 @@ def test_vertex_averaging_agrees_with_the_evolver(evolver, tmp_path):
                     "edges\n1 1 2\n2 2 3\n3 3 4\n4 4 1\n5 1 5\n6 2 5\n7 3 5\n8 4 5\n"
                     "faces\n1 1 6 -5\n2 2 7 -6\n3 3 8 -7\n4 4 5 -8\n")
     script = "V\nlist vertices\nprint total_area\n"
+    ref = _ref(evolver, str(path), script, tmp_path)
+    ours = _ours(str(path), script)
+    assert _same(ours, ref, STEPS), "\n".join(ours) + "\n----\n" + "\n".join(ref)
+
+
+def test_four_dimensions_with_a_constraint_in_x4_agree_with_the_evolver(evolver, tmp_path):
+    # facet tension only; the centre vertex on x4 = 0.1 x3 + 0.05; after r the
+    # midpoints of the fixed rim are free
+    path = tmp_path / "sq4.fe"
+    path.write_text("space_dimension 4\nconstraint 1 formula: x4 = 0.1*x3 + 0.05\nvertices\n"
+                    "1 0 0 0 0 fixed\n2 1 0 0 0 fixed\n3 1 1 0 0 fixed\n4 0 1 0 0 fixed\n"
+                    "5 0.3 0.4 0.2 0.1 constraint 1\n"
+                    "edges\n1 1 2\n2 2 3\n3 3 4\n4 4 1\n5 1 5\n6 2 5\n7 3 5\n8 4 5\n"
+                    "faces\n1 1 6 -5\n2 2 7 -6\n3 3 8 -7\n4 4 5 -8\n")
+    script = "g 5\nlist vertices\nr\ng 5\nprint total_area\n"
     ref = _ref(evolver, str(path), script, tmp_path)
     ours = _ours(str(path), script)
     assert _same(ours, ref, STEPS), "\n".join(ours) + "\n----\n" + "\n".join(ref)
