@@ -298,6 +298,12 @@ class _CmdTransformer(ExprTransformer):
     def edgeswap(self, _r, gen):
         return ("edgeswap", gen)
 
+    def equiangulate_gen(self, _e, gen):
+        return ("equiangulate", gen)
+
+    def equiangulate_bare(self, _e):
+        return ("bare", "u", None)           # a whole sweep, like u
+
     def delete(self, _r, gen):
         return ("delete", gen)
 
