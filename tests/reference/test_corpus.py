@@ -48,10 +48,16 @@ def _rows():
     return [(r[0], r[4]) for r in rows if r[4] != "companion"]
 
 
-def _params():
+def _params(sheets=None):
+    """All datafiles; the elastic sheets (60-80 s each with ``r; g 5``) are
+    marked slow, their load and ``g 5`` stages run by default
+    (``sheets=True``: only the sheets, not marked)."""
     out = []
     for name, kind in _rows():
-        out.append(pytest.param(name, kind, id=name.split("__")[-1]))
+        if sheets and kind != "elastic-sheet":
+            continue
+        marks = [pytest.mark.slow] if kind == "elastic-sheet" and not sheets else []
+        out.append(pytest.param(name, kind, id=name.split("__")[-1], marks=marks))
     if not out:
         out.append(pytest.param(None, None, id="corpus-absent",
                                 marks=pytest.mark.skip(reason="no third-party corpus")))
@@ -73,11 +79,14 @@ def printed_values(text):
     return got
 
 
-def run_script(name, monkeypatch):
+def run_script(name, monkeypatch, first_stages=False):
     """Load ``name`` in the corpus files folder and feed SCRIPT.txt as the
-    Evolver's standard input; returns what was printed and the messages."""
+    Evolver's standard input (with ``first_stages`` only up to its ``r; g 5``);
+    returns what was printed and the messages."""
     with open(os.path.join(CORPUS, "SCRIPT.txt"), encoding="latin-1") as fh:
         script = fh.read()
+    if first_stages:
+        script = script[:script.index("r; g 5")] + "q\nq\n"
     monkeypatch.chdir(os.path.join(CORPUS, "files"))
     out, err = io.StringIO(), io.StringIO()
     with np.errstate(all="ignore"):
@@ -92,10 +101,24 @@ def run_script(name, monkeypatch):
 
 @pytest.mark.parametrize("name,kind", _params())
 def test_corpus_datafile(name, kind, monkeypatch):
+    _compare(name, monkeypatch, False)
+
+
+@pytest.mark.parametrize("name,kind", _params(sheets=True))
+def test_corpus_elastic_sheet_first_stages(name, kind, monkeypatch):
+    """The default run's version of the slow sheets: load and ``g 5``
+    (read sections, exec, set-quantity, torus curvature, conj_grad with an
+    optimizing parameter) against the same transcripts."""
+    _compare(name, monkeypatch, True)
+
+
+def _compare(name, monkeypatch, first_stages):
     with open(os.path.join(CORPUS, "reference", name + ".out"), encoding="latin-1") as fh:
         ref = printed_values(fh.read())
     assert ref, "the reference transcript has no values"
-    text, err = run_script(name, monkeypatch)
+    if first_stages:
+        ref = {k: v for k, v in ref.items() if k[0] != "rg5"}
+    text, err = run_script(name, monkeypatch, first_stages)
     got = printed_values(text)
     bad = [(k, v, got.get(k)) for k, v in ref.items()
            if got.get(k) is None or abs(got[k] - v) > LOOSE * max(1.0, abs(v))]
