@@ -355,11 +355,16 @@ class Iterator:
             # -pscale dE/dp, moved like a vertex coordinate (with conj_grad
             # too: the parameters join the CG sums and history)
             pscale = OP.scales(s)
-            fq = -pscale * OP.gradient(s)
+            if settings.conj_grad and np.any(pscale != 1.0):
+                # REF's CG sums with PSCALE: matched on one hexagon (0.3),
+                # not on another (0.5); only PSCALE 1 is measured exactly
+                OP.refuse(s, "conj_grad and a PSCALE other than 1")
+            graw = OP.gradient(s)
+            fq = -pscale * graw
             pvel = pscale * fq
         else:
             self._pbase = None
-            fq = np.zeros(0)
+            fq = graw = np.zeros(0)
 
         def params_at(scale_):
             if popt:
@@ -417,14 +422,14 @@ class Iterator:
                 num = S
                 if settings.ribiere:
                     num -= float(np.sum(vel[cgv] * self.cg_f_old[cgv]))
-                    num -= float(fq @ q_old)
+                    num -= float(graw @ q_old)      # REF: grad·oldgrad, no pscale
                 gamma = num / self.cg_S_old
                 if gamma > 10 or gamma < 0:     # negative: restart (PR+)
                     gamma = 0.0
             h = vel.copy() if self.cg_history is None else vel + gamma * self.cg_history
             h[~cgv] = vel[~cgv]
             self.cg_history = h
-            self.cg_q = fq
+            self.cg_q = graw
             self.cg_S_old = S
             self.cg_f_old = f_raw      # the Evolver keeps the unprojected force
             vel = h
