@@ -315,7 +315,7 @@ def _o(interp, raw, arg):
     pop_edges(interp.session)
 
 
-@register("u", usage="u", help="one equiangulation sweep", family=FAMILY)
+@register("u", "equiangulate", usage="u", help="one equiangulation sweep", family=FAMILY)
 def _u(interp, raw, arg):
     linear_only(interp.session, "u (equiangulation)")
     equiangulate(interp.session)
