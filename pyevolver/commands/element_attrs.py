@@ -358,9 +358,11 @@ def set_attr(session: SessionLike, base, name, idx, value):
 def set_elements(session: SessionLike, gen, attr, expr, env, unset, idx=None):
     """``set gen attr expr`` / ``unset gen attr``: every value computed first, then assigned."""
     els = elements.generate(session, gen, env)
-    qname = A.membership_name(session, gen.kind, attr, expr)
+    # a foreach variable (set vv gbend) has its kind only at run time
+    kind = gen.kind if gen.kind is not None or not els else els[0].kind
+    qname = A.membership_name(session, kind, attr, expr)
     if qname is not None:
-        A.set_membership(session, gen.kind, els, qname, not unset)
+        A.set_membership(session, kind, els, qname, not unset)
         return
     if A.is_flag(gen.kind, attr) and (expr is None or unset):
         for el in els:         # boolean attributes: set = 1, unset = 0

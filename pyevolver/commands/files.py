@@ -188,6 +188,17 @@ def _x_read(interp, node):
     read_file(interp.session, name)
 
 
+@register("exec", usage='exec "commands"', statement="exec",
+          help="run a string (or string expression) as commands", family=FAMILY)
+def _x_exec(interp, node):
+    text = interp.value(node[1])
+    if not isinstance(text, str):
+        raise CommandError("exec needs a quoted string or string expression (for example: "
+                           "exec sprintf \"print %d\", 3)")
+    short = text if len(text) <= 60 else text[:57] + "..."
+    interp.run_string(text, 'exec "' + short.replace("\n", " ") + '"')
+
+
 @register("dump", usage='dump ["file"]', statement="dump",
           help="write the surface as a datafile", family=FAMILY)
 def _x_dump(interp, node):

@@ -116,6 +116,33 @@ class Interpreter:
         else:
             registry.statement(kind).handler(self, node)
 
+    def run_string(self, text, where):
+        """Run ``text`` (any number of commands) as the Evolver's ``exec``
+        does: parsed by the command parser at run time, in the global scope
+        (the caller's locals and ``foreach`` elements are not visible; REF:
+        ``exec "print xx"`` inside a procedure with parameter ``xx`` is a
+        syntax error).  An error names ``where`` and stops the rest."""
+        env = self.env
+        if len(env.scopes) > MAX_NESTING:
+            raise CommandError(f"{where}: exec strings run each other too deeply")
+        scopes, frames = env.scopes, env.frames
+        depth = len(scopes)
+        env.frames = []
+        try:
+            for chunk, ln in split_commands(text):
+                ast = parse_command(chunk, where, ln)
+                scopes.append({})
+                try:
+                    self.execute(ast)
+                finally:
+                    del scopes[depth:]
+        except PyEvolverError as exc:
+            if str(exc).startswith(where):
+                raise
+            raise CommandError(f"{where}: {exc}") from None
+        finally:
+            env.frames = frames
+
     def _x_seq(self, node):
         for st in node[1]:
             self.execute(st)

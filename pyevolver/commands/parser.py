@@ -38,7 +38,6 @@ UNSUPPORTED_REASONS = {
     "permload": "use replace_load, as the Evolver's manual advises; ::= permanent "
                 "variables are not supported either",
     "system": "scripts never run programs", "shell": "scripts never run programs",
-    "exec": "scripts never run programs",
     "detorus": "the torus model cannot be unwrapped yet",
     "dissolve": "removing elements one by one is not implemented; delete merges edges",
 }
@@ -149,6 +148,9 @@ class _CmdTransformer(ExprTransformer):
 
     def define_array(self, _d, name, typ, dims=None):
         return ("define_array", str(name).lower(), str(typ).lower(), dims or [])
+
+    def exec_(self, _e, expr):
+        return ("exec", expr)
 
     def read(self, _r, expr=None):
         return ("read", expr)
@@ -295,6 +297,12 @@ class _CmdTransformer(ExprTransformer):
 
     def edgeswap(self, _r, gen):
         return ("edgeswap", gen)
+
+    def equiangulate_gen(self, _e, gen):
+        return ("equiangulate", gen)
+
+    def equiangulate_bare(self, _e):
+        return ("bare", "u", None)           # a whole sweep, like u
 
     def delete(self, _r, gen):
         return ("delete", gen)

@@ -36,7 +36,7 @@ def _x_abort(interp, node):
     raise CommandError("Command aborted (abort).")
 
 
-@register("system", "shell", "exec", "permload", "define boundary", "define quantity",
+@register("system", "shell", "permload", "define boundary", "define quantity",
           "define method_instance", "detorus", "dissolve", "binary_printf",
           "binary_off_file", "postscript", "reorder_storage", "renumber_all",
           usage="(refused)", statement="unsupported", help="refused by name",

@@ -107,6 +107,34 @@ def edgeswap(session: SessionLike, edges, echo=True):
     return n
 
 
+def equiangulate_edges(session: SessionLike, edges):
+    """``equiangulate edge_generator``: one equiangulation test of the listed
+    edges, flipping those that pass (manual: EQUIANGULATE).  REF reports
+    "Edges equiangulated: N" when the command ends (or at ``flush_counts``);
+    ``equi_count`` adds up within a command and starts again after a report."""
+    session.no_string("equiangulate")
+    only = np.zeros(session.surface.ne, bool)
+    only[np.asarray(edges, np.int64)] = True
+    n = _replaced(session, EQ.equiangulate(session.surface, only=only))
+    word = "Edges equiangulated"
+    if word not in session.pending:         # reported since: the count starts again
+        session.counts["equi"] = 0
+    session.counts["equi"] = session.counts.get("equi", 0) + n
+    session.report(word, n)
+    return n
+
+
+def flush_counts(session: SessionLike):
+    """``flush_counts``: print the counts the running command has made
+    nonzero (``Edges equiangulated: 28``) now instead of when it ends."""
+    for word, n in session.pending.items():
+        if n and word in ("Fixed", "Unfixed"):
+            session.note(f"{word}: {n}\n")
+        elif n:
+            session.write(f"{word}: {n}\n")
+    session.pending = {"Fixed": 0, "Unfixed": 0}
+
+
 def _bisect(session: SessionLike, edges, echo):
     n = _divide(session, edges)
     bump_count(session, "refine", n)                # REF: l and K accumulate, r does not
@@ -318,6 +346,23 @@ def _x_edgeswap(interp, node):
     if {el.kind for el in els} - {"edge"}:
         raise CommandError("edgeswap needs edges (for example: edgeswap edge[3])")
     edgeswap(s, [el.i for el in els])
+
+
+@register("equiangulate", usage="equiangulate edges [where ...]", statement="equiangulate",
+          help="flip the given edges where that improves equiangularity", family=FAMILY)
+def _x_equiangulate(interp, node):
+    linear_only(interp.session, "equiangulate")
+    s = interp.session
+    els = elements.generate(s, node[1], interp.env)
+    if {el.kind for el in els} - {"edge"}:
+        raise CommandError("equiangulate needs edges (for example: equiangulate edge[3])")
+    equiangulate_edges(s, [el.i for el in els])
+
+
+@register("flush_counts", usage="flush_counts", help="print the pending counts now",
+          family=FAMILY, arg="none")
+def _flush_counts(interp, raw, arg):
+    flush_counts(interp.session)
 
 
 @register("delete", usage="delete edges|facets [where ...]", statement="delete",

@@ -350,12 +350,21 @@ class Iterator:
         if popt:
             if len(cons):
                 OP.refuse(s, "fixed volumes or FIXED quantities")
-            if settings.conj_grad:
-                OP.refuse(s, "conj_grad")
             self._pbase: np.ndarray | None = OP.values(s)
-            pvel = -OP.scales(s) ** 2 * OP.gradient(s)
+            # in the scaled parameter q = p / pscale the force is
+            # -pscale dE/dp, moved like a vertex coordinate (with conj_grad
+            # too: the parameters join the CG sums and history)
+            pscale = OP.scales(s)
+            if settings.conj_grad and np.any(pscale != 1.0):
+                # REF's CG sums with PSCALE: matched on one hexagon (0.3),
+                # not on another (0.5); only PSCALE 1 is measured exactly
+                OP.refuse(s, "conj_grad and a PSCALE other than 1")
+            graw = OP.gradient(s)
+            fq = -pscale * graw
+            pvel = pscale * fq
         else:
             self._pbase = None
+            fq = graw = np.zeros(0)
 
         def params_at(scale_):
             if popt:
@@ -392,19 +401,35 @@ class Iterator:
             # Fletcher-Reeves: gamma = S/S_old with S = sum vel.f; Polak-Ribiere
             # (the Evolver's default, toggle `ribiere`) subtracts sum vel.f_old;
             # a negative gamma restarts (PR+).  Found by printing v_velocity and
-            # v_force of evolver-nox-d on cube.fe and tankex.fe.
-            S = float(np.sum(vel[mobile] * f[mobile]))
+            # v_force of evolver-nox-d on cube.fe and tankex.fe.  Vertices on
+            # parametric boundaries are left out of the sums and keep their
+            # plain motion; the optimizing parameters add (p-scale dE/dp)^2 and
+            # (their Ribiere term) to the sums but move along their plain
+            # gradient (REF: the CG direction is kept in the parameters'
+            # "grad", the motion uses their "velocity"; measured on the
+            # shengdie torus sheets, whose ends are boundaries).
+            bnd = s.vattr.get("boundary")
+            cgv = mobile if bnd is None else mobile & (bnd == 0)
+            S = float(np.sum(vel[cgv] * f[cgv])) + float(fq @ fq)
+            q_old = getattr(self, "cg_q", None)
+            if self.cg_history is not None and (
+                    self.cg_history.shape != vel.shape or q_old is None
+                    or len(q_old) != len(fq)):
+                self.cg_history = None          # the surface or parameters changed
             if self.cg_history is None or self.cg_S_old < 1e-15:
                 gamma = 0.0
             else:
                 num = S
                 if settings.ribiere:
-                    num -= float(np.sum(vel[mobile] * self.cg_f_old[mobile]))
+                    num -= float(np.sum(vel[cgv] * self.cg_f_old[cgv]))
+                    num -= float(graw @ q_old)      # REF: grad·oldgrad, no pscale
                 gamma = num / self.cg_S_old
                 if gamma > 10 or gamma < 0:     # negative: restart (PR+)
                     gamma = 0.0
-            h = vel if self.cg_history is None else vel + gamma * self.cg_history
+            h = vel.copy() if self.cg_history is None else vel + gamma * self.cg_history
+            h[~cgv] = vel[~cgv]
             self.cg_history = h
+            self.cg_q = graw
             self.cg_S_old = S
             self.cg_f_old = f_raw      # the Evolver keeps the unprojected force
             vel = h

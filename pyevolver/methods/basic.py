@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import UnsupportedError
 from ..geometry import kernels as G
 from .jets import skew
 from ..model.formulas import located
@@ -229,6 +230,53 @@ def _facet_vector_integral_grad(t, comps, idx, w):
     Qbar = 0.5 * np.einsum("q,nqk->nk", W, Q)
     g2 = n2_grad_dot(P, Qbar)
     per = (g1 + g2) * w[:, None, None]
+    return scatter(s.nv, s.F[idx].ravel(), per.reshape(-1, 3))
+
+
+def _point_coords(t, P, etype, idx):
+    """Coordinates and the elements' scalar extra attributes at points P (n, 3)."""
+    s = t.surface
+    coords = {"x": P[:, 0], "y": P[:, 1], "z": P[:, 2]}
+    for (et, name), arr in s.extra.items():
+        if et == etype and arr.ndim == 1:
+            coords[name] = arr[idx]
+    return coords
+
+
+def _vertex_scalar_gradient(t, m, idx, w):
+    """Gradient (nv, 3) of ``Σ_v w_v f(x_v)``: ``w_v ∇f(x_v)`` (manual:
+    vertex_scalar_integral, the integrand evaluated at the vertex)."""
+    s = t.surface
+    idx = np.asarray(idx, np.int64)
+    X = s.X[idx]
+    if s.sdim != 3:
+        raise UnsupportedError("the gradient of vertex_scalar_integral outside 3 dimensions")
+    grad = m.scalar.gradient(s.param_env(), _point_coords(t, X, "vertex", idx), len(idx))
+    return scatter(s.nv, idx, grad * np.asarray(w, float)[:, None])
+
+
+def _facet_scalar_gradient(t, m, idx, w):
+    """Gradient (nv, 3) of ``Σ_f w_f A_f Σ_q W_q f(x_q)`` (the degree-6 rule
+    of :func:`_facet_scalar_integral`, x_q = Σ_c B_qc x_c): the quadrature
+    mean times ∇A_f plus ``A_f Σ_q W_q B_qc ∇f(x_q)`` at corner c."""
+    s = t.surface
+    idx = np.asarray(idx, np.int64)
+    n = len(idx)
+    if n == 0:
+        return np.zeros((s.nv, 3))
+    if s.sdim != 3:
+        raise UnsupportedError("the gradient of facet_scalar_integral outside 3 dimensions")
+    P = facet_points(t)[idx]
+    B, W = G.TRI6_B, G.TRI6_W
+    flat = np.einsum("qc,ncj->nqj", B, P).reshape(-1, 3)
+    coords = _point_coords(t, flat, "facet", np.repeat(idx, len(W)))
+    params = s.param_env()
+    f = m.scalar.values(params, coords, len(flat)).reshape(n, len(W))
+    df = m.scalar.gradient(params, coords, len(flat)).reshape(n, len(W), 3)
+    A = t.facet_area[idx]
+    per = (f @ W)[:, None, None] * facet_area_grad(t)[idx]
+    per += A[:, None, None] * np.einsum("q,qc,nqj->ncj", W, B, df)
+    per *= np.asarray(w, float)[:, None, None]
     return scatter(s.nv, s.F[idx].ravel(), per.reshape(-1, 3))
 
 
@@ -455,8 +503,9 @@ register_method("edge_length", "edge", _edge_length, _length_gradient, _length_h
 register_method("edge_area", "edge", _edge_length, _length_gradient)
 register_method("edge_tension", "edge", _edge_tension, _edge_tension_gradient)
 register_method("facet_tension", "facet", _facet_tension, _facet_tension_gradient)
-register_method("vertex_scalar_integral", "vertex", _vertex_scalar_integral)
-register_method("facet_scalar_integral", "facet", _facet_scalar_integral)
+register_method("vertex_scalar_integral", "vertex", _vertex_scalar_integral,
+                _vertex_scalar_gradient)
+register_method("facet_scalar_integral", "facet", _facet_scalar_integral, _facet_scalar_gradient)
 register_method("facet_vector_integral", "facet", _facet_vector_integral, _facet_vector_gradient)
 register_method("edge_scalar_integral", "edge", _edge_scalar_integral)
 register_method("edge_vector_integral", "edge", _edge_vector_integral, _edge_vector_gradient)

@@ -75,6 +75,11 @@ def star_sums(t):
     if Pc is not None:
         P = Pc                                               # P[axis][corner] (nf,)
         N2 = t.facet_N2.T
+    elif s.periods is not None:
+        # the torus: each facet's corners unwrapped by its edges' wraps, so
+        # a star across the periodic wrap sees its true neighbours
+        P = facet_points(t).transpose(2, 1, 0)
+        N2 = t.facet_N2.T
     else:
         P = np.ascontiguousarray(s.X.T)[:, Fc]               # (3 axes, 3 corners, nf)
         a = P[:, 1] - P[:, 0]
@@ -109,9 +114,12 @@ def _h_zero(s, method):
     return None
 
 
-def _check_supported(s):
-    if s.periods is not None:
-        raise UnsupportedError("curvature methods in the torus model")
+def _check_supported(s, what=None):
+    """Refuse ``what`` (a method reading ``s.X`` directly, not the unwrapped
+    facet corners) in the torus model; the star methods built on
+    :func:`star_sums` / :func:`facet_points` work across the wrap."""
+    if what is not None and s.periods is not None:
+        raise UnsupportedError(f"{what} in the torus model")
 
 
 def _check_closed(s, what, constraints=False):
@@ -671,6 +679,7 @@ def circle_willmore_values(ctx, m, idx):
     on blob0.fe).  Not differentiable where some β = 0 or π."""
     s = ctx.surface
     _check_closed(s, "circle_willmore")
+    _check_supported(s, "circle_willmore")
     e, i, j, k, l_ = _edge_quads(s)
     beta = _bobenko_beta(s.X, i, j, k, l_)
     per_v = 0.5 * (np.bincount(i, weights=beta, minlength=s.nv)
@@ -681,6 +690,7 @@ def circle_willmore_values(ctx, m, idx):
 def circle_willmore_gradient(t, m, idx, w):
     s = t.surface
     _check_closed(s, "circle_willmore")
+    _check_supported(s, "circle_willmore")
     wv = vertex_weights(s.nv, idx, w)
     e, i, j, k, l_ = _edge_quads(s)
     _, (gi, gj, gk, gl) = _bobenko_beta(s.X, i, j, k, l_, grad=True)

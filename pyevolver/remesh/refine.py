@@ -37,7 +37,14 @@ def boundary_midpoints(s, tails, heads, vnew, target=None):
         if not len(sel):
             continue
         v, head, tail = vnew[sel], heads[sel], tails[sel]
-        goal = 0.5 * (s.X[tail] + s.X[head]) if target is None else target[sel]
+        if target is not None:
+            goal = target[sel]
+        elif s.periods is not None:
+            # the torus: the new vertex already sits at the wrapped edge's
+            # midpoint (tail + half the edge vector), not at the chord's
+            goal = s.X[v].copy()
+        else:
+            goal = 0.5 * (s.X[tail] + s.X[head])
         names = tuple(f"p{k + 1}" for k in range(b.nparams))
 
         def curve(P):

@@ -75,7 +75,7 @@ def _numbers(lines):
     return [ln for ln in lines if ln.strip() and (ln.strip()[0] in "-0123456789")]
 
 
-@pytest.mark.parametrize("opts", ["pscale = 0.3", "pdelta = 0.001", ""])
+@pytest.mark.parametrize("opts", ["pscale = 0.3", "pdelta = 0.001", "", "pscale = 0.5"])
 def test_parameter_moves_as_in_the_evolver(evolver, tmp_path, opts):
     f = _hexagon(tmp_path, opts)
     pr = 'printf "%.15g %.15g\\n", rr, vertex[1].z\n'
@@ -85,6 +85,20 @@ def test_parameter_moves_as_in_the_evolver(evolver, tmp_path, opts):
     ref = [ln for ln in _numbers(ref) if len(ln.split()) == 2]
     out = [ln for ln in _numbers(out) if len(ln.split()) == 2]
     assert len(ref) == 4, ref
+    assert _same(out, ref, STEPS), (out, ref, err)
+
+
+@pytest.mark.parametrize("opts", ["pdelta = 0.001", "pdelta = 0.003 pscale = 1"])
+def test_parameter_moves_with_conj_grad_as_in_the_evolver(evolver, tmp_path, opts):
+    """conj_grad: the parameters join the CG sums (velocity·grad, and
+    grad·oldgrad for Polak-Ribiere) and move along their plain gradient."""
+    f = _hexagon(tmp_path, opts)
+    pr = 'printf "%.15g %.15g %.15g\\n", rr, vertex[1].z, total_energy\n'
+    script = "U\ng 2\n" + pr + "ribiere\ng 1\n" + pr + "ribiere\ng 1\n" + pr
+    _, ref, out, err = _run_both(evolver, f, script, tmp_path)
+    ref = [ln for ln in _numbers(ref) if len(ln.split()) == 3]
+    out = [ln for ln in _numbers(out) if len(ln.split()) == 3]
+    assert len(ref) == 3, ref
     assert _same(out, ref, STEPS), (out, ref, err)
 
 
@@ -111,6 +125,8 @@ def test_dump_keeps_the_declaration(tmp_path):
 
 @pytest.mark.parametrize("cmd", ["hessian", "newton", "bfgs", "U; g"])
 def test_unsupported_combinations_are_refused_by_name(tmp_path, cmd):
+    # _hexagon's parameter has PSCALE 0.3: with conj_grad refused (REF's CG
+    # sums with a PSCALE other than 1 are not matched)
     sess = pyevolver.load(_hexagon(tmp_path))
     with pytest.raises(pyevolver.errors.PyEvolverError,
                        match="not supported in pyevolver: OPTIMIZING_PARAMETER with"):

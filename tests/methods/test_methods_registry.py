@@ -23,7 +23,7 @@ def test_builtin_entries_have_value_gradient_hessian():
 def test_views_follow_the_registry():
     assert METHODS["facet_area"] == ("facet", REGISTRY["facet_area"].value)
     assert GRADIENTS["edge_length"] is REGISTRY["edge_length"].gradient
-    assert "vertex_scalar_integral" in METHODS and "vertex_scalar_integral" not in GRADIENTS
+    assert "edge_scalar_integral" in METHODS and "edge_scalar_integral" not in GRADIENTS
     assert "edge_area" in GRADIENTS and "edge_area" not in HESSIANS
     assert method_info("edge_length")[0] == "edge"
 

@@ -410,7 +410,7 @@ def test_diverging_projection_restores():
 
 
 ESCAPES = [
-    'system "touch {p}"', 'shell', 'exec "print 1"', 'eval("1")',
+    'system "touch {p}"', 'shell', 'exec "system \\"touch {p}\\""', 'eval("1")',
     'print 1 | "touch {p}"', '{{ print 1 }} | "sh -c touch\\ {p}"', '__import__("os")',
     'load_library "libc.so.6"', 'unix_command "touch {p}"', '!touch {p}', 'print `touch {p}`',
     'read "/dev/zero"', 'read "/dev/stdin"', 'print 1 >>> "/dev/null"', 'dump "/dev/full"',
