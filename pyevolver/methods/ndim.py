@@ -58,14 +58,7 @@ class NDTotals(Totals):
         self.facet_x0 = X[F[:, 0]] if s.nf else np.zeros((0, X.shape[1]))
         self.facet_area = G.gram_facet_areas(self.facet_S)
         self.total_area = float(self.facet_area.sum())
-        self.terms = {}
-        energy = float(self.facet_area @ s.facet_tension)
-        self.terms["facet_tension"] = energy
-        et = s.eattr.get("tension")
-        if et is not None:
-            e = float(self.edge_length @ et)
-            self.terms["edge_tension"] = e
-            energy += e
+        energy = self._tension_energy()
         self.con_energy, self.con_content = 0.0, None
         self.volumes = np.zeros(0)
         self.energy = self._finish_energy(energy, 0.0)

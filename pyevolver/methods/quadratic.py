@@ -157,14 +157,7 @@ class QuadTotals(Totals):
         EX, Et = Q.edge_frames(self.edge_P)
         self.edge_length = np.linalg.norm(Et, axis=2) @ Q.GL3_W
         self.total_area = float(self.facet_area.sum())
-        self.terms = {}
-        energy = float(self.facet_area @ s.facet_tension)
-        self.terms["facet_tension"] = energy
-        et = s.eattr.get("tension")
-        if et is not None:
-            e = float(self.edge_length @ et)
-            self.terms["edge_tension"] = e
-            energy += e
+        energy = self._tension_energy()
         self.con_energy, self.con_content = self._integrals()
         energy += self.con_energy
         if convex_edges(s):

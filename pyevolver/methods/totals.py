@@ -65,14 +65,7 @@ class Totals:
             self.facet_volume = G.facet_volumes(self.facet_x0, self.facet_S,
                                                 s.symmetric_content)
         self.total_area = float(self.facet_area.sum())
-        self.terms = {}
-        energy = float(self.facet_area @ s.facet_tension)
-        self.terms["facet_tension"] = energy
-        et = s.eattr.get("tension")
-        if et is not None:
-            e = float(self.edge_length @ et)
-            self.terms["edge_tension"] = e
-            energy += e
+        energy = self._tension_energy()
         self.con_energy, self.con_content = self._integrals()
         energy += self.con_energy
         gap = self._gap_energy()
@@ -181,6 +174,20 @@ class Totals:
                 q = self.eval_points(comp, flat, "edge", rep).reshape(n, 2) @ G.GL2_W
                 total += q * d[:, k]
         return total
+
+    def _tension_energy(self) -> float:
+        """Facet and edge tension energy; starts ``self.terms`` with both
+        (the linear, quadratic and n-D totals share it)."""
+        s = self.surface
+        self.terms = {}
+        energy = float(self.facet_area @ s.facet_tension)
+        self.terms["facet_tension"] = energy
+        et = s.eattr.get("tension")
+        if et is not None:
+            e = float(self.edge_length @ et)
+            self.terms["edge_tension"] = e
+            energy += e
+        return energy
 
     def _integrals(self):
         """Constraint and boundary ENERGY / CONTENT edge integrals."""
