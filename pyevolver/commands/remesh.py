@@ -340,23 +340,23 @@ def _x_refine(interp, node):
 @register("edgeswap", usage="edgeswap edges [where ...]", statement="edgeswap",
           help="flip the edges that are quadrilateral diagonals", family=FAMILY)
 def _x_edgeswap(interp, node):
-    linear_only(interp.session, "edgeswap")
-    s = interp.session
-    els = elements.generate(s, node[1], interp.env)
+    edgeswap(interp.session, _edges_of(interp, node, "edgeswap"))
+
+
+def _edges_of(interp, node, word):
+    """Indices of the edges a ``word edges [where ...]`` command names
+    (linear model only; anything but edges is an error)."""
+    linear_only(interp.session, word)
+    els = elements.generate(interp.session, node[1], interp.env)
     if {el.kind for el in els} - {"edge"}:
-        raise CommandError("edgeswap needs edges (for example: edgeswap edge[3])")
-    edgeswap(s, [el.i for el in els])
+        raise CommandError(f"{word} needs edges (for example: {word} edge[3])")
+    return [el.i for el in els]
 
 
 @register("equiangulate", usage="equiangulate edges [where ...]", statement="equiangulate",
           help="flip the given edges where that improves equiangularity", family=FAMILY)
 def _x_equiangulate(interp, node):
-    linear_only(interp.session, "equiangulate")
-    s = interp.session
-    els = elements.generate(s, node[1], interp.env)
-    if {el.kind for el in els} - {"edge"}:
-        raise CommandError("equiangulate needs edges (for example: equiangulate edge[3])")
-    equiangulate_edges(s, [el.i for el in els])
+    equiangulate_edges(interp.session, _edges_of(interp, node, "equiangulate"))
 
 
 @register("flush_counts", usage="flush_counts", help="print the pending counts now",
