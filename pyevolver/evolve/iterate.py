@@ -18,6 +18,7 @@ from ..constraints import (displace, project_tangent, project_to_constraints, re
                        restore_state, state)
 from . import gradient as GR
 from . import optparams as OP
+from ..errors import ConstraintError
 
 
 def _solve(A, d):
@@ -99,6 +100,32 @@ class StepResult:
     warnings: list = field(default_factory=list)
     totals: Any = None
     motion: tuple | None = None
+
+
+def _check_freedom(s, mobile, ncons):
+    """REF's ERROR 3004 before a step: fewer degrees of freedom than fixed
+    volumes and quantities (e.g. column.fe after ``t 0.1`` leaves only FIXED
+    vertices and its fixed volume).  A mobile vertex counts its coordinates
+    less its two-sided level-set constraints, or its boundary's parameters
+    (an upper bound of the motions, so only a sure shortage is an error)."""
+    if ncons == 0:
+        return
+    free = np.where(mobile, s.X.shape[1], 0)
+    if s.vcon:
+        for c, on in s.vcon.items():
+            flags = getattr(s.constraints.get(c), "flags", set()) or set()
+            if not ({"nonnegative", "nonpositive"} & set(flags)):
+                free = free - (mobile & np.asarray(on, bool))
+    bnd = s.vattr.get("boundary")
+    if bnd is not None:
+        for bid, b in s.boundaries.items():
+            sel = mobile & (bnd == bid)
+            free = np.where(sel, b.nparams, free)
+    dof = int(np.maximum(free, 0).sum())
+    if dof < ncons:
+        raise ConstraintError(f"Degrees of freedom, {dof}, is less than number of "
+                              f"constraints, {ncons}. (REF's ERROR 3004; perhaps a "
+                              "constraint is not applied to any elements?)")
 
 
 class _Constraints:
@@ -343,6 +370,7 @@ class Iterator:
         s = self.surface
         mobile = self._mobile()
         cons = _Constraints(s)
+        _check_freedom(s, mobile, len(cons))
         t0 = s.evaluate()
         f = -GR.energy_gradient(t0)
         # optimizing parameters: moved by -scale * pscale * dE/dp with the vertices

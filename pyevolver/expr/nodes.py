@@ -291,6 +291,10 @@ class Or(Node):
         return (self.a, self.b)
 
 
+#: > 0 while the branches of an element-wise ``?:`` are evaluated
+_LENIENT = 0
+
+
 class Cond(Node):
     __slots__ = ("c", "a", "b")
 
@@ -304,7 +308,16 @@ class Cond(Node):
         if isinstance(c, ArrayValue) or not (is_number(c) or isinstance(c, str)):
             raise ExpressionError(f"the condition of '?:' must be a number, got {_what(c)}")
         if isinstance(c, np.ndarray):
-            return np.where(c != 0, self.a.ev(env), self.b.ev(env))
+            # both branches are evaluated on every row: a domain error in the
+            # rows the condition discards is not an error (REF evaluates per
+            # element)
+            global _LENIENT
+            _LENIENT += 1
+            try:
+                a, b = self.a.ev(env), self.b.ev(env)
+            finally:
+                _LENIENT -= 1
+            return np.where(c != 0, a, b)
         return self.a.ev(env) if c else self.b.ev(env)
 
     def children(self):
@@ -329,6 +342,15 @@ class Func(Node):
                 if self.name == "sqrt" and not isinstance(v, np.ndarray) and v < 0:
                     # REF's ERROR 1263
                     raise ExpressionError(f"Square root of negative number {v:g}.")
+                if self.name == "log":
+                    # REF: ERROR 1425 for a number, ERROR 1264 "Log of zero or
+                    # negative number" inside element integrands (slidestr.fe's
+                    # content integral under `U`); log(0) of a number is -inf
+                    if isinstance(v, np.ndarray):
+                        if not _LENIENT and np.any(v <= 0):
+                            raise ExpressionError("Log of zero or negative number.")
+                    elif v < 0:
+                        raise ExpressionError("log of negative number.")
                 return _num(FUNC1[self.name](v))
             return _num(FUNC2[self.name](vals[0], vals[1]))
 

@@ -67,3 +67,27 @@ def test_map_env_falls_back_to_the_parent_then_the_constants():
     assert env.lookup("a") == 1.0 and env.lookup("b") == 2.0 and env.lookup("pi") == math.pi
     with pytest.raises(ExpressionError):
         env.lookup("nope")
+
+
+def test_log_domain_as_the_evolver():
+    """REF: `print log(-1)` is ERROR 1425, `print log(0)` prints -inf; in an
+    element integrand a log of zero or a negative number is ERROR 1264
+    (slidestr.fe under `U`, tests/reference/test_iterate_reference.py) —
+    except in the rows an element-wise ``?:`` discards."""
+    log = lambda a: N.Func("log", [a])
+    assert log(N.Num(0.0)).ev({}) == -math.inf
+    with pytest.raises(ExpressionError, match="log of negative number"):
+        log(N.Num(-1.0)).ev({})
+
+    class Arr(N.Node):
+        def __init__(self, v):
+            self.v = v
+
+        def ev(self, env):
+            return self.v
+
+    v = np.array([2.0, 0.0, -1.0])
+    with pytest.raises(ExpressionError, match="Log of zero or negative number"):
+        log(Arr(v)).ev({})
+    out = N.Cond(Arr(v > 0), log(Arr(v)), N.Num(0.0)).ev({})
+    np.testing.assert_array_equal(out, [math.log(2.0), 0.0, 0.0])

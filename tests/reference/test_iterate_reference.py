@@ -131,3 +131,27 @@ def test_dependent_constraints_do_not_blow_up(evolver):
     for r in res:
         assert math.isfinite(r.area) and 9.0 < r.area < 1.05 * 4 * math.pi, r
         assert _rel(r.energy, ref[0].group(3)) <= 1e-8, (r.energy, ref[0].group(3))
+
+
+@pytest.mark.parametrize("name, script, message", [
+    # t 0.1 leaves only FIXED vertices and the fixed volume: REF's ERROR 3004
+    ("column", "g 5\nt 0.1\ng 5", "Degrees of freedom, 0, is less than number of constraints, 1"),
+    # a content integral's log() of a negative number in a trial move: ERROR 1264
+    ("slidestr", "U\ng 5", "Log of zero or negative number"),
+])
+def test_runtime_errors_as_the_evolver(evolver, name, script, message):
+    """Where REF stops a `g` with an error, pyevolver fails the same command
+    (and, unlike REF, restores the surface as it was before it)."""
+    import subprocess
+    p = subprocess.run([evolver, "-p1", example(f"{name}.fe")], input=script + "\nq\nq\n",
+                       capture_output=True, text=True, timeout=60)
+    ref = p.stdout + p.stderr
+    assert message in ref
+    rc, out, err = run_pyevolver(example(f"{name}.fe"), script + "\nprint total_energy\n")
+    assert message in err
+    # the last g is not printed to its end: REF's g lines stop where ours do
+    ref_g = [m.group(3) for m in map(LINE.match, ref.split("\n")) if m]
+    our_g = [m.group(3) for m in map(LINE.match, out) if m]
+    assert len(our_g) == len(ref_g)
+    for a, b in zip(our_g, ref_g):
+        assert float(a) == pytest.approx(float(b), rel=LOOSE)
