@@ -34,7 +34,7 @@ def edge_divide(s, edges):
         now = todo[ok[todo]]
         mask = np.zeros(s.ne, bool)
         mask[now] = True
-        s = split_edges(s, mask)
+        s = split_edges(s, mask, one_by_one=True)
         todo = todo[~ok[todo]]
     return s, count
 

@@ -13,7 +13,7 @@ import numpy as np
 from ..geometry import kernels as G
 from ..constraints import constrained_vertices, project_to_constraints
 from ..model.records import along_first, record_along_first, record_vertex_rings
-from .grow import grow
+from .grow import grow, reorder_new_edges
 from .rings import Rings, rounds
 
 
@@ -93,7 +93,7 @@ def refine(s):
     return split_edges(s, ~s.eattr["no_refine"])
 
 
-def split_edges(s, ref):
+def split_edges(s, ref, one_by_one=False):
     """Bisect the edges where ``ref`` (a (ne,) bool mask) is true and split
     every facet across its bisected sides (4, 3 or 2 triangles).
 
@@ -101,6 +101,17 @@ def split_edges(s, ref):
     corner; with two, the corner between them is cut off first and the rest
     is cut from the first midpoint to the opposite corner (what bisecting
     the two sides one after the other gives).
+
+    ``one_by_one`` (``refine edges``, ``l``; no facet may have two bisected
+    sides): elements numbered and facets laid out as REF's edge division
+    does one edge after the other (measured with ``list edges`` and
+    ``ff.vertex[k]`` after ``refine edge where id == 1 or id == 3`` on
+    cube.fe): per edge in id order its head half, then for each facet in the
+    edge's facet loop the cut from the midpoint to the opposite corner and a
+    new facet; the new facet is the triangle on the tail half and starts
+    with it, the old facet keeps the head half's triangle and starts with
+    the cut.  (The order of the corners decides ``ff.vertex[1]``, hence
+    e.g. ``form_factors`` set from it in mylarcube.fe.)
     """
     nv, ne, nf = s.nv, s.ne, s.nf
     ref = np.asarray(ref, bool)
@@ -122,6 +133,28 @@ def split_edges(s, ref):
     rot[one] = np.argmax(rs[one], axis=1)
     two = nref == 2
     rot[two] = (np.argmin(rs[two], axis=1) + 1) % 3
+    if one_by_one and np.any(nref > 1):
+        raise ValueError("split_edges(one_by_one=True): a facet with two bisected sides")
+    perm = None
+    f1 = np.nonzero(one)[0]
+    if one_by_one and len(f1):
+        # REF's order: per edge (id order), its facets in the edge's loop
+        e_of = idx[f1, rot[f1]]
+        fw_of = fwd[f1, rot[f1]]
+        rank = np.zeros(ne, np.int64)
+        rank[R] = np.arange(k)
+        pos = np.where(fw_of == along_first(s)[e_of], 0, 1)
+        order = np.lexsort((f1, pos, rank[e_of]))
+        f1 = f1[order]
+        r_of = rank[e_of[order]]
+        cnt = np.bincount(r_of, minlength=k)
+        start = np.cumsum(1 + cnt) - (1 + cnt)        # each edge's head half
+        q = np.arange(len(f1)) - np.searchsorted(r_of, r_of)   # place in its loop
+        cut = start[r_of] + 1 + q
+        perm = np.empty(k + len(f1), np.int64)
+        perm[start] = np.arange(k)
+        perm[cut] = k + np.arange(len(f1))
+        half[R] = ne + start
     cols = (np.arange(3)[None, :] + rot[:, None]) % 3
     I = np.take_along_axis(idx, cols, 1)
     FW = np.take_along_axis(fwd, cols, 1)
@@ -134,7 +167,8 @@ def split_edges(s, ref):
     # interior edges and facets, case by case
     f3 = np.nonzero(nref == 3)[0]
     f2 = np.nonzero(two)[0]
-    f1 = np.nonzero(one)[0]
+    if perm is None:
+        f1 = np.nonzero(one)[0]
     e_par = np.concatenate([np.repeat(f3, 3), np.repeat(f2, 2), f1])
     ne2 = ne + k
     base3 = ne2 + 3 * np.arange(len(f3))
@@ -146,6 +180,9 @@ def split_edges(s, ref):
     fb1 = nf + 3 * len(f3) + 2 * len(f2) + np.arange(len(f1))
 
     t = grow(s, v_from_edge=R, e_from_edge=R, e_from_facet=e_par, f_from_facet=f_par)
+    if perm is not None:
+        reorder_new_edges(t, ne, perm)
+        base1 = ne + cut
 
     # -- geometry of midpoints (torus: in the tail's cell)
     wv = s.wrap_shift()
@@ -153,8 +190,8 @@ def split_edges(s, ref):
     t.X[nv:nv + k] = s.X[s.E[R, 0]] + 0.5 * ev[R]
     # -- edge halves
     t.E[R, 1] = mid[R]
-    t.E[ne:ne + k, 0] = mid[R]
-    t.E[ne:ne + k, 1] = s.E[R, 1]
+    t.E[half[R], 0] = mid[R]
+    t.E[half[R], 1] = s.E[R, 1]
     if "wrap" in t.eattr:
         t.eattr["wrap"][R] = 0.0          # tail half stays in the tail's cell
         # (the head half copied the whole wrap from its parent)
@@ -200,8 +237,19 @@ def split_edges(s, ref):
         c2 = np.where(FW[f1, 2], s.E[I[f1, 2], 0], s.E[I[f1, 2], 1])
         E[d] = np.stack([m0, c2], 1)
         fi, se = first[f1], second[f1]
-        FE[f1] = np.stack([fi[:, 0], d, S[f1, 2]], 1)
-        FE[fb1] = np.stack([se[:, 0], S[f1, 1], ~d], 1)
+        if perm is None:
+            FE[f1] = np.stack([fi[:, 0], d, S[f1, 2]], 1)
+            FE[fb1] = np.stack([se[:, 0], S[f1, 1], ~d], 1)
+        else:
+            # REF: the new facet is the tail half's triangle, starting with
+            # it; the old one keeps the head half's, starting with the cut
+            fw = FW[f1, 0][:, None]
+            tail_tri = np.where(fw, np.stack([fi[:, 0], d, S[f1, 2]], 1),
+                                np.stack([se[:, 0], S[f1, 1], ~d], 1))
+            head_tri = np.where(fw, np.stack([~d, se[:, 0], S[f1, 1]], 1),
+                                np.stack([d, S[f1, 2], fi[:, 0]], 1))
+            FE[fb1] = tail_tri
+            FE[f1] = head_tri
         new_edges += [(d, f1, ("m", 0), ("c", 2))]
 
     if "wrap" in t.eattr and new_edges:
@@ -219,7 +267,7 @@ def split_edges(s, ref):
         for eidx, f, p, q in new_edges:
             t.eattr["wrap"][eidx] = offset(q[0], q[1], f) - offset(p[0], p[1], f)
 
-    _split_rings(s, t, R, half)
+    _split_rings(s, t, R, half, None if perm is None else np.sort(base1))
     _split_loops(s, t, R, half)
     new_v = np.arange(nv, nv + k)
     boundary_midpoints(t, s.E[R, 0], s.E[R, 1], new_v)
@@ -242,7 +290,7 @@ def _split_loops(s, t, R, half):
     record_along_first(t, out)
 
 
-def _split_rings(s, t, R, half):
+def _split_rings(s, t, R, half, inner=None):
     """Record REF's edge rings (:mod:`pyevolver.remesh.rings`) at the vertices
     of ``t``: ``s`` with the edges ``R`` split (new head halves ``half[R]``)
     and its facets cut.
@@ -260,7 +308,8 @@ def _split_rings(s, t, R, half):
         g.remove(h_all[sel], 2 * R[sel] + 1)
         g.insert(h_all[sel], 2 * half[R[sel]] + 1)
     g.set_pair(t.E[R, 1], 2 * half[R], 2 * R + 1)
-    inner = np.arange(ne + k, t.ne)
+    if inner is None:
+        inner = np.arange(ne + k, t.ne)
     iv = t.E[inner].ravel()
     islot = 2 * np.repeat(inner, 2) + np.tile([0, 1], len(inner))
     for sel in rounds(iv, islot):
