@@ -18,6 +18,7 @@ from ..constraints import (displace, project_tangent, project_to_constraints, re
                        restore_state, state)
 from . import gradient as GR
 from . import optparams as OP
+from .mobility import Mobility
 
 
 def _solve(A, d):
@@ -61,6 +62,7 @@ class IterateSettings:
     ribiere: bool = True               # Polak-Ribiere, else Fletcher-Reeves
     check_increase: bool = False
     hessian_normal: bool = True        # ``hessian``: normal motion only
+    area_normalization: bool = False   # mobility 1 / (star area / 3) (evolve.mobility)
 
     @classmethod
     def from_mappings(cls, settings: Mapping, toggles: Mapping) -> "IterateSettings":
@@ -74,7 +76,8 @@ class IterateSettings:
                    conj_grad=bool(toggles.get("conj_grad", 0)),
                    ribiere=bool(toggles.get("ribiere", 1)),
                    check_increase=bool(toggles.get("check_increase", 0)),
-                   hessian_normal=bool(toggles.get("hessian_normal", 1)))
+                   hessian_normal=bool(toggles.get("hessian_normal", 1)),
+                   area_normalization=bool(toggles.get("area_normalization", 0)))
 
 
 @dataclass
@@ -205,11 +208,17 @@ class Iterator:
         """Project vectors (list of (nv,3)) onto the constraint tangent spaces."""
         return project_tangent(self.surface, vecs)
 
+    def _mobility(self, t):
+        """The force-to-velocity conversion at the evaluation ``t`` (REF
+        takes the restoring motions' metric at the moved positions: catbody.fe
+        ``r; g 10`` with area normalization, 6e-4 off with the starting one)."""
+        return Mobility(t, self.settings.area_normalization)
+
     def _constrained_dirs(self, t, cons, mobile):
         gs = cons.gradients(t)
         for g in gs:
             g[~mobile] = 0.0
-        us = self._project_tangent(gs)
+        us = self._mobility(t).apply(self._project_tangent(gs))
         k = len(gs)
         A = np.empty((k, k))
         for i in range(k):
@@ -276,6 +285,11 @@ class Iterator:
                 # converged: REF stops here even when the difference grew
                 # (itdebug on check 14, step 7: "Diff: 0.382765", one
                 # volume_restore(), done at 0.6068)
+                if it == 9 and not trial:
+                    # converged at the last of the 10 corrections: REF's count
+                    # ran out, and the next step starts CG afresh (catbody.fe
+                    # with area normalization, `U; r; g 3`)
+                    self.cg_history = None
                 return t_new
             if err_new > 100 * err and err > 0:
                 if report is not None:
@@ -378,8 +392,10 @@ class Iterator:
         f_raw = f
         s._one_sided_released = None
         targets = cons.targets(s)
+        mob = self._mobility(t0)
         for _pass in range(2):
-            (f,) = self._project_tangent([f_raw])
+            (f_tan,) = self._project_tangent([f_raw])
+            (f,) = mob.apply([f_tan])
             lam = np.zeros(len(cons))
             if len(cons):
                 gs, us, A = self._constrained_dirs(t0, cons, mobile)
@@ -410,7 +426,7 @@ class Iterator:
             # shengdie torus sheets, whose ends are boundaries).
             bnd = s.vattr.get("boundary")
             cgv = mobile if bnd is None else mobile & (bnd == 0)
-            S = float(np.sum(vel[cgv] * f[cgv])) + float(fq @ fq)
+            S = float(np.sum(vel[cgv] * f_tan[cgv])) + float(fq @ fq)
             q_old = getattr(self, "cg_q", None)
             if self.cg_history is not None and (
                     self.cg_history.shape != vel.shape or q_old is None

@@ -1,0 +1,71 @@
+"""The mobility of ``g``: how a step turns forces into velocities.
+
+The Evolver's manual (model.htm, "Mobility"): the velocity is ``M f`` for a
+mobility tensor M, and "the same inner product has to be used in projecting
+the velocity tangent to the constraints".  Implemented here:
+
+* unit mobility (the default): M = I;
+* ``area_normalization``: M = diag(1 / a_v), a_v one third of the area of
+  vertex v's star of facets (one half of the length of its star of edges in
+  the string model);
+* ``approximate_curvature``: M = S⁻¹ with S the mass matrix of the linear
+  interpolation over the facets (edges in the string model).
+
+The iterator applies M to the tangent-projected force and to the
+tangent-projected constraint gradients, so the Lagrange multipliers
+(pressures) and the restoring motions are those of the metric.  Measured on
+evolver-nox-d by printing ``v_velocity`` (cube.fe: with area normalization
+the corner velocity 1.2 and face-centre velocity 2.4 are those of
+``M (f - λ g)`` with ``λ = g·M f / g·M g``).
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+
+def star_measure(t: Any) -> np.ndarray:
+    """Per-vertex area associated with each vertex, shape (nv,).
+
+    One third of the total area of the facets around the vertex; in the
+    string model one half of the total length of its edges (toggle.htm,
+    AREA_NORMALIZATION).
+    """
+    s = t.surface
+    if s.string or s.nf == 0 and s.ne:
+        L = t.edge_length
+        return (np.bincount(s.E[:, 0], weights=L, minlength=s.nv)
+                + np.bincount(s.E[:, 1], weights=L, minlength=s.nv)) / 2.0
+    A = np.repeat(t.facet_area, 3)
+    return np.bincount(s.F.ravel(), weights=A, minlength=s.nv) / 3.0
+
+
+class Mobility:
+    """The force-to-velocity conversion of one ``g`` step.
+
+    Parameters
+    ----------
+    t : Totals
+        The evaluation the conversion is taken at.
+    area_normalization : bool
+        M = diag(1 / star measure).
+    """
+
+    def __init__(self, t: Any, area_normalization: bool = False):
+        self.diag: np.ndarray | None = None
+        if area_normalization:
+            a = star_measure(t)
+            with np.errstate(divide="ignore"):
+                self.diag = np.where(a > 0, 1.0 / np.where(a > 0, a, 1.0), 0.0)
+
+    @property
+    def identity(self) -> bool:
+        """True for unit mobility."""
+        return self.diag is None
+
+    def apply(self, vecs: list[np.ndarray]) -> list[np.ndarray]:
+        """``M v`` for each (nv, dim) array of ``vecs``."""
+        if self.diag is None:
+            return vecs
+        return [v * self.diag[:, None] for v in vecs]

@@ -1,0 +1,102 @@
+"""The mobility options of ``g`` (pyevolver.evolve.mobility) against
+evolver-nox-d run live: every progress line of each ``g`` block agrees in
+area and energy within STEPS (the printed 15 digits), and the final
+``total_energy`` too."""
+import io
+import os
+import re
+
+import numpy as np
+import pytest
+
+from pyevolver import Session
+from pyevolver.evolve.mobility import Mobility, star_measure
+
+from comparison import run_pyevolver
+from conftest import example
+from reference import run_reference
+from tolerances import ROUNDOFF, STEPS
+
+LINE = re.compile(r"^\s*(\d+)\. (?:area|length):\s*(\S+) energy:\s*(\S+)\s+scale:\s*(\S+)")
+TAIL = 'printf "FINAL %.17g\\n", total_energy\n'
+
+
+def _rel(a, b):
+    a, b = float(a), float(b)
+    return abs(a - b) / max(abs(a), abs(b), 1e-300)
+
+
+def compare_g(evolver, path, cmds, tmp_path, tol=STEPS):
+    """Run ``cmds`` in both programs; every g line and the final energy agree."""
+    ref = run_reference(evolver, path, cmds + "\n" + TAIL, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(path, cmds + "\n" + TAIL + "q\n", cwd=str(tmp_path))
+    assert "not supported" not in err and "Traceback" not in err, err
+    rl = [m.groups() for m in map(LINE.match, ref) if m]
+    ml = [m.groups() for m in map(LINE.match, out) if m]
+    assert rl and len(rl) == len(ml), (ref, out, err)
+    for r, m in zip(rl, ml):
+        assert r[0] == m[0]
+        assert _rel(r[1], m[1]) <= tol and _rel(r[2], m[2]) <= tol, (r, m)
+    rf = [l.split()[1] for l in ref if l.startswith("FINAL")]
+    mf = [l.split()[1] for l in out if l.startswith("FINAL")]
+    assert rf and mf and _rel(rf[0], mf[0]) <= tol, (rf, mf)
+    return rl
+
+
+def grain(tmp_path):
+    """100grain.fe without its autopop and autochop lines (popping is
+    another family's)."""
+    text = open(example("100grain.fe")).read()
+    text = re.sub(r"(?m)^(autopop|autochop)\b.*$", "", text)
+    path = tmp_path / "grain.fe"
+    path.write_text(text)
+    return str(path)
+
+
+# -- closed form ------------------------------------------------------------------------
+def test_star_measure_of_the_cube():
+    """cube.fe: a corner is on 6 triangles of area 1/4 (star 3/2), a face
+    centre on 4 (star 1): a third of each."""
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    a = star_measure(s.surface.evaluate())
+    corner = np.all(np.isin(s.surface.X, (0.0, 1.0)), axis=1)
+    assert corner.sum() == 8
+    assert np.allclose(a[corner], 0.5, rtol=0, atol=ROUNDOFF)
+    assert np.allclose(a[~corner], 1 / 3, rtol=0, atol=ROUNDOFF)
+    m = Mobility(s.surface.evaluate(), area_normalization=True)
+    (v,) = m.apply([np.ones((s.surface.nv, 3))])
+    assert np.allclose(v[corner], 2.0) and np.allclose(v[~corner], 3.0)
+    assert Mobility(s.surface.evaluate()).identity
+
+
+def test_star_measure_of_a_string():
+    """The string model: half the length of the edges at each vertex."""
+    s = Session.load(example("popstr.fe"), out=io.StringIO())
+    t = s.surface.evaluate()
+    a = star_measure(t)
+    assert np.isclose(a[4], 0.5 * 4 * np.sqrt(0.5), rtol=ROUNDOFF)
+    assert np.allclose(a[:4], 0.5 * np.sqrt(0.5), rtol=ROUNDOFF)
+
+
+# -- area normalization against REF ----------------------------------------------------------
+@pytest.mark.parametrize("name,cmds", [
+    ("cube", "area_normalization\nm 0.1\ng 3"),
+    ("cube", "area_normalization\ng 10"),
+    ("mound", "area_normalization\nr\ng 10"),            # constraint, volume, gravity
+    ("catbody", "area_normalization\nr\ng 10"),          # boundaries, volume off target
+    ("quad", "area_normalization\nr\ng 10"),
+    ("cube", "area_normalization\nU\nr\ng 10"),          # CG in the metric
+    ("mound", "area_normalization\nU\nr\ng 10"),
+    ("catbody", "area_normalization\nU\nr\ng 10"),       # CG restart after 10 restorings
+    ("cube", "area_normalization\nU\nribiere off\nr\ng 6"),
+])
+def test_area_normalization_matches_reference(evolver, name, cmds, tmp_path):
+    compare_g(evolver, example(name + ".fe"), cmds, tmp_path)
+
+
+def test_area_normalization_string_model(evolver, tmp_path):
+    """100grain.fe's string network on the torus (area_normalization and a
+    fixed scale from its top section), and a constrained string drop."""
+    compare_g(evolver, grain(tmp_path), "g 10", tmp_path)
+    compare_g(evolver, example("slidestr.fe"), "area_normalization\nr\ng 10", tmp_path,
+              tol=1e-11)
