@@ -16,9 +16,10 @@ import numpy as np
 
 from ..constraints import (displace, project_tangent, project_to_constraints, release_one_sided,
                        restore_state, state)
+from ..errors import UnsupportedError
 from . import gradient as GR
 from . import optparams as OP
-from .mobility import Mobility
+from .mobility import Mobility, normal_project
 
 
 def _solve(A, d):
@@ -63,6 +64,8 @@ class IterateSettings:
     check_increase: bool = False
     hessian_normal: bool = True        # ``hessian``: normal motion only
     area_normalization: bool = False   # mobility 1 / (star area / 3) (evolve.mobility)
+    normal_motion: bool = False        # velocity projected on the vertex normal
+    runge_kutta: bool = False          # a fixed-scale step by RK4
 
     @classmethod
     def from_mappings(cls, settings: Mapping, toggles: Mapping) -> "IterateSettings":
@@ -77,7 +80,9 @@ class IterateSettings:
                    ribiere=bool(toggles.get("ribiere", 1)),
                    check_increase=bool(toggles.get("check_increase", 0)),
                    hessian_normal=bool(toggles.get("hessian_normal", 1)),
-                   area_normalization=bool(toggles.get("area_normalization", 0)))
+                   area_normalization=bool(toggles.get("area_normalization", 0)),
+                   normal_motion=bool(toggles.get("normal_motion", 0)),
+                   runge_kutta=bool(toggles.get("runge_kutta", 0)))
 
 
 @dataclass
@@ -165,6 +170,23 @@ class _Constraints:
         for q in self.quantities:
             gs.append(GR.quantity_gradient(t, q))
         return gs
+
+
+def _refuse_normal_motion(s, cons):
+    """The cases of ``normal_motion`` whose REF numbers were not reproduced.
+
+    Equal to REF: cube.fe (with its volume off target too), cat.fe, quad.fe
+    (``r; g 10``, ``r; U; g 10``).  Not: a fixed volume with fixed vertices
+    (catbody.fe) or with level-set constraints (mound.fe), where REF's
+    second step moves mirror-image vertices differently.
+    """
+    if s.string:
+        raise UnsupportedError("normal_motion in the string model",
+                               "the string model's vertex normal is not implemented")
+    if len(cons) and (bool(s.vattr["fixed"].any()) or bool(s.vcon)
+                      or bool((s.vattr.get("boundary", np.zeros(1)) != 0).any())):
+        raise UnsupportedError("normal_motion with fixed volumes or quantities and fixed or "
+                               "constrained vertices", "REF's normal there was not reproduced")
 
 
 class Iterator:
@@ -392,6 +414,8 @@ class Iterator:
         f_raw = f
         s._one_sided_released = None
         targets = cons.targets(s)
+        if settings.normal_motion:
+            _refuse_normal_motion(s, cons)
         mob = self._mobility(t0)
         for _pass in range(2):
             (f_tan,) = self._project_tangent([f_raw])
@@ -412,6 +436,10 @@ class Iterator:
             release_one_sided(s, f_raw - sum(l * g for l, g in zip(lam, gs)))
             if not getattr(s, "_one_sided_released", None):
                 break
+        if settings.normal_motion:
+            # (REF projects before CG, whose sums see the projected velocity,
+            # and the CG direction again: cube.fe and cat.fe `r; U; g 10`)
+            vel = normal_project(t0, vel)
         # conjugate gradient
         if settings.conj_grad:
             # Fletcher-Reeves: gamma = S/S_old with S = sum vel.f; Polak-Ribiere
@@ -444,6 +472,8 @@ class Iterator:
                     gamma = 0.0
             h = vel.copy() if self.cg_history is None else vel + gamma * self.cg_history
             h[~cgv] = vel[~cgv]
+            if settings.normal_motion:
+                h = normal_project(t0, h)
             self.cg_history = h
             self.cg_q = graw
             self.cg_S_old = S
@@ -484,6 +514,11 @@ class Iterator:
                 scale, E0, s1 = self._line_search(E, settings.scale, smax)
             except _Infinite:
                 return self._undo(X0, t0, settings.scale, lam, trial_msgs, motion)
+        if fixed_scale and settings.runge_kutta:
+            if len(cons):
+                raise UnsupportedError("runge_kutta with fixed volumes or quantities",
+                                       "REF's stages there were not reproduced")
+            vel = self._runge_kutta(X0, vel, settings.scale_scale * scale, cons, mobile)
         # actual move (REF prints what the trial moves reported first)
         report = trial_msgs
         self._carry = (us, A)
@@ -533,6 +568,41 @@ class Iterator:
         return StepResult(t.energy, t.total_area, scale,
                           b.lagrange.copy() if b.n else np.zeros(0), qp, True,
                           warnings=report + warnings, totals=t, motion=motion)
+
+    def _plain_velocity(self, t, cons, mobile):
+        """The velocity (nv, 3) at the evaluation ``t`` without CG: the
+        force held at fixed vertices, projected on the constraints, converted
+        by the mobility, less the fixed values' multiples, normal-projected
+        with ``normal_motion``."""
+        f = -GR.energy_gradient(t)
+        f[~mobile] = 0.0
+        (f,) = self._mobility(t).apply(self._project_tangent([f]))
+        if len(cons):
+            gs, us, A = self._constrained_dirs(t, cons, mobile)
+            lam = _solve(A, np.array([float(np.sum(f * g)) for g in gs]))
+            f = f - sum(l * u for l, u in zip(lam, us))
+        if self.settings.normal_motion:
+            f = normal_project(t, f)
+        return f
+
+    def _runge_kutta(self, X0, k1, h, cons, mobile):
+        """The velocity of a fixed-scale Runge-Kutta step ``h`` from the
+        state ``X0`` with first stage ``k1`` (iterate.htm; the toggle acts
+        only with a fixed scale, toggle.htm RUNGE_KUTTA).
+
+        The stages of RK4 are taken at X0 + h/2 k1, X0 + h/2 k2 and
+        X0 + h k3; REF 2.70 then moves by its last stage k4, not by
+        (k1 + 2 k2 + 2 k3 + k4) / 6: quad.fe ``r; m 0.1; g 1`` gives
+        4.41826089959718 with k4, 4.40845090908222 with the RK4 average
+        (measured; docs/differences.md).
+        """
+        s = self.surface
+        ks = [k1]
+        for c in (0.5, 0.5, 1.0):
+            displace(s, X0, c * h * ks[-1])
+            ks.append(self._plain_velocity(s.evaluate(), cons, mobile))
+        restore_state(s, X0)
+        return ks[3]
 
     def _undo(self, X0, t0, scale, lam, report, motion=None):
         """A motion to an infinite or NaN energy, or a constraint projection

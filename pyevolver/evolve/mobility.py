@@ -69,3 +69,27 @@ class Mobility:
         if self.diag is None:
             return vecs
         return [v * self.diag[:, None] for v in vecs]
+
+
+def vertex_normals(t: Any) -> np.ndarray:
+    """Per-vertex normals (nv, 3) of ``normal_motion``: the gradient of the
+    volume, Σ over the vertex's facets of N/6 with N the facet's normal
+    (x1 - x0) × (x2 - x0) (toggle.htm NORMAL_MOTION: "surface normal,
+    defined as the volume gradient")."""
+    s = t.surface
+    N = np.repeat(t.facet_N2 / 6.0, 3, axis=0)
+    out = np.zeros((s.nv, 3))
+    for k in range(3):
+        out[:, k] = np.bincount(s.F.ravel(), weights=N[:, k], minlength=s.nv)
+    return out
+
+
+def normal_project(t: Any, vel: np.ndarray) -> np.ndarray:
+    """``vel`` (nv, 3) projected per vertex on the line of its normal
+    (:func:`vertex_normals`); zero where the normal vanishes."""
+    n = vertex_normals(t)
+    nn = np.einsum("ij,ij->i", n, n)
+    c = np.einsum("ij,ij->i", vel, n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.where(nn > 0, c / np.where(nn > 0, nn, 1.0), 0.0)
+    return n * k[:, None]

@@ -100,3 +100,53 @@ def test_area_normalization_string_model(evolver, tmp_path):
     compare_g(evolver, grain(tmp_path), "g 10", tmp_path)
     compare_g(evolver, example("slidestr.fe"), "area_normalization\nr\ng 10", tmp_path,
               tol=1e-11)
+
+
+# -- normal_motion --------------------------------------------------------------------------
+@pytest.mark.parametrize("name,cmds", [
+    ("cube", "normal_motion\nr\ng 10"),
+    ("cube", "normal_motion\nr\nset body target 1.3\ng 4"),    # restoring a volume
+    ("cat", "normal_motion\nr\nU\ng 10"),              # CG: projected before and after
+])
+def test_normal_motion_matches_reference(evolver, name, cmds, tmp_path):
+    compare_g(evolver, example(name + ".fe"), cmds, tmp_path)
+
+
+def test_normal_motion_refused_where_not_reproduced():
+    from pyevolver.errors import UnsupportedError
+    s = Session.load(example("catbody.fe"), out=io.StringIO())
+    s.run("normal_motion")
+    with pytest.raises(UnsupportedError, match="normal_motion with fixed volumes"):
+        s.g(1)
+
+
+def test_normal_motion_moves_along_the_normal():
+    """Closed form: on cube.fe a face centre's velocity is along its face
+    normal, a corner's along the diagonal."""
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.run("normal_motion; r; m 0.1; g 1")
+    _, _, X, V = s.__dict__["_last_motion"]       # start positions, velocities
+    corner = np.all(np.isin(X, (0.0, 1.0)), axis=1)
+    assert corner.sum() == 8
+    n = np.sign(X[corner] - 0.5)
+    u = V[corner] / np.linalg.norm(V[corner], axis=1)[:, None]
+    assert np.allclose(np.abs(np.einsum("ij,ij->i", u, n)), np.sqrt(3), rtol=0, atol=1e-12)
+
+
+# -- runge_kutta ------------------------------------------------------------------------------
+@pytest.mark.parametrize("name,cmds", [
+    ("quad", "runge_kutta\nr\nm 0.1\ng 5"),
+    ("cat", "runge_kutta\nr\nm 0.05\ng 5"),
+    ("quad", "area_normalization\nrunge_kutta\nr\nm 0.01\ng 3"),
+    ("cube", "runge_kutta\ng 3"),                     # optimizing scale: no effect (REF)
+])
+def test_runge_kutta_matches_reference(evolver, name, cmds, tmp_path):
+    compare_g(evolver, example(name + ".fe"), cmds, tmp_path)
+
+
+def test_runge_kutta_refused_with_fixed_volumes():
+    from pyevolver.errors import UnsupportedError
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.run("runge_kutta; m 0.1")
+    with pytest.raises(UnsupportedError, match="runge_kutta with fixed volumes"):
+        s.g(1)
