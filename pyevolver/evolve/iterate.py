@@ -19,7 +19,7 @@ from ..constraints import (displace, project_tangent, project_to_constraints, re
 from ..errors import UnsupportedError
 from . import gradient as GR
 from . import optparams as OP
-from .mobility import Mobility, normal_project
+from .mobility import Mobility, diffuse, normal_project
 
 
 def _solve(A, d):
@@ -66,6 +66,8 @@ class IterateSettings:
     area_normalization: bool = False   # mobility 1 / (star area / 3) (evolve.mobility)
     normal_motion: bool = False        # velocity projected on the vertex normal
     runge_kutta: bool = False          # a fixed-scale step by RK4
+    diffusion: bool = False            # gas diffusion between bodies
+    diffusion_coeff: float = 0.0
 
     @classmethod
     def from_mappings(cls, settings: Mapping, toggles: Mapping) -> "IterateSettings":
@@ -82,7 +84,9 @@ class IterateSettings:
                    hessian_normal=bool(toggles.get("hessian_normal", 1)),
                    area_normalization=bool(toggles.get("area_normalization", 0)),
                    normal_motion=bool(toggles.get("normal_motion", 0)),
-                   runge_kutta=bool(toggles.get("runge_kutta", 0)))
+                   runge_kutta=bool(toggles.get("runge_kutta", 0)),
+                   diffusion=bool(toggles.get("diffusion", 0)),
+                   diffusion_coeff=float(settings.get("diffusion_coeff", 0.0)))
 
 
 @dataclass
@@ -380,6 +384,8 @@ class Iterator:
         mobile = self._mobile()
         cons = _Constraints(s)
         t0 = s.evaluate()
+        if settings.diffusion and s.bodies.n:
+            self._diffuse(t0, settings)
         f = -GR.energy_gradient(t0)
         # optimizing parameters: moved by -scale * pscale * dE/dp with the vertices
         popt = bool(OP.names(s))
@@ -568,6 +574,18 @@ class Iterator:
         return StepResult(t.energy, t.total_area, scale,
                           b.lagrange.copy() if b.n else np.zeros(0), qp, True,
                           warnings=report + warnings, totals=t, motion=motion)
+
+    def _diffuse(self, t, settings):
+        """Gas diffusion at the start of a step: the fixed target volumes
+        move by :func:`~pyevolver.evolve.mobility.diffuse`."""
+        s = t.surface
+        if s.string:
+            raise UnsupportedError("diffusion in the string model",
+                                   "edge_diffusion is not implemented")
+        b = s.bodies
+        d = diffuse(t, settings.diffusion_coeff, settings.scale)
+        ok = ~np.isnan(b.target)
+        b.target[ok] = b.target[ok] + d[ok]
 
     def _plain_velocity(self, t, cons, mobile):
         """The velocity (nv, 3) at the evaluation ``t`` without CG: the

@@ -93,3 +93,26 @@ def normal_project(t: Any, vel: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         k = np.where(nn > 0, c / np.where(nn > 0, nn, 1.0), 0.0)
     return n * k[:, None]
+
+
+def diffuse(t: Any, coeff: float, scale: float) -> np.ndarray:
+    """The target volume changes (nb,) of one ``g`` step's gas diffusion.
+
+    iterate.htm, "Diffusion": across each facet the amount
+    ``scale * diffusion_constant * facet_area * pressure_difference`` goes
+    from the body of higher pressure to the other (the outside has pressure
+    0); the facet attribute ``facet_diffusion``, when defined, replaces the
+    constant facet by facet.  The pressures are the bodies' current Lagrange
+    multipliers (those of the last step: REF changes nothing on the first
+    ``g`` of a file), the scale the current one (measured on a two-cube
+    file: after ``g 2`` the targets moved by 0.1 * 0.181284 * A * p with the
+    first step's scale and pressures and the facet areas after it).
+    """
+    s = t.surface
+    b = s.bodies
+    p = np.where(np.isnan(b.target), np.nan_to_num(b.pressure), b.lagrange)
+    B = b.facet_matrix.tocsr()
+    dp = B.T @ p                                    # (nf,) p(+ side) - p(- side)
+    k = s.extra.get(("facet", "facet_diffusion"))
+    w = (np.full(s.nf, coeff) if k is None else np.asarray(k, float)) * t.facet_area * dp
+    return -scale * (B @ w)

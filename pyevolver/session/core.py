@@ -64,7 +64,7 @@ def _deferred_sigint():
 
 # motion options that change what g does; refused rather than ignored
 UNSUPPORTED_MOTION = (
-                      "approximate_curvature", "diffusion", "autopop", "jiggle")
+                      "approximate_curvature", "autopop", "jiggle")
 
 
 class Session(SessionAPI):
