@@ -19,7 +19,7 @@ from ..constraints import (displace, project_tangent, project_to_constraints, re
 from ..errors import UnsupportedError
 from . import gradient as GR
 from . import optparams as OP
-from .mobility import Mobility, diffuse, normal_project
+from .mobility import Mobility, diffuse, jiggle_vertices, normal_project
 
 
 def _solve(A, d):
@@ -68,6 +68,8 @@ class IterateSettings:
     runge_kutta: bool = False          # a fixed-scale step by RK4
     diffusion: bool = False            # gas diffusion between bodies
     diffusion_coeff: float = 0.0
+    jiggle: bool = False               # a random perturbation after each step
+    jiggle_temperature: float = 0.05
 
     @classmethod
     def from_mappings(cls, settings: Mapping, toggles: Mapping) -> "IterateSettings":
@@ -86,7 +88,9 @@ class IterateSettings:
                    normal_motion=bool(toggles.get("normal_motion", 0)),
                    runge_kutta=bool(toggles.get("runge_kutta", 0)),
                    diffusion=bool(toggles.get("diffusion", 0)),
-                   diffusion_coeff=float(settings.get("diffusion_coeff", 0.0)))
+                   diffusion_coeff=float(settings.get("diffusion_coeff", 0.0)),
+                   jiggle=bool(toggles.get("jiggle", 0)),
+                   jiggle_temperature=float(settings.get("jiggle_temperature", 0.05)))
 
 
 @dataclass
@@ -218,6 +222,7 @@ class Iterator:
         self.pressures_valid = False
         self.newton_delta: float | None = None   # the damping the last `newton` run ended with
         self._diverged = False        # a constraint projection of the last move diverged
+        self.rng = np.random.default_rng(1)      # the jiggle toggle's (the session's)
 
     # -- helpers ----------------------------------------------------------------
     @property
@@ -556,6 +561,10 @@ class Iterator:
             self.cg_history = None
             if not math.isfinite(t.energy) or self._diverged or not np.all(np.isfinite(s.X)):
                 return self._undo(X0, t0, scale, lam, report, motion)
+        if settings.jiggle:
+            # iterate.htm: after the constraints are enforced "if jiggling is
+            # on, the surface is randomly perturbed" (then projected again)
+            self._project(jiggle_vertices(s, settings.jiggle_temperature, self.rng))
         # reported pressures: P = -lambda
         b = s.bodies
         qp = {}

@@ -116,3 +116,24 @@ def diffuse(t: Any, coeff: float, scale: float) -> np.ndarray:
     k = s.extra.get(("facet", "facet_diffusion"))
     w = (np.full(s.nf, coeff) if k is None else np.asarray(k, float)) * t.facet_area * dp
     return -scale * (B @ w)
+
+
+def jiggle_vertices(s: Any, temperature: float, rng: np.random.Generator) -> np.ndarray:
+    """Jiggle a surface in place (the ``jiggle`` toggle's perturbation of
+    each ``g`` step): every vertex not FIXED nor on a parametric boundary
+    moves by a Gaussian displacement of deviation ``temperature`` times the
+    mean edge length (single.htm, ``j``), in the first ``sdim`` coordinates.
+
+    Returns the indices (m,) of the moved vertices (the caller projects
+    them to their constraints).  Random, so not REF's numbers: seeded by
+    the caller's generator.
+    """
+    sigma = temperature * (float(np.mean(s.evaluate().edge_length)) if s.ne else 0.0)
+    move = ~s.vattr["fixed"]
+    if "boundary" in s.vattr:
+        move &= s.vattr["boundary"] == 0
+    idx = np.nonzero(move)[0]
+    X = s.X.copy()
+    X[idx, :s.sdim] += sigma * rng.standard_normal((len(idx), s.sdim))
+    s.X = X
+    return idx

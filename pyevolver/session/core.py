@@ -63,8 +63,7 @@ def _deferred_sigint():
             signal.signal(signal.SIGINT, old)
 
 # motion options that change what g does; refused rather than ignored
-UNSUPPORTED_MOTION = (
-                      "approximate_curvature", "autopop", "jiggle")
+UNSUPPORTED_MOTION = ("approximate_curvature", "autopop")
 
 
 class Session(SessionAPI):
@@ -466,6 +465,7 @@ class Session(SessionAPI):
         surface (created on first use), its settings those of the session."""
         if self._iterator is None:
             self._iterator = Iterator(lambda: self.surface)
+        self._iterator.rng = self.rng           # jiggle: the generator of `j` and `random`
         self._iterator.settings = IterateSettings.from_mappings(self.settings, self.toggles)
         return self._iterator
 

@@ -182,3 +182,30 @@ def test_diffusion_keyword_and_dumps(evolver, tmp_path):
         for a, b, c in zip(want, got, ref):
             assert _rel(a[2], b[2]) <= STEPS and _rel(a[2], c[2]) <= STEPS, (a, b, c)
         assert len(got) == len(ref) == 2
+
+
+# -- jiggle -----------------------------------------------------------------------------------
+def test_jiggle_toggle_statistics():
+    """With ``jiggle`` on and a zero scale, a g step moves each free vertex
+    by a Gaussian of deviation jiggle_temperature × mean edge length
+    (single.htm, j); FIXED vertices stay; seeded, so repeatable."""
+    def run(seed):
+        s = Session.load(example("quad.fe"), out=io.StringIO())
+        s.run(f"r; r; r; m 0; jiggle on; jiggle_temperature := 0.1; random_seed := {seed}")
+        L = float(np.mean(s.surface.evaluate().edge_length))
+        X0 = s.surface.X.copy()
+        s.run("g 1")
+        return (s.surface.X - X0) / L, s.surface.vattr["fixed"]
+    d, fixed = run(7)
+    free = d[~fixed]
+    assert np.all(d[fixed] == 0.0)
+    assert len(free) > 200
+    assert abs(free.std() / 0.1 - 1) < 0.1 and abs(free.mean()) < 0.02
+    assert np.array_equal(run(7)[0], d) and not np.array_equal(run(8)[0], d)
+
+
+def test_jiggle_off_changes_nothing():
+    a = Session.load(example("cube.fe"), out=io.StringIO())
+    b = Session.load(example("cube.fe"), out=io.StringIO())
+    b.run("jiggle on; jiggle off")
+    assert [r.energy for r in a.g(5)] == [r.energy for r in b.g(5)]
