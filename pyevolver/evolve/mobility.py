@@ -23,6 +23,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 
 def star_measure(t: Any) -> np.ndarray:
@@ -41,6 +43,23 @@ def star_measure(t: Any) -> np.ndarray:
     return np.bincount(s.F.ravel(), weights=A, minlength=s.nv) / 3.0
 
 
+def mass_matrix(t: Any) -> sp.csr_matrix:
+    """The mass matrix (nv, nv) of linear interpolation: ∫ φ_i φ_j over the
+    facets, A/12 (2 on the diagonal, 1 off it) per triangle of area A; over
+    the edges in the string model, L/6 (2, 1) per edge of length L
+    (model.htm, "Approximate polyhedral curvature")."""
+    s = t.surface
+    if s.string or s.nf == 0 and s.ne:
+        V, w = s.E, t.edge_length / 6.0
+    else:
+        V, w = s.F, t.facet_area / 12.0
+    k = V.shape[1]
+    rows = np.repeat(V, k, axis=1).ravel()
+    cols = np.tile(V, (1, k)).ravel()
+    vals = (w[:, None] * (np.ones((k, k)) + np.eye(k)).ravel()[None, :]).ravel()
+    return sp.csr_matrix((vals, (rows, cols)), shape=(s.nv, s.nv))
+
+
 class Mobility:
     """The force-to-velocity conversion of one ``g`` step.
 
@@ -52,8 +71,22 @@ class Mobility:
         M = diag(1 / star measure).
     """
 
-    def __init__(self, t: Any, area_normalization: bool = False):
+    def __init__(self, t: Any, area_normalization: bool = False,
+                 approximate_curvature: bool = False, mobile: np.ndarray | None = None):
         self.diag: np.ndarray | None = None
+        self.lu: Any = None
+        if approximate_curvature:
+            S = mass_matrix(t)
+            keep = np.ones(S.shape[0], bool) if mobile is None else np.asarray(mobile, bool)
+            bnd = t.surface.vattr.get("boundary")
+            if bnd is not None:
+                # REF moves no vertex of a parametric boundary (cat.fe with its
+                # rings free: the fixed rings' numbers)
+                keep = keep & (bnd == 0)
+            self.keep = np.nonzero(keep)[0]
+            if len(self.keep):
+                self.lu = spla.splu(S[self.keep][:, self.keep].tocsc())
+            return
         if area_normalization:
             a = star_measure(t)
             with np.errstate(divide="ignore"):
@@ -62,10 +95,17 @@ class Mobility:
     @property
     def identity(self) -> bool:
         """True for unit mobility."""
-        return self.diag is None
+        return self.diag is None and self.lu is None
 
     def apply(self, vecs: list[np.ndarray]) -> list[np.ndarray]:
         """``M v`` for each (nv, dim) array of ``vecs``."""
+        if self.lu is not None:
+            out = []
+            for v in vecs:
+                w = np.zeros_like(v)
+                w[self.keep] = self.lu.solve(np.ascontiguousarray(v[self.keep]))
+                out.append(w)
+            return out
         if self.diag is None:
             return vecs
         return [v * self.diag[:, None] for v in vecs]

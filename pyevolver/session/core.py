@@ -63,7 +63,7 @@ def _deferred_sigint():
             signal.signal(signal.SIGINT, old)
 
 # motion options that change what g does; refused rather than ignored
-UNSUPPORTED_MOTION = ("approximate_curvature", "autopop")
+UNSUPPORTED_MOTION = ("autopop",)
 
 
 class Session(SessionAPI):

@@ -211,3 +211,45 @@ def test_jiggle_off_changes_nothing():
     b = Session.load(example("cube.fe"), out=io.StringIO())
     b.run("jiggle on; jiggle off")
     assert [r.energy for r in a.g(5)] == [r.energy for r in b.g(5)]
+
+
+# -- approximate curvature --------------------------------------------------------------------
+def test_mass_matrix_closed_form():
+    """∫ φ_i φ_j of linear interpolation: its entries sum to the area (the
+    length in the string model), and a triangle's rows are A/12 (2, 1, 1)."""
+    from pyevolver.evolve.mobility import mass_matrix
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    t = s.surface.evaluate()
+    M = mass_matrix(t)
+    assert abs(M.sum() - 6.0) < ROUNDOFF
+    assert np.allclose(M.diagonal(), star_measure(t) / 2, rtol=0, atol=ROUNDOFF)
+    g = Session.load(example("popstr.fe"), out=io.StringIO()).surface.evaluate()
+    assert abs(mass_matrix(g).sum() - g.total_length) < ROUNDOFF
+
+
+@pytest.mark.parametrize("name,cmds,tol", [
+    ("quad", "approx_curv\nr\nm 0.01\ng 3", STEPS),
+    ("quad", "approx_curv\nr\ng 5", STEPS),
+    ("cat", "approx_curv\nr\nU\ng 5", STEPS),
+])
+def test_approximate_curvature_matches_reference(evolver, name, cmds, tol, tmp_path):
+    compare_g(evolver, example(name + ".fe"), cmds, tmp_path, tol)
+
+
+def test_approximate_curvature_string_and_free_boundary(evolver, tmp_path):
+    """100grain.fe's network (area normalization off), and cat.fe with its
+    rings free to slide: REF moves no boundary vertex (equal within 1e-10;
+    REF's ring vertices are recomputed from their parameters)."""
+    compare_g(evolver, grain(tmp_path), "area_normalization off\napprox_curv\ng 3", tmp_path)
+    text = open(example("cat.fe")).read().replace(" fixed", "")
+    path = tmp_path / "catfree.fe"
+    path.write_text(text)
+    compare_g(evolver, str(path), "approx_curv\nr\nm 0.01\ng 3", tmp_path, 1e-10)
+
+
+def test_approximate_curvature_refusals():
+    from pyevolver.errors import UnsupportedError
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.run("approx_curv")
+    with pytest.raises(UnsupportedError, match="approx_curv with fixed volumes"):
+        s.g(1)
