@@ -237,7 +237,7 @@ class Iterator:
         self.pressures_valid = False
         self.newton_delta: float | None = None   # the damping the last `newton` run ended with
         self._diverged = False        # a constraint projection of the last move diverged
-        self.rng = np.random.default_rng(1)      # the jiggle toggle's (the session's)
+        self.rng = np.random.default_rng(1)      # the jiggle toggle's (the caller's may replace it)
 
     # -- helpers ----------------------------------------------------------------
     @property
@@ -413,6 +413,10 @@ class Iterator:
         if popt:
             if len(cons):
                 OP.refuse(s, "fixed volumes or FIXED quantities")
+            for opt in ("area_normalization", "normal_motion", "runge_kutta",
+                        "approximate_curvature"):
+                if getattr(settings, opt):      # the parameters' mobility is not measured
+                    OP.refuse(s, opt)
             self._pbase: np.ndarray | None = OP.values(s)
             # in the scaled parameter q = p / pscale the force is
             # -pscale dE/dp, moved like a vertex coordinate (with conj_grad
