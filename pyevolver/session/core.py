@@ -485,8 +485,8 @@ class Session(SessionAPI):
         """
         for name in UNSUPPORTED_MOTION:
             if self.toggles.get(name):
-                raise UnsupportedError(f"g with {name} on", "only the plain gradient motion "
-                                       "is implemented")
+                raise UnsupportedError(f"g with {name} on", "popping during g "
+                                       "is not implemented")
         if self.toggles.get("_effective_area_motion"):
             # REF's effective_area command also changes the motion (the top-section
             # keyword EFFECTIVE_AREA changes only the squared curvature)

@@ -80,15 +80,16 @@ def test_star_measure_of_a_string():
 
 # -- area normalization against REF ----------------------------------------------------------
 @pytest.mark.parametrize("name,cmds", [
-    ("cube", "area_normalization\nm 0.1\ng 3"),
-    ("cube", "area_normalization\ng 10"),
-    ("mound", "area_normalization\nr\ng 10"),            # constraint, volume, gravity
-    ("catbody", "area_normalization\nr\ng 10"),          # boundaries, volume off target
-    ("quad", "area_normalization\nr\ng 10"),
-    ("cube", "area_normalization\nU\nr\ng 10"),          # CG in the metric
-    ("mound", "area_normalization\nU\nr\ng 10"),
     ("catbody", "area_normalization\nU\nr\ng 10"),       # CG restart after 10 restorings
-    ("cube", "area_normalization\nU\nribiere off\nr\ng 6"),
+    ("mound", "area_normalization\nr\ng 6"),             # constraint, volume, gravity
+    pytest.param("cube", "area_normalization\nm 0.1\ng 3", marks=pytest.mark.slow),
+    pytest.param("cube", "area_normalization\ng 10", marks=pytest.mark.slow),
+    pytest.param("catbody", "area_normalization\nr\ng 10", marks=pytest.mark.slow),
+    pytest.param("quad", "area_normalization\nr\ng 10", marks=pytest.mark.slow),
+    pytest.param("cube", "area_normalization\nU\nr\ng 10", marks=pytest.mark.slow),
+    pytest.param("mound", "area_normalization\nU\nr\ng 10", marks=pytest.mark.slow),
+    pytest.param("cube", "area_normalization\nU\nribiere off\nr\ng 6",
+                 marks=pytest.mark.slow),
 ])
 def test_area_normalization_matches_reference(evolver, name, cmds, tmp_path):
     compare_g(evolver, example(name + ".fe"), cmds, tmp_path)
@@ -96,7 +97,13 @@ def test_area_normalization_matches_reference(evolver, name, cmds, tmp_path):
 
 def test_area_normalization_string_model(evolver, tmp_path):
     """100grain.fe's string network on the torus (area_normalization and a
-    fixed scale from its top section), and a constrained string drop."""
+    fixed scale from its top section)."""
+    compare_g(evolver, grain(tmp_path), "g 3", tmp_path)
+
+
+@pytest.mark.slow
+def test_area_normalization_string_model_long(evolver, tmp_path):
+    """100grain.fe ``g 10`` and a constrained string drop."""
     compare_g(evolver, grain(tmp_path), "g 10", tmp_path)
     compare_g(evolver, example("slidestr.fe"), "area_normalization\nr\ng 10", tmp_path,
               tol=1e-11)
@@ -104,9 +111,10 @@ def test_area_normalization_string_model(evolver, tmp_path):
 
 # -- normal_motion --------------------------------------------------------------------------
 @pytest.mark.parametrize("name,cmds", [
-    ("cube", "normal_motion\nr\ng 10"),
-    ("cube", "normal_motion\nr\nset body target 1.3\ng 4"),    # restoring a volume
-    ("cat", "normal_motion\nr\nU\ng 10"),              # CG: projected before and after
+    ("cat", "normal_motion\nr\nU\ng 6"),               # CG: projected before and after
+    pytest.param("cube", "normal_motion\nr\ng 10", marks=pytest.mark.slow),
+    pytest.param("cube", "normal_motion\nr\nset body target 1.3\ng 4",   # restoring
+                 marks=pytest.mark.slow),
 ])
 def test_normal_motion_matches_reference(evolver, name, cmds, tmp_path):
     compare_g(evolver, example(name + ".fe"), cmds, tmp_path)
@@ -135,10 +143,10 @@ def test_normal_motion_moves_along_the_normal():
 
 # -- runge_kutta ------------------------------------------------------------------------------
 @pytest.mark.parametrize("name,cmds", [
-    ("quad", "runge_kutta\nr\nm 0.1\ng 5"),
-    ("cat", "runge_kutta\nr\nm 0.05\ng 5"),
     ("quad", "area_normalization\nrunge_kutta\nr\nm 0.01\ng 3"),
-    ("cube", "runge_kutta\ng 3"),                     # optimizing scale: no effect (REF)
+    pytest.param("quad", "runge_kutta\nr\nm 0.1\ng 5", marks=pytest.mark.slow),
+    pytest.param("cat", "runge_kutta\nr\nm 0.05\ng 5", marks=pytest.mark.slow),
+    pytest.param("cube", "runge_kutta\ng 3", marks=pytest.mark.slow),   # optimizing: no effect
 ])
 def test_runge_kutta_matches_reference(evolver, name, cmds, tmp_path):
     compare_g(evolver, example(name + ".fe"), cmds, tmp_path)
@@ -157,14 +165,17 @@ DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
 
 
 @pytest.mark.parametrize("name,cmds", [
-    ("diffusion_cubes.fe", "g 3\nv"),
-    ("diffusion_cubes.fe", "m 0.05\ng 3\ndiffusion_coeff := 0.3\ng 2\ndiffusion off\ng 2"),
     ("diffusion_cubes_attr.fe", "m 0.05\ng 3\ndiffusion_coeff := 0.3\ng 2"),   # facet_diffusion
+    pytest.param("diffusion_cubes.fe", "g 3\nv", marks=pytest.mark.slow),
+    pytest.param("diffusion_cubes.fe",
+                 "m 0.05\ng 3\ndiffusion_coeff := 0.3\ng 2\ndiffusion off\ng 2",
+                 marks=pytest.mark.slow),
 ])
 def test_diffusion_matches_reference(evolver, name, cmds, tmp_path):
     compare_g(evolver, os.path.join(DATA, name), cmds, tmp_path)
 
 
+@pytest.mark.slow
 def test_diffusion_keyword_and_dumps(evolver, tmp_path):
     """DIFFUSION sets diffusion_coeff and turns the toggle on; REF's dump
     after ``g 2`` goes on in pyevolver as in REF, and so does ours in REF."""
@@ -228,14 +239,15 @@ def test_mass_matrix_closed_form():
 
 
 @pytest.mark.parametrize("name,cmds,tol", [
-    ("quad", "approx_curv\nr\nm 0.01\ng 3", STEPS),
-    ("quad", "approx_curv\nr\ng 5", STEPS),
-    ("cat", "approx_curv\nr\nU\ng 5", STEPS),
+    ("cat", "approx_curv\nr\nU\ng 4", STEPS),
+    pytest.param("quad", "approx_curv\nr\nm 0.01\ng 3", STEPS, marks=pytest.mark.slow),
+    pytest.param("quad", "approx_curv\nr\ng 5", STEPS, marks=pytest.mark.slow),
 ])
 def test_approximate_curvature_matches_reference(evolver, name, cmds, tol, tmp_path):
     compare_g(evolver, example(name + ".fe"), cmds, tmp_path, tol)
 
 
+@pytest.mark.slow
 def test_approximate_curvature_string_and_free_boundary(evolver, tmp_path):
     """100grain.fe's network (area normalization off), and cat.fe with its
     rings free to slide: REF moves no boundary vertex (equal within 1e-10;
