@@ -145,6 +145,9 @@ def scene_settings(session: SessionLike, scene):
             session.settings[k] = scene.values[k]
     if "total_time" in scene.values:        # TOTAL_TIME: a dump goes on with its clock
         session.total_time = float(scene.values["total_time"])
+    if "diffusion" in scene.values:            # DIFFUSION: the constant, and the toggle on
+        session.settings["diffusion_coeff"] = float(scene.values["diffusion"])
+        session.toggles["diffusion"] = 1
     if "scale" in scene.values:
         session.settings["scale"] = scene.values["scale"]
         if scene.values.get("scale_fixed"):

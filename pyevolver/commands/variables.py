@@ -29,7 +29,7 @@ DEFAULTS = {
     "constraint_tolerance": 1e-12, "jiggle_temperature": 0.05, "random_seed": 1.0,
     "autochop_length": 0.0, "integral_order_1d": 3.0, "integral_order_2d": 6.0,
     "hessian_epsilon": 1e-10, "sq_mean_mix": 0.0,
-    "last_eigenvalue": 0.0, "linear_metric_mix": 0.5,
+    "last_eigenvalue": 0.0, "linear_metric_mix": 0.5, "diffusion_coeff": 0.0,
 }
 
 

@@ -221,6 +221,8 @@ class _FeWriter:
             self.w(f"SQUARED_CURVATURE {num(s.sq_curvature_modulus)}")
         if opts is not None:
             st = opts.settings
+            if st.get("diffusion_coeff"):
+                self.w(f"DIFFUSION: {num(st['diffusion_coeff'])}")
             fixed = " FIXED" if opts.toggles.get("_fixed_scale") else ""
             self.w(f"SCALE {num(st['scale'])}{fixed}")
             self.w(f"SCALE_LIMIT {num(st['scale_limit'])}")
@@ -478,6 +480,10 @@ class _FeWriter:
                 parts.append(f"pressure {num(b.pressure[k])}")
             if b.volconst is not None and b.volconst[k]:
                 parts.append(f"volconst {num(b.volconst[k])}")
+            if not np.isnan(b.target[k]) and b.lagrange[k] and \
+                    self.opts is not None and self.opts.toggles.get("diffusion"):
+                # the pressure the next step's diffusion starts from (REF writes it)
+                parts.append(f"lagrange_multiplier {num(b.lagrange[k])}")
             if b.density is not None and b.density[k]:
                 parts.append(f"density {num(b.density[k])}")
             parts += self._extra_text("body", k)

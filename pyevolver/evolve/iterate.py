@@ -16,9 +16,11 @@ import numpy as np
 
 from ..constraints import (displace, project_tangent, project_to_constraints, release_one_sided,
                        restore_state, state)
+from ..errors import UnsupportedError
 from . import gradient as GR
 from . import optparams as OP
 from ..errors import ConstraintError
+from .mobility import Mobility, diffuse, jiggle_vertices, normal_project
 
 
 def _solve(A, d):
@@ -62,6 +64,14 @@ class IterateSettings:
     ribiere: bool = True               # Polak-Ribiere, else Fletcher-Reeves
     check_increase: bool = False
     hessian_normal: bool = True        # ``hessian``: normal motion only
+    area_normalization: bool = False   # mobility 1 / (star area / 3) (evolve.mobility)
+    normal_motion: bool = False        # velocity projected on the vertex normal
+    runge_kutta: bool = False          # a fixed-scale step by RK4
+    diffusion: bool = False            # gas diffusion between bodies
+    diffusion_coeff: float = 0.0
+    jiggle: bool = False               # a random perturbation after each step
+    approximate_curvature: bool = False  # mobility: the inverse linear mass matrix
+    jiggle_temperature: float = 0.05
 
     @classmethod
     def from_mappings(cls, settings: Mapping, toggles: Mapping) -> "IterateSettings":
@@ -75,7 +85,15 @@ class IterateSettings:
                    conj_grad=bool(toggles.get("conj_grad", 0)),
                    ribiere=bool(toggles.get("ribiere", 1)),
                    check_increase=bool(toggles.get("check_increase", 0)),
-                   hessian_normal=bool(toggles.get("hessian_normal", 1)))
+                   hessian_normal=bool(toggles.get("hessian_normal", 1)),
+                   area_normalization=bool(toggles.get("area_normalization", 0)),
+                   normal_motion=bool(toggles.get("normal_motion", 0)),
+                   runge_kutta=bool(toggles.get("runge_kutta", 0)),
+                   diffusion=bool(toggles.get("diffusion", 0)),
+                   diffusion_coeff=float(settings.get("diffusion_coeff", 0.0)),
+                   jiggle=bool(toggles.get("jiggle", 0)),
+                   approximate_curvature=bool(toggles.get("approximate_curvature", 0)),
+                   jiggle_temperature=float(settings.get("jiggle_temperature", 0.05)))
 
 
 @dataclass
@@ -191,6 +209,36 @@ class _Constraints:
         return gs
 
 
+def _refuse_normal_motion(s, cons):
+    """The cases of ``normal_motion`` whose REF numbers were not reproduced.
+
+    Equal to REF: cube.fe (with its volume off target too), cat.fe, quad.fe
+    (``r; g 10``, ``r; U; g 10``).  Not: a fixed volume with fixed vertices
+    (catbody.fe) or with level-set constraints (mound.fe), where REF's
+    second step moves mirror-image vertices differently.
+    """
+    if s.string:
+        raise UnsupportedError("normal_motion in the string model",
+                               "the string model's vertex normal is not implemented")
+    if len(cons) and (bool(s.vattr["fixed"].any()) or bool(s.vcon)
+                      or bool((s.vattr.get("boundary", np.zeros(1)) != 0).any())):
+        raise UnsupportedError("normal_motion with fixed volumes or quantities and fixed or "
+                               "constrained vertices", "REF's normal there was not reproduced")
+
+
+def _refuse_approx_curv(s, cons, mobile):
+    """The cases of ``approx_curv`` not reproduced: fixed volumes or
+    quantities (REF 2.70 exits at the first ``g``: cube.fe, mound.fe,
+    slidestr.fe) and moving vertices on level-set constraints (1.5e-5 off
+    REF on a constrained film)."""
+    if len(cons):
+        raise UnsupportedError("approx_curv with fixed volumes or quantities",
+                               "evolver-nox-d 2.70 exits at the first g there")
+    if s.vcon and any(bool((m & mobile).any()) for m in s.vcon.values()):
+        raise UnsupportedError("approx_curv with vertices on level-set constraints",
+                               "REF's projection in that metric was not reproduced")
+
+
 class Iterator:
     """Runs ``g`` steps on a surface; keeps the state carried from step to
     step (conjugate-gradient history, whether the pressures are valid, the
@@ -216,6 +264,7 @@ class Iterator:
         self.pressures_valid = False
         self.newton_delta: float | None = None   # the damping the last `newton` run ended with
         self._diverged = False        # a constraint projection of the last move diverged
+        self.rng = np.random.default_rng(1)      # the jiggle toggle's (the caller's may replace it)
 
     # -- helpers ----------------------------------------------------------------
     @property
@@ -232,11 +281,18 @@ class Iterator:
         """Project vectors (list of (nv,3)) onto the constraint tangent spaces."""
         return project_tangent(self.surface, vecs)
 
+    def _mobility(self, t):
+        """The force-to-velocity conversion at the evaluation ``t`` (REF
+        takes the restoring motions' metric at the moved positions: catbody.fe
+        ``r; g 10`` with area normalization, 6e-4 off with the starting one)."""
+        return Mobility(t, self.settings.area_normalization,
+                        self.settings.approximate_curvature, self._mobile())
+
     def _constrained_dirs(self, t, cons, mobile):
         gs = cons.gradients(t)
         for g in gs:
             g[~mobile] = 0.0
-        us = self._project_tangent(gs)
+        us = self._mobility(t).apply(self._project_tangent(gs))
         k = len(gs)
         A = np.empty((k, k))
         for i in range(k):
@@ -303,6 +359,11 @@ class Iterator:
                 # converged: REF stops here even when the difference grew
                 # (itdebug on check 14, step 7: "Diff: 0.382765", one
                 # volume_restore(), done at 0.6068)
+                if it == 9 and not trial:
+                    # converged at the last of the 10 corrections: REF's count
+                    # ran out, and the next step starts CG afresh (catbody.fe
+                    # with area normalization, `U; r; g 3`)
+                    self.cg_history = None
                 return t_new
             if err_new > 100 * err and err > 0:
                 if report is not None:
@@ -372,12 +433,18 @@ class Iterator:
         cons = _Constraints(s)
         _check_freedom(s, mobile, len(cons))
         t0 = s.evaluate()
+        if settings.diffusion and s.bodies.n:
+            self._diffuse(t0, settings)
         f = -GR.energy_gradient(t0)
         # optimizing parameters: moved by -scale * pscale * dE/dp with the vertices
         popt = bool(OP.names(s))
         if popt:
             if len(cons):
                 OP.refuse(s, "fixed volumes or FIXED quantities")
+            for opt in ("area_normalization", "normal_motion", "runge_kutta",
+                        "approximate_curvature"):
+                if getattr(settings, opt):      # the parameters' mobility is not measured
+                    OP.refuse(s, opt)
             self._pbase: np.ndarray | None = OP.values(s)
             # in the scaled parameter q = p / pscale the force is
             # -pscale dE/dp, moved like a vertex coordinate (with conj_grad
@@ -406,8 +473,14 @@ class Iterator:
         f_raw = f
         s._one_sided_released = None
         targets = cons.targets(s)
+        if settings.normal_motion:
+            _refuse_normal_motion(s, cons)
+        if settings.approximate_curvature:
+            _refuse_approx_curv(s, cons, mobile)
+        mob = self._mobility(t0)
         for _pass in range(2):
-            (f,) = self._project_tangent([f_raw])
+            (f_tan,) = self._project_tangent([f_raw])
+            (f,) = mob.apply([f_tan])
             lam = np.zeros(len(cons))
             if len(cons):
                 gs, us, A = self._constrained_dirs(t0, cons, mobile)
@@ -424,6 +497,10 @@ class Iterator:
             release_one_sided(s, f_raw - sum(l * g for l, g in zip(lam, gs)))
             if not getattr(s, "_one_sided_released", None):
                 break
+        if settings.normal_motion:
+            # (REF projects before CG, whose sums see the projected velocity,
+            # and the CG direction again: cube.fe and cat.fe `r; U; g 10`)
+            vel = normal_project(t0, vel)
         # conjugate gradient
         if settings.conj_grad:
             # Fletcher-Reeves: gamma = S/S_old with S = sum vel.f; Polak-Ribiere
@@ -438,7 +515,7 @@ class Iterator:
             # shengdie torus sheets, whose ends are boundaries).
             bnd = s.vattr.get("boundary")
             cgv = mobile if bnd is None else mobile & (bnd == 0)
-            S = float(np.sum(vel[cgv] * f[cgv])) + float(fq @ fq)
+            S = float(np.sum(vel[cgv] * f_tan[cgv])) + float(fq @ fq)
             q_old = getattr(self, "cg_q", None)
             if self.cg_history is not None and (
                     self.cg_history.shape != vel.shape or q_old is None
@@ -456,6 +533,8 @@ class Iterator:
                     gamma = 0.0
             h = vel.copy() if self.cg_history is None else vel + gamma * self.cg_history
             h[~cgv] = vel[~cgv]
+            if settings.normal_motion:
+                h = normal_project(t0, h)
             self.cg_history = h
             self.cg_q = graw
             self.cg_S_old = S
@@ -496,6 +575,11 @@ class Iterator:
                 scale, E0, s1 = self._line_search(E, settings.scale, smax)
             except _Infinite:
                 return self._undo(X0, t0, settings.scale, lam, trial_msgs, motion)
+        if fixed_scale and settings.runge_kutta:
+            if len(cons):
+                raise UnsupportedError("runge_kutta with fixed volumes or quantities",
+                                       "REF's stages there were not reproduced")
+            vel = self._runge_kutta(X0, vel, settings.scale_scale * scale, cons, mobile)
         # actual move (REF prints what the trial moves reported first)
         report = trial_msgs
         self._carry = (us, A)
@@ -527,6 +611,10 @@ class Iterator:
             self.cg_history = None
             if not math.isfinite(t.energy) or self._diverged or not np.all(np.isfinite(s.X)):
                 return self._undo(X0, t0, scale, lam, report, motion)
+        if settings.jiggle:
+            # iterate.htm: after the constraints are enforced "if jiggling is
+            # on, the surface is randomly perturbed" (then projected again)
+            self._project(jiggle_vertices(s, settings.jiggle_temperature, self.rng))
         # reported pressures: P = -lambda
         b = s.bodies
         qp = {}
@@ -545,6 +633,53 @@ class Iterator:
         return StepResult(t.energy, t.total_area, scale,
                           b.lagrange.copy() if b.n else np.zeros(0), qp, True,
                           warnings=report + warnings, totals=t, motion=motion)
+
+    def _diffuse(self, t, settings):
+        """Gas diffusion at the start of a step: the fixed target volumes
+        move by :func:`~pyevolver.evolve.mobility.diffuse`."""
+        s = t.surface
+        if s.string:
+            raise UnsupportedError("diffusion in the string model",
+                                   "edge_diffusion is not implemented")
+        b = s.bodies
+        d = diffuse(t, settings.diffusion_coeff, settings.scale)
+        ok = ~np.isnan(b.target)
+        b.target[ok] = b.target[ok] + d[ok]
+
+    def _plain_velocity(self, t, cons, mobile):
+        """The velocity (nv, 3) at the evaluation ``t`` without CG: the
+        force held at fixed vertices, projected on the constraints, converted
+        by the mobility, less the fixed values' multiples, normal-projected
+        with ``normal_motion``."""
+        f = -GR.energy_gradient(t)
+        f[~mobile] = 0.0
+        (f,) = self._mobility(t).apply(self._project_tangent([f]))
+        if len(cons):
+            gs, us, A = self._constrained_dirs(t, cons, mobile)
+            lam = _solve(A, np.array([float(np.sum(f * g)) for g in gs]))
+            f = f - sum(l * u for l, u in zip(lam, us))
+        if self.settings.normal_motion:
+            f = normal_project(t, f)
+        return f
+
+    def _runge_kutta(self, X0, k1, h, cons, mobile):
+        """The velocity of a fixed-scale Runge-Kutta step ``h`` from the
+        state ``X0`` with first stage ``k1`` (iterate.htm; the toggle acts
+        only with a fixed scale, toggle.htm RUNGE_KUTTA).
+
+        The stages of RK4 are taken at X0 + h/2 k1, X0 + h/2 k2 and
+        X0 + h k3; REF 2.70 then moves by its last stage k4, not by
+        (k1 + 2 k2 + 2 k3 + k4) / 6: quad.fe ``r; m 0.1; g 1`` gives
+        4.41826089959718 with k4, 4.40845090908222 with the RK4 average
+        (measured; docs/differences.md).
+        """
+        s = self.surface
+        ks = [k1]
+        for c in (0.5, 0.5, 1.0):
+            displace(s, X0, c * h * ks[-1])
+            ks.append(self._plain_velocity(s.evaluate(), cons, mobile))
+        restore_state(s, X0)
+        return ks[3]
 
     def _undo(self, X0, t0, scale, lam, report, motion=None):
         """A motion to an infinite or NaN energy, or a constraint projection

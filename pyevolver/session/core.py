@@ -63,8 +63,7 @@ def _deferred_sigint():
             signal.signal(signal.SIGINT, old)
 
 # motion options that change what g does; refused rather than ignored
-UNSUPPORTED_MOTION = ("area_normalization", "normal_motion", "runge_kutta",
-                      "approximate_curvature", "diffusion", "autopop", "jiggle")
+UNSUPPORTED_MOTION = ("autopop",)
 
 
 class Session(SessionAPI):
@@ -466,6 +465,7 @@ class Session(SessionAPI):
         surface (created on first use), its settings those of the session."""
         if self._iterator is None:
             self._iterator = Iterator(lambda: self.surface)
+        self._iterator.rng = self.rng           # jiggle: the generator of `j` and `random`
         self._iterator.settings = IterateSettings.from_mappings(self.settings, self.toggles)
         return self._iterator
 
@@ -485,8 +485,8 @@ class Session(SessionAPI):
         """
         for name in UNSUPPORTED_MOTION:
             if self.toggles.get(name):
-                raise UnsupportedError(f"g with {name} on", "only the plain gradient motion "
-                                       "is implemented")
+                raise UnsupportedError(f"g with {name} on", "popping during g "
+                                       "is not implemented")
         if self.toggles.get("_effective_area_motion"):
             # REF's effective_area command also changes the motion (the top-section
             # keyword EFFECTIVE_AREA changes only the squared curvature)

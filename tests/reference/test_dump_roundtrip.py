@@ -549,10 +549,13 @@ def test_effective_area_keyword_and_command(evolver, tmp_path):
 
 
 def test_runge_kutta_keyword(tmp_path):
+    """RUNGE_KUTTA (REF's dumps write it) turns the toggle on; it acts with a
+    fixed scale only, where a fixed volume (this cube's) is refused by name."""
     s, _, _ = _load(tmp_path, "RUNGE_KUTTA\n")
     assert s.toggles["runge_kutta"] == 1
-    with pytest.raises(PyEvolverError, match="g with runge_kutta on"):
-        s.run("g 1")
+    s.run("g 1")
+    with pytest.raises(PyEvolverError, match="runge_kutta with fixed volumes"):
+        s.run("m 0.1; g 1")
 
 
 def test_integer_attribute_of_a_datafile(evolver, tmp_path):
