@@ -100,6 +100,15 @@ def sub_elements(session: SessionLike, el, kind):
     i = el.i
     if s.string and "facet" in (el.kind, kind) and el.kind != "body":
         return _string_sub_elements(session, el, kind)
+    if s.simplex and el.kind in ("vertex", "facet") and kind in ("vertex", "facet", "edge"):
+        if el.kind == "facet" and kind == "vertex":
+            return [ElemRef("vertex", int(v)) for v in s.SF[i]]
+        if el.kind == "vertex" and kind == "facet":
+            # REF: the newest facet first
+            fs = np.nonzero((s.SF == i).any(axis=1))[0][::-1]
+            return [ElemRef("facet", int(f)) for f in fs]
+        if kind == "edge":
+            return []          # the simplex model keeps no edges
     if el.kind == "vertex":
         if kind == "edge" and "ring_time" in s.eattr:
             return [ElemRef("edge", e, g) for e, g in SM.vertex_edges(s, i)]

@@ -25,7 +25,8 @@ def list_elements(session: SessionLike, gen, env):
         return
     session.note({"vertex": "// Id               X                Y" +
                 ("               Z" if session.surface.sdim >= 3 else ""),
-                "edge": "// Id    endpoints", "facet": "// Id    edges",
+                "edge": "// Id    endpoints",
+                "facet": "// Id      vertices" if session.surface.simplex else "// Id    edges",
                 "body": "// Id    facets"}[kind] + "\n")
     for el in els:
         session.write(fn(session, el.i) + "\n")
@@ -125,6 +126,8 @@ def _list_facet(session: SessionLike, i):
     s = session.surface
     t = session.totals
     eid, fid = s.ids("edge"), s.ids("facet")
+    if s.simplex:
+        return _list_simplex_facet(session, i)
     if s.string:
         enc = SM.chain(s, i)
         edges = [int(eid[e]) if e >= 0 else -int(eid[~e]) for e in enc]
@@ -153,6 +156,22 @@ def _list_facet(session: SessionLike, i):
         attrs += (" " if attrs else "") + f"backcolor {_colour_name(bc)} "
     line = (f"{fid[i]:3d}   " + _wrapped(edges, 15) + attrs + (" " if attrs else "")
             + f"/*area {area:g}*/")
+    orig = s.fattr["original"][i]
+    if orig and orig != fid[i]:
+        line += f" original {orig}"
+    return line + _extra_text(session, "facet", i)
+
+
+def _list_simplex_facet(session: SessionLike, i):
+    """The simplex model: the facet's vertices (REF: ``%3d``, then ``%4d`` each)."""
+    s = session.surface
+    fid, vid = s.ids("facet"), s.ids("vertex")
+    line = f"{fid[i]:3d}  " + "".join(f"{int(vid[v]):4d}" for v in s.SF[i])
+    if s.facet_tension[i] != 1.0:
+        line += f"  density {s.facet_tension[i]:g}"
+    if s.fattr["fixed"][i]:
+        line += "  fixed"
+    line += f" /*area {session.totals.facet_area[i]:g}*/"
     orig = s.fattr["original"][i]
     if orig and orig != fid[i]:
         line += f" original {orig}"

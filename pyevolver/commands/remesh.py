@@ -18,6 +18,7 @@ from ..remesh import delete_edges as DEL, edge_divide as ED, equiangulate as EQ
 from ..remesh import notch as NO, pop as POP, vertex_average as VA
 from ..remesh.quadratic import refine_quadratic
 from ..remesh.refine import refine as _refine_all
+from ..remesh.simplex import refine as refine_simplex
 from . import element_attrs, elements, variables
 from .registry import register
 from .values import ElemRef, SessionLike, as_float, is_true
@@ -28,6 +29,11 @@ def refine(session: SessionLike, echo=True):
     s = session.surface
     if s.string:
         session._string_split(np.nonzero(~s.eattr["no_refine"])[0])
+    elif s.simplex:
+        session._replace_surface(refine_simplex(s))
+        # REF multiplies the scale limit by 2^(k-2) (measured: 1 -> 2 -> 4 for
+        # k = 3, 1 -> 4 -> 16 for k = 4, unchanged for k = 2)
+        session.settings["scale_limit"] *= 2.0 ** (s.simplex - 2)
     elif s.order == 2:
         session._replace_surface(refine_quadratic(s))
     else:

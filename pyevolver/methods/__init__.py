@@ -20,6 +20,7 @@ from . import (basic, curvature_hessian, elastic, gauss_integral, harmonic,  # n
 from . import quadratic as _quadratic  # noqa: F401  (the quadratic model's totals and methods)
 from . import string as _string  # noqa: F401  (registers the string model's totals)
 from . import ndim as _ndim  # noqa: F401  (the totals of SPACE_DIMENSION > 3)
+from . import simplex as _simplex  # noqa: F401  (the simplex model's totals)
 from .registry import (CURVATURE_METHODS, GRADIENTS, HESSIANS, METHODS, NO_HESSIAN, REGISTRY,
                        Method, lookup, method_info, register_method)
 from .totals import Totals, evaluate

@@ -341,7 +341,9 @@ def evaluate(surface: Surface) -> Totals:
         :class:`pyevolver.methods.string.StringTotals` in the string model).
     """
     model = "string" if surface.string else "soapfilm"
-    if surface.X.shape[1] > 3:
+    if surface.simplex:
+        model = "simplex"       # pyevolver.methods.simplex
+    elif surface.X.shape[1] > 3:
         model = "ndim"          # pyevolver.methods.ndim
     elif getattr(surface, "order", 1) == 2:
         model = "quadratic"

@@ -14,6 +14,7 @@ from .formulas import located
 from .ids import IdMap, Lazy, split_midpoints
 from .records import first_facets_on_load, record_edge_first_facet
 from .scene import Scene
+from . import simplex as SX
 from .string import STRING_METHODS, init_rings
 from .surface import HOOKS, Quantity, Surface
 
@@ -34,6 +35,8 @@ class _Builder:
         s.sdim_line = sc.decl_lines.get("space_dimension")
         s.string = sc.string
         sd = int(sc.values.get("surface_dimension", 1 if s.string else 2))
+        if sc.simplex:
+            return self._simplex()
         if sd not in (1, 2):
             raise self.error(f"not supported in pyevolver: SURFACE_DIMENSION {sd} "
                              f"(the simplex model)", sc.decl_lines.get("surface_dimension"))
@@ -76,6 +79,17 @@ class _Builder:
             vols = s.evaluate().volumes
             for pos, a in self._actual_volume.items():
                 s.bodies.volconst[pos] += a - vols[pos]
+        return s
+
+    def _simplex(self):
+        """The simplex model (:mod:`pyevolver.model.simplex`)."""
+        SX.check_scene(self)
+        s = self.s
+        s.gravity_constant = self.sc.values.get("gravity_constant", 1.0)
+        self._vertices()
+        SX.build_faces(self)
+        self._bodies()
+        self._quantities()
         return s
 
     def _constraint_ids(self, vals, what, blk, pos):

@@ -126,5 +126,11 @@ class Scene:
         return "string" in self.flags or int(self.values.get("surface_dimension", 2)) == 1
 
     @property
+    def simplex(self):
+        """The simplex model (``SIMPLEX_REPRESENTATION``): facets are oriented
+        vertex lists."""
+        return "simplex_representation" in self.flags
+
+    @property
     def torus(self):
         return "torus" in self.flags or "torus_filled" in self.flags

@@ -116,6 +116,11 @@ class Surface:
         self.order = 1
         self.sf_ptr = np.zeros(1, np.int64)
         self.sf_enc = np.zeros(0, np.int64)
+        # the simplex model (SIMPLEX_REPRESENTATION, pyevolver.model.simplex):
+        # ``simplex`` is the surface dimension k, and facet f is the oriented
+        # vertex list ``SF[f]`` (k + 1 vertices); E and FE stay empty
+        self.simplex = 0
+        self.SF = np.zeros((0, 0), np.int64)
 
     # -- topology helpers ---------------------------------------------------
     @property
@@ -142,6 +147,8 @@ class Surface:
     def n_facets(self):
         """Facets as the command language counts them: the edge chains in
         the string model, the triangles otherwise."""
+        if self.simplex:
+            return len(self.SF)
         return len(self.sf_ptr) - 1 if self.string else len(self.FE)
 
     def topology(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -206,6 +213,8 @@ class Surface:
 
     def __repr__(self) -> str:
         model = "string" if self.string else "soapfilm"
+        if self.simplex:
+            model = f"simplex, dimension {self.simplex}"
         if self.order == 2:
             model += ", quadratic"
         torus = ", torus" if self.periods is not None else ""
