@@ -94,7 +94,11 @@ def get_attr(session: SessionLike, base, name, idx):
             b = s.vattr.get("boundary")
             return float(b is not None and b[i] == int(idx))
         if name == "valence":
+            if s.simplex:           # REF: the number of facets at the vertex
+                return float(np.count_nonzero((s.SF == i).any(axis=1)))
             return float(np.count_nonzero((s.E == i).any(axis=1)))
+        if name in ("vertexnormal", "vertex_normal") and s.simplex:
+            raise UnsupportedError(f"{name} in the simplex model")
         if name in ("vertexnormal", "vertex_normal"):
             if isinstance(idx, tuple):
                 raise ExpressionError(f"vertex {name} is a vector; index it as {name}[i]")
@@ -145,6 +149,10 @@ def get_attr(session: SessionLike, base, name, idx):
     elif k == "facet":
         if name == "area":
             return float((t.sfacet_area if s.string else t.facet_area)[i])
+        if s.simplex and name in ("x", "y", "z", "valence"):
+            if name == "valence":
+                return 0.0          # REF
+            raise CommandError("Internal error: Trying to take normal in simplex model.")
         if s.string and name in ("x", "y", "z", "valence"):
             if name == "valence":
                 return float(s.sf_ptr[i + 1] - s.sf_ptr[i])

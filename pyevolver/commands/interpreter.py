@@ -25,6 +25,7 @@ from ..limits import MAX_ARRAY_ENTRIES, MAX_NESTING
 from . import (constraints, eigen, element_attrs, elements, evolution, extensions, files,  # noqa: F401
                fixing, model_order, output, remesh, toggles)
 from . import refused  # noqa: F401
+from . import simplex
 from . import registry, variables
 from .cformat import print_value
 from .nodes import ElemIndex
@@ -113,8 +114,14 @@ class Interpreter:
         run = getattr(self, "_x_" + kind, None)
         if run is not None:
             run(node)
+        elif kind in simplex.STATEMENTS and self._simplex() and simplex.statement(self, node):
+            return
         else:
             registry.statement(kind).handler(self, node)
+
+    def _simplex(self):
+        """True when the surface is in the simplex model (commands.simplex)."""
+        return bool(getattr(self.session.surface, "simplex", 0))
 
     def run_string(self, text, where):
         """Run ``text`` (any number of commands) as the Evolver's ``exec``
@@ -633,6 +640,8 @@ class Interpreter:
             return
         cmd = registry.lookup(raw, arg)
         if cmd is not None:
+            if self._simplex() and simplex.answer(self, raw):
+                return
             cmd.handler(self, raw, arg)
             return
         if name in s.variables and arg is None:

@@ -197,6 +197,9 @@ class _FeWriter:
         self.w()
         if s.string:
             self.w("STRING")
+        if s.simplex:
+            self.w("SIMPLEX_REPRESENTATION")
+            self.w(f"SURFACE_DIMENSION {s.simplex}")
         if s.sdim != 3:
             self.w(f"SPACE_DIMENSION {s.sdim}")
         if s.periods is not None:
@@ -442,6 +445,8 @@ class _FeWriter:
             if s.string:                 # a chain of edges (encoded ~e when reversed)
                 parts = [str(int(e) + 1) if e >= 0 else str(int(e))
                          for e in s.sf_enc[s.sf_ptr[k]:s.sf_ptr[k + 1]]]
+            elif s.simplex:              # the simplex model: the oriented vertex list
+                parts = [str(int(v) + 1) for v in s.SF[k]]
             else:
                 parts = [str(int(e) + 1) if e >= 0 else str(int(e)) for e in s.FE[k]]
             if fa.get("fixed") is not None and fa["fixed"][k]:

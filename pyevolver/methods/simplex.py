@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import UnsupportedError
 from ..geometry import kernels as G
 from ..geometry import simplex as GS
 from ..model.surface import Surface
@@ -52,6 +53,11 @@ class SimplexTotals(Totals):
         b = s.bodies
         self.volumes = (b.facet_matrix @ self.facet_volume + b.volconst) if b.n else np.zeros(0)
         self.energy = self._finish_energy(energy, 0.0)
+
+    @property
+    def facet_N2(self) -> np.ndarray:  # type: ignore[override]
+        """Refused: a simplex facet has no normal vector here."""
+        raise UnsupportedError("facet normals in the simplex model")
 
     def energy_gradient(self) -> np.ndarray:
         """Gradient (nv, d) of the total energy."""
