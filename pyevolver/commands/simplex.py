@@ -55,6 +55,13 @@ _REFUSED = {
     "j": "REF's jiggle amplitude without edges was not measured",
     "jiggle": "REF's jiggle amplitude without edges was not measured",
 }
+_HESSIAN_WORDS = {"newton", "ritz", "saddle", "eigenprobe", "lanczos", "hessian_menu"}
+_MOTION = {
+    "area_normalization": "REF's vertex areas there were not reproduced (simplex3.fe r; "
+                          "g 3: 0.7812 against 0.7762 with a 1/(k+1) star)",
+    "diffusion": "diffusion between bodies is not implemented for simplex facets",
+    "jiggle": "REF's jiggle amplitude without edges was not measured",
+}
 #: statements with REF's answer in the simplex model
 STATEMENTS = {"delete", "edgeswap", "equiangulate", "refine"}
 
@@ -75,6 +82,13 @@ def answer(interp, raw: str) -> bool:
         raise UnsupportedError(f"{raw} in the simplex model", _REFUSED[word])
     if word in ("hessian", "hessian_seek"):
         hessian_answer(s)
+    if word in _HESSIAN_WORDS:
+        raise UnsupportedError(f"{raw} in the simplex model", "it needs the Hessian, which "
+                               "REF 2.70 does not have for simplex volumes")
+    if word == "g":
+        for opt, why in _MOTION.items():
+            if s.toggles.get(opt):
+                raise UnsupportedError(f"g with {opt} in the simplex model", why)
     return False
 
 
