@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 
 from ..errors import CommandError, UnsupportedError
+from . import elements
 
 _ERRORS = {
     "w": "Can only do area weed on soapfilm model.",
@@ -110,7 +111,6 @@ def statement(interp, node) -> bool:
     edges), else refused by name."""
     kind = node[0]
     if kind == "refine":
-        from . import elements
         els = elements.generate(interp.session, node[1], interp.env)
         if not els:
             return True

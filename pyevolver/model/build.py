@@ -35,8 +35,6 @@ class _Builder:
         s.sdim_line = sc.decl_lines.get("space_dimension")
         s.string = sc.string
         sd = int(sc.values.get("surface_dimension", 1 if s.string else 2))
-        if sc.simplex:
-            return self._simplex()
         if sd not in (1, 2):
             raise self.error(f"not supported in pyevolver: SURFACE_DIMENSION {sd} "
                              f"(the simplex model)", sc.decl_lines.get("surface_dimension"))
@@ -79,17 +77,6 @@ class _Builder:
             vols = s.evaluate().volumes
             for pos, a in self._actual_volume.items():
                 s.bodies.volconst[pos] += a - vols[pos]
-        return s
-
-    def _simplex(self):
-        """The simplex model (:mod:`pyevolver.model.simplex`)."""
-        SX.check_scene(self)
-        s = self.s
-        s.gravity_constant = self.sc.values.get("gravity_constant", 1.0)
-        self._vertices()
-        SX.build_faces(self)
-        self._bodies()
-        self._quantities()
         return s
 
     def _constraint_ids(self, vals, what, blk, pos):
@@ -794,7 +781,7 @@ def build_surface(scene: Scene) -> Surface:
         :class:`~pyevolver.errors.DatafileError` located in the datafile.
     """
     try:
-        return _Builder(scene).build()
+        return SX.build(_Builder(scene)) if scene.simplex else _Builder(scene).build()
     except DatafileError as exc:
         lines = scene.source_lines
         if exc.excerpt is None and exc.line and lines and 0 < exc.line <= len(lines):

@@ -71,6 +71,27 @@ def check_scene(builder) -> None:
         raise refuse("SQUARED_CURVATURE", sc.decl_lines.get("squared_curvature"))
 
 
+def build(builder):
+    """The Surface of a simplex-model scene, built with the soapfilm builder's
+    vertex, body and attribute readers (``builder``:
+    :class:`pyevolver.model.build._Builder`)."""
+    sc, s = builder.sc, builder.s
+    check_scene(builder)
+    builder._actual_volume = {}
+    s.params = dict(sc.parameters)
+    s.sdim = sc.space_dimension
+    s.sdim_line = sc.decl_lines.get("space_dimension")
+    s.gravity_constant = sc.values.get("gravity_constant", 1.0)
+    builder._vertices()
+    build_faces(builder)
+    builder._bodies()
+    builder._quantities()
+    if builder._actual_volume:
+        raise builder.error("not supported in pyevolver: ACTUAL_VOLUME in the simplex model",
+                            sc.decl_lines.get("simplex_representation"))
+    return s
+
+
 def build_faces(builder) -> None:
     """Read the faces section as oriented vertex lists into ``s.SF``."""
     sc, s = builder.sc, builder.s
