@@ -54,6 +54,7 @@ def _numbers(lines):
     (EX, "r\ng 10"), (EX, "r\nr\ng 3"), (EX, "r\nU\ng 5"), (EX, "r\nm 0.05\ng 5"),
     (os.path.join(DATA, "simplex_pressure.fe"), "r\ng 6\nv"),
     (os.path.join(DATA, "simplex_tetra.fe"), "r\ng 8\nv"),
+    (os.path.join(DATA, "simplex_4d.fe"), "r\ng 4"),
 ])
 def test_evolution_as_reference(evolver, tmp_path, path, cmds):
     ref = run_reference(evolver, path, cmds, cwd=str(tmp_path))

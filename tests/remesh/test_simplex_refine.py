@@ -84,7 +84,7 @@ def _facet_lines(lines):
 
 
 @pytest.mark.parametrize("name,moved", [("simplex3", False), ("simplex3", True),
-                                        ("simplex_tetra", True)])
+                                        ("simplex_tetra", True), ("simplex_4d", True)])
 def test_numbering_as_reference(evolver, tmp_path, name, moved):
     """``r; r`` then ``list facets`` and ``list vertices``: the same facets,
     vertex lists (in order) and coordinates as REF."""
