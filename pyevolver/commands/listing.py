@@ -168,9 +168,9 @@ def _list_simplex_facet(session: SessionLike, i):
     fid, vid = s.ids("facet"), s.ids("vertex")
     line = f"{fid[i]:3d}  " + "".join(f"{int(vid[v]):4d}" for v in s.SF[i])
     if s.facet_tension[i] != 1.0:
-        line += f"  density {s.facet_tension[i]:g}"
+        line += f"  density {s.facet_tension[i]:g} "
     if s.fattr["fixed"][i]:
-        line += "  fixed"
+        line += " fixed "
     line += f" /*area {session.totals.facet_area[i]:g}*/"
     orig = s.fattr["original"][i]
     if orig and orig != fid[i]:
