@@ -55,7 +55,7 @@ _REFUSED = {
     "rawestv": "REF 2.70's averaging of simplex vertices was not reproduced",
     "j": "REF's jiggle amplitude without edges was not measured",
     "jiggle": "REF's jiggle amplitude without edges was not measured",
-    "approximate_curvature": "the mass matrix of simplex facets is not implemented",
+    "bfgs": "pyevolver's BFGS works on triangulated surfaces",
 }
 _HESSIAN_WORDS = {"newton", "ritz", "saddle", "eigenprobe", "lanczos", "hessian_menu"}
 _MOTION = {
