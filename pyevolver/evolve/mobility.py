@@ -32,9 +32,14 @@ def star_measure(t: Any) -> np.ndarray:
 
     One third of the total area of the facets around the vertex; in the
     string model one half of the total length of its edges (toggle.htm,
-    AREA_NORMALIZATION).
+    AREA_NORMALIZATION); in the simplex model 1/(k+1) of the k-volumes of
+    its facets (REF's ``v_velocity / v_force``, measured).
     """
     s = t.surface
+    if getattr(s, "simplex", 0):        # the simplex model: 1/(k+1) of each facet
+        k1 = s.SF.shape[1]
+        return np.bincount(s.SF.ravel(), weights=np.repeat(t.facet_area, k1),
+                           minlength=s.nv) / k1
     if s.string or s.nf == 0 and s.ne:
         L = t.edge_length
         return (np.bincount(s.E[:, 0], weights=L, minlength=s.nv)

@@ -55,6 +55,8 @@ def _numbers(lines):
     (os.path.join(DATA, "simplex_pressure.fe"), "r\ng 6\nv"),
     (os.path.join(DATA, "simplex_tetra.fe"), "r\ng 8\nv"),
     (os.path.join(DATA, "simplex_4d.fe"), "r\ng 4"),
+    (os.path.join(DATA, "simplex_4d.fe"), "r\narea_normalization\ng 4"),
+    (os.path.join(DATA, "simplex_pressure.fe"), "r\narea_normalization\ng 4"),
 ])
 def test_evolution_as_reference(evolver, tmp_path, path, cmds):
     ref = run_reference(evolver, path, cmds, cwd=str(tmp_path))
@@ -109,7 +111,8 @@ def test_notes_as_reference(evolver, tmp_path, cmd):
 
 
 @pytest.mark.parametrize("cmd", ["u", "K 0.2", "l 0.5", "rawv", "j", "delete facet[1]",
-                                 "refine facet[1]"])
+                                 "refine facet[1]", "area_normalization\ng 1",
+                                 "diffusion\ng 1", "newton", "bfgs 2"])
 def test_refused_by_name(cmd):
     with pytest.raises(PyEvolverError, match="not supported in pyevolver: .* simplex model"):
         _ours(EX, "r\n" + cmd)
