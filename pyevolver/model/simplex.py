@@ -7,11 +7,13 @@ all (``edge_count`` is 0, ``list edges`` is empty) and so does pyevolver:
 the facets are one ``(nf, k + 1)`` vertex array ``Surface.SF``, ``E`` and
 ``FE`` stay empty, ``Surface.simplex`` is k.
 
-What is supported (against REF): FIXED vertices, facet TENSION, bodies with
-fixed volume or PRESSURE (their volume needs SPACE_DIMENSION k + 1), ``r``.
-What is refused by name here: constraints, boundaries, named quantities, the
-torus model and the quadratic model, an edges section (used by REF only for
-constraint and quantity integrals, which are refused).
+What is supported (against REF): FIXED vertices, level-set constraints on
+vertices (a refined edge's midpoint is on the constraints common to its
+ends, as REF), facet TENSION, bodies with fixed volume or PRESSURE (their
+volume needs SPACE_DIMENSION k + 1), ``r``.  What is refused by name here:
+constraint integrals and CONVEX constraints, boundaries, named quantities,
+the torus model and the quadratic model, an edges section (used by REF only
+for constraint and quantity integrals, which are refused).
 """
 from __future__ import annotations
 
@@ -58,8 +60,11 @@ def check_scene(builder) -> None:
         raise refuse("the torus model (the manual: no torus model or symmetry groups)")
     if "quadratic" in sc.flags:
         raise refuse("the quadratic model (the manual: not allowed)")
-    if sc.constraints:
-        raise refuse("constraints", next(iter(sc.constraints.values())).line)
+    for c in sc.constraints.values():
+        if c.energy or c.content:
+            raise refuse("constraint ENERGY and CONTENT integrals", c.line)
+        if "convex" in c.flags:
+            raise refuse("CONVEX constraints", c.line)
     if sc.boundaries:
         raise refuse("boundaries", next(iter(sc.boundaries.values())).line)
     if sc.quantities or sc.method_instances:
@@ -82,7 +87,9 @@ def build(builder):
     s.sdim = sc.space_dimension
     s.sdim_line = sc.decl_lines.get("space_dimension")
     s.gravity_constant = sc.values.get("gravity_constant", 1.0)
+    s.constraints = dict(sc.constraints)
     builder._vertices()
+    builder._project()
     build_faces(builder)
     builder._bodies()
     builder._quantities()

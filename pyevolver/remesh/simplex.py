@@ -18,8 +18,9 @@ The rule, measured on evolver-nox-d (REF) with one-facet datafiles:
 * the facet itself becomes the first child; the others are appended, facet
   after facet, with the facet's attributes (``original`` is the facet's).
 
-A new vertex is FIXED when both ends of its edge are (the manual: the
-midpoint inherits the common attributes of the edge's endpoints).
+A new vertex is FIXED when both ends of its edge are, and on the level-set
+constraints of both (the manual: the midpoint inherits the common attributes
+of the edge's endpoints); it is projected on them.
 """
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ import copy
 import numpy as np
 import scipy.sparse as sp
 
+from ..constraints import constrained_vertices, project_to_constraints
 from ..errors import CommandError, UnsupportedError
 from .. import limits
 
@@ -114,6 +116,9 @@ def refine(s):
             rows = np.arange(top + 1, top + 1 + nmid)
         va[name] = np.concatenate([arr, rows])
     t.vattr = va
+    # a midpoint is on the constraints common to its edge's ends (REF)
+    t.vcon = {cid: np.concatenate([on, on[ends[:, 0]] & on[ends[:, 1]]])
+              for cid, on in s.vcon.items()}
     parent = np.repeat(np.arange(nf), nkid - 1)                 # of the appended facets
     t.SF = np.concatenate([child[:, 0], child[:, 1:].reshape(-1, k + 1)])
     fa = {}
@@ -147,4 +152,8 @@ def refine(s):
         b.volume = None
     t.bodies = b
     t.topology_version = getattr(s, "topology_version", 0) + 1
+    new = np.arange(nv, nv + nmid)
+    if t.vcon and len(project_to_constraints(t, new[constrained_vertices(t)[new]])):
+        raise CommandError("r: new vertices could not be projected on their constraints; "
+                           "the surface is unchanged")
     return t

@@ -55,6 +55,7 @@ def _numbers(lines):
     (os.path.join(DATA, "simplex_pressure.fe"), "r\ng 6\nv"),
     (os.path.join(DATA, "simplex_tetra.fe"), "r\ng 8\nv"),
     (os.path.join(DATA, "simplex_4d.fe"), "r\ng 4"),
+    (os.path.join(DATA, "simplex_constraint.fe"), "r\ng 6\nr\ng 2"),
     (os.path.join(DATA, "simplex_4d.fe"), "r\narea_normalization\ng 4"),
     (os.path.join(DATA, "simplex_pressure.fe"), "r\narea_normalization\ng 4"),
 ])
@@ -125,9 +126,10 @@ def test_hessian_without_volumes_refused(tmp_path):
         _ours(str(p), "hessian")
 
 
-def test_dump_loads_in_both(evolver, tmp_path):
+@pytest.mark.parametrize("path", [EX, os.path.join(DATA, "simplex_constraint.fe")])
+def test_dump_loads_in_both(evolver, tmp_path, path):
     out = str(tmp_path / "ours.dmp")
-    _ours(EX, f'r\ng 2\ndump "{out}"')
+    _ours(path, f'r\ng 2\ndump "{out}"')
     text = open(out).read()
     assert "SIMPLEX_REPRESENTATION" in text and "SURFACE_DIMENSION 3" in text
     cmds = "print total_energy\nv\ng 3"

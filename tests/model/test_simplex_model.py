@@ -40,7 +40,9 @@ def test_tetra_in_three_space():
 
 
 @pytest.mark.parametrize("extra,where,match", [
-    ("constraint 1\nformula: x = 0\n", "top", "constraints in the simplex model"),
+    ("constraint 1\nformula: x = 0\nenergy:\ne1: 0\ne2: 0\ne3: 0\n", "top",
+     "constraint ENERGY and CONTENT integrals in the simplex model"),
+    ("constraint 1 convex\nformula: x = 0\n", "top", "CONVEX constraints"),
     ("quantity q energy method vertex_scalar_integral\nscalar_integrand: x\n", "top",
      "named quantities in the simplex model"),
     ("TORUS\nPERIODS\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", "top", "torus model"),

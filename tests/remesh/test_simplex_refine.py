@@ -109,3 +109,14 @@ def test_refused_dimensions():
         simplex = 5
     with pytest.raises(Exception, match="simplex model of dimension 5"):
         RS.refine(S())
+
+
+def test_midpoints_keep_common_constraints():
+    s = _session(os.path.join(DATA, "simplex_constraint.fe"))
+    s.run("r")
+    on = s.surface.vcon[1]
+    # vertices 1..4 are on x4 = 0.1 x1; the midpoints 12 (1-4), 13 (1-3), 15 (1-2)
+    # and 6 (3-4), 8 (2-4), 10 (2-3) too, those towards vertex 5 not (REF)
+    assert np.nonzero(on)[0].tolist() == [0, 1, 2, 3, 5, 7, 9, 11, 12, 14]
+    X = s.surface.X
+    assert np.allclose(X[on, 3], 0.1 * X[on, 0])
