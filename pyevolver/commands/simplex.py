@@ -102,8 +102,9 @@ def answer(interp, raw: str) -> bool:
 def hessian_answer(session) -> None:
     """REF's hessian in the simplex model: an error (volumes), a crash (none)."""
     b = session.surface.bodies
-    if b.n and any(not math.isnan(v) for v in b.target):
-        if not session.iterator.pressures_valid:
+    if b.n:
+        fixed = any(not math.isnan(v) for v in b.target)
+        if fixed and not session.iterator.pressures_valid:
             raise CommandError("Pressures invalid. Do regular iteration before Hessian "
                                "to set pressures.")
         raise CommandError("Use Lagrange model for simplex volumes.")

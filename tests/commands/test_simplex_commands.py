@@ -91,12 +91,14 @@ def test_queries_as_reference(evolver, tmp_path):
     assert _numbers(ours) == pytest.approx(_numbers(ref), rel=1e-12)
 
 
-@pytest.mark.parametrize("cmd", ["w 0.001", "n 0.5", "V", "hessian", "g 1\nhessian"])
-def test_errors_as_reference(evolver, tmp_path, cmd):
-    ref = _ref_threads(evolver, EX, "r\n" + cmd, str(tmp_path), p1=True)
+@pytest.mark.parametrize("path,cmd", [(EX, c) for c in ("w 0.001", "n 0.5", "V", "hessian",
+                                                       "g 1\nhessian")]
+                         + [(os.path.join(DATA, "simplex_pressure.fe"), "hessian")])
+def test_errors_as_reference(evolver, tmp_path, path, cmd):
+    ref = _ref_threads(evolver, path, "r\n" + cmd, str(tmp_path), p1=True)
     msg = next(ln for ln in ref if ln.startswith("ERROR"))
     with pytest.raises(CommandError) as exc:
-        _ours(EX, "r\n" + cmd)
+        _ours(path, "r\n" + cmd)
     assert str(exc.value).split(": ", 1)[-1] in msg, (str(exc.value), msg)
 
 
