@@ -341,7 +341,7 @@ def evaluate(surface: Surface) -> Totals:
         :class:`pyevolver.methods.string.StringTotals` in the string model).
     """
     model = "string" if surface.string else "soapfilm"
-    if surface.simplex:
+    if getattr(surface, "simplex", 0):
         model = "simplex"       # pyevolver.methods.simplex
     elif surface.X.shape[1] > 3:
         model = "ndim"          # pyevolver.methods.ndim
