@@ -14,6 +14,7 @@ from .formulas import located
 from .ids import IdMap, Lazy, split_midpoints
 from .records import first_facets_on_load, record_edge_first_facet
 from .scene import Scene
+from . import symmetry
 from .string import STRING_METHODS, init_rings
 from .surface import HOOKS, Quantity, Surface
 
@@ -55,7 +56,8 @@ class _Builder:
         s.gravity_constant = sc.values.get("gravity_constant", 1.0)
         s.gap_constant = sc.values.get("gap_constant", 1.0)
         s.sq_curvature_modulus = float(sc.values.get("squared_curvature", 0.0))
-        if sc.torus:
+        s.symmetry_group = symmetry.declared(sc, s, self.error)
+        if sc.torus or sc.symmetry_group == "torus":
             vals = sc.values.get("_periods")
             sd = s.sdim
             P = np.eye(3)
@@ -194,6 +196,7 @@ class _Builder:
         n = len(blk.ids)
         self.eid = IdMap(blk.ids, "edge", sc.filename, blk.lines)
         E = np.zeros((n, 2), np.int64)
+        self._wrap_codes = np.zeros(n, np.int64)
         data = blk.data
         if "quadratic" in sc.flags and n:     # (pyevolver.remesh.quadratic.from_listed)
             data, s.listed_midpoints = split_midpoints(data, self.vid, blk.lines, blk.ids)
@@ -245,6 +248,8 @@ class _Builder:
                                      blk.lines[pos])
                 elif kw in ("bare", "original", "orientation"):
                     pass
+                elif kw == "wrap" and sc.symmetry_group is not None:
+                    self._wrap_codes[pos] = int(vals[0])
                 elif kw == "wrap":
                     raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: WRAP "
                                      "(symmetry groups are not implemented)", blk.lines[pos])
@@ -263,7 +268,8 @@ class _Builder:
             w = np.zeros((n, 3))
             for pos, wr in sc.wraps.items():
                 w[pos, :len(wr)] = wr
-            s.eattr["wrap"] = w
+            s.eattr["wrap"] = w if s.symmetry_group is None else \
+                symmetry.decode_torus(self._wrap_codes, s.sdim)
         for cid, c in sc.constraints.items():
             if "global" in c.flags:
                 s.econ[cid] = np.ones(n, np.int8)
