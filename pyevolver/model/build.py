@@ -9,7 +9,6 @@ import scipy.sparse as sp
 from ..errors import DatafileError, PyEvolverError, UnsupportedError
 from ..expr.nodes import Formula
 from ..limits import MAX_ARRAY_ENTRIES
-from ..geometry import kernels as G
 from .formulas import located
 from .ids import IdMap, Lazy, split_midpoints
 from .records import first_facets_on_load, record_edge_first_facet
@@ -252,7 +251,7 @@ class _Builder:
                     self._wrap_codes[pos] = int(vals[0])
                 elif kw == "wrap":
                     raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: WRAP "
-                                     "(symmetry groups are not implemented)", blk.lines[pos])
+                                     "without SYMMETRY_GROUP", blk.lines[pos])
                 else:
                     raise self.error(f"edge {blk.ids[pos]}: '{kw}' is not an edge attribute",
                                      blk.lines[pos])
@@ -442,7 +441,7 @@ class _Builder:
             if key[0] == "facet":
                 s.extra[key] = s.extra[key][parent]
         if s.periods is not None and nnew_v:
-            self._torus_centers(big, starts, lengths, enc, nface)
+            symmetry.torus_face_centers(s, big, starts, lengths, enc)
         if nnew_v:
             # the mean of huge (finite) coordinates or periods can overflow
             bad = np.nonzero(~np.all(np.isfinite(s.X[nv:]), axis=1))[0]
@@ -568,31 +567,6 @@ class _Builder:
 
     def _face_center(self, rim):
         return self.s.X[rim].mean(axis=0)
-
-    def _torus_centers(self, big, starts, lengths, enc, nface):
-        """Torus: the centre is the mean of the unwrapped rim; spokes get wraps."""
-        s = self.s
-        P = s.periods
-        wrap = s.eattr["wrap"]
-        nv0 = s.nv - len(big)
-        ne_spoke = s.ne - int(lengths[big].sum())
-        for j, k in enumerate(big):
-            st, n = starts[k], lengths[k]
-            loop = enc[st:st + n]
-            idx, sgn = G.edge_index(loop)
-            # unwrapped offsets (in periods) of rim vertices relative to the first
-            offs = np.zeros((n, 3))
-            for m in range(1, n):
-                offs[m] = offs[m - 1] + wrap[idx[m - 1]] * sgn[m - 1]
-            rim = np.where(sgn > 0, s.E[idx, 0], s.E[idx, 1])
-            pts = s.X[rim] + offs @ P
-            c = nv0 + j
-            s.X[c] = pts.mean(axis=0)
-            for m in range(n):
-                e = ne_spoke + m
-                # spoke from rim m (at offset offs[m]) to centre (offset 0)
-                wrap[e] = -offs[m]
-            ne_spoke += n
 
     # -- bodies -------------------------------------------------------------------
     def _bodies(self):

@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.kernels import edge_index
+
 #: the built-in groups of the manual and of REF 2.70, with why pyevolver has
 #: not got them (the torus group is supported)
 GROUPS = {
@@ -87,3 +89,29 @@ def declared(scene, surface, error) -> str | None:
     if why is not None:
         raise error(f"not supported in pyevolver: {why}", scene.decl_lines.get("symmetry_group"))
     return name
+
+
+def torus_face_centers(s, big, starts, lengths, enc) -> None:
+    """The torus model at load: the centre of each face of more than three
+    edges (``big``, its loop ``enc[starts[k]:starts[k] + lengths[k]]``) is
+    the mean of the rim unwrapped from its first vertex; the spokes (the
+    last edges, in face order) get the wraps from rim to centre."""
+    P = s.periods
+    wrap = s.eattr["wrap"]
+    nv0 = s.nv - len(big)
+    ne_spoke = s.ne - int(lengths[big].sum())
+    for j, k in enumerate(big):
+        st, n = starts[k], lengths[k]
+        loop = enc[st:st + n]
+        idx, sgn = edge_index(loop)
+        # unwrapped offsets (in periods) of rim vertices relative to the first
+        offs = np.zeros((n, 3))
+        for m in range(1, n):
+            offs[m] = offs[m - 1] + wrap[idx[m - 1]] * sgn[m - 1]
+        rim = np.where(sgn > 0, s.E[idx, 0], s.E[idx, 1])
+        pts = s.X[rim] + offs @ P
+        s.X[nv0 + j] = pts.mean(axis=0)
+        for m in range(n):
+            # spoke from rim m (at offset offs[m]) to centre (offset 0)
+            wrap[ne_spoke + m] = -offs[m]
+        ne_spoke += n

@@ -6,13 +6,19 @@ import numpy as np
 from .refine import split_edges
 
 
-def edge_divide(s, edges):
+def edge_divide(s, edges, head_frame=False):
     """Bisect ``edges`` (indices) of surface ``s``, ignoring NO_REFINE.
 
     Each facet on a bisected edge is cut from the midpoint to its opposite
     corner.  Edges are taken in increasing index order; when two chosen
     edges share a facet, the second is bisected after the first split (in
     a later round), as the Evolver does one edge after the other.
+
+    ``head_frame`` (``K`` in the torus model): the midpoint of an edge that
+    wraps is put at the head's side of the cell (``head - vector/2``) while
+    the new edges keep the wraps of the tail-side midpoint, as REF's ``K``
+    does (measured on twointor.fe and symtest.fe: REF's energy after ``K``
+    jumps; ``l`` and ``refine edges`` put the midpoint right).
 
     Returns
     -------
@@ -34,7 +40,12 @@ def edge_divide(s, edges):
         now = todo[ok[todo]]
         mask = np.zeros(s.ne, bool)
         mask[now] = True
+        nv0, shift = s.nv, None
+        if head_frame and s.periods is not None:
+            shift = s.eattr["wrap"][np.sort(now)] @ s.periods
         s = split_edges(s, mask, one_by_one=True)
+        if shift is not None:
+            s.X[nv0:nv0 + len(shift)] -= shift
         todo = todo[~ok[todo]]
     return s, count
 
