@@ -188,8 +188,8 @@ class _Deleter:
         the torus: REF puts the midpoint in the frame of the edge's tail when
         the tail lies in the unit cell, else of the head when that does
         (measured on twointor.fe ``r; g 5; t 0.15``)."""
-        if not delta.any():
-            return False
+        if not delta.any() or self.s.symmetry_group is not None:
+            return False        # (SYMMETRY_GROUP "torus": the kept vertex's frame, as REF)
         k_in, e_in = self._inside
         tail_in, head_in = (k_in, e_in) if head == elim else (e_in, k_in)
         frame = head if (not tail_in and head_in) else (elim if head == keep else keep)
