@@ -74,7 +74,7 @@ def test_skinny_head_frame_moves_only_wrapped_midpoints():
     s = pyevolver.load(example("symtest.fe")).surface
     wrapped = int(np.nonzero(np.abs(s.eattr["wrap"]).sum(axis=1))[0][0])
     a, _ = edge_divide(s, [0, wrapped])
-    b, _ = edge_divide(s, [0, wrapped], head_frame=True)
+    b, _ = edge_divide(s, [0, wrapped], head_frame=[wrapped])
     d = b.X[s.nv:] - a.X[s.nv:]
     assert np.allclose(d[0], 0)
     assert np.allclose(d[1], -s.eattr["wrap"][wrapped] @ s.periods)
