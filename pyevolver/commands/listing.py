@@ -10,6 +10,7 @@ import numpy as np
 from ..expr import nodes as N
 from ..geometry.kernels import edge_index
 from ..model import string as SM
+from ..model.symmetry import encode_torus
 from . import constraints, elements
 from .values import SessionLike
 
@@ -95,7 +96,9 @@ def _list_edge(session: SessionLike, i):
     if s.order == 2:                      # REF: "/*midpt*/  16" in the quadratic model
         line += f"  /*midpt*/ {vid[s.midv[i]]:3d} "
     w = s.eattr.get("wrap")
-    if w is not None:
+    if w is not None and s.symmetry_group is not None:      # REF: the group element's code
+        line += f" wrap {int(encode_torus(w[i:i + 1])[0])} "
+    elif w is not None:
         line += " " + " ".join({0: "*", 1: "+", -1: "-"}.get(int(x), "?")
                                for x in w[i, :s.sdim])
     ten = s.edge_tension[i]

@@ -66,11 +66,11 @@ def _replaced(session: SessionLike, result, count=None, note=None, echo=True):
     return n
 
 
-def _divide(session: SessionLike, edges):
+def _divide(session: SessionLike, edges, head_frame=()):
     """Bisect ``edges`` (the string model splits them); returns how many."""
     if session.surface.string:
         return session._string_split(np.asarray(edges, np.int64))
-    return _replaced(session, ED.edge_divide(session.surface, edges))
+    return _replaced(session, ED.edge_divide(session.surface, edges, head_frame))
 
 
 def refine_edges(session: SessionLike, edges, echo=True):
@@ -141,8 +141,8 @@ def flush_counts(session: SessionLike):
     session.pending = {"Fixed": 0, "Unfixed": 0}
 
 
-def _bisect(session: SessionLike, edges, echo):
-    n = _divide(session, edges)
+def _bisect(session: SessionLike, edges, echo, head_frame=()):
+    n = _divide(session, edges, head_frame)
     bump_count(session, "refine", n)                # REF: l and K accumulate, r does not
     if echo:
         session.note(f"New edges: {n}\n")
@@ -159,7 +159,8 @@ def edge_divide_long(session: SessionLike, length, echo=True):
 def skinny(session: SessionLike, angle, echo=True):
     """``K θ``: bisect the longest edge of facets with an angle below θ."""
     session.no_string("K (skinny triangles)")
-    return _bisect(session, ED.skinny_edges(session.surface, angle), echo)
+    against: list = []          # edges the choosing facet runs against (torus: REF's midpoint)
+    return _bisect(session, ED.skinny_edges(session.surface, angle, against), echo, against)
 
 
 def notch(session: SessionLike, angle, echo=True):

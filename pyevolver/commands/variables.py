@@ -99,7 +99,9 @@ def internal(session: SessionLike, name):
         "space_dimension": lambda: s.sdim, "surface_dimension": lambda: 1 if s.string else 2,
         "high_constraint": lambda: max(s.constraints, default=0),
         "high_boundary": lambda: max(s.boundaries, default=0),
-        "torus": lambda: 1 if s.periods is not None else 0,
+        # REF: the torus model is its "torus" group (symmetry_group 1 too);
+        # SYMMETRY_GROUP "torus" alone is not TORUS
+        "torus": lambda: int(s.periods is not None and s.symmetry_group is None),
         "datafilename": lambda: session.filename,
         "gravity_constant": lambda: s.gravity_constant,
         "sq_curvature_modulus": lambda: s.sq_curvature_modulus,
@@ -114,7 +116,8 @@ def internal(session: SessionLike, name):
         "refine_count": lambda: session.counts.get("refine", 0), "where_count": lambda: 0,
         "random": lambda: float(session.rng.random()),
         "quantity_count": lambda: len(s.quantities),
-        "symmetry_group": lambda: 0, "simplex_representation": lambda: 0,
+        "symmetry_group": lambda: int(s.periods is not None),
+        "simplex_representation": lambda: 0,
         "lagrange_order": lambda: s.order, "linear": lambda: int(s.order == 1),
         "quadratic": lambda: int(s.order == 2),
         "lagrange": lambda: 0,

@@ -23,6 +23,8 @@ from .scan import (_ARRAY_TOKEN, _ATTR_FUNCTION, _BAD_NUMBER, _INT_ATTR_TYPES, _
                    _NUMTOK_RE, _PROC_START, _SPACE_DIM_RE, _lowest_free, _proc_end,
                    _skip_transforms)
 
+_SYMMETRY_RE = re.compile(r'\bsymmetry_group\s+"([^"\n]*)"', re.I)
+
 VALUE_NAMES = {
     "square_curvature": "squared_curvature",
     "spring_constant": "gap_constant",
@@ -101,6 +103,17 @@ class TopSection:
                     raise _MatrixError(line, "PERIODS: the numbers must be finite")
                 self.scene.values["_periods"] = vals
         return out
+
+    def _symmetry_group(self, text, sec):
+        """``SYMMETRY_GROUP "name"`` taken out of the text into
+        ``scene.symmetry_group`` (the builder checks the name:
+        :mod:`pyevolver.model.symmetry`)."""
+        m = _SYMMETRY_RE.search(text)
+        if not m:
+            return text
+        self.scene.symmetry_group = m.group(1).lower()
+        self.scene.decl_lines["symmetry_group"] = self._src(sec, text.count("\n", 0, m.start()) + 1)
+        return text[:m.start()] + " " * (m.end() - m.start()) + text[m.end():]
 
     def _peek_space_dimension(self, text):
         m = re.search(r"\bspace_dimension\s+(\d+)", text, re.I)
@@ -185,6 +198,7 @@ class TopSection:
             col = fdef.start(1) - (text.rfind("\n", 0, fdef.start(1)) + 1) + 1
             raise self.error("not supported in pyevolver: DEFINE ... ATTRIBUTE ... FUNCTION "
                              "(attributes computed when read)", self._src(sec, line), col)
+        text = self._symmetry_group(text, sec)
         try:
             if _MATRIX_RE.search(text):
                 text = self._extract_matrices(text)

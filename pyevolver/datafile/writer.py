@@ -29,6 +29,7 @@ from ..atomic import atomic_write
 from ..errors import UnsupportedError
 from ..expr import nodes as N
 from ..model.surface import Surface
+from ..model.symmetry import encode_torus
 
 _CON_FLAGS = ("global", "convex", "nonwall", "nonnegative", "nonpositive")
 _NAME = re.compile(r"^[a-z_][a-z0-9_]*$", re.I)
@@ -202,8 +203,12 @@ class _FeWriter:
             self.w(f"SURFACE_DIMENSION {s.simplex}")
         if s.sdim != 3:
             self.w(f"SPACE_DIMENSION {s.sdim}")
-        if s.periods is not None:
-            self.w("TORUS_FILLED" if s.torus_filled else "TORUS")
+        group = getattr(s, "symmetry_group", None)
+        if group is not None:
+            self.w(f'SYMMETRY_GROUP "{group}"')
+        if s.periods is not None and (group is None or np.any(s.periods != np.eye(3))):
+            if group is None:
+                self.w("TORUS_FILLED" if s.torus_filled else "TORUS")
             self.w("PERIODS")
             for row in np.asarray(s.periods)[:s.sdim, :s.sdim]:
                 self.w(" ".join(num(v) for v in row))
@@ -407,6 +412,9 @@ class _FeWriter:
         s = self.s
         ea = s.eattr
         wrap = ea.get("wrap") if s.periods is not None else None
+        codes = None
+        if wrap is not None and getattr(s, "symmetry_group", None) is not None:
+            codes, wrap = encode_torus(wrap), None
         if wrap is not None and np.any(~np.isin(wrap, (-1, 0, 1))):
             self.refuse("an edge wrapping more than one period")
         mem = self.members["edge"]
@@ -418,6 +426,8 @@ class _FeWriter:
                 parts.append(str(s.midv[k] + 1))
             if wrap is not None:
                 parts += [{0: "*", 1: "+", -1: "-"}[int(v)] for v in wrap[k]]
+            elif codes is not None and codes[k]:
+                parts.append(f"wrap {codes[k]}")
             if ea.get("fixed") is not None and ea["fixed"][k]:
                 parts.append("fixed")
             if ea.get("boundary") is not None and ea["boundary"][k]:

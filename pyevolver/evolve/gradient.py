@@ -135,14 +135,15 @@ def body_volume_gradients(t):
     vg = facet_volume_grad(t, s.symmetric_content)
     out = np.zeros((b.n, s.nv, 3))
     Bm = b.facet_matrix.tocsr()
-    if s.periods is not None:
+    lift = s.periods is not None and s.symmetry_group is None   # (a group: no lift)
+    if lift:
         D = torus_lift_shifts(s)
         P = _facet_points(t)
     content = content_edge_terms(t)
     for i in range(b.n):
         w = np.asarray(Bm.getrow(i).todense()).ravel()
         out[i] = corner_scatter(t, vg, w)
-        if s.periods is not None:
+        if lift:
             if s.symmetric_content:
                 out[i] += corner_scatter(t, _n2_grad_dot(P, D[i]) / 6.0)
             else:

@@ -85,9 +85,35 @@ FUNC2 = {
     "minimum": np.minimum, "incompleteellipticf": _ellipf,
     "incompleteelliptice": _ellipeinc,
 }
+
+
+def _wrap_fields(w):
+    """(k, ...) signed per-axis wraps of torus-group codes (6-bit fields,
+    5-bit two's complement: 31 is -1; pyevolver.model.symmetry)."""
+    c = np.asarray(np.rint(w), dtype=np.int64)
+    f = np.stack([(c >> (6 * d)) & 31 for d in range(5)])
+    return np.where(f >= 16, f - 32, f)
+
+
+def _wrap_code(f):
+    return sum((f[d] & 31) << (6 * d) for d in range(len(f))).astype(float)
+
+
+def _wrap_compose(a, b):
+    """The torus group's product of two wrap codes (the translations add)."""
+    return _wrap_code(_wrap_fields(a) + _wrap_fields(b))
+
+
+def _wrap_inverse(a):
+    """The torus group's inverse of a wrap code."""
+    return _wrap_code(-_wrap_fields(a))
+
+
+FUNC1["wrap_inverse"] = _wrap_inverse
+FUNC2["wrap_compose"] = _wrap_compose
 # recognised but refused
 UNSUPPORTED_FUNCS = {
-    "wrap_compose", "wrap_inverse", "usr1", "usr2", "usr3", "usr4", "usr5",
+    "usr1", "usr2", "usr3", "usr4", "usr5",
     "usr6", "usr7", "usr8", "usr9", "usr10",
 }
 

@@ -233,7 +233,9 @@ class Totals:
             # edge content counts toward the bodies of the facets the edge is on
             vols = vols + b.facet_matrix @ self.facet_edge_sum(self.con_content)
         vols = vols + b.volconst
-        if s.periods is not None:
+        if s.periods is not None and s.symmetry_group is None:
+            # (a symmetry group's volumes are the facets' unwrapped contents:
+            # pyevolver.model.symmetry)
             D = torus_lift_shifts(s)                  # (nb, nf, 3)
             N2 = self.facet_N2
             if s.symmetric_content:

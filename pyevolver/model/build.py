@@ -9,12 +9,12 @@ import scipy.sparse as sp
 from ..errors import DatafileError, PyEvolverError, UnsupportedError
 from ..expr.nodes import Formula
 from ..limits import MAX_ARRAY_ENTRIES
-from ..geometry import kernels as G
 from .formulas import located
 from .ids import IdMap, Lazy, split_midpoints
 from .records import first_facets_on_load, record_edge_first_facet
 from .scene import Scene
 from . import simplex as SX
+from . import symmetry
 from .string import STRING_METHODS, init_rings
 from .surface import HOOKS, Quantity, Surface
 
@@ -56,7 +56,8 @@ class _Builder:
         s.gravity_constant = sc.values.get("gravity_constant", 1.0)
         s.gap_constant = sc.values.get("gap_constant", 1.0)
         s.sq_curvature_modulus = float(sc.values.get("squared_curvature", 0.0))
-        if sc.torus:
+        s.symmetry_group = symmetry.declared(sc, s, self.error)
+        if sc.torus or sc.symmetry_group == "torus":
             vals = sc.values.get("_periods")
             sd = s.sdim
             P = np.eye(3)
@@ -195,6 +196,7 @@ class _Builder:
         n = len(blk.ids)
         self.eid = IdMap(blk.ids, "edge", sc.filename, blk.lines)
         E = np.zeros((n, 2), np.int64)
+        self._wrap_codes = np.zeros(n, np.int64)
         data = blk.data
         if "quadratic" in sc.flags and n:     # (pyevolver.remesh.quadratic.from_listed)
             data, s.listed_midpoints = split_midpoints(data, self.vid, blk.lines, blk.ids)
@@ -246,9 +248,11 @@ class _Builder:
                                      blk.lines[pos])
                 elif kw in ("bare", "original", "orientation"):
                     pass
+                elif kw == "wrap" and sc.symmetry_group is not None:
+                    self._wrap_codes[pos] = int(vals[0])
                 elif kw == "wrap":
                     raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: WRAP "
-                                     "(symmetry groups are not implemented)", blk.lines[pos])
+                                     "without SYMMETRY_GROUP", blk.lines[pos])
                 else:
                     raise self.error(f"edge {blk.ids[pos]}: '{kw}' is not an edge attribute",
                                      blk.lines[pos])
@@ -264,7 +268,8 @@ class _Builder:
             w = np.zeros((n, 3))
             for pos, wr in sc.wraps.items():
                 w[pos, :len(wr)] = wr
-            s.eattr["wrap"] = w
+            s.eattr["wrap"] = w if s.symmetry_group is None else \
+                symmetry.decode_torus(self._wrap_codes, s.sdim)
         for cid, c in sc.constraints.items():
             if "global" in c.flags:
                 s.econ[cid] = np.ones(n, np.int8)
@@ -437,7 +442,7 @@ class _Builder:
             if key[0] == "facet":
                 s.extra[key] = s.extra[key][parent]
         if s.periods is not None and nnew_v:
-            self._torus_centers(big, starts, lengths, enc, nface)
+            symmetry.torus_face_centers(s, big, starts, lengths, enc)
         if nnew_v:
             # the mean of huge (finite) coordinates or periods can overflow
             bad = np.nonzero(~np.all(np.isfinite(s.X[nv:]), axis=1))[0]
@@ -563,31 +568,6 @@ class _Builder:
 
     def _face_center(self, rim):
         return self.s.X[rim].mean(axis=0)
-
-    def _torus_centers(self, big, starts, lengths, enc, nface):
-        """Torus: the centre is the mean of the unwrapped rim; spokes get wraps."""
-        s = self.s
-        P = s.periods
-        wrap = s.eattr["wrap"]
-        nv0 = s.nv - len(big)
-        ne_spoke = s.ne - int(lengths[big].sum())
-        for j, k in enumerate(big):
-            st, n = starts[k], lengths[k]
-            loop = enc[st:st + n]
-            idx, sgn = G.edge_index(loop)
-            # unwrapped offsets (in periods) of rim vertices relative to the first
-            offs = np.zeros((n, 3))
-            for m in range(1, n):
-                offs[m] = offs[m - 1] + wrap[idx[m - 1]] * sgn[m - 1]
-            rim = np.where(sgn > 0, s.E[idx, 0], s.E[idx, 1])
-            pts = s.X[rim] + offs @ P
-            c = nv0 + j
-            s.X[c] = pts.mean(axis=0)
-            for m in range(n):
-                e = ne_spoke + m
-                # spoke from rim m (at offset offs[m]) to centre (offset 0)
-                wrap[e] = -offs[m]
-            ne_spoke += n
 
     # -- bodies -------------------------------------------------------------------
     def _bodies(self):

@@ -89,6 +89,7 @@ class Scene:
     method_instances: dict = field(default_factory=dict)  # name -> MethodDecl
     attributes: dict = field(default_factory=dict)     # (etype, name) -> (type, size)
     periods: np.ndarray | None = None
+    symmetry_group: str | None = None                  # SYMMETRY_GROUP "name", lower case
     read_warnings: list = field(default_factory=list)  # (line, message) of the read section
     macros: dict = field(default_factory=dict)         # #define macros kept (keep_macros)
     vertices: ElementBlock = field(default_factory=ElementBlock)

@@ -100,6 +100,7 @@ class Surface:
         self.constraints = {}
         self.boundaries = {}
         self.periods = None
+        self.symmetry_group = None   # SYMMETRY_GROUP "torus": the torus model (model/symmetry.py)
         self.symmetric_content = False
         self.torus_filled = False
         self.params = {}

@@ -30,8 +30,7 @@ import heapq
 import numpy as np
 
 from ..constraints import project_to_constraints
-from ..errors import UnsupportedError
-from ..geometry.kernels import gram_facet_areas
+from ..geometry.kernels import edge_index, gram_facet_areas
 from .shrink import subset
 
 
@@ -41,9 +40,10 @@ def _dec(x):
 
 class _Deleter:
     def __init__(self, s):
-        if s.periods is not None:
-            raise UnsupportedError("deleting edges in the torus model")
         self.s = s
+        # the torus model: per-edge period shifts, kept up to date as ends merge
+        self.P = s.periods
+        self.W = s.eattr["wrap"].copy() if s.periods is not None else None
         self.X = s.X.copy()
         self.moved = []
         self.E = s.E.copy()
@@ -68,9 +68,14 @@ class _Deleter:
             self.esig[:, -1] = s.eattr["boundary"]
         self.count = 0
 
-    def length(self, e):
+    def vec(self, e):
+        """Edge ``e``'s vector head - tail (across the torus wrap)."""
         a, b = self.E[e]
-        return float(np.linalg.norm(self.X[b] - self.X[a]))
+        d = self.X[b] - self.X[a]
+        return d if self.W is None else d + self.W[e] @ self.P
+
+    def length(self, e):
+        return float(np.linalg.norm(self.vec(e)))
 
     def facets_of(self, e):
         return np.nonzero(self.falive & (self.FEabs == e).any(axis=1))[0]
@@ -83,9 +88,21 @@ class _Deleter:
         """Indices of the live facets with a corner at vertex ``v``."""
         return np.nonzero(self.falive & np.isin(self.FEabs, self.edges_at(v)).any(axis=1))[0]
 
-    def neighbours(self, v):
-        ends = self.E[self.edges_at(v)]
-        return set(np.where(ends[:, 0] == v, ends[:, 1], ends[:, 0]).tolist())
+    def neighbours(self, v, shift=None):
+        """``{(w, offset): edge}`` of the vertices joined to ``v``, with the
+        period offset of that copy of ``w`` from ``v`` (plus ``shift``; the
+        offsets are all zero outside the torus model)."""
+        at = self.edges_at(v)
+        out = {}
+        for x in at.tolist():
+            a, b = (int(y) for y in self.E[x])
+            if self.W is None:
+                off = ()
+            else:
+                off = self.W[x] if a == v else -self.W[x]
+                off = tuple((off + shift).tolist()) if shift is not None else tuple(off.tolist())
+            out[(b if a == v else a, off)] = x
+        return out
 
     def _eliminable(self, v, e):
         return (not self.vfixed[v]) and np.array_equal(self.vsig[v], self.esig[e])
@@ -119,11 +136,25 @@ class _Deleter:
                 ea, eb = sides
             c = [v for v in self.E[eb] if v != elim][0]
             merges.append((f, *self._survivor(eb, ea), int(c)))
+        # the offset (in periods) of the eliminated vertex from the kept one
+        delta = None
+        if self.W is not None:
+            delta = self.W[e].copy() if int(self.E[e, 0]) == keep else -self.W[e]
         # a common neighbour outside those facets: its two edges become one
-        for c in sorted(self.neighbours(keep) & self.neighbours(elim) - {m[3] for m in merges}):
-            eb, ea = self._edge_between(elim, c), self._edge_between(keep, c)
-            merges.append((None, *self._survivor(eb, ea), c))
+        nk, ne_ = self.neighbours(keep), self.neighbours(elim, delta)
+        done = {x for m in merges for x in m[1:3]}
+        for key in sorted(set(nk) & set(ne_)):
+            eb, ea = ne_[key], nk[key]
+            if eb in done or ea in done:
+                continue
+            merges.append((None, *self._survivor(eb, ea), key[0]))
         E, FE = self.E, self.FE
+        head = int(E[e, 1])
+        if delta is not None:
+            self._inside = self._in_cell(np.array([keep, elim]))
+            self.W[E[:, 0] == elim] += delta
+            self.W[E[:, 1] == elim] -= delta
+            self.X[elim] = self.X[elim] + delta @ self.P    # its copy next to keep
         E[E == elim] = keep
         for f, eb, ea, c in merges:
             # the two sides now join the same vertices; eb is kept, ea dropped
@@ -140,11 +171,36 @@ class _Deleter:
             # (not on a parametric boundary, where the kept vertex stays put)
             self.X[keep] = 0.5 * (self.X[keep] + self.X[elim])
             self.moved.append(keep)
+            if delta is not None and self._frame_at_elim(keep, elim, head, delta):
+                self._shift(keep, -delta)
         self.valive[elim] = False
         self.ealive[e] = False
         self._drop_pillows(keep)
         self.count += 1
         return True
+
+    def _in_cell(self, v):
+        c = np.linalg.solve(self.P.T, self.X[v].T).T
+        return np.all((c > -1e-9) & (c < 1 + 1e-9), axis=1)
+
+    def _frame_at_elim(self, keep, elim, head, delta):
+        """Whether the merged vertex takes the eliminated vertex's copy of
+        the torus: REF puts the midpoint in the frame of the edge's tail when
+        the tail lies in the unit cell, else of the head when that does
+        (measured on twointor.fe ``r; g 5; t 0.15``)."""
+        if not delta.any() or self.s.symmetry_group is not None:
+            return False        # (SYMMETRY_GROUP "torus": the kept vertex's frame, as REF)
+        k_in, e_in = self._inside
+        tail_in, head_in = (k_in, e_in) if head == elim else (e_in, k_in)
+        frame = head if (not tail_in and head_in) else (elim if head == keep else keep)
+        return frame == elim
+
+    def _shift(self, v, s):
+        """Move vertex ``v`` by the periods ``s`` (the same point of the
+        torus): its edges' wraps follow."""
+        self.X[v] = self.X[v] + s @ self.P
+        self.W[self.ealive & (self.E[:, 0] == v)] += s
+        self.W[self.ealive & (self.E[:, 1] == v)] -= s
 
     def _survivor(self, eb, ea):
         """``(kept, dropped)`` of two sides that merge: the Evolver keeps the
@@ -156,13 +212,9 @@ class _Deleter:
             return bool(self.efixed[x]) or bool(self.esig[x].any())
         if held(ea) and not held(eb):
             return ea, eb
+        if not held(eb) and len(self.facets_of(ea)) > len(self.facets_of(eb)):
+            return ea, eb
         return eb, ea
-
-    def _edge_between(self, u, v):
-        E = self.E
-        hit = np.nonzero(self.ealive & (((E[:, 0] == u) & (E[:, 1] == v)) |
-                                        ((E[:, 0] == v) & (E[:, 1] == u))))[0]
-        return int(hit[0])
 
     def _drop_pillows(self, v):
         """Facets at ``v`` that now share all three edges come in pairs (a
@@ -190,6 +242,8 @@ class _Deleter:
             return self.s
         t = subset(self.s, self.E, self.FE, self.valive, self.ealive, self.falive)
         t.X = self.X[self.valive].copy()
+        if self.W is not None:
+            t.eattr["wrap"] = self.W[self.ealive].copy()
         moved = np.unique(np.array(self.moved, np.int64))
         moved = moved[self.valive[moved]] if len(moved) else moved
         if len(moved):
@@ -214,6 +268,11 @@ def _in_id_order(first, visit):
                 heapq.heappush(heap, int(j))
 
 
+def _edge_vectors(s):
+    D = s.X[s.E[:, 1]] - s.X[s.E[:, 0]]
+    return D if s.periods is None else D + s.eattr["wrap"] @ s.periods
+
+
 def delete_short_edges(s, length):
     """``t length``: visit the edges in id order and delete each that is
     shorter than ``length`` when it is visited (as the Evolver's ``delete
@@ -222,7 +281,7 @@ def delete_short_edges(s, length):
     Returns ``(new surface, number deleted)``.
     """
     d = _Deleter(s)
-    L = np.linalg.norm(s.X[s.E[:, 1]] - s.X[s.E[:, 0]], axis=1)
+    L = np.linalg.norm(_edge_vectors(s), axis=1)
 
     def visit(e):
         if not d.ealive[e] or d.length(e) >= length or not d.delete(e) or not d.moved:
@@ -239,14 +298,16 @@ def weed_small_facets(s, area):
 
     Returns ``(new surface, number of facets weeded)``.
     """
-    F = s.F
-    A = gram_facet_areas(np.stack([s.X[F[:, 1]] - s.X[F[:, 0]], s.X[F[:, 2]] - s.X[F[:, 0]]], 1))
+    D = _edge_vectors(s)
+    idx, sgn = edge_index(s.FE)
+    A = gram_facet_areas(np.stack([D[idx[:, 0]] * sgn[:, 0, None],
+                                   D[idx[:, 1]] * sgn[:, 1, None]], 1))
     return _weed(s, np.nonzero(A < area)[0], area)
 
 
 def _facet_area(d, f):
-    P = d.X[[d.E[_dec(x)][0] if x >= 0 else d.E[_dec(x)][1] for x in d.FE[f]]]
-    return float(gram_facet_areas(np.stack([P[1] - P[0], P[2] - P[0]])[None])[0])
+    sides = [d.vec(_dec(x)) * (1 if x >= 0 else -1) for x in d.FE[f][:2]]
+    return float(gram_facet_areas(np.stack(sides)[None])[0])
 
 
 def _weed(s, facets, area):

@@ -6,13 +6,21 @@ import numpy as np
 from .refine import split_edges
 
 
-def edge_divide(s, edges):
+def edge_divide(s, edges, head_frame=()):
     """Bisect ``edges`` (indices) of surface ``s``, ignoring NO_REFINE.
 
     Each facet on a bisected edge is cut from the midpoint to its opposite
     corner.  Edges are taken in increasing index order; when two chosen
     edges share a facet, the second is bisected after the first split (in
     a later round), as the Evolver does one edge after the other.
+
+    ``head_frame`` (``K`` in the torus model): edges whose midpoint is put
+    at the head's side of the cell (``head - vector/2``) while the new edges
+    keep the wraps of the tail-side midpoint, as REF's ``K`` does with an
+    edge its skinny facet runs against (measured on twointor.fe and
+    symtest.fe, where REF's energy after ``K`` jumps, and on a sheared
+    wavy sheet, where the facet runs along the wrapping edge and the
+    midpoint is right; ``l`` and ``refine edges`` put it right).
 
     Returns
     -------
@@ -34,7 +42,13 @@ def edge_divide(s, edges):
         now = todo[ok[todo]]
         mask = np.zeros(s.ne, bool)
         mask[now] = True
+        nv0, shift = s.nv, None
+        if len(head_frame) and s.periods is not None:
+            now_s = np.sort(now)
+            shift = (s.eattr["wrap"][now_s] @ s.periods) * np.isin(now_s, head_frame)[:, None]
         s = split_edges(s, mask, one_by_one=True)
+        if shift is not None:
+            s.X[nv0:nv0 + len(shift)] -= shift
         todo = todo[~ok[todo]]
     return s, count
 
@@ -44,7 +58,7 @@ def long_edges(s, length):
     return np.nonzero(s.evaluate().edge_length > length)[0]
 
 
-def skinny_edges(s, angle):
+def skinny_edges(s, angle, against=None):
     """``K θ``: the longest edge of every facet whose smallest angle is below
     ``angle`` (radians), as edge indices.
 
@@ -73,7 +87,11 @@ def skinny_edges(s, angle):
     cand = np.nonzero(skinny)[0]
     cand = cand[np.argsort(s.ids("facet")[cand], kind="stable")]
     chosen = set()
+    col = 2 - np.argmax(L[:, ::-1], axis=1)
+    sgn = s.topology()[1]
     for f in cand.tolist():                     # the skinny facets only
         if not chosen.intersection(idx[f].tolist()):
             chosen.add(int(longest[f]))
+            if against is not None and sgn[f, col[f]] < 0:
+                against.append(int(longest[f]))     # (the facet runs against it)
     return np.array(sorted(chosen), np.int64)

@@ -105,7 +105,7 @@ def test_shipped_script(evolver, case, tmp_path):
     ("edge_tuber.cmd", "set edge tuber_status tuber_edge_to_do where id < 3\nedge_tuber(0.1)",
      "new_vertex"),
     ("detorus_capper.cmd", "", "array elements in constraint formulas"),
-    ("slicer.cmd", "", "wrap_inverse"),
+    ("slicer.cmd", "slicer", "frontbody"),
     ("3ds.cmd", "", "syntax error"),
 ])
 def test_scripts_refused_by_name(script, run, word, tmp_path):

@@ -91,3 +91,13 @@ def test_log_domain_as_the_evolver():
         log(Arr(v)).ev({})
     out = N.Cond(Arr(v > 0), log(Arr(v)), N.Num(0.0)).ev({})
     np.testing.assert_array_equal(out, [math.log(2.0), 0.0, 0.0])
+
+
+def test_wrap_compose_and_inverse_of_the_torus_group():
+    from pyevolver.expr.functions import FUNC1, FUNC2
+    import numpy as np
+    assert FUNC2["wrap_compose"](64.0, 31.0) == 95          # +y then -x
+    assert FUNC1["wrap_inverse"](95.0) == 1985               # +x -y
+    assert FUNC1["wrap_inverse"](126977.0) == 4127           # -x +z
+    codes = np.array([0.0, 1.0, 1984.0, 4096.0])
+    assert (FUNC2["wrap_compose"](codes, FUNC1["wrap_inverse"](codes)) == 0).all()

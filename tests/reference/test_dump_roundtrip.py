@@ -27,10 +27,9 @@ from tolerances import PRINTED, STEPS
 # Wulff file); simplex3.fe: tests/commands/test_simplex_commands.py (REF -p1 crashes at its g)
 SUPPORTED = ["addload_example", "cat", "catbody", "catman", "column", "cube", "mound",
              "mylarcube", "octa", "phelanc", "popstr", "qmound", "quad", "slidestr", "sphere",
-             "relaxed", "tankex", "twointor"]
+             "relaxed", "symtest", "tankex", "twointor"]
 REFUSED = [("100grain", "g 3"), ("100grain", "r; g 3"), ("knotty", "g 3"), ("knotty", "r; g 3"),
-           ("metric", "g 3"), ("quadm", "g 3"),
-           ("symtest", "g 3")]
+           ("metric", "g 3"), ("quadm", "g 3")]
 PRE = ["g 3", "r; g 3"]
 
 SCRIPT = ('printf "R %.17g %.17g %d %d %d %d\\n", total_energy, total_area, vertex_count, '
