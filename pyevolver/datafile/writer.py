@@ -289,6 +289,8 @@ class _FeWriter:
             out.append("global")
         if m.modulus != 1.0:
             out.append(f"modulus {num(m.modulus)}")
+        if getattr(m, "parameter_1", None) is not None:
+            out.append(f"parameter_1 {num(m.parameter_1)}")
         if m.ignore_fixed:
             out.append("ignore_fixed")
         if m.ignore_constraints:

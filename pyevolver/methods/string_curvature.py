@@ -1,0 +1,235 @@
+"""String-model bending energies at vertices: ``sqcurve_string``,
+``sqcurve2_string`` and ``sqcurve3_string``.
+
+Surface Evolver 2.70 manual, "Quantities and methods", with the formulas
+evolver-nox-d actually uses (found by experiment, tests/methods/
+test_string_curvature.py).  At a vertex with two edges, ``s1`` and ``s2`` the
+lengths of the edge coming in and the edge going out (the vertex's two edges,
+whatever their orientation), ``c`` the cosine of the exterior angle ``t``
+and ``h = (s1 + s2)/2``:
+
+* the Evolver does not use ``t²`` itself but the first two terms of its
+  series in ``1 − c``: ``T = 2(1 − c) + (1 − c)²/3`` (exact to O(t⁶));
+* ``sqcurve_string``: ``T^(p/2) h^(1−p)``, the integral of ``κ^p`` with
+  ``κ = √T / h`` over the length ``h``; ``p`` is the instance's
+  ``parameter_1`` or else the variable ``curvature_power`` (default 2, created
+  at the first evaluation as the Evolver does).  The manual's
+  ``4(1 − cos t)/(s1 + s2)`` is the leading term for ``p = 2``;
+* ``sqcurve3_string``: ``T (1/s1 + 1/s2)/2`` (no power);
+* ``sqcurve2_string``: ``(σ/h + h₀)² h`` with ``σ`` the sine of the turn
+  from the ``xy`` cross product.  Only ``h₀ = 0`` is supported (then
+  ``σ²/h``): with ``h₀ ≠ 0`` the Evolver's sign of ``σ`` depends on the
+  order of the edges in its vertex lists, which is refused by name.
+
+Vertices with fewer than two edges count 0; vertices with more than two are
+refused (the Evolver takes "the first two edges it finds").  Gradients are
+analytic; the Hessians are the registry's finite differences of them.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import UnsupportedError
+from ..model.string import STRING_METHODS
+from .registry import register_method
+
+
+def _param(s, name: str, default: float) -> float:
+    """A variable's value, created with its default at the first use."""
+    if name not in s.params:
+        s.params[name] = default
+    try:
+        return float(s.params[name])
+    except (TypeError, ValueError):
+        return default
+
+
+def vertex_pairs(s, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                              np.ndarray]:
+    """For the vertices ``idx`` with two edges: their positions ``k`` in idx,
+    the vertices ``v``, the two edges ``e1 < e2``.  Refuses vertices with
+    more than two edges."""
+    E = s.E
+    ne = len(E)
+    ends = np.concatenate([E[:, 0], E[:, 1]])
+    eid = np.concatenate([np.arange(ne), np.arange(ne)])
+    order = np.lexsort((eid, ends))
+    ends, eid = ends[order], eid[order]
+    val = np.bincount(ends, minlength=s.nv)
+    idx = np.asarray(idx, np.int64)
+    if (val[idx] > 2).any():
+        raise UnsupportedError("string curvature methods at vertices with more than two edges",
+                               "the Evolver uses the first two edges of its vertex list")
+    start = np.concatenate([[0], np.cumsum(val)])[:-1]
+    k = np.nonzero(val[idx] == 2)[0]
+    v = idx[k]
+    e1 = eid[start[v]]
+    e2 = eid[start[v] + 1]
+    return k, v, e1, e2
+
+
+def turn_vectors(t, v: np.ndarray, e1: np.ndarray, e2: np.ndarray):
+    """The incoming ``t1`` (into ``v`` along ``e1``), outgoing ``t2`` (out of
+    ``v`` along ``e2``) vectors, (m, D) each, and the far ends ``a``, ``b``."""
+    s = t.surface
+    E = s.E
+    d1 = t.edge_vec[e1]
+    d2 = t.edge_vec[e2]
+    head1 = E[e1, 1] == v
+    t1 = np.where(head1[:, None], d1, -d1)
+    a = np.where(head1, E[e1, 0], E[e1, 1])
+    tail2 = E[e2, 0] == v
+    t2 = np.where(tail2[:, None], d2, -d2)
+    b = np.where(tail2, E[e2, 1], E[e2, 0])
+    return t1, t2, a, b
+
+
+def _geometry(t, idx):
+    s = t.surface
+    k, v, e1, e2 = vertex_pairs(s, idx)
+    t1, t2, a, b = turn_vectors(t, v, e1, e2)
+    s1 = np.linalg.norm(t1, axis=1)
+    s2 = np.linalg.norm(t2, axis=1)
+    c = np.einsum("ij,ij->i", t1, t2) / (s1 * s2)
+    return k, v, a, b, t1, t2, s1, s2, c
+
+
+def _series(c):
+    """T(c) = 2(1 − c) + (1 − c)²/3 and dT/dc."""
+    u = 1.0 - c
+    return 2.0 * u + u * u / 3.0, -2.0 - 2.0 * u / 3.0
+
+
+def _scatter_turn(s, v, a, b, G1, G2):
+    """Gradient (nv, D) from derivatives with respect to t1 = x_v − x_a and
+    t2 = x_b − x_v."""
+    idx = np.concatenate([v, a, v, b])
+    vec = np.concatenate([G1, -G1, -G2, G2])
+    D = s.X.shape[1]
+    out = np.zeros((s.nv, D))
+    for j in range(D):
+        out[:, j] = np.bincount(idx, weights=vec[:, j], minlength=s.nv)
+    return out
+
+
+def _chain(t1, t2, s1, s2, c, fc, fs1, fs2):
+    """∂f/∂t1, ∂f/∂t2 from ∂f/∂c and ∂f/∂s1, ∂f/∂s2 (each (m,))."""
+    inv = 1.0 / (s1 * s2)
+    dc1 = t2 * inv[:, None] - (c / s1 ** 2)[:, None] * t1
+    dc2 = t1 * inv[:, None] - (c / s2 ** 2)[:, None] * t2
+    G1 = fc[:, None] * dc1 + (fs1 / s1)[:, None] * t1
+    G2 = fc[:, None] * dc2 + (fs2 / s2)[:, None] * t2
+    return G1, G2
+
+
+def _power(m, s) -> float:
+    p = getattr(m, "parameter_1", None)
+    if p is not None:
+        return float(p)
+    return _param(s, "curvature_power", 2.0)
+
+
+# ---- sqcurve_string ----------------------------------------------------------------
+def _sqcurve_parts(t, m, idx):
+    k, v, a, b, t1, t2, s1, s2, c = _geometry(t, idx)
+    p = _power(m, t.surface)
+    T, dT = _series(c)
+    h = 0.5 * (s1 + s2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = np.where(T > 0, T, 0.0) ** (p / 2.0) * h ** (1.0 - p)
+        fT = np.nan_to_num((p / 2.0) * np.where(T > 0, T, 0.0) ** (p / 2.0 - 1.0)
+                           * h ** (1.0 - p)) if p != 2 else h ** (1.0 - p)
+        fh = (1.0 - p) * f / h
+    return k, v, a, b, t1, t2, s1, s2, c, f, fT * dT, fh / 2.0
+
+
+def sqcurve(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
+    """Per-vertex ``T^(p/2) h^(1−p)``, shape (len(idx),)."""
+    out = np.zeros(len(idx))
+    parts = _sqcurve_parts(t, m, idx)
+    out[parts[0]] = parts[9]
+    return out
+
+
+def sqcurve_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Gradient (nv, D) of ``Σ w_v f_v``."""
+    k, v, a, b, t1, t2, s1, s2, c, _, fc, fh = _sqcurve_parts(t, m, idx)
+    wk = np.asarray(w, float)[k]
+    G1, G2 = _chain(t1, t2, s1, s2, c, wk * fc, wk * fh, wk * fh)
+    return _scatter_turn(t.surface, v, a, b, G1, G2)
+
+
+# ---- sqcurve3_string ---------------------------------------------------------------
+def sqcurve3(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
+    """Per-vertex ``T (1/s1 + 1/s2)/2``, shape (len(idx),)."""
+    out = np.zeros(len(idx))
+    k, _, _, _, _, _, s1, s2, c = _geometry(t, idx)
+    out[k] = _series(c)[0] * (1.0 / s1 + 1.0 / s2) / 2.0
+    return out
+
+
+def sqcurve3_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Gradient (nv, D) of ``Σ w_v T (1/s1 + 1/s2)/2``."""
+    k, v, a, b, t1, t2, s1, s2, c = _geometry(t, idx)
+    wk = np.asarray(w, float)[k]
+    T, dT = _series(c)
+    r = (1.0 / s1 + 1.0 / s2) / 2.0
+    G1, G2 = _chain(t1, t2, s1, s2, c, wk * dT * r, -wk * T / (2 * s1 ** 2),
+                    -wk * T / (2 * s2 ** 2))
+    return _scatter_turn(t.surface, v, a, b, G1, G2)
+
+
+# ---- sqcurve2_string ---------------------------------------------------------------
+def _check_h_zero(s):
+    h0 = s.params.get("h_zero")
+    attr = s.extra.get(("vertex", "h_zero"))
+    try:
+        nonzero = (h0 is not None and float(h0) != 0.0)
+    except (TypeError, ValueError):
+        nonzero = True
+    if nonzero or (attr is not None and np.any(np.asarray(attr, float) != 0)):
+        raise UnsupportedError("sqcurve2_string with a nonzero h_zero",
+                               "the Evolver's sign of the turn then depends on the order "
+                               "of the edges in its vertex lists")
+
+
+def _cross_z(t1, t2):
+    return t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]
+
+
+def sqcurve2(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
+    """Per-vertex ``σ²/h``, σ = (t1 × t2)_z/(s1 s2), shape (len(idx),)."""
+    _check_h_zero(t.surface)
+    out = np.zeros(len(idx))
+    k, _, _, _, t1, t2, s1, s2, _ = _geometry(t, idx)
+    sg = _cross_z(t1, t2) / (s1 * s2)
+    out[k] = sg * sg / (0.5 * (s1 + s2))
+    return out
+
+
+def sqcurve2_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Gradient (nv, D) of ``Σ w_v cz²/(s1² s2² h)``."""
+    _check_h_zero(t.surface)
+    k, v, a, b, t1, t2, s1, s2, _ = _geometry(t, idx)
+    wk = np.asarray(w, float)[k]
+    cz = _cross_z(t1, t2)
+    h = 0.5 * (s1 + s2)
+    f = cz * cz / (s1 ** 2 * s2 ** 2 * h)
+    fcz = wk * 2.0 * cz / (s1 ** 2 * s2 ** 2 * h)
+    fs1 = wk * f * (-2.0 / s1 - 0.5 / h)
+    fs2 = wk * f * (-2.0 / s2 - 0.5 / h)
+    G1 = (fs1 / s1)[:, None] * t1
+    G2 = (fs2 / s2)[:, None] * t2
+    G1[:, 0] += fcz * t2[:, 1]
+    G1[:, 1] -= fcz * t2[:, 0]
+    G2[:, 0] -= fcz * t1[:, 1]
+    G2[:, 1] += fcz * t1[:, 0]
+    return _scatter_turn(t.surface, v, a, b, G1, G2)
+
+
+register_method("sqcurve_string", "vertex", sqcurve, sqcurve_gradient)
+register_method("sqcurve3_string", "vertex", sqcurve3, sqcurve3_gradient)
+register_method("sqcurve2_string", "vertex", sqcurve2, sqcurve2_gradient)
+STRING_METHODS.update({"sqcurve_string", "sqcurve2_string", "sqcurve3_string"})
