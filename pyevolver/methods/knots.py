@@ -26,8 +26,13 @@ of two edges, ``L`` and ``V`` edge lengths and vectors:
   ``(1 − cos α)²`` is not what the program computes).
 
 Each element's value is its row of the pair sum.  Gradients are analytic
-(every ordered term differentiated in full); ``knot_energy`` has an analytic
-(dense) Hessian, the others the registry's finite differences.
+(every ordered term differentiated in full, checked against differences);
+``g`` moves by them, except: ``uniform_knot_energy`` moves by REF's force
+(the charge part of the gradient halved, :func:`uniform_knot_force`) and
+``g`` with ``proj_knot_energy`` is refused by name (REF's force differs
+from :func:`proj_knot_gradient` in a way not reproduced).  ``knot_energy``
+has an analytic (dense) Hessian; ``hessian`` with the others is refused by
+name, where REF stops with its error 1571.
 """
 from __future__ import annotations
 
@@ -35,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import PyEvolverError
+from ..errors import PyEvolverError, UnsupportedError
 from ..model.string import STRING_METHODS
 from ._common import assemble
 from .registry import register_method
@@ -336,13 +341,40 @@ def circle_knot_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.n
     return _edge_scatter(s, idx, gV, gL, gM, V, L)
 
 
+def uniform_knot_force(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """REF's "gradient" of ``uniform_knot_energy`` (what ``g`` moves by): the
+    part through the distances in full, the part through the charges
+    (:func:`uniform_knot_gradient`) halved — measured with ``v_force``
+    (tests/methods/test_knots.py); not the gradient of its value."""
+    s = t.surface
+    idx = np.asarray(idx, np.int64)
+    full = uniform_knot_gradient(t, m, idx, w)
+    q = _uniform_charges(t, idx)
+    D, r2 = _pair_matrix(s.X[idx])
+    C = -knot_power(s) * np.outer(np.asarray(w, float) * q, q) * \
+        r2 ** (-knot_power(s) / 2.0 - 1.0)
+    g_r = _vertex_pair_grad(s, idx, C, D)
+    return g_r + 0.5 * (full - g_r)
+
+
+def proj_knot_refused(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``g`` with ``proj_knot_energy``: refused by name (see the module)."""
+    raise UnsupportedError("the gradient of method proj_knot_energy",
+                           "REF's force is not the gradient of its energy "
+                           "(proj_knot_gradient) and was not reproduced")
+
+
+_NO_H = "REF: ERROR 1571 (the method has no Hessian available)"
 register_method("knot_energy", "vertex", knot, knot_gradient, knot_hessian)
-register_method("uniform_knot_energy", "vertex", uniform_knot, uniform_knot_gradient)
-register_method("edge_knot_energy", "edge", edge_knot, edge_knot_gradient)
-register_method("edge_edge_knot_energy", "edge", edge_knot, edge_knot_gradient)
-register_method("buck_knot_energy", "edge", buck_knot, buck_knot_gradient)
-register_method("proj_knot_energy", "edge", proj_knot, proj_knot_gradient)
-register_method("circle_knot_energy", "edge", circle_knot, circle_knot_gradient)
+register_method("uniform_knot_energy", "vertex", uniform_knot, uniform_knot_force,
+                no_hessian=_NO_H)
+register_method("edge_knot_energy", "edge", edge_knot, edge_knot_gradient, no_hessian=_NO_H)
+register_method("edge_edge_knot_energy", "edge", edge_knot, edge_knot_gradient,
+                no_hessian=_NO_H)
+register_method("buck_knot_energy", "edge", buck_knot, buck_knot_gradient, no_hessian=_NO_H)
+register_method("proj_knot_energy", "edge", proj_knot, proj_knot_refused, no_hessian=_NO_H)
+register_method("circle_knot_energy", "edge", circle_knot, circle_knot_gradient,
+                no_hessian=_NO_H)
 STRING_METHODS.update({"knot_energy", "uniform_knot_energy", "edge_knot_energy",
                        "edge_edge_knot_energy", "buck_knot_energy", "proj_knot_energy",
                        "circle_knot_energy"})

@@ -19,7 +19,9 @@ and ``h = (s1 + s2)/2``:
 * ``sqcurve2_string``: ``(σ/h + h₀)² h`` with ``σ`` the sine of the turn
   from the ``xy`` cross product.  Only ``h₀ = 0`` is supported (then
   ``σ²/h``): with ``h₀ ≠ 0`` the Evolver's sign of ``σ`` depends on the
-  order of the edges in its vertex lists, which is refused by name.
+  order of the edges in its vertex lists, which is refused by name; a
+  method of the plane: ``g`` with it in space dimension 3 is refused by
+  name (REF's force out of the plane was not reproduced).
 
 Vertices with fewer than two edges count 0; vertices with more than two are
 refused (the Evolver takes "the first two edges it finds").  Gradients are
@@ -210,6 +212,16 @@ def sqcurve2(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
 
 
 def sqcurve2_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """What ``g`` moves by: :func:`sqcurve2_full_gradient` in the plane,
+    refused by name in space (REF's force there differs)."""
+    if t.surface.sdim > 2:
+        raise UnsupportedError("the gradient of method sqcurve2_string in space dimension 3",
+                               "a method of the plane: REF's force out of it was not "
+                               "reproduced")
+    return sqcurve2_full_gradient(t, m, idx, w)
+
+
+def sqcurve2_full_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Gradient (nv, D) of ``Σ w_v cz²/(s1² s2² h)``."""
     _check_h_zero(t.surface)
     k, v, a, b, t1, t2, s1, s2, _ = _geometry(t, idx)
@@ -231,5 +243,38 @@ def sqcurve2_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndar
 
 register_method("sqcurve_string", "vertex", sqcurve, sqcurve_gradient)
 register_method("sqcurve3_string", "vertex", sqcurve3, sqcurve3_gradient)
-register_method("sqcurve2_string", "vertex", sqcurve2, sqcurve2_gradient)
+register_method("sqcurve2_string", "vertex", sqcurve2, sqcurve2_gradient,
+                no_hessian="REF: the method has no Hessian (manual)")
 STRING_METHODS.update({"sqcurve_string", "sqcurve2_string", "sqcurve3_string"})
+
+
+# ---- the vertex attribute mean_curvature ------------------------------------------
+def string_mean_curvature(s, t) -> np.ndarray:
+    """(nv,) the string model's vertex ``mean_curvature`` (REF's values):
+    ``F·N/(N·N)``, ``F = u_out − u_in`` the difference of the unit edge
+    vectors (minus the length gradient) and ``N = rot90(x_b − x_a)/2`` in
+    the xy plane (minus the gradient of the enclosed area), ``a`` the tail of
+    the edge coming in and ``b`` the head of the edge going out.  0 at
+    vertices with one edge; a vertex whose two edges both come in or both go
+    out is refused (REF's sign there follows its vertex lists)."""
+    k, v, e1, e2 = vertex_pairs(s, np.arange(s.nv))
+    E = s.E
+    in1 = E[e1, 1] == v
+    out2 = E[e2, 0] == v
+    in2 = E[e2, 1] == v
+    out1 = E[e1, 0] == v
+    swap = ~in1 & in2
+    if np.any(~((in1 & out2) | (out1 & in2))):
+        raise UnsupportedError("vertex mean_curvature in the string model where both edges "
+                               "point into or out of the vertex",
+                               "REF's sign there follows its vertex lists")
+    ein = np.where(swap, e2, e1)
+    eout = np.where(swap, e1, e2)
+    t1, t2, a, b = turn_vectors(t, v, ein, eout)
+    F = t2 / np.linalg.norm(t2, axis=1)[:, None] - t1 / np.linalg.norm(t1, axis=1)[:, None]
+    d = t1 + t2
+    N = 0.5 * np.stack([-d[:, 1], d[:, 0]], axis=1)
+    out = np.zeros(s.nv)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out[v] = np.einsum("ij,ij->i", F[:, :2], N) / np.einsum("ij,ij->i", N, N)
+    return out
