@@ -15,6 +15,8 @@ and ``h = (s1 + s2)/2``:
   ``parameter_1`` or else the variable ``curvature_power`` (default 2, created
   at the first evaluation as the Evolver does).  The manual's
   ``4(1 − cos t)/(s1 + s2)`` is the leading term for ``p = 2``;
+* ``sqcurve_string_marked``: ``sqcurve_string`` with only the edges whose
+  attribute ``sqcurve_string_mark`` is nonzero (0 at a vertex with one);
 * ``sqcurve3_string``: ``T (1/s1 + 1/s2)/2`` (no power);
 * ``sqcurve2_string``: ``(σ/h + h₀)² h`` with ``σ`` the sine of the turn
   from the ``xy`` cross product.  Only ``h₀ = 0`` is supported (then
@@ -48,15 +50,20 @@ def _param(s, name: str, default: float) -> float:
         return default
 
 
-def vertex_pairs(s, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                              np.ndarray]:
+def vertex_pairs(s, idx: np.ndarray, marked: bool = False) -> tuple[
+        np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """For the vertices ``idx`` with two edges: their positions ``k`` in idx,
     the vertices ``v``, the two edges ``e1 < e2``.  Refuses vertices with
-    more than two edges."""
+    more than two edges.  ``marked``: only the edges whose attribute
+    ``sqcurve_string_mark`` is nonzero count (``sqcurve_string_marked``)."""
     E = s.E
     ne = len(E)
-    ends = np.concatenate([E[:, 0], E[:, 1]])
-    eid = np.concatenate([np.arange(ne), np.arange(ne)])
+    eids = np.arange(ne)
+    if marked:
+        mark = s.extra.get(("edge", "sqcurve_string_mark"))
+        eids = eids[np.asarray(mark, float) != 0] if mark is not None else eids[:0]
+    ends = np.concatenate([E[eids, 0], E[eids, 1]])
+    eid = np.concatenate([eids, eids])
     order = np.lexsort((eid, ends))
     ends, eid = ends[order], eid[order]
     val = np.bincount(ends, minlength=s.nv)
@@ -88,9 +95,9 @@ def turn_vectors(t, v: np.ndarray, e1: np.ndarray, e2: np.ndarray):
     return t1, t2, a, b
 
 
-def _geometry(t, idx):
+def _geometry(t, idx, marked=False):
     s = t.surface
-    k, v, e1, e2 = vertex_pairs(s, idx)
+    k, v, e1, e2 = vertex_pairs(s, idx, marked)
     t1, t2, a, b = turn_vectors(t, v, e1, e2)
     s1 = np.linalg.norm(t1, axis=1)
     s2 = np.linalg.norm(t2, axis=1)
@@ -134,8 +141,8 @@ def _power(m, s) -> float:
 
 
 # ---- sqcurve_string ----------------------------------------------------------------
-def _sqcurve_parts(t, m, idx):
-    k, v, a, b, t1, t2, s1, s2, c = _geometry(t, idx)
+def _sqcurve_parts(t, m, idx, marked=False):
+    k, v, a, b, t1, t2, s1, s2, c = _geometry(t, idx, marked)
     p = _power(m, t.surface)
     T, dT = _series(c)
     h = 0.5 * (s1 + s2)
@@ -158,6 +165,22 @@ def sqcurve(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
 def sqcurve_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Gradient (nv, D) of ``Σ w_v f_v``."""
     k, v, a, b, t1, t2, s1, s2, c, _, fc, fh = _sqcurve_parts(t, m, idx)
+    wk = np.asarray(w, float)[k]
+    G1, G2 = _chain(t1, t2, s1, s2, c, wk * fc, wk * fh, wk * fh)
+    return _scatter_turn(t.surface, v, a, b, G1, G2)
+
+
+def sqcurve_marked(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
+    """``sqcurve_string`` over the marked edges only, shape (len(idx),)."""
+    out = np.zeros(len(idx))
+    parts = _sqcurve_parts(t, m, idx, marked=True)
+    out[parts[0]] = parts[9]
+    return out
+
+
+def sqcurve_marked_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Gradient (nv, D) of ``Σ w_v f_v`` over the marked edges."""
+    k, v, a, b, t1, t2, s1, s2, c, _, fc, fh = _sqcurve_parts(t, m, idx, marked=True)
     wk = np.asarray(w, float)[k]
     G1, G2 = _chain(t1, t2, s1, s2, c, wk * fc, wk * fh, wk * fh)
     return _scatter_turn(t.surface, v, a, b, G1, G2)
@@ -242,10 +265,12 @@ def sqcurve2_full_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np
 
 
 register_method("sqcurve_string", "vertex", sqcurve, sqcurve_gradient)
+register_method("sqcurve_string_marked", "vertex", sqcurve_marked, sqcurve_marked_gradient)
 register_method("sqcurve3_string", "vertex", sqcurve3, sqcurve3_gradient)
 register_method("sqcurve2_string", "vertex", sqcurve2, sqcurve2_gradient,
                 no_hessian="REF: the method has no Hessian (manual)")
-STRING_METHODS.update({"sqcurve_string", "sqcurve2_string", "sqcurve3_string"})
+STRING_METHODS.update({"sqcurve_string", "sqcurve2_string", "sqcurve3_string",
+                       "sqcurve_string_marked"})
 
 
 # ---- the vertex attribute mean_curvature ------------------------------------------

@@ -178,3 +178,36 @@ def test_string_mean_curvature_refused_on_reversed_edges(tmp_path):
     s = Session.load(str(p), out=io.StringIO()).surface
     with pytest.raises(UnsupportedError):
         SC.string_mean_curvature(s, s.evaluate())
+
+
+MARKED = """string
+space_dimension 3
+define edge attribute sqcurve_string_mark integer
+quantity qm energy method sqcurve_string_marked global
+quantity qs energy modulus 0 method sqcurve_string global
+vertices
+1 0 0 0
+2 1 0 0.1
+3 2 0.3 0
+4 1 1 0.2
+5 3 1 0
+6 1.2 -1 0.3
+edges
+1 1 2 sqcurve_string_mark 1
+2 2 3 sqcurve_string_mark 1
+3 2 4
+4 3 5 sqcurve_string_mark 1
+5 6 2 sqcurve_string_mark 0
+"""
+
+
+def test_marked_agrees_with_the_evolver(evolver, tmp_path):
+    p = tmp_path / "marked.fe"
+    p.write_text(MARKED)
+    script = ('printf "%.15g\\n", qm.value\ng 3\nset edge[2] sqcurve_string_mark 0\n'
+              'set edge[3] sqcurve_string_mark 1\nrecalc\nprintf "%.15g\\n", qm.value\ng 2\n')
+    ref, out, err = _run_both(evolver, str(p), script, tmp_path)
+    pick = lambda lines: [ln for ln in lines if "energy:" in ln or ln.strip()[:1].isdigit()]
+    ref, out = pick(ref), pick(out)
+    assert len(ref) == 7, ref
+    assert _same(out, ref, STEPS), (out, ref, err)
