@@ -424,7 +424,7 @@ class _FeWriter:
             c = self._cons(s.econ, k, signed=True)
             if c:
                 parts.append(c)
-            if ea.get("tension") is not None and ea["tension"][k] != 0:
+            if ea.get("tension") is not None and ea["tension"][k] != (1.0 if s.string else 0.0):
                 parts.append(f"density {num(ea['tension'][k])}")
             if ea.get("no_refine") is not None and ea["no_refine"][k]:
                 parts.append("no_refine")
