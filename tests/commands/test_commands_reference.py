@@ -1,7 +1,6 @@
 """The command language prints what evolver-nox-d prints (reference check 18,
 run live through both programs)."""
 import os
-
 import re
 
 import pytest
