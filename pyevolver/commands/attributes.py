@@ -81,8 +81,8 @@ ATTRIBUTES = [
      "with `normal_curvature` on), 0 at FIXED and boundary vertices, as REF"),
     ("vertex", "mean_curvature (string model)", "supported: F·N/(N·N), F the difference of "
      "the unit vectors of the edge going out and the edge coming in, N half the xy "
-     "rotation of the chord from the previous to the next vertex (REF's values, "
-     "tension-free); 0 at ends; refused where both edges come in or both go out"),
+     "rotation of the chord from the previous to the next vertex, the sign of the first "
+     "edge of REF's vertex ring (REF's values, tension-free); 0 at ends"),
     ("vertex", "sqcurve (string model)", "refused by name (REF prints 0 without facets and "
      "unexplained numbers with them)"),
     ("vertex", "dihedral", "string model: 2 asin(F/2), F the length of the sum of the unit "

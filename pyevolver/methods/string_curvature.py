@@ -19,11 +19,12 @@ and ``h = (s1 + s2)/2``:
   attribute ``sqcurve_string_mark`` is nonzero (0 at a vertex with one);
 * ``sqcurve3_string``: ``T (1/s1 + 1/s2)/2`` (no power);
 * ``sqcurve2_string``: ``(σ/h + h₀)² h`` with ``σ`` the sine of the turn
-  from the ``xy`` cross product.  Only ``h₀ = 0`` is supported (then
-  ``σ²/h``): with ``h₀ ≠ 0`` the Evolver's sign of ``σ`` depends on the
-  order of the edges in its vertex lists, which is refused by name; a
-  method of the plane: ``g`` with it in space dimension 3 is refused by
-  name (REF's force out of the plane was not reproduced).
+  from the ``xy`` cross product of the vertex's edges taken in the order
+  of REF's edge ring (its first edge coming in; so the sign of ``σ``
+  follows REF's vertex lists, not the curve's orientation), ``h₀`` the
+  vertex attribute or variable ``h_zero``; a method of the plane: ``g``
+  with it in space dimension 3 is refused by name (REF's force out of the
+  plane was not reproduced).
 
 Vertices with fewer than two edges count 0; vertices with more than two are
 refused (the Evolver takes "the first two edges it finds").  Gradients are
@@ -207,30 +208,51 @@ def sqcurve3_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndar
 
 
 # ---- sqcurve2_string ---------------------------------------------------------------
-def _check_h_zero(s):
-    h0 = s.params.get("h_zero")
+def ring_pairs(s, idx):
+    """Like :func:`vertex_pairs`, with ``e1`` the vertex's first edge in
+    REF's ring (``vattr["ring_head"]``, :mod:`pyevolver.model.string`) and
+    ``e2`` the other: the order in which REF "finds" them."""
+    k, v, e1, e2 = vertex_pairs(s, idx)
+    head = s.vattr.get("ring_head")
+    if head is not None:
+        swap = head[v] == e2
+        e1, e2 = np.where(swap, e2, e1), np.where(swap, e1, e2)
+    return k, v, e1, e2
+
+
+def h_zero(s, v) -> np.ndarray:
+    """(m,) the intrinsic curvature at vertices ``v``: the vertex attribute
+    ``h_zero`` when declared, else the variable ``h_zero`` (0 when unset)."""
     attr = s.extra.get(("vertex", "h_zero"))
+    if attr is not None:
+        return np.asarray(attr, float)[v]
     try:
-        nonzero = (h0 is not None and float(h0) != 0.0)
+        return np.full(len(v), float(s.params.get("h_zero", 0.0) or 0.0))
     except (TypeError, ValueError):
-        nonzero = True
-    if nonzero or (attr is not None and np.any(np.asarray(attr, float) != 0)):
-        raise UnsupportedError("sqcurve2_string with a nonzero h_zero",
-                               "the Evolver's sign of the turn then depends on the order "
-                               "of the edges in its vertex lists")
+        return np.zeros(len(v))
 
 
 def _cross_z(t1, t2):
     return t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]
 
 
-def sqcurve2(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
-    """Per-vertex ``σ²/h``, σ = (t1 × t2)_z/(s1 s2), shape (len(idx),)."""
-    _check_h_zero(t.surface)
-    out = np.zeros(len(idx))
-    k, _, _, _, t1, t2, s1, s2, _ = _geometry(t, idx)
+def _sq2_parts(t, idx):
+    s = t.surface
+    k, v, e1, e2 = ring_pairs(s, idx)
+    t1, t2, a, b = turn_vectors(t, v, e1, e2)
+    s1 = np.linalg.norm(t1, axis=1)
+    s2 = np.linalg.norm(t2, axis=1)
+    h = 0.5 * (s1 + s2)
     sg = _cross_z(t1, t2) / (s1 * s2)
-    out[k] = sg * sg / (0.5 * (s1 + s2))
+    return k, v, a, b, t1, t2, s1, s2, h, sg, h_zero(s, v)
+
+
+def sqcurve2(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
+    """Per-vertex ``(σ/h + h₀)² h``, σ = (t1 × t2)_z/(s1 s2) with the edges
+    in REF's ring order, shape (len(idx),)."""
+    out = np.zeros(len(idx))
+    k, _, _, _, _, _, _, _, h, sg, h0 = _sq2_parts(t, idx)
+    out[k] = (sg / h + h0) ** 2 * h
     return out
 
 
@@ -245,16 +267,14 @@ def sqcurve2_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndar
 
 
 def sqcurve2_full_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Gradient (nv, D) of ``Σ w_v cz²/(s1² s2² h)``."""
-    _check_h_zero(t.surface)
-    k, v, a, b, t1, t2, s1, s2, _ = _geometry(t, idx)
+    """Gradient (nv, D) of ``Σ w_v (σ/h + h₀)² h`` = ``Σ w_v (σ²/h + 2h₀σ + h₀²h)``."""
+    k, v, a, b, t1, t2, s1, s2, h, sg, h0 = _sq2_parts(t, idx)
     wk = np.asarray(w, float)[k]
-    cz = _cross_z(t1, t2)
-    h = 0.5 * (s1 + s2)
-    f = cz * cz / (s1 ** 2 * s2 ** 2 * h)
-    fcz = wk * 2.0 * cz / (s1 ** 2 * s2 ** 2 * h)
-    fs1 = wk * f * (-2.0 / s1 - 0.5 / h)
-    fs2 = wk * f * (-2.0 / s2 - 0.5 / h)
+    fs = wk * (2.0 * sg / h + 2.0 * h0)                     # ∂f/∂σ
+    fh = wk * (-(sg / h) ** 2 + h0 * h0)                    # ∂f/∂h
+    fcz = fs / (s1 * s2)
+    fs1 = -fs * sg / s1 + 0.5 * fh
+    fs2 = -fs * sg / s2 + 0.5 * fh
     G1 = (fs1 / s1)[:, None] * t1
     G2 = (fs2 / s2)[:, None] * t2
     G1[:, 0] += fcz * t2[:, 1]
@@ -276,30 +296,19 @@ STRING_METHODS.update({"sqcurve_string", "sqcurve2_string", "sqcurve3_string",
 # ---- the vertex attribute mean_curvature ------------------------------------------
 def string_mean_curvature(s, t) -> np.ndarray:
     """(nv,) the string model's vertex ``mean_curvature`` (REF's values):
-    ``F·N/(N·N)``, ``F = u_out − u_in`` the difference of the unit edge
-    vectors (minus the length gradient) and ``N = rot90(x_b − x_a)/2`` in
-    the xy plane (minus the gradient of the enclosed area), ``a`` the tail of
-    the edge coming in and ``b`` the head of the edge going out.  0 at
-    vertices with one edge; a vertex whose two edges both come in or both go
-    out is refused (REF's sign there follows its vertex lists)."""
-    k, v, e1, e2 = vertex_pairs(s, np.arange(s.nv))
-    E = s.E
-    in1 = E[e1, 1] == v
-    out2 = E[e2, 0] == v
-    in2 = E[e2, 1] == v
-    out1 = E[e1, 0] == v
-    swap = ~in1 & in2
-    if np.any(~((in1 & out2) | (out1 & in2))):
-        raise UnsupportedError("vertex mean_curvature in the string model where both edges "
-                               "point into or out of the vertex",
-                               "REF's sign there follows its vertex lists")
-    ein = np.where(swap, e2, e1)
-    eout = np.where(swap, e1, e2)
-    t1, t2, a, b = turn_vectors(t, v, ein, eout)
+    ``σ F·N/(N·N)`` with the vertex's edges in REF's ring order
+    (:func:`ring_pairs`), ``a`` and ``b`` the far ends of the first and the
+    second edge, ``F = u(b − v) − u(v − a)`` (u: unit vector; minus the
+    length gradient), ``N = rot90(x_b − x_a)/2`` in the xy plane and ``σ``
+    +1 when the first edge comes into the vertex, −1 when it goes out.  0 at
+    vertices with one edge."""
+    k, v, e1, e2 = ring_pairs(s, np.arange(s.nv))
+    t1, t2, a, b = turn_vectors(t, v, e1, e2)
     F = t2 / np.linalg.norm(t2, axis=1)[:, None] - t1 / np.linalg.norm(t1, axis=1)[:, None]
     d = t1 + t2
     N = 0.5 * np.stack([-d[:, 1], d[:, 0]], axis=1)
+    sign = np.where(s.E[e1, 1] == v, 1.0, -1.0)
     out = np.zeros(s.nv)
     with np.errstate(divide="ignore", invalid="ignore"):
-        out[v] = np.einsum("ij,ij->i", F[:, :2], N) / np.einsum("ij,ij->i", N, N)
+        out[v] = sign * np.einsum("ij,ij->i", F[:, :2], N) / np.einsum("ij,ij->i", N, N)
     return out

@@ -90,10 +90,43 @@ def test_one_vertex_series(tmp_path):
     assert abs(SC.sqcurve2(t, None, idx).sum() - np.sin(t_) ** 2 / h) <= 1e-14
 
 
-def test_h_zero_refused(tmp_path):
-    with pytest.raises(Exception, match="sqcurve2_string with a nonzero h_zero"):
-        Session.load(_file(tmp_path, QS[2:3], decl="parameter h_zero = 0.5"),
-                     out=io.StringIO(), err=io.StringIO())
+H_ZERO = """string
+space_dimension 2
+define vertex attribute h_zero real
+quantity qa energy method sqcurve2_string global
+vertices
+1 0 0 h_zero 0.3
+2 1 0 h_zero -0.2
+3 1.3 2 h_zero 0.5
+4 0 1.2 h_zero 0.1
+5 -0.8 0.4 h_zero 0.7
+edges
+1 1 2
+2 3 2
+3 3 4
+4 4 5
+5 5 1
+"""
+
+
+@pytest.mark.parametrize("cmds", ["g 3", "r\ng 3", "r\nr\ng 2"])
+def test_h_zero_in_ring_order_agrees_with_the_evolver(evolver, tmp_path, cmds):
+    """σ's sign follows REF's edge rings (edge 2 is reversed here), also
+    after r; the vertex attribute h_zero."""
+    p = tmp_path / "hzero.fe"
+    p.write_text(H_ZERO)
+    script = f'printf "%.15g\\n", qa.value\n{cmds}\nprintf "%.15g\\n", qa.value\n'
+    ref, out, err = _run_both(evolver, str(p), script, tmp_path)
+    pick = lambda lines: [ln for ln in lines if "energy:" in ln or ln.strip()[:1].isdigit()]
+    ref, out = pick(ref), pick(out)
+    assert len(ref) >= 4, ref
+    assert _same(out, ref, STEPS), (out, ref, err)
+
+
+def test_h_zero_variable_in_space_agrees_with_the_evolver(evolver, tmp_path):
+    f = _file(tmp_path, QS[2:3], decl="parameter h_zero = 0.7")
+    ref, out, err = _run_both(evolver, f, 'printf "%.15g\\n", qc.value\n', tmp_path)
+    assert _same(_numbers(out), _numbers(ref), PRINTED), (out, ref, err)
 
 
 def test_three_edges_at_a_vertex_refused(tmp_path):
@@ -107,9 +140,11 @@ def test_three_edges_at_a_vertex_refused(tmp_path):
 
 @pytest.mark.parametrize("name,p", [("sqcurve_string", None), ("sqcurve_string", 3.0),
                                     ("sqcurve_string", 1.5), ("sqcurve2_string", None),
-                                    ("sqcurve3_string", None)])
+                                    ("sqcurve2_string", "h_zero"), ("sqcurve3_string", None)])
 def test_gradients_against_central_differences(tmp_path, name, p):
-    s = Session.load(_file(tmp_path, [("qq", f"method {name} global")]),
+    decl = "parameter h_zero = 0.6" if p == "h_zero" else ""
+    p = None if p == "h_zero" else p
+    s = Session.load(_file(tmp_path, [("qq", f"method {name} global")], decl=decl),
                      out=io.StringIO()).surface
     m = s.quantities["qq"].methods[0][0]
     m.parameter_1 = p
@@ -171,13 +206,18 @@ def test_string_mean_curvature_agrees_with_the_evolver(evolver, tmp_path):
     assert _same(out, ref, PRINTED), (out, ref, err)
 
 
-def test_string_mean_curvature_refused_on_reversed_edges(tmp_path):
+def test_string_mean_curvature_on_reversed_edges_agrees_with_the_evolver(evolver, tmp_path):
+    """Edge 2 reversed: vertex 2 has both edges coming in, vertex 3 both
+    going out (REF's sign follows the first edge of its ring)."""
     p = tmp_path / "rev.fe"
-    p.write_text("string\nspace_dimension 2\nvertices\n1 0 0\n2 1 0\n3 1 1\n"
-                 "edges\n1 1 2\n2 3 2\n3 3 1\n")
-    s = Session.load(str(p), out=io.StringIO()).surface
-    with pytest.raises(UnsupportedError):
-        SC.string_mean_curvature(s, s.evaluate())
+    p.write_text("string\nspace_dimension 2\nvertices\n1 0 0\n2 1 0\n3 1.3 2\n4 0 1.2\n"
+                 "5 -0.8 0.4\nedges\n1 1 2\n2 3 2\n3 3 4\n4 4 5\n5 5 1\n")
+    script = "foreach vertex vv do printf \"%.15g\\n\", vv.mean_curvature\nr\n" \
+             "foreach vertex vv do printf \"%.15g\\n\", vv.mean_curvature\n"
+    ref, out, err = _run_both(evolver, str(p), script, tmp_path)
+    ref, out = _numbers(ref), _numbers(out)
+    assert len(ref) == 15, ref
+    assert _same(out, ref, PRINTED), (out, ref, err)
 
 
 MARKED = """string
