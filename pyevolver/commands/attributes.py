@@ -83,8 +83,8 @@ ATTRIBUTES = [
      "the unit vectors of the edge going out and the edge coming in, N half the xy "
      "rotation of the chord from the previous to the next vertex, the sign of the first "
      "edge of REF's vertex ring (REF's values, tension-free); 0 at ends"),
-    ("vertex", "sqcurve (string model)", "refused by name (REF prints 0 without facets and "
-     "unexplained numbers with them)"),
+    ("vertex", "sqcurve (string model)", "0 without facets (REF's value, also after g); "
+     "refused by name on strings with facets (REF prints numbers not reproduced)"),
     ("vertex", "dihedral", "string model: 2 asin(F/2), F the length of the sum of the unit "
      "edge vectors, clamped to π (REF); soapfilm model: REF's error \"Dihedral only for "
      "edges\""),
@@ -282,6 +282,8 @@ def element_attr(session, base, name, idx):
             fn = SC.string_mean_curvature if s.string else GA.vertex_mean_curvature
             return float(cache(session).get(session, name, fn)[i])
         if name == "sqcurve":
+            if s.string and len(s.sf_ptr) <= 1:
+                return 0.0              # REF: 0 on strings without facets (knotty.fe)
             _no_string(s, name)
             tg = session.toggles
             mode = ("norm" if tg.get("normal_curvature") else

@@ -251,3 +251,12 @@ def test_marked_agrees_with_the_evolver(evolver, tmp_path):
     ref, out = pick(ref), pick(out)
     assert len(ref) == 7, ref
     assert _same(out, ref, STEPS), (out, ref, err)
+
+
+def test_string_sqcurve_attribute_is_zero_without_facets(evolver, tmp_path):
+    f = _file(tmp_path, QS[:1])
+    script = 'printf "%.15g\\n", max(vertex, sqcurve)\ng 2\nprintf "%.15g\\n", vertex[2].sqcurve\n'
+    ref, out, err = _run_both(evolver, f, script, tmp_path)
+    ref, out = _numbers(ref), _numbers(out)
+    assert ref[0] == "0" and ref[-1] == "0", ref
+    assert _same(out, ref, STEPS), (out, ref, err)
