@@ -23,7 +23,9 @@ of two edges, ``L`` and ``V`` edge lengths and vectors:
   ``cos α`` between edge a and the tangent at ``M_a`` of the circle through
   ``M_a`` tangent to edge b at ``M_b`` — polynomially
   ``(L_a L_b + V_a·V_b − 2 (V_a·d)(V_b·d)/|d|²)/|d|²`` (the manual's
-  ``(1 − cos α)²`` is not what the program computes).
+  ``(1 − cos α)²`` is not what the program computes);
+* ``writhe`` (edge): ``Σ_{a≠b} (V_a × V_b)·d/(4π |d|³)`` (the manual's sum
+  over 4π, ordered pairs).
 
 Each element's value is its row of the pair sum.  Gradients are analytic
 (every ordered term differentiated in full, checked against differences);
@@ -341,6 +343,36 @@ def circle_knot_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.n
     return _edge_scatter(s, idx, gV, gL, gM, V, L)
 
 
+def _writhe_parts(t, idx):
+    V, L, M = _edge_vectors(t, idx)
+    d, d2 = _mid_pairs(M)
+    np.fill_diagonal(d2, 1.0)
+    C = np.cross(V[:, None, :], V[None, :, :])              # V_a × V_b
+    det = np.einsum("abk,abk->ab", C, d)
+    r3 = d2 ** 1.5
+    return V, L, d, d2, C, det, r3
+
+
+def writhe(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
+    """Per-edge ``Σ_b (V_a × V_b)·d_ab / (4π |d_ab|³)`` (the Gauss integral)."""
+    _, _, _, _, _, det, r3 = _writhe_parts(t, idx)
+    return (det / r3).sum(axis=1) / (4.0 * np.pi)
+
+
+def writhe_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Gradient (nv, D) of ``Σ_a w_a Σ_b det(V_a, V_b, d)/(4π|d|³)``."""
+    s = t.surface
+    V, L, d, d2, C, det, r3 = _writhe_parts(t, idx)
+    W = np.asarray(w, float)[:, None] / (4.0 * np.pi) / r3
+    np.fill_diagonal(W, 0.0)
+    # ∂/∂V_a = V_b × d, ∂/∂V_b = d × V_a
+    gV = np.einsum("ab,abk->ak", W, np.cross(V[None, :, :], d)) \
+        + np.einsum("ab,abk->bk", W, np.cross(d, V[:, None, :]))
+    Gd = W[:, :, None] * C - (3.0 * W * det / d2)[:, :, None] * d
+    gM = Gd.sum(axis=1) - Gd.sum(axis=0)
+    return _edge_scatter(s, idx, gV, np.zeros(len(L)), gM, V, L)
+
+
 def uniform_knot_force(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """REF's "gradient" of ``uniform_knot_energy`` (what ``g`` moves by): the
     part through the distances in full, the part through the charges
@@ -375,6 +407,7 @@ register_method("buck_knot_energy", "edge", buck_knot, buck_knot_gradient, no_he
 register_method("proj_knot_energy", "edge", proj_knot, proj_knot_refused, no_hessian=_NO_H)
 register_method("circle_knot_energy", "edge", circle_knot, circle_knot_gradient,
                 no_hessian=_NO_H)
+register_method("writhe", "edge", writhe, writhe_gradient, no_hessian=_NO_H)
 STRING_METHODS.update({"knot_energy", "uniform_knot_energy", "edge_knot_energy",
                        "edge_edge_knot_energy", "buck_knot_energy", "proj_knot_energy",
-                       "circle_knot_energy"})
+                       "circle_knot_energy", "writhe"})

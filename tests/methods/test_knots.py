@@ -23,7 +23,7 @@ _X = np.c_[2 * np.cos(_TH), 2 * np.sin(_TH), 0.3 * np.sin(2 * _TH)] + 0.1 * np.a
     [[0.3, -0.2, 0.1], [-0.1, 0.4, 0.2], [0.2, 0.1, -0.3], [0.0, -0.3, 0.1],
      [0.1, 0.2, 0.0], [-0.4, 0.1, 0.2], [0.2, -0.1, -0.1], [0.1, 0.3, 0.4]])
 METHODS = ["knot_energy", "uniform_knot_energy", "edge_knot_energy", "edge_edge_knot_energy",
-           "buck_knot_energy", "proj_knot_energy", "circle_knot_energy"]
+           "buck_knot_energy", "proj_knot_energy", "circle_knot_energy", "writhe"]
 
 
 def _octagon(tmp_path, methods, decl="", tension=1):
@@ -61,7 +61,7 @@ def test_values_agree_with_the_evolver(evolver, tmp_path, power):
 
 
 @pytest.mark.parametrize("method", ["knot_energy", "edge_knot_energy", "buck_knot_energy",
-                                    "circle_knot_energy", "uniform_knot_energy"])
+                                    "circle_knot_energy", "uniform_knot_energy", "writhe"])
 def test_steps_agree_with_the_evolver(evolver, tmp_path, method):
     f = _octagon(tmp_path, [method])
     ref, out, err = _run_both(evolver, f, "g 3\n", tmp_path)
