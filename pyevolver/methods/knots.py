@@ -68,8 +68,15 @@ def _vgrad(s, idx, vec):
     return out
 
 
+def _no_torus(s):
+    if s.periods is not None:
+        raise UnsupportedError("knot energies in the torus model",
+                               "which images of the pairs REF takes was not measured")
+
+
 def _edge_vectors(t, idx):
     s = t.surface
+    _no_torus(s)
     idx = np.asarray(idx, np.int64)
     V = t.edge_vec[idx]
     L = t.edge_length[idx]
@@ -96,6 +103,7 @@ def _pair_matrix(X):
 
 
 def _charges(s, idx):
+    _no_torus(s)
     q = s.extra.get(("vertex", "node_charge"))
     return np.ones(len(idx)) if q is None else np.asarray(q, float)[idx]
 
@@ -155,6 +163,7 @@ def knot_hessian(t: Any, m: Any, idx: np.ndarray, w: np.ndarray, basis: Any = No
 
 def _uniform_charges(t, idx):
     s = t.surface
+    _no_torus(s)
     L = t.edge_length
     qa = np.bincount(s.E[:, 0], weights=L, minlength=s.nv) + \
         np.bincount(s.E[:, 1], weights=L, minlength=s.nv)
