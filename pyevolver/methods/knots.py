@@ -24,6 +24,9 @@ of two edges, ``L`` and ``V`` edge lengths and vectors:
   ``M_a`` tangent to edge b at ``M_b`` — polynomially
   ``(L_a L_b + V_a·V_b − 2 (V_a·d)(V_b·d)/|d|²)/|d|²`` (the manual's
   ``(1 − cos α)²`` is not what the program computes);
+* ``edge_min_knot_energy`` (edge, value only): ``Σ L_a L_b / δ²`` over
+  ordered pairs without a common vertex, ``δ`` the distance between the
+  edges;
 * ``writhe`` (edge): ``Σ_{a≠b} (V_a × V_b)·d/(4π |d|³)`` (the manual's sum
   over 4π, ordered pairs).
 
@@ -382,6 +385,45 @@ def writhe_gradient(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarra
     return _edge_scatter(s, idx, gV, np.zeros(len(L)), gM, V, L)
 
 
+def segment_distances(P0, P1, Q0, Q1) -> np.ndarray:
+    """Distances between the segments P0P1 and Q0Q1 (broadcast arrays of
+    points): the closest points' parameters clamped to [0, 1], the second
+    one first when the first is clamped (as in Ericson's algorithm)."""
+    u, v, w = P1 - P0, Q1 - Q0, P0 - Q0
+    a = (u * u).sum(-1)
+    b = (u * v).sum(-1)
+    c = (v * v).sum(-1)
+    d = (u * w).sum(-1)
+    e = (v * w).sum(-1)
+    den = a * c - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sc = np.clip(np.where(den > 1e-14 * a * c, (b * e - c * d) / den, 0.0), 0.0, 1.0)
+        tc = np.where(c > 0, (b * sc + e) / c, 0.0)
+        tk = np.clip(tc, 0.0, 1.0)
+        sc = np.where(tc != tk, np.clip(np.where(a > 0, (tk * b - d) / a, 0.0), 0.0, 1.0), sc)
+    dP = w + sc[..., None] * u - tk[..., None] * v
+    return np.sqrt((dP * dP).sum(-1))
+
+
+def edge_min_knot(t: Any, m: Any, idx: np.ndarray) -> np.ndarray:
+    """Per-edge ``Σ_b L_a L_b / δ_ab²``, δ the distance between the edges
+    (closest points), over the edges b without a common vertex."""
+    s = t.surface
+    idx = np.asarray(idx, np.int64)
+    E = s.E[idx]
+    V, L, _ = _edge_vectors(t, idx)
+    P0 = s.X[E[:, 0]]
+    P1 = P0 + V
+    dist = segment_distances(P0[:, None], P1[:, None], P0[None], P1[None])
+    adj = np.zeros((len(idx), len(idx)), bool)
+    for i in range(2):
+        for j in range(2):
+            adj |= E[:, i][:, None] == E[:, j][None, :]
+    with np.errstate(divide="ignore"):
+        val = np.where(adj, 0.0, np.outer(L, L) / np.where(adj, 1.0, dist) ** 2)
+    return val.sum(axis=1)
+
+
 def uniform_knot_force(t: Any, m: Any, idx: np.ndarray, w: np.ndarray) -> np.ndarray:
     """REF's "gradient" of ``uniform_knot_energy`` (what ``g`` moves by): the
     part through the distances in full, the part through the charges
@@ -417,6 +459,8 @@ register_method("proj_knot_energy", "edge", proj_knot, proj_knot_refused, no_hes
 register_method("circle_knot_energy", "edge", circle_knot, circle_knot_gradient,
                 no_hessian=_NO_H)
 register_method("writhe", "edge", writhe, writhe_gradient, no_hessian=_NO_H)
+# (no gradient: the manual's "DO NOT use as an energy"; g with it is refused by name)
+register_method("edge_min_knot_energy", "edge", edge_min_knot)
 STRING_METHODS.update({"knot_energy", "uniform_knot_energy", "edge_knot_energy",
                        "edge_edge_knot_energy", "buck_knot_energy", "proj_knot_energy",
-                       "circle_knot_energy", "writhe"})
+                       "circle_knot_energy", "writhe", "edge_min_knot_energy"})

@@ -52,11 +52,12 @@ def _numbers(lines):
 
 @pytest.mark.parametrize("power", [2, 3])
 def test_values_agree_with_the_evolver(evolver, tmp_path, power):
-    f = _octagon(tmp_path, METHODS, decl=f"parameter knot_power = {power}")
-    script = "".join(f'printf "%.15g\\n", q{k}.value\n' for k in range(len(METHODS)))
+    f = _octagon(tmp_path, METHODS + ["edge_min_knot_energy"],
+                 decl=f"parameter knot_power = {power}")
+    script = "".join(f'printf "%.15g\\n", q{k}.value\n' for k in range(len(METHODS) + 1))
     ref, out, err = _run_both(evolver, f, script, tmp_path)
     ref, out = _numbers(ref), _numbers(out)
-    assert len(ref) == len(METHODS), ref
+    assert len(ref) == len(METHODS) + 1, ref
     assert _same(out, ref, PRINTED), (out, ref, err)
 
 
@@ -159,6 +160,15 @@ def test_knot_energy_hessian_against_the_gradient(tmp_path):
             num[:, 3 * i + k] = (g[0] - g[1]) / (2 * h)
     s.X = X0
     assert np.abs(H - num).max() <= FD * max(1.0, np.abs(H).max())
+
+
+def test_segment_distances():
+    P0 = np.array([[0.0, 0, 0], [0, 0, 0], [0, 0, 0]])
+    P1 = np.array([[1.0, 0, 0], [1, 0, 0], [1, 0, 0]])
+    Q0 = np.array([[0.5, 1, 2], [2, 0, 1], [-1, -2, 0]])
+    Q1 = np.array([[0.5, -1, 2], [3, 0, 1], [-3, -2, 0]])
+    want = [2.0, np.sqrt(2.0), np.sqrt(5.0)]       # crossing above, end to end, corner
+    assert np.allclose(KN.segment_distances(P0, P1, Q0, Q1), want, rtol=0, atol=1e-15)
 
 
 def test_buck_denominator_error(tmp_path):
