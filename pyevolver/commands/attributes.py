@@ -15,6 +15,7 @@ from ..methods import attributes as GA
 from ..errors import ExpressionError, UnsupportedError
 from ..expr import nodes as N
 from ..methods import method_info
+from ..methods import string_curvature as SC
 from ..model.string import facets_of_edge
 from ..constraints import boundary_eval
 from . import elements
@@ -78,8 +79,12 @@ ATTRIBUTES = [
     ("vertex", "sqcurve", "supported: h² of `sq_mean_curvature` (of "
      "`eff_area_sq_mean_curvature` with `effective_area` on, of `normal_sq_mean_curvature` "
      "with `normal_curvature` on), 0 at FIXED and boundary vertices, as REF"),
-    ("vertex", "mean_curvature, sqcurve (string model)", "refused by name (REF's string "
-     "formula was not reproduced)"),
+    ("vertex", "mean_curvature (string model)", "supported: F·N/(N·N), F the difference of "
+     "the unit vectors of the edge going out and the edge coming in, N half the xy "
+     "rotation of the chord from the previous to the next vertex, the sign of the first "
+     "edge of REF's vertex ring (REF's values, tension-free); 0 at ends"),
+    ("vertex", "sqcurve (string model)", "0 without facets (REF's value, also after g); "
+     "refused by name on strings with facets (REF prints numbers not reproduced)"),
     ("vertex", "dihedral", "string model: 2 asin(F/2), F the length of the sum of the unit "
      "edge vectors, clamped to π (REF); soapfilm model: REF's error \"Dihedral only for "
      "edges\""),
@@ -274,9 +279,11 @@ def element_attr(session, base, name, idx):
                 raise ExpressionError(f"{name} takes one index")
             return _component(vec, idx, name)
         if name == "mean_curvature":
-            _no_string(s, name)
-            return float(cache(session).get(session, name, GA.vertex_mean_curvature)[i])
+            fn = SC.string_mean_curvature if s.string else GA.vertex_mean_curvature
+            return float(cache(session).get(session, name, fn)[i])
         if name == "sqcurve":
+            if s.string and len(s.sf_ptr) <= 1:
+                return 0.0              # REF: 0 on strings without facets (knotty.fe)
             _no_string(s, name)
             tg = session.toggles
             mode = ("norm" if tg.get("normal_curvature") else

@@ -170,6 +170,9 @@ class _TopTransformer(ExprTransformer):
     def m_modulus(self, _t, e):
         return ("modulus", e)
 
+    def m_parameter_1(self, _t, e):
+        return ("parameter_1", e)
+
     def m_ignore_fixed(self, _t):
         return ("ignore_fixed", None)
 

@@ -484,6 +484,8 @@ class TopSection:
                 m.vector = self._components(o[1], "q", sec, line)
             elif o[0] == "modulus":
                 m.modulus = self._const(o[1], self._src(sec, line), "modulus")
+            elif o[0] == "parameter_1":
+                m.parameter_1 = self._const(o[1], self._src(sec, line), "parameter_1")
             elif o[0] == "ignore_fixed":
                 m.ignore_fixed = True
             elif o[0] == "ignore_constraints":

@@ -297,6 +297,8 @@ class _FeWriter:
             out.append("global")
         if m.modulus != 1.0:
             out.append(f"modulus {num(m.modulus)}")
+        if getattr(m, "parameter_1", None) is not None:
+            out.append(f"parameter_1 {num(m.parameter_1)}")
         if m.ignore_fixed:
             out.append("ignore_fixed")
         if m.ignore_constraints:
@@ -435,7 +437,7 @@ class _FeWriter:
             c = self._cons(s.econ, k, signed=True)
             if c:
                 parts.append(c)
-            if ea.get("tension") is not None and ea["tension"][k] != 0:
+            if ea.get("tension") is not None and ea["tension"][k] != (1.0 if s.string else 0.0):
                 parts.append(f"density {num(ea['tension'][k])}")
             if ea.get("no_refine") is not None and ea["no_refine"][k]:
                 parts.append("no_refine")

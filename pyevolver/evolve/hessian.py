@@ -180,7 +180,7 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
         if gradient:
             g = g + k * legacy_gradient(t)
     # named quantities: energies with weight 1, fixed ones with −λ
-    weighted = [(q, 1.0) for q in s.quantities.values() if q.kind == "energy"]
+    weighted = [(q, 1.0) for q in s.quantities.values() if q.kind == "energy" and q.modulus]
     weighted += [(q, -lam[len(cons.bodies) + k]) for k, q in enumerate(cons.quantities)]
     for q, wq in weighted:
         hq = _quantity_hessian(t, q, wq)

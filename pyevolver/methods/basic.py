@@ -42,10 +42,6 @@ def _edge_length(ctx, m, idx):
     return ctx.edge_length[idx]
 
 
-def _edge_tension(ctx, m, idx):
-    return ctx.edge_length[idx] * ctx.surface.edge_tension[idx]
-
-
 def _facet_tension(ctx, m, idx):
     return ctx.facet_area[idx] * ctx.surface.facet_tension[idx]
 
@@ -484,10 +480,6 @@ def _facet_tension_gradient(t, m, idx, w):
     return corner_scatter(t, facet_area_grad(t), _per_facet(t, idx, w * s.facet_tension[idx]))
 
 
-def _edge_tension_gradient(t, m, idx, w):
-    return edge_length_grad(t, idx, w * t.surface.edge_tension[idx])
-
-
 def _edge_vector_gradient(t, m, idx, w):
     return edge_vector_integral_grad(t, m.vector or [], idx, w)
 
@@ -501,7 +493,9 @@ register_method("facet_volume", "facet", _facet_volume, _volume_gradient, _volum
                 hessian_applies=lambda s: s.periods is None)
 register_method("edge_length", "edge", _edge_length, _length_gradient, _length_hessian)
 register_method("edge_area", "edge", _edge_length, _length_gradient)
-register_method("edge_tension", "edge", _edge_tension, _edge_tension_gradient)
+# the method edge_tension is the edge length, whatever the edges' tension (REF; the
+# manual: "edge_tension or edge_length ... Length of edge")
+register_method("edge_tension", "edge", _edge_length, _length_gradient, _length_hessian)
 register_method("facet_tension", "facet", _facet_tension, _facet_tension_gradient)
 register_method("vertex_scalar_integral", "vertex", _vertex_scalar_integral,
                 _vertex_scalar_gradient)

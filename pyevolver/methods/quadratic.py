@@ -353,14 +353,6 @@ def _length_gradient(t, m, idx, w):
     return t.length_grad(*_per_edge(t, idx, w))
 
 
-def _edge_tension(t, m, idx):
-    return t.edge_length[idx] * t.surface.edge_tension[idx]
-
-
-def _edge_tension_gradient(t, m, idx, w):
-    return t.length_grad(*_per_edge(t, idx, np.asarray(w) * t.surface.edge_tension[idx]))
-
-
 def _facet_vector_integral(t, m, idx):
     return flux(t.facet_P[idx], _formula_field(t.surface, m.vector or []), grad=False)[0]
 
@@ -406,7 +398,7 @@ for _name, _et, _v, _g in (
         ("facet_tension", "facet", _facet_tension, _facet_tension_gradient),
         ("facet_volume", "facet", _facet_volume, _volume_gradient),
         ("edge_length", "edge", _edge_length, _length_gradient),
-        ("edge_tension", "edge", _edge_tension, _edge_tension_gradient),
+        ("edge_tension", "edge", _edge_length, _length_gradient),   # = edge_length in REF
         ("facet_vector_integral", "facet", _facet_vector_integral, _facet_vector_gradient),
         ("facet_scalar_integral", "facet", _facet_scalar_integral, None),
         ("vertex_scalar_integral", "vertex", _vertex_scalar_integral, None),

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import UnsupportedError
 from ..model.records import edge_facets
+from ..model.string import STRING_METHODS
 from ._common import assemble, facet_points, n2_grad_dot, scatter
 from .registry import register_method
 
@@ -266,3 +267,4 @@ register_method("hooke_energy", "edge", hooke, hooke_gradient, hooke_hessian)
 register_method("hooke2_energy", "edge", hooke2, hooke2_gradient, hooke2_hessian)
 register_method("hooke3_energy", "edge", hooke3, hooke3_gradient, hooke3_hessian)
 register_method("dihedral_hooke", "edge", dihedral_hooke, dihedral_hooke_gradient)
+STRING_METHODS.update({"hooke_energy", "hooke2_energy", "hooke3_energy"})   # edges only

@@ -288,6 +288,8 @@ class Totals:
             raise
 
     def _quantity_value(self, q, magnitude=False):
+        if q.kind == "energy" and q.modulus == 0:
+            return 0.0              # REF does not evaluate an energy of modulus 0
         if q.function is not None:
             s = self.surface
             env = self.instance_values(q)

@@ -44,6 +44,7 @@ class MethodDecl:
     ignore_fixed: bool = False
     ignore_constraints: bool = False
     line: int | None = None          # source line of a METHOD_INSTANCE declaration
+    parameter_1: float | None = None  # the instance's PARAMETER_1 (sqcurve_string's power)
 
 
 @dataclass

@@ -64,11 +64,12 @@ def boundary_midpoints(s, tails, heads, vnew, target=None):
             dp = np.where(np.isfinite(dp), dp, 0.0)
             lam = np.ones(len(P))
             cur = np.einsum("ni,ni->n", r, r)
-            for _ in range(10):               # damping: halve until the distance drops
+            for _ in range(10):   # damping: halve until the distance drops (REF takes
+                # a step that changes it by round-off: knotty.fe r; r vertex 32)
                 Pn = P + lam[:, None] * dp
                 Xn, Jn = curve(Pn)
                 rn = Xn - goal
-                worse = np.einsum("ni,ni->n", rn, rn) > cur * (1 + 1e-15) + 1e-300
+                worse = np.einsum("ni,ni->n", rn, rn) > cur * (1 + 1e-12) + 1e-300
                 if not worse.any():
                     break
                 lam = np.where(worse, lam * 0.5, lam)

@@ -10,6 +10,7 @@ import numpy as np
 from ..constraints import constrained_vertices, project_tangent, project_to_constraints
 from ..geometry.kernels import edge_vectors
 from .grow import grow
+from .refine import boundary_midpoints
 
 
 def _ring_split(s, t, R, mid, half):
@@ -88,6 +89,9 @@ def split_edges(s, R):
     t.sf_ptr = np.concatenate([[0], np.cumsum(np.bincount(owner, weights=reps,
                                                            minlength=len(s.sf_ptr) - 1))]
                               ).astype(np.int64)
+    # on a parametric boundary: the curve point nearest the chord's midpoint
+    # (as in the soapfilm model; knotty.fe after r)
+    boundary_midpoints(t, s.E[R, 0], s.E[R, 1], mid)
     sel = mid[constrained_vertices(t)[mid]]
     if len(sel):
         project_to_constraints(t, sel)

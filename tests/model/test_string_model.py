@@ -190,12 +190,10 @@ def test_string_torus(evolver, tmp_path):
 
 
 def test_unsupported_string_files(evolver, tmp_path):
-    """knotty.fe's knot energies are refused by name when loaded; 100grain.fe
-    loads (its read section runs) but its g needs autopop, refused by name
-    (its area normalization is tested in tests/evolve/test_mobility.py)."""
+    """100grain.fe loads (its read section runs) but its g needs autopop,
+    refused by name (its area normalization is tested in
+    tests/evolve/test_mobility.py); knotty.fe runs (tests/methods/test_knots.py)."""
     from pyevolver.errors import PyEvolverError
-    with pytest.raises(PyEvolverError, match="sqcurve_string"):
-        _session(example("knotty.fe"))
     s = _session(example("100grain.fe"))
     ref = run_reference(evolver, example("100grain.fe"), 'printf "%.15g\\n", total_length',
                         cwd=str(tmp_path))

@@ -75,3 +75,36 @@ def test_vertex_average_moves(tmp_path):
     # free ends do not move either (one edge)
     f = _string(tmp_path, [(0, 0), (0.5, 0.5), (2, 0)], fixed_ends=False)
     assert np.allclose(vertex_average(f, "raw").X, raw.X, atol=ROUNDOFF)
+
+
+TREFOIL = """string
+parameter maj_r = 2
+parameter min_r = 0.5
+boundary 1 parameter 1
+x1:  cos(2*p1)*(maj_r + min_r*cos(3*p1))
+x2:  sin(2*p1)*(maj_r + min_r*cos(3*p1))
+x3:  min_r*sin(3*p1)
+vertices
+""" + "".join(f"{i + 1} {0.2 * i}*pi boundary 1\n" for i in range(10)) + "edges\n" + \
+    "".join(f"{i + 1} {i + 1} {(i + 1) % 10 + 1} boundary 1\n" for i in range(10))
+
+
+def test_split_on_a_boundary_agrees_with_the_evolver(evolver, tmp_path):
+    """knotty.fe's curve refined twice: the new vertices are the curve's
+    points nearest the chords' midpoints, REF's parameters to round-off
+    (the curve wraps at p1 = 2π between vertices 10 and 1)."""
+    from reference import run_reference
+    import io
+    from pyevolver.session.core import Session
+    f = tmp_path / "trefoil.fe"
+    f.write_text(TREFOIL)
+    script = 'r\nr\nforeach vertex vv do printf "%.15g %.15g %.15g\\n", vv.p1, vv.x, vv.z\n'
+    ref = [ln for ln in run_reference(evolver, str(f), script, cwd=str(tmp_path))
+           if ln.strip() and ln[:1] in "-0123456789"]
+    out = io.StringIO()
+    Session.load(str(f), out=out).run(script)
+    ours = [ln for ln in out.getvalue().split("\n") if ln.strip() and ln[:1] in "-0123456789"]
+    assert len(ref) == 40
+    a = np.array([[float(x) for x in ln.split()] for ln in ref])
+    b = np.array([[float(x) for x in ln.split()] for ln in ours])
+    assert np.abs(a - b).max() <= 1e-12
