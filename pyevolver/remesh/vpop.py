@@ -99,22 +99,272 @@ def nonminimal_vertices(s, which=None):
     return np.nonzero(bad)[0]
 
 
+def _star(s, v):
+    """Spokes (edge indices, their far ends) and facets at vertex ``v``."""
+    sp = np.nonzero((s.E[:, 0] == v) | (s.E[:, 1] == v))[0]
+    far = np.where(s.E[sp, 0] == v, s.E[sp, 1], s.E[sp, 0])
+    fs = np.nonzero((s.F == v).any(axis=1))[0]
+    return sp, far, fs
+
+
+def _cells(s, v, sp, fs):
+    """The complement regions of the surface near ``v``: each a list of
+    (facet, side) with side +1 for the facet's normal side.
+
+    Round each spoke the facets are sorted by their angle about the spoke
+    (outward from ``v``); the region between two neighbours touches the
+    first on the side the rotation leaves it and the second on the side it
+    arrives at.
+    """
+    X = s.X
+    F = s.F
+    N = np.cross(X[F[fs, 1]] - X[F[fs, 0]], X[F[fs, 2]] - X[F[fs, 0]])
+    pos = {int(f): k for k, f in enumerate(fs)}
+    parent = list(range(2 * len(fs)))
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    absFE = np.where(s.FE >= 0, s.FE, ~s.FE)
+    for e in sp:
+        a, b = s.E[e]
+        p = b if a == v else a
+        d = X[p] - X[v]
+        d = d / np.linalg.norm(d)
+        on = [k for k, f in enumerate(fs) if e in absFE[f]]
+        c = np.array([next(w for w in F[fs[k]] if w != v and w != p) for k in on])
+        u = X[c] - X[v]
+        u = u - np.outer(u @ d, d)
+        ref = u[0] / np.linalg.norm(u[0])
+        side = np.cross(d, ref)
+        ang = np.mod(np.arctan2(u @ side, u @ ref), 2 * np.pi)
+        order = np.argsort(ang, kind="stable")
+        for i in range(len(order)):
+            k1, k2 = on[order[i]], on[order[(i + 1) % len(order)]]
+            u1, u2 = u[order[i]], u[order[(i + 1) % len(order)]]
+            s1 = 1 if N[k1] @ np.cross(d, u1) > 0 else -1          # leaving k1
+            s2 = 1 if N[k2] @ np.cross(d, u2) < 0 else -1          # arriving at k2
+            x, y = 2 * k1 + (s1 < 0), 2 * k2 + (s2 < 0)
+            parent[find(x)] = find(y)
+    groups = {}
+    for i in range(2 * len(fs)):
+        groups.setdefault(find(i), []).append((int(fs[i // 2]), 1 if i % 2 == 0 else -1))
+    return list(groups.values())
+
+
+def _check_star(s, v):
+    vid = int(s.ids("vertex")[v])
+    if s.periods is not None:
+        raise UnsupportedError("popping a vertex in the torus model", f"vertex {vid}")
+    if s.bodies.n:
+        raise UnsupportedError("popping a vertex on a surface with bodies",
+                               "which body the new facets belong to is not implemented")
+    for q in s.quantities.values():
+        if any(sgn is not None and et in ("edge", "facet") for (_, et, _, sgn) in q.methods):
+            raise UnsupportedError("popping a vertex on a surface whose quantities list "
+                                   "edges or facets", f"quantity {q.name}")
+
+
+def _pop_one(s, v):
+    """Pop vertex ``v`` (index) by the sphere construction; returns the new
+    surface.  Refuses (UnsupportedError) what was not checked against REF."""
+    _check_star(s, v)
+    vid = int(s.ids("vertex")[v])
+    sp, far, fs = _star(s, v)
+    X = s.X
+    ten = s.fattr["tension"][fs]
+    if not np.all(ten == ten[0]):
+        raise UnsupportedError("popping a vertex whose facets have unequal tensions",
+                               f"vertex {vid}")
+    if (far == v).any() or len(set(far.tolist())) != len(far):
+        raise UnsupportedError("popping a vertex with a loop or multiple edges",
+                               f"vertex {vid}")
+    cells = _cells(s, v, sp, fs)
+    for c in cells:
+        if len({f for f, _ in c}) != len(c) or len(c) < 3:
+            raise UnsupportedError("popping a vertex whose regions touch a facet twice",
+                                   f"vertex {vid}")
+    return _build(s, v, sp, far, fs, cells)
+
+
+def _cell_loop(s, v, sp, c):
+    """Spoke positions in order round cell ``c`` (list of (facet, side))."""
+    F = s.F
+    spoke_of = {}
+    for k, e in enumerate(sp):
+        spoke_of[int(s.E[e, 0] if s.E[e, 1] == v else s.E[e, 1])] = k
+    arcs = []
+    for f, _ in c:
+        a, b = [spoke_of[int(w)] for w in F[f] if w != v]
+        arcs.append((a, b, f))
+    loop = [arcs[0][0], arcs[0][1]]
+    used = {0}
+    while len(used) < len(arcs):
+        cur = loop[-1]
+        nxt = next(i for i in range(len(arcs)) if i not in used and cur in arcs[i][:2])
+        used.add(nxt)
+        a, b, _ = arcs[nxt]
+        loop.append(b if a == cur else a)
+    if loop[-1] != loop[0]:
+        raise UnsupportedError("popping a vertex whose regions are not discs",
+                               f"vertex {int(s.ids('vertex')[v])}")
+    return loop[:-1]
+
+
+def cell_sizes(s, v, sp, cells):
+    """Solid angle (seen from ``v``) of each cell's polygon of spoke
+    midpoints."""
+    W = 0.5 * (s.X[v] + s.X[np.where(s.E[sp, 0] == v, s.E[sp, 1], s.E[sp, 0])])
+    out = []
+    for c in cells:
+        loop = _cell_loop(s, v, sp, c)
+        P = W[loop] - s.X[v]
+        P = P / np.linalg.norm(P, axis=1)[:, None]
+        m = P.mean(axis=0)
+        m = m / np.linalg.norm(m)
+        tot = 0.0
+        for i in range(len(P)):
+            a, b = P[i], P[(i + 1) % len(P)]
+            num = abs(np.dot(m, np.cross(a, b)))
+            den = 1 + m @ a + a @ b + b @ m
+            tot += 2 * np.arctan2(num, den)
+        out.append(tot)
+    return np.array(out)
+
+
+def _build(s, v, sp, far, fs, cells):
+    from .grow import grow
+    from .shrink import subset
+    sizes = cell_sizes(s, v, sp, cells)
+    big = int(np.argmax(sizes))
+    keep = [c for i, c in enumerate(cells) if i != big]
+    loops = [_cell_loop(s, v, sp, c) for c in keep]
+    centred = [i for i, lp in enumerate(loops) if len(lp) > 4]
+    quads = [i for i, lp in enumerate(loops) if len(lp) == 4]
+    m, k = len(fs), len(sp)
+    # new vertices: w per spoke (edge-born), a centre per centred cell
+    # new edges: per facet its arc w_p-w_q and diagonal; per centred cell its spokes
+    # new facets: per facet its second half; per cell its triangles
+    cell_f = [int(keep[i][0][0]) for i in centred]
+    e_par = list(fs) + list(fs) + [int(keep[i][0][0]) for i in quads] + \
+        [cell_f[j] for j, i in enumerate(centred) for _ in loops[i]]
+    f_tri = []
+    for i, lp in enumerate(loops):
+        n = len(lp) - 2 if len(lp) <= 4 else len(lp)
+        f_tri += [int(keep[i][0][0])] * n
+    t = grow(s, v_from_edge=list(sp), v_from_facet=cell_f, e_from_facet=e_par,
+             f_from_facet=list(fs) + f_tri)
+    nv, ne, nf = s.nv, s.ne, s.nf
+    W = nv + np.arange(k)
+    C = nv + k + np.arange(len(centred))
+    t.X[W] = 0.5 * (s.X[v] + s.X[far])
+    spoke_of = {int(p): j for j, p in enumerate(far)}
+    # spokes now start at their w
+    for j, e in enumerate(sp):
+        if t.E[e, 0] == v:
+            t.E[e, 0] = W[j]
+        else:
+            t.E[e, 1] = W[j]
+    arc = ne + np.arange(m)
+    diag = ne + m + np.arange(m)
+    arc_of = {}
+    absFE = np.where(s.FE >= 0, s.FE, ~s.FE)
+    for i, f in enumerate(fs):
+        row = [int(x) for x in s.FE[f]]
+        vs = [int(x) for x in s.F[f]]
+        kv = vs.index(v)
+        p, q = vs[(kv + 1) % 3], vs[(kv + 2) % 3]
+        wp, wq = W[spoke_of[p]], W[spoke_of[q]]
+        e_vp, e_pq, e_qv = row[kv], row[(kv + 1) % 3], row[(kv + 2) % 3]
+        t.E[arc[i]] = (wq, wp)
+        t.E[diag[i]] = (wp, q)
+        # (wp, p, q) keeps f; (q, wq, wp) is new
+        t.FE[f] = (e_vp, e_pq, ~diag[i])      # e_vp now runs wp -> p (same sign)
+        t.FE[nf + i] = (diag[i], ~e_qv if False else e_qv, arc[i])
+        arc_of[int(f)] = (int(arc[i]), int(wq), int(wp))
+    # fix the sign of e_qv in the new half: it runs q -> wq
+    for i, f in enumerate(fs):
+        e = t.FE[nf + i, 1]
+        ei = e if e >= 0 else ~e
+        a, b = t.E[ei]
+        vs = [int(x) for x in s.F[f]]
+        kv = vs.index(v)
+        q = vs[(kv + 2) % 3]
+        t.FE[nf + i, 1] = ei if a == q else ~ei
+    # cells
+    fpos = nf + m
+    epos = ne + 2 * m
+    for i, lp in enumerate(loops):
+        ws = [W[j] for j in lp]
+        # the arc between consecutive loop points
+        def arc_between(a, b):
+            for f, _ in keep[i]:
+                ea, x, y = arc_of[f]
+                if (x, y) == (a, b):
+                    return ea
+                if (x, y) == (b, a):
+                    return ~ea
+            raise AssertionError
+        if len(lp) == 3:
+            t.FE[fpos] = [arc_between(ws[j], ws[(j + 1) % 3]) for j in range(3)]
+            fpos += 1
+            continue
+        if len(lp) == 4:
+            # the diagonal runs from the arc's tail (in the facet's own
+            # orientation) of the cell's facet of lowest id
+            fid = s.ids("facet")
+            f0 = min((f for f, _ in keep[i]), key=lambda f: fid[f])
+            r = ws.index(arc_of[f0][1])
+            a, b, c, d = (ws[(r + j) % 4] for j in range(4))
+            dg = epos
+            epos += 1
+            t.E[dg] = (a, c)
+            t.FE[fpos] = (arc_between(a, b), arc_between(b, c), ~dg)
+            t.FE[fpos + 1] = (dg, arc_between(c, d), arc_between(d, a))
+            fpos += 2
+            continue
+        c = C[centred.index(i)]
+        t.X[c] = s.X[far[lp]].mean(axis=0) * 0.5 + 0.5 * s.X[v]
+        spk = epos + np.arange(len(lp))
+        epos += len(lp)
+        for j in range(len(lp)):
+            t.E[spk[j]] = (c, ws[j])
+        for j in range(len(lp)):
+            j2 = (j + 1) % len(lp)
+            t.FE[fpos] = (spk[j], arc_between(ws[j], ws[j2]), ~spk[j2])
+            fpos += 1
+    assert fpos == t.nf and epos == t.ne
+    vkeep = np.ones(t.nv, bool)
+    vkeep[v] = False
+    return subset(t, t.E, t.FE, vkeep, np.ones(t.ne, bool), np.ones(t.nf, bool))
+
+
 def pop_vertices(s, which=None):
-    """Pop the non-minimal vertices of ``s`` (all, or those in ``which``).
+    """Pop the non-minimal vertices of ``s`` (all, or those in ``which``),
+    in id order, each on the surface the previous pops left.
 
     Returns ``(surface, n)``; ``s`` itself is never modified.
     """
     bad = nonminimal_vertices(s, which)
     if not len(bad):
         return s, 0
-    v = int(s.ids("vertex")[bad[0]])
     tested, ncomp, triple, high = link_summary(s)
-    b = bad[0]
-    if ncomp[b] > 1:
-        what = "two cones meeting at the vertex"
-    elif high[b]:
-        what = "an edge with four or more facets at the vertex"
-    else:
-        what = f"{int(triple[b])} triple edges at the vertex"
-    raise UnsupportedError("popping a non-minimal vertex", f"vertex {v}: {what}; the "
-                           "Evolver's reconnection of it is not implemented")
+    for b in bad:
+        vid = int(s.ids("vertex")[b])
+        if ncomp[b] > 1:
+            raise UnsupportedError("popping a vertex where cones meet", f"vertex {vid}: "
+                                   "the Evolver's merging or splitting of the cones is not "
+                                   "implemented")
+        if high[b]:
+            raise UnsupportedError("popping a vertex on an edge with four or more facets",
+                                   f"vertex {vid}")
+    ids = s.ids("vertex")[bad]
+    n = 0
+    for vid in ids:
+        v = int(np.nonzero(s.ids("vertex") == vid)[0][0])
+        s = _pop_one(s, v)
+        n += 1
+    return s, n
