@@ -29,6 +29,11 @@ def string_o(session: SessionLike):
     raise UnsupportedError("command o (vertex popping) in the string model")
 
 
+def _kraynik(session: SessionLike):
+    """The ``kraynikpopvertex`` toggle (on by default in the Evolver)."""
+    return bool(session.toggles.get("kraynikpopvertex", 1))
+
+
 def _set_counts(session: SessionLike, vertices=None, edges=None, total=None):
     if vertices is not None:
         session.counts["vertex_pop"] = vertices
@@ -44,7 +49,7 @@ def pop_all(session: SessionLike, echo=True):
     when either step is refused."""
     s0 = session.surface
     s1, ne_ = POP.pop_edges(s0)
-    s2, nv_ = VP.pop_vertices(s1)
+    s2, nv_ = VP.pop_vertices(s1, kraynik=_kraynik(session))
     if s2 is not s0:
         session._replace_surface(s2)
     _set_counts(session, vertices=nv_, edges=0, total=nv_)
@@ -58,7 +63,7 @@ def pop_listed(session: SessionLike, kind, items, echo=True):
     elements that are not minimal."""
     s0 = session.surface
     if kind == "vertex":
-        s1, n = VP.pop_vertices(s0, which=items)
+        s1, n = VP.pop_vertices(s0, which=items, kraynik=_kraynik(session))
         if s1 is not s0:
             session._replace_surface(s1)
         _set_counts(session, vertices=n, total=n)

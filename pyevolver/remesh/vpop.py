@@ -168,7 +168,26 @@ def _check_star(s, v):
                                    "edges or facets", f"quantity {q.name}")
 
 
-def _pop_one(s, v):
+def prism_kind(s, v, sp, cells):
+    """3 or 4 when the link of ``v``, its nodes of degree 2 left out, is the
+    graph of a triangular prism or of a cube (the cells then have 3, 3, 4, 4,
+    4 or six times 4 triple nodes), else 0.  The Evolver pops these two cones
+    its own way (a triangular prism by ``kraynikpopvertex``'s special pop, a
+    cube to a square), not by the sphere."""
+    val = _edge_valence(s)
+    sizes = []
+    for c in cells:
+        loop = _cell_loop(s, v, sp, c)
+        sizes.append(int(np.count_nonzero(val[sp[loop]] == 3)))
+    sizes.sort()
+    if sizes == [3, 3, 4, 4, 4]:
+        return 3
+    if sizes == [4] * 6:
+        return 4
+    return 0
+
+
+def _pop_one(s, v, kraynik=True):
     """Pop vertex ``v`` (index) by the sphere construction; returns the new
     surface.  Refuses (UnsupportedError) what was not checked against REF."""
     _check_star(s, v)
@@ -187,6 +206,15 @@ def _pop_one(s, v):
         if len({f for f, _ in c}) != len(c) or len(c) < 3:
             raise UnsupportedError("popping a vertex whose regions touch a facet twice",
                                    f"vertex {vid}")
+    kind = prism_kind(s, v, sp, cells)
+    if kind == 3 and kraynik:
+        raise UnsupportedError("popping a vertex whose link is a triangular prism with "
+                               "kraynikpopvertex on", f"vertex {vid}: the Evolver's special pop "
+                               "of this cone (to an edge, or to a face with pop_to_face) is not "
+                               "implemented; kraynikpopvertex off pops it by the sphere")
+    if kind == 4:
+        raise UnsupportedError("popping a vertex whose link is a cube", f"vertex {vid}: the "
+                               "Evolver pops this cone to a square, which is not implemented")
     return _build(s, v, sp, far, fs, cells)
 
 
@@ -342,7 +370,7 @@ def _build(s, v, sp, far, fs, cells):
     return subset(t, t.E, t.FE, vkeep, np.ones(t.ne, bool), np.ones(t.nf, bool))
 
 
-def pop_vertices(s, which=None):
+def pop_vertices(s, which=None, kraynik=True):
     """Pop the non-minimal vertices of ``s`` (all, or those in ``which``),
     in id order, each on the surface the previous pops left.
 
@@ -365,6 +393,6 @@ def pop_vertices(s, which=None):
     n = 0
     for vid in ids:
         v = int(np.nonzero(s.ids("vertex") == vid)[0][0])
-        s = _pop_one(s, v)
+        s = _pop_one(s, v, kraynik)
         n += 1
     return s, n
