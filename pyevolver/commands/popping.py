@@ -5,10 +5,12 @@ edges, then the non-minimal vertices) and the ``pop`` statement
 REF's reports and counts, as measured with evolver-nox-d:
 
 - ``o`` prints ``Edges popped: N`` (the four-facet edges it pops first, as
-  ``O`` does) and ``Vertices popped: M``; afterwards ``vertex_pop_count`` and
-  ``pop_count`` are ``M`` and ``edge_pop_count`` is 0.
-- ``pop`` of vertices prints ``Vertices popped: M`` when ``M > 0`` (nothing
-  when no vertex of the list needs popping); of edges ``Edges popped: N``.
+  ``O`` does) and ``Vertices popped: M``; afterwards ``vertex_pop_count`` is
+  ``M`` and ``edge_pop_count`` is 0.
+- ``pop`` of vertices prints ``Vertices popped: M`` and sets
+  ``vertex_pop_count``; of edges ``Edges popped: N`` and ``edge_pop_count``;
+  nothing is printed when nothing was popped.
+- ``pop_count`` is ``vertex_pop_count + edge_pop_count``.
 
 The string model's ``o`` is not handled here (:func:`string_o`).
 """
@@ -34,13 +36,12 @@ def _kraynik(session: SessionLike):
     return bool(session.toggles.get("kraynikpopvertex", 1))
 
 
-def _set_counts(session: SessionLike, vertices=None, edges=None, total=None):
+def _set_counts(session: SessionLike, vertices=None, edges=None):
+    """Set the counts a pop command reports (``pop_count`` is their sum)."""
     if vertices is not None:
         session.counts["vertex_pop"] = vertices
     if edges is not None:
         session.counts["edge_pop"] = edges
-    if total is not None:
-        session.counts["pop"] = total
 
 
 def pop_all(session: SessionLike, echo=True):
@@ -52,7 +53,7 @@ def pop_all(session: SessionLike, echo=True):
     s2, nv_ = VP.pop_vertices(s1, kraynik=_kraynik(session))
     if s2 is not s0:
         session._replace_surface(s2)
-    _set_counts(session, vertices=nv_, edges=0, total=nv_)
+    _set_counts(session, vertices=nv_, edges=0)
     if echo:
         session.note(f"Edges popped: {ne_}\nVertices popped: {nv_}\n")
     return ne_, nv_
@@ -66,15 +67,15 @@ def pop_listed(session: SessionLike, kind, items, echo=True):
         s1, n = VP.pop_vertices(s0, which=items, kraynik=_kraynik(session))
         if s1 is not s0:
             session._replace_surface(s1)
-        _set_counts(session, vertices=n, total=n)
+        _set_counts(session, vertices=n)
         if echo and n:
             session.note(f"Vertices popped: {n}\n")
         return n
     s1, n = POP.pop_edges(s0, which=items)
     if s1 is not s0:
         session._replace_surface(s1)
-    _set_counts(session, edges=n, total=n)
-    if echo:
+    _set_counts(session, edges=n)
+    if echo and n:
         session.note(f"Edges popped: {n}\n")
     return n
 

@@ -110,7 +110,7 @@ def internal(session: SessionLike, name):
         "edge_delete_count": lambda: session.counts.get("edge_delete", 0),
         "vertex_pop_count": lambda: session.counts.get("vertex_pop", 0),
         "edge_pop_count": lambda: session.counts.get("edge_pop", 0),
-        "pop_count": lambda: session.counts.get("pop", 0),
+        "pop_count": lambda: session.counts.get("vertex_pop", 0) + session.counts.get("edge_pop", 0),
         "notch_count": lambda: session.counts.get("notch", 0),
         "refine_count": lambda: session.counts.get("refine", 0), "where_count": lambda: 0,
         "random": lambda: float(session.rng.random()),

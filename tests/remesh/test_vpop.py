@@ -1,0 +1,229 @@
+"""Vertex popping in the soap-film model (pyevolver.remesh.vpop): which
+vertices are non-minimal, the sphere construction, the split of two cones,
+and the refusals; the numbers against evolver-nox-d, run live on
+hand-made cones (a centre vertex joined to the vertices of a fixed frame).
+"""
+import io
+import re
+
+import numpy as np
+import pytest
+from conftest import example
+from reference import run_reference
+
+from pyevolver import Session
+from pyevolver.errors import PyEvolverError
+from pyevolver.remesh import pop as POP, vpop as VP
+
+G_LINE = re.compile(r"area:\s*(\S+)\s+energy:\s*(\S+)")
+TAIL = "print vertex_count\nprint edge_count\nprint facet_count\n"
+
+
+# -- hand-made cones ------------------------------------------------------------------
+
+def _frame_cone(path, P, edges, centre):
+    """A free centre vertex joined to the fixed vertices ``P`` (fixed frame
+    ``edges``), one triangle per frame edge."""
+    L = ["vertices", "1 %r %r %r" % tuple(map(float, centre))]
+    L += ["%d %r %r %r fixed" % (i + 2, *map(float, p)) for i, p in enumerate(P)]
+    L.append("edges")
+    L += ["%d %d %d fixed" % (k + 1, a + 2, b + 2) for k, (a, b) in enumerate(edges)]
+    L += ["%d 1 %d" % (len(edges) + i + 1, i + 2) for i in range(len(P))]
+    L.append("faces")
+    L += ["%d %d %d %d" % (k + 1, len(edges) + a + 1, k + 1, -(len(edges) + b + 1))
+          for k, (a, b) in enumerate(edges)]
+    path.write_text("\n".join(L) + "\n")
+    return str(path)
+
+
+def _prism(n, seed):
+    rng = np.random.default_rng(seed)
+    t = 2 * np.pi * np.arange(n) / n
+    P = np.concatenate([np.stack([np.cos(t), np.sin(t), np.full(n, z)], 1) for z in (-1, 1)])
+    P += 0.05 * rng.standard_normal(P.shape)
+    edges = [(k, (k + 1) % n) for k in range(n)] + [(n + k, n + (k + 1) % n) for k in range(n)]
+    edges += [(k, n + k) for k in range(n)]
+    return P, edges, 0.1 * np.random.default_rng(seed + 100).standard_normal(3)
+
+
+def _dodecahedron(seed):
+    phi = (1 + 5 ** 0.5) / 2
+    P = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    for a in (-1, 1):
+        for b in (-1, 1):
+            P += [(0, a / phi, b * phi), (a / phi, b * phi, 0), (b * phi, 0, a / phi)]
+    P = np.array(P, float)
+    d = np.linalg.norm(P[:, None] - P[None], axis=2)
+    m = d[d > 1e-9].min()
+    edges = [(i, j) for i in range(20) for j in range(i + 1, 20) if abs(d[i, j] - m) < 1e-6]
+    rng = np.random.default_rng(seed)
+    return P + 0.05 * rng.standard_normal(P.shape), edges, 0.1 * rng.standard_normal(3)
+
+
+def _double_cone(path, n, h1, h2):
+    """Two cones of ``n`` facets with their apex at the origin (vertex 1),
+    middle rings free, rims fixed at z = h1 and z = -h2."""
+    V = [(0.0, 0.0, 0.0, "")]
+    t = 2 * np.pi * np.arange(n) / n
+
+    def ring(z, r, fixed):
+        V.extend((float(r * np.cos(a)), float(r * np.sin(a)), float(z), "fixed" if fixed else "")
+                 for a in t)
+        return list(range(len(V) - n + 1, len(V) + 1))
+    um, ur, lm, lr = ring(h1 / 2, 0.5, False), ring(h1, 1, True), ring(-h2 / 2, 0.5, False), \
+        ring(-h2, 1, True)
+    E, F = {}, []
+
+    def edge(a, b, fixed=False):
+        if (b, a) in E:
+            return -E[(b, a)][0]
+        if (a, b) not in E:
+            E[(a, b)] = (len(E) + 1, "fixed" if fixed else "")
+        return E[(a, b)][0]
+    for mid, rim in ((um, ur), (lm, lr)):
+        for k in range(n):
+            a, b, A, B = mid[k], mid[(k + 1) % n], rim[k], rim[(k + 1) % n]
+            F.append((edge(1, a), edge(a, b), edge(b, 1)))
+            F.append((edge(a, A), edge(A, B, True), edge(B, a)))
+            F.append((edge(a, B), edge(B, b), edge(b, a)))
+    L = ["vertices"] + ["%d %r %r %r %s" % (i + 1, *v) for i, v in enumerate(V)]
+    L += ["edges"] + ["%d %d %d %s" % (i, a, b, f) for (a, b), (i, f) in E.items()]
+    L += ["faces"] + ["%d %d %d %d" % (i + 1, *f) for i, f in enumerate(F)]
+    path.write_text("\n".join(L) + "\n")
+    return str(path)
+
+
+# -- helpers ----------------------------------------------------------------------------
+
+def _ours(path, cmds):
+    out = io.StringIO()
+    s = Session.load(path, out=out)
+    s.run(cmds)
+    return s, out.getvalue().rstrip("\n").split("\n")
+
+
+def _numbers(lines):
+    g = [float(m.group(2)) for m in map(G_LINE.search, lines) if m]
+    ints = [int(ln.split()[0]) for ln in lines if re.fullmatch(r"\s*\d+\s*", ln)]
+    pops = [ln for ln in lines if "popped" in ln]
+    return pops, ints, g
+
+
+def _same_as_reference(evolver, path, cmds, tmp_path, tol=1e-9):
+    ref = _numbers(run_reference(evolver, path, cmds, cwd=str(tmp_path)))
+    s, ours = _ours(path, cmds)
+    ours = _numbers(ours)
+    assert ours[0] == ref[0]
+    assert ours[1] == ref[1]
+    assert len(ours[2]) == len(ref[2])
+    for x, y in zip(ours[2], ref[2]):
+        assert abs(x - y) <= tol * abs(y), (ours[2], ref[2])
+    return s
+
+
+# -- detection --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name", ["cube.fe", "mound.fe", "catbody.fe", "twointor.fe",
+                                  "octa.fe"])
+def test_examples_have_no_nonminimal_vertex(name):
+    """The shipped films (octa.fe before its edges are popped: its centre
+    is on four-facet edges, which o pops first) pass the test."""
+    s = Session.load(example(name), out=io.StringIO()).surface
+    assert len(VP.nonminimal_vertices(s)) == 0 or name == "octa.fe"
+
+
+def test_octa_centre_after_edge_pops_is_nonminimal():
+    s = Session.load(example("octa.fe"), out=io.StringIO()).surface
+    t, n = POP.pop_edges(s)
+    assert n == 6
+    bad = VP.nonminimal_vertices(t)
+    assert list(t.ids("vertex")[bad]) == [1]
+    tested, ncomp, triple, high = VP.link_summary(t)
+    assert (ncomp[bad[0]], triple[bad[0]], high[bad[0]]) == (1, 12, 0)
+    # the fixed frame vertices are not tested
+    assert not tested[t.vattr["fixed"]].any()
+
+
+def test_double_cone_link_has_two_components(tmp_path):
+    s = Session.load(_double_cone(tmp_path / "dc.fe", 6, 1.0, 1.0), out=io.StringIO()).surface
+    tested, ncomp, triple, high = VP.link_summary(s)
+    assert list(VP.nonminimal_vertices(s)) == [0]
+    assert ncomp[0] == 2 and triple[0] == 0
+    assert (ncomp[1:][tested[1:]] == 1).all()
+
+
+def test_cone_flatness_of_coaxial_cones(tmp_path):
+    """(|N1| + |N2|) / (A1 + A2) of two regular cones is the harmonic mean
+    of the cosines of their facets' tilts."""
+    s = Session.load(_double_cone(tmp_path / "dc.fe", 6, 0.3, 0.6), out=io.StringIO()).surface
+    c = [np.cos(np.arctan(h / np.cos(np.pi / 6))) for h in (0.3, 0.6)]
+    assert abs(VP.cone_flatness(s, 0, VP._cones(s, 0)) - 2 / (1 / c[0] + 1 / c[1])) < 1e-12
+
+
+# -- against the Evolver --------------------------------------------------------------
+
+def test_octa_o_then_g_matches_reference(evolver, tmp_path):
+    """octa.fe ``g 5; o; g 5``: six edge pops, then the centre (twelve
+    triple edges, cells of 3, 4, 5 and 6 sides) popped by the sphere."""
+    s = _same_as_reference(evolver, example("octa.fe"), "g 5\no\n" + TAIL + "g 5", tmp_path)
+    assert (s.surface.nv, s.surface.ne, s.surface.nf) == (33, 120, 88)
+
+
+@pytest.mark.parametrize("shape", ["dodeca", "prism5", "prism6"])
+def test_cones_over_frames_match_reference(evolver, tmp_path, shape):
+    """Pentagonal cells (a centre each), quadrilaterals (one diagonal) and
+    the largest cell dropped; prism6 differs from REF only by the diagonal
+    of some quadrilaterals (the energy after g 20 within 1e-4)."""
+    P, edges, c = _dodecahedron(1) if shape == "dodeca" else _prism(int(shape[-1]), 1)
+    path = _frame_cone(tmp_path / f"{shape}.fe", P, edges, c)
+    tol = 2e-5 if shape == "prism6" else 1e-9
+    _same_as_reference(evolver, path, "o\n" + TAIL + "g 20", tmp_path, tol)
+
+
+def test_cone_with_regular_spokes_matches_reference(evolver, tmp_path):
+    """After ``r`` the centre also has spokes with two facets: each gets
+    its midpoint on the sphere too."""
+    P, edges, c = _prism(5, 1)
+    path = _frame_cone(tmp_path / "p5.fe", P, edges, c)
+    _same_as_reference(evolver, path, "r\no\n" + TAIL + "g 10", tmp_path)
+
+
+def test_narrow_cones_are_split(evolver, tmp_path):
+    path = _double_cone(tmp_path / "dc.fe", 6, 1.0, 3.0)
+    s = _same_as_reference(evolver, path, "o\n" + TAIL + "print vertex_pop_count", tmp_path)
+    X = s.surface.X
+    assert np.array_equal(X[-1], X[0])          # the copy sits on the old vertex
+
+
+def test_broad_cones_are_refused_unchanged(evolver, tmp_path):
+    """REF merges these into a neck (31 vertices); pyevolver refuses and
+    leaves the surface as it was."""
+    path = _double_cone(tmp_path / "dc.fe", 6, 0.4, 0.4)
+    ref = run_reference(evolver, path, "o\n" + TAIL, cwd=str(tmp_path))
+    counts = [ln.split() for ln in ref if ln.strip().isdigit()]
+    assert "Vertices popped: 1" in ref and counts[0] == ["31"]
+    s = Session.load(path, out=io.StringIO())
+    before = s.surface
+    with pytest.raises(PyEvolverError, match="broad cones"):
+        s.run("o")
+    assert s.surface is before
+
+
+def test_triangular_prism_cone(evolver, tmp_path):
+    """kraynikpopvertex (on by default) pops this cone its own way: refused;
+    with it off the Evolver uses the sphere, as pyevolver does."""
+    P, edges, c = _prism(3, 1)
+    path = _frame_cone(tmp_path / "p3.fe", P, edges, c)
+    s = Session.load(path, out=io.StringIO())
+    with pytest.raises(PyEvolverError, match="triangular prism"):
+        s.run("o")
+    _same_as_reference(evolver, path, "kraynikpopvertex off\no\n" + TAIL + "g 10", tmp_path)
+
+
+def test_cube_cone_is_refused(tmp_path):
+    P, edges, c = _prism(4, 2)
+    path = _frame_cone(tmp_path / "p4.fe", P, edges, c)
+    s = Session.load(path, out=io.StringIO())
+    with pytest.raises(PyEvolverError, match="cube"):
+        s.run("o")
+    assert s.surface.nv == 9
