@@ -259,9 +259,6 @@ def _check_star(s, v):
     vid = int(s.ids("vertex")[v])
     if s.periods is not None:
         raise UnsupportedError("popping a vertex in the torus model", f"vertex {vid}")
-    if s.bodies.n:
-        raise UnsupportedError("popping a vertex on a surface with bodies",
-                               "which body the new facets belong to is not implemented")
     for q in s.quantities.values():
         if any(sgn is not None and et in ("edge", "facet") for (_, et, _, sgn) in q.methods):
             raise UnsupportedError("popping a vertex on a surface whose quantities list "
@@ -361,6 +358,60 @@ def cell_sizes(s, v, sp, cells):
             tot += 2 * np.arctan2(num, den)
         out.append(tot)
     return np.array(out)
+
+
+def _region_body(s, region):
+    """The body filling a complement region (list of (facet, side)), or -1:
+    a facet's normal side is outside the bodies that list it with +."""
+    M = s.bodies.facet_matrix.tocsc()
+    found = set()
+    for f, side in region:
+        col = M[:, f].toarray().ravel()
+        bs = np.nonzero(col == -side)[0]
+        found.add(int(bs[0]) if len(bs) else -1)
+    if len(found) != 1:
+        raise UnsupportedError("popping a vertex whose regions are not single bodies")
+    return found.pop()
+
+
+def _cell_bodies(s, t, v, first, keep, big):
+    """Body memberships of the cells' new facets (``t``'s facets from
+    ``first`` on, built cell by cell in ``keep`` order): each separates its
+    cell's region (outside the sphere) from the largest cell's region, which
+    now fills the sphere."""
+    import scipy.sparse as sps
+    inner = _region_body(s, big)
+    nb, nf = s.bodies.n, t.nf
+    F = t.F
+    X = t.X
+    rows, cols, vals = [], [], []
+    k = first
+    for c in keep:
+        outer = _region_body(s, c)
+        n = len(c) - 2 if len(c) <= 4 else len(c)
+        for f in range(k, k + n):
+            a, b, d = X[F[f, 0]], X[F[f, 1]], X[F[f, 2]]
+            nrm = np.cross(b - a, d - a)
+            out = float(nrm @ ((a + b + d) / 3 - s.X[v])) > 0      # normal into the cell
+            for body, sg in ((outer, -1 if out else 1), (inner, 1 if out else -1)):
+                if body >= 0 and body != (inner if body == outer else -2):
+                    rows.append(body)
+                    cols.append(f)
+                    vals.append(sg)
+        k += n
+    b = t.bodies
+    M = b.facet_matrix.tocoo()
+    old = M.col < first
+    r = np.concatenate([M.row[old], rows]).astype(np.int64)
+    cc = np.concatenate([M.col[old], cols]).astype(np.int64)
+    vv = np.concatenate([M.data[old], vals]).astype(float)
+    b.facet_matrix = sps.csr_matrix((vv, (r, cc)), shape=(nb, nf))
+    ob, of, osg = b.occurrences
+    ok = of < first
+    b.occurrences = (np.concatenate([ob[ok], np.asarray(rows, np.int64)]),
+                     np.concatenate([of[ok], np.asarray(cols, np.int64)]),
+                     np.concatenate([osg[ok], np.asarray(vals, osg.dtype)]))
+    b.volume = None
 
 
 def _build(s, v, sp, far, fs, cells):
@@ -465,6 +516,8 @@ def _build(s, v, sp, far, fs, cells):
             t.FE[fpos] = (spk[j], arc_between(ws[j], ws[j2]), ~spk[j2])
             fpos += 1
     assert fpos == t.nf and epos == t.ne
+    if s.bodies.n:
+        _cell_bodies(s, t, v, nf + m, keep, cells[big])
     vkeep = np.ones(t.nv, bool)
     vkeep[v] = False
     return subset(t, t.E, t.FE, vkeep, np.ones(t.ne, bool), np.ones(t.nf, bool))
