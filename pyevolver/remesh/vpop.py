@@ -107,16 +107,17 @@ def _star(s, v):
     return sp, far, fs
 
 
-def _cells(s, v, sp, fs):
+def _cells(s, v, sp, fs, X=None):
     """The complement regions of the surface near ``v``: each a list of
     (facet, side) with side +1 for the facet's normal side.
 
     Round each spoke the facets are sorted by their angle about the spoke
     (outward from ``v``); the region between two neighbours touches the
     first on the side the rotation leaves it and the second on the side it
-    arrives at.
+    arrives at.  ``X``: the positions to use (the torus: the far ends
+    lifted next to ``v``).
     """
-    X = s.X
+    X = s.X if X is None else X
     F = s.F
     N = np.cross(X[F[fs, 1]] - X[F[fs, 0]], X[F[fs, 2]] - X[F[fs, 0]])
     pos = {int(f): k for k, f in enumerate(fs)}
@@ -255,10 +256,20 @@ def _split_cones(s, v):
     return t
 
 
+def _lifted(s, v, sp, far):
+    """Positions with each far end of a spoke lifted next to ``v`` (the
+    torus model), and each spoke's period offset (in cells) from ``v`` to its
+    far end (None outside the torus)."""
+    if s.periods is None or "wrap" not in s.eattr:
+        return s.X, None
+    W = s.eattr["wrap"][sp]
+    off = np.where((s.E[sp, 0] == v)[:, None], W, -W)
+    X = s.X.copy()
+    X[far] = s.X[far] + off @ s.periods
+    return X, off
+
+
 def _check_star(s, v):
-    vid = int(s.ids("vertex")[v])
-    if s.periods is not None:
-        raise UnsupportedError("popping a vertex in the torus model", f"vertex {vid}")
     for q in s.quantities.values():
         if any(sgn is not None and et in ("edge", "facet") for (_, et, _, sgn) in q.methods):
             raise UnsupportedError("popping a vertex on a surface whose quantities list "
@@ -298,7 +309,8 @@ def _pop_one(s, v, kraynik=True):
     if (far == v).any() or len(set(far.tolist())) != len(far):
         raise UnsupportedError("popping a vertex with a loop or multiple edges",
                                f"vertex {vid}")
-    cells = _cells(s, v, sp, fs)
+    XL, off = _lifted(s, v, sp, far)
+    cells = _cells(s, v, sp, fs, XL)
     for c in cells:
         if len({f for f, _ in c}) != len(c) or len(c) < 3:
             raise UnsupportedError("popping a vertex whose regions touch a facet twice",
@@ -312,7 +324,7 @@ def _pop_one(s, v, kraynik=True):
     if kind == 4:
         raise UnsupportedError("popping a vertex whose link is a cube", f"vertex {vid}: the "
                                "Evolver pops this cone to a square, which is not implemented")
-    return _build(s, v, sp, far, fs, cells)
+    return _build(s, v, sp, far, fs, cells, XL, off)
 
 
 def _cell_loop(s, v, sp, c):
@@ -339,14 +351,15 @@ def _cell_loop(s, v, sp, c):
     return loop[:-1]
 
 
-def cell_sizes(s, v, sp, cells):
+def cell_sizes(s, v, sp, cells, X=None):
     """Solid angle (seen from ``v``) of each cell's polygon of spoke
     midpoints."""
-    W = 0.5 * (s.X[v] + s.X[np.where(s.E[sp, 0] == v, s.E[sp, 1], s.E[sp, 0])])
+    X = s.X if X is None else X
+    W = 0.5 * (X[v] + X[np.where(s.E[sp, 0] == v, s.E[sp, 1], s.E[sp, 0])])
     out = []
     for c in cells:
         loop = _cell_loop(s, v, sp, c)
-        P = W[loop] - s.X[v]
+        P = W[loop] - X[v]
         P = P / np.linalg.norm(P, axis=1)[:, None]
         m = P.mean(axis=0)
         m = m / np.linalg.norm(m)
@@ -414,10 +427,10 @@ def _cell_bodies(s, t, v, first, keep, big):
     b.volume = None
 
 
-def _build(s, v, sp, far, fs, cells):
+def _build(s, v, sp, far, fs, cells, XL, off):
     from .grow import grow
     from .shrink import subset
-    sizes = cell_sizes(s, v, sp, cells)
+    sizes = cell_sizes(s, v, sp, cells, XL)
     big = int(np.argmax(sizes))
     keep = [c for i, c in enumerate(cells) if i != big]
     loops = [_cell_loop(s, v, sp, c) for c in keep]
@@ -439,7 +452,7 @@ def _build(s, v, sp, far, fs, cells):
     nv, ne, nf = s.nv, s.ne, s.nf
     W = nv + np.arange(k)
     C = nv + k + np.arange(len(centred))
-    t.X[W] = 0.5 * (s.X[v] + s.X[far])
+    t.X[W] = 0.5 * (XL[v] + XL[far])
     spoke_of = {int(p): j for j, p in enumerate(far)}
     # spokes now start at their w
     for j, e in enumerate(sp):
@@ -460,6 +473,9 @@ def _build(s, v, sp, far, fs, cells):
         e_vp, e_pq, e_qv = row[kv], row[(kv + 1) % 3], row[(kv + 2) % 3]
         t.E[arc[i]] = (wq, wp)
         t.E[diag[i]] = (wp, q)
+        if off is not None:           # the spokes keep their wraps (w is in v's cell)
+            t.eattr["wrap"][arc[i]] = 0
+            t.eattr["wrap"][diag[i]] = off[spoke_of[q]]
         # (wp, p, q) keeps f; (q, wq, wp) is new
         t.FE[f] = (e_vp, e_pq, ~diag[i])      # e_vp now runs wp -> p (same sign)
         t.FE[nf + i] = (diag[i], ~e_qv if False else e_qv, arc[i])
@@ -501,16 +517,20 @@ def _build(s, v, sp, far, fs, cells):
             dg = epos
             epos += 1
             t.E[dg] = (a, c)
+            if off is not None:
+                t.eattr["wrap"][dg] = 0
             t.FE[fpos] = (arc_between(a, b), arc_between(b, c), ~dg)
             t.FE[fpos + 1] = (dg, arc_between(c, d), arc_between(d, a))
             fpos += 2
             continue
         c = C[centred.index(i)]
-        t.X[c] = s.X[far[lp]].mean(axis=0) * 0.5 + 0.5 * s.X[v]
+        t.X[c] = t.X[ws].mean(axis=0)
         spk = epos + np.arange(len(lp))
         epos += len(lp)
         for j in range(len(lp)):
             t.E[spk[j]] = (c, ws[j])
+            if off is not None:
+                t.eattr["wrap"][spk[j]] = 0
         for j in range(len(lp)):
             j2 = (j + 1) % len(lp)
             t.FE[fpos] = (spk[j], arc_between(ws[j], ws[j2]), ~spk[j2])

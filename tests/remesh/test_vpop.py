@@ -21,18 +21,31 @@ TAIL = "print vertex_count\nprint edge_count\nprint facet_count\n"
 
 # -- hand-made cones ------------------------------------------------------------------
 
-def _frame_cone(path, P, edges, centre):
+def _frame_cone(path, P, edges, centre, torus=None):
     """A free centre vertex joined to the fixed vertices ``P`` (fixed frame
-    ``edges``), one triangle per frame edge."""
-    L = ["vertices", "1 %r %r %r" % tuple(map(float, centre))]
-    L += ["%d %r %r %r fixed" % (i + 2, *map(float, p)) for i, p in enumerate(P)]
-    L.append("edges")
-    L += ["%d %d %d fixed" % (k + 1, a + 2, b + 2) for k, (a, b) in enumerate(edges)]
-    L += ["%d 1 %d" % (len(edges) + i + 1, i + 2) for i in range(len(P))]
-    L.append("faces")
-    L += ["%d %d %d %d" % (k + 1, len(edges) + a + 1, k + 1, -(len(edges) + b + 1))
-          for k, (a, b) in enumerate(edges)]
-    path.write_text("\n".join(L) + "\n")
+    ``edges``), one triangle per frame edge.  ``torus=(L, shift)``: the same
+    shifted by ``shift`` in a cubic torus of period L (coordinates wrapped
+    into the cell, edges with their wrap symbols)."""
+    Y = np.vstack([centre, P]).astype(float)
+    pairs = list(edges) + [(-1, i) for i in range(len(P))]   # -1: the centre
+    wraps = [""] * len(pairs)
+    if torus is not None:
+        L, shift = torus
+        true = Y + np.asarray(shift, float)
+        Y = np.mod(true, L)
+        for k, (a, b) in enumerate(pairs):
+            w = np.round((true[b + 1] - true[a + 1] - (Y[b + 1] - Y[a + 1])) / L).astype(int)
+            wraps[k] = " " + " ".join({0: "*", 1: "+", -1: "-"}[int(x)] for x in w)
+    L_ = ([f"TORUS_FILLED\nperiods\n{L} 0 0\n0 {L} 0\n0 0 {L}"] if torus else []) + ["vertices"]
+    L_ += ["1 %r %r %r" % tuple(map(float, Y[0]))]
+    L_ += ["%d %r %r %r fixed" % (i + 2, *map(float, p)) for i, p in enumerate(Y[1:])]
+    L_.append("edges")
+    L_ += ["%d %d %d%s%s" % (k + 1, a + 2, b + 2, wraps[k], " fixed" if k < len(edges) else "")
+           for k, (a, b) in enumerate(pairs)]
+    L_.append("faces")
+    L_ += ["%d %d %d %d" % (k + 1, len(edges) + a + 1, k + 1, -(len(edges) + b + 1))
+           for k, (a, b) in enumerate(edges)]
+    path.write_text("\n".join(L_) + "\n")
     return str(path)
 
 
@@ -297,3 +310,14 @@ def test_cone_with_bodies_matches_reference(evolver, tmp_path):
     assert [ln for ln in ours if "." in ln and "area" not in ln][-12:] == \
         [ln for ln in ref if "." in ln and "area" not in ln][-12:]
     assert s.surface.bodies.n == 12
+
+
+@pytest.mark.parametrize("pre", ["", "r\n"])
+def test_torus_model_matches_reference(evolver, tmp_path, pre):
+    """The dodecahedron cone in a torus, its centre by a corner of the cell
+    (spokes wrapping in every direction): midpoints and cells taken next to
+    the vertex, the new edges' wraps."""
+    P, edges, c = _dodecahedron(1)
+    path = _frame_cone(tmp_path / "dt.fe", P, edges, c, torus=(5.0, (0.05, -0.02, 0.03)))
+    s = _same_as_reference(evolver, path, pre + "o\n" + TAIL + "g 10", tmp_path)
+    assert s.surface.periods is not None
