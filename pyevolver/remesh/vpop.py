@@ -27,10 +27,13 @@ its largest cell removed) is in :func:`pop_vertices`.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sps
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import UnsupportedError
+from .grow import grow
+from .shrink import subset
 
 
 def _edge_valence(s):
@@ -230,7 +233,6 @@ def _split_cones(s, v):
     """Two cones meeting at ``v``: split them (the second cone, the one
     without ``v``'s lowest-numbered edge, moves to a copy of ``v`` at the
     same place), or refuse the Evolver's merging into a neck."""
-    from .grow import grow
     vid = int(s.ids("vertex")[v])
     cones = _cones(s, v)
     if cone_flatness(s, v, cones) > CONE_MERGE:
@@ -392,7 +394,6 @@ def _cell_bodies(s, t, v, first, keep, big):
     ``first`` on, built cell by cell in ``keep`` order): each separates its
     cell's region (outside the sphere) from the largest cell's region, which
     now fills the sphere."""
-    import scipy.sparse as sps
     inner = _region_body(s, big)
     nb, nf = s.bodies.n, t.nf
     F = t.F
@@ -428,8 +429,6 @@ def _cell_bodies(s, t, v, first, keep, big):
 
 
 def _build(s, v, sp, far, fs, cells, XL, off):
-    from .grow import grow
-    from .shrink import subset
     sizes = cell_sizes(s, v, sp, cells, XL)
     big = int(np.argmax(sizes))
     keep = [c for i, c in enumerate(cells) if i != big]

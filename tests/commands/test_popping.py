@@ -8,6 +8,7 @@ from conftest import example
 from reference import run_reference
 
 from pyevolver import Session
+from pyevolver.commands import popping
 from pyevolver.errors import PyEvolverError
 
 
@@ -80,3 +81,11 @@ def test_o_in_the_string_model_is_not_handled_here():
     s = Session.load(example("popstr.fe"), out=io.StringIO())
     with pytest.raises(PyEvolverError, match="string model"):
         s.run("o")
+
+
+def test_kraynik_toggle_default():
+    """kraynikpopvertex is on in a fresh session (as in the Evolver)."""
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    assert popping._kraynik(s) is True
+    s.run("kraynikpopvertex off")
+    assert popping._kraynik(s) is False
