@@ -229,6 +229,146 @@ def cone_flatness(s, v, cones):
     return num / den if den > 0 else 0.0
 
 
+def _cone_cycle(s, v, ce, cf):
+    """Spokes (edge indices) of a cone in the order of its link cycle, and
+    the facet between each spoke and the next."""
+    absFE = np.where(s.FE >= 0, s.FE, ~s.FE)
+    arcs = {f: [int(e) for e in absFE[f] if int(e) in set(ce)] for f in cf}
+    cyc, fac = [ce[0]], []
+    f = next(g for g in cf if ce[0] in arcs[g])
+    while len(fac) < len(cf):
+        a, b = arcs[f]
+        nxt = b if a == cyc[-1] else a
+        fac.append(f)
+        if len(fac) == len(cf):
+            break
+        cyc.append(nxt)
+        f = next(g for g in cf if g != f and nxt in arcs[g])
+    return cyc, fac
+
+
+def _merge_cones(s, v, cones):
+    """Two broad cones at ``v`` widened into a neck (REF's merge, measured on
+    double cones of equal facet counts): each spoke of the first cone is
+    paired with the nearest spoke of the second, going round both in the
+    same sense; each pair meets at a ring point halfway between their
+    midpoints; the cones' facets lose their corners (as in the sphere pop)
+    and, unless the two cones' insides are the same body, a fan from the
+    ring's mean closes the neck (the septum)."""
+    vid = int(s.ids("vertex")[v])
+    if len(cones[0][0]) != len(cones[1][0]):
+        raise UnsupportedError("popping a vertex where two broad cones of unequal facet counts "
+                               "meet", f"vertex {vid}: the Evolver merges them into a neck by "
+                               "a rule not implemented")
+    _check_star(s, v)
+    sp, far, fs = _star(s, v)
+    XL, off = _lifted(s, v, sp, far)
+    spos = {int(e): j for j, e in enumerate(sp)}
+    U = [_cone_cycle(s, v, ce, cf) for ce, cf in cones]
+    n = len(U[0][0])
+    vec = [np.array([XL[far[spos[e]]] - XL[v] for e in U[k][0]]) for k in range(2)]
+    axis = vec[0].mean(axis=0) - vec[1].mean(axis=0)
+    # the same rotational sense round the axis for both cycles
+    for k in range(2):
+        turn = np.cross(vec[k], np.roll(vec[k], -1, axis=0)).sum(axis=0) @ axis
+        if turn < 0:
+            U[k] = (U[k][0][::-1], U[k][1][::-1][1:] + U[k][1][::-1][:1])
+            vec[k] = vec[k][::-1]
+    unit = [x / np.linalg.norm(x, axis=1)[:, None] for x in vec]
+    best = min(range(n), key=lambda sh: -float(np.sum(unit[0] * np.roll(unit[1], -sh, axis=0))))
+    pair_b = [U[1][0][(j + best) % n] for j in range(n)]
+    cells = _cells(s, v, sp, fs, XL)
+    side_of = {}
+    for i, c in enumerate(cells):
+        for f, sd in c:
+            side_of[(f, sd)] = i
+    conef = [set(cf) for _, cf in cones]
+    caps = [next(i for i, c in enumerate(cells) if all(f in conef[k] for f, _ in c))
+            for k in range(2)]
+    septum = True
+    if s.bodies.n:
+        b0, b1 = (_region_body(s, cells[c]) for c in caps)
+        septum = not (b0 == b1 and b0 >= 0)
+    m = len(fs)
+    ring_par = [int(U[0][1][j]) for j in range(n)]
+    e_par = [int(f) for f in fs] + ring_par + ([ring_par[0]] * n if septum else [])
+    f_par = [int(f) for f in fs] + ([ring_par[0]] * n if septum else [])
+    t = grow(s, v_from_edge=[int(U[0][0][j]) for j in range(n)] +
+             ([int(U[0][0][0])] if septum else []), e_from_facet=e_par, f_from_facet=f_par)
+    nv, ne, nf = s.nv, s.ne, s.nf
+    R = nv + np.arange(n)
+    ring_of = {}
+    for j in range(n):
+        a, b = U[0][0][j], pair_b[j]
+        t.X[R[j]] = XL[v] + 0.25 * (vec[0][j] + (XL[far[spos[b]]] - XL[v]))
+        ring_of[a] = ring_of[b] = int(R[j])
+    for e in sp:                        # spokes start at their ring point
+        t.E[e] = np.where(t.E[e] == v, ring_of[int(e)], t.E[e])
+    ring_e = ne + m + np.arange(n)
+    ring_idx = {}
+    for j in range(n):
+        t.E[ring_e[j]] = (R[j], R[(j + 1) % n])
+        ring_idx[(int(R[j]), int(R[(j + 1) % n]))] = int(ring_e[j])
+        if off is not None:
+            t.eattr["wrap"][ring_e[j]] = 0
+
+    def ring_edge(a, b):
+        if (a, b) in ring_idx:
+            return ring_idx[(a, b)]
+        return ~ring_idx[(b, a)]
+    spoke_far = {int(far[j]): int(e) for j, e in enumerate(sp)}
+    for i, f in enumerate(fs):
+        row = [int(x) for x in s.FE[f]]
+        vs = [int(x) for x in s.F[f]]
+        kv = vs.index(v)
+        p, q = vs[(kv + 1) % 3], vs[(kv + 2) % 3]
+        rp, rq = ring_of[spoke_far[p]], ring_of[spoke_far[q]]
+        e_vp, e_pq, e_qv = row[kv], row[(kv + 1) % 3], row[(kv + 2) % 3]
+        # the quad rp p q rq is split along p - rq (REF's neck; the sphere
+        # pop uses the other diagonal): (p, q, rq) keeps f, (rp, p, rq) is new
+        d = ne + i
+        t.E[d] = (p, rq)
+        if off is not None:
+            t.eattr["wrap"][d] = -off[spos[spoke_far[p]]]
+        eq = e_qv if e_qv >= 0 else ~e_qv
+        t.FE[f] = (e_pq, eq if t.E[eq, 0] == q else ~eq, ~d)
+        t.FE[nf + i] = (e_vp, d, ring_edge(rq, rp))
+    if septum:
+        c = nv + n
+        t.X[c] = t.X[R].mean(axis=0)
+        spk = ne + m + n + np.arange(n)
+        for j in range(n):
+            t.E[spk[j]] = (c, R[j])
+            if off is not None:
+                t.eattr["wrap"][spk[j]] = 0
+        for j in range(n):
+            t.FE[nf + m + j] = (spk[j], ring_edge(int(R[j]), int(R[(j + 1) % n])),
+                                ~spk[(j + 1) % n])
+        if s.bodies.n:
+            _septum_bodies(s, t, v, nf + m, n, [cells[c_] for c_ in caps],
+                           vec[0].mean(axis=0))
+    vkeep = np.ones(t.nv, bool)
+    vkeep[v] = False
+    return subset(t, t.E, t.FE, vkeep, np.ones(t.ne, bool), np.ones(t.nf, bool))
+
+
+def _septum_bodies(s, t, v, first, n, caps, up):
+    """Body memberships of the septum's facets: it separates the first
+    cone's inside (direction ``up`` from ``v``) from the second's."""
+    b0, b1 = (_region_body(s, c) for c in caps)
+    F = t.F
+    rows, cols, vals = [], [], []
+    for f in range(first, first + n):
+        a, b, d = t.X[F[f, 0]], t.X[F[f, 1]], t.X[F[f, 2]]
+        into0 = float(np.cross(b - a, d - a) @ up) > 0
+        for body, sg in ((b0, -1 if into0 else 1), (b1, 1 if into0 else -1)):
+            if body >= 0:
+                rows.append(body)
+                cols.append(f)
+                vals.append(sg)
+    _set_body_columns(t, first, rows, cols, vals)
+
+
 def _split_cones(s, v):
     """Two cones meeting at ``v``: split them (the second cone, the one
     without ``v``'s lowest-numbered edge, moves to a copy of ``v`` at the
@@ -236,8 +376,7 @@ def _split_cones(s, v):
     vid = int(s.ids("vertex")[v])
     cones = _cones(s, v)
     if cone_flatness(s, v, cones) > CONE_MERGE:
-        raise UnsupportedError("popping a vertex where two broad cones meet", f"vertex {vid}: "
-                               "the Evolver merges them into a neck, which is not implemented")
+        return _merge_cones(s, v, cones)
     eid = s.ids("edge")
     cones.sort(key=lambda c: min(eid[e] for e in c[0]))
     move = np.array(cones[1][0], np.int64)
@@ -413,13 +552,18 @@ def _cell_bodies(s, t, v, first, keep, big):
                     cols.append(f)
                     vals.append(sg)
         k += n
+    _set_body_columns(t, first, rows, cols, vals)
+
+
+def _set_body_columns(t, first, rows, cols, vals):
+    """Replace the body memberships of ``t``'s facets from ``first`` on."""
     b = t.bodies
     M = b.facet_matrix.tocoo()
     old = M.col < first
     r = np.concatenate([M.row[old], rows]).astype(np.int64)
     cc = np.concatenate([M.col[old], cols]).astype(np.int64)
     vv = np.concatenate([M.data[old], vals]).astype(float)
-    b.facet_matrix = sps.csr_matrix((vv, (r, cc)), shape=(nb, nf))
+    b.facet_matrix = sps.csr_matrix((vv, (r, cc)), shape=(b.n, t.nf))
     ob, of, osg = b.occurrences
     ok = of < first
     b.occurrences = (np.concatenate([ob[ok], np.asarray(rows, np.int64)]),

@@ -73,18 +73,20 @@ def _dodecahedron(seed):
     return P + 0.05 * rng.standard_normal(P.shape), edges, 0.1 * rng.standard_normal(3)
 
 
-def _double_cone(path, n, h1, h2):
-    """Two cones of ``n`` facets with their apex at the origin (vertex 1),
-    middle rings free, rims fixed at z = h1 and z = -h2."""
+def _double_cone(path, n, h1, h2, rot=0.0, n2=None):
+    """Two cones (``n`` and ``n2`` facets, the second turned by ``rot``)
+    with their apex at the origin (vertex 1), middle rings free, rims fixed
+    at z = h1 and z = -h2."""
     V = [(0.0, 0.0, 0.0, "")]
-    t = 2 * np.pi * np.arange(n) / n
 
-    def ring(z, r, fixed):
+    def ring(z, r, fixed, m, turn):
+        t = 2 * np.pi * np.arange(m) / m + turn
         V.extend((float(r * np.cos(a)), float(r * np.sin(a)), float(z), "fixed" if fixed else "")
                  for a in t)
-        return list(range(len(V) - n + 1, len(V) + 1))
-    um, ur, lm, lr = ring(h1 / 2, 0.5, False), ring(h1, 1, True), ring(-h2 / 2, 0.5, False), \
-        ring(-h2, 1, True)
+        return list(range(len(V) - m + 1, len(V) + 1))
+    n2 = n if n2 is None else n2
+    um, ur = ring(h1 / 2, 0.5, False, n, 0.0), ring(h1, 1, True, n, 0.0)
+    lm, lr = ring(-h2 / 2, 0.5, False, n2, rot), ring(-h2, 1, True, n2, rot)
     E, F = {}, []
 
     def edge(a, b, fixed=False):
@@ -94,8 +96,9 @@ def _double_cone(path, n, h1, h2):
             E[(a, b)] = (len(E) + 1, "fixed" if fixed else "")
         return E[(a, b)][0]
     for mid, rim in ((um, ur), (lm, lr)):
-        for k in range(n):
-            a, b, A, B = mid[k], mid[(k + 1) % n], rim[k], rim[(k + 1) % n]
+        m = len(mid)
+        for k in range(m):
+            a, b, A, B = mid[k], mid[(k + 1) % m], rim[k], rim[(k + 1) % m]
             F.append((edge(1, a), edge(a, b), edge(b, 1)))
             F.append((edge(a, A), edge(A, B, True), edge(B, a)))
             F.append((edge(a, B), edge(B, b), edge(b, a)))
@@ -208,16 +211,21 @@ def test_narrow_cones_are_split(evolver, tmp_path):
     assert np.array_equal(X[-1], X[0])          # the copy sits on the old vertex
 
 
-def test_broad_cones_are_refused_unchanged(evolver, tmp_path):
-    """REF merges these into a neck (31 vertices); pyevolver refuses and
-    leaves the surface as it was."""
-    path = _double_cone(tmp_path / "dc.fe", 6, 0.4, 0.4)
-    ref = run_reference(evolver, path, "o\n" + TAIL, cwd=str(tmp_path))
-    counts = [ln.split() for ln in ref if ln.strip().isdigit()]
-    assert "Vertices popped: 1" in ref and counts[0] == ["31"]
+@pytest.mark.parametrize("h1,h2,rot", [(0.4, 0.4, 0.0), (0.3, 0.45, 0.6), (0.1, 0.6, -0.3)])
+def test_broad_cones_merge_into_a_neck(evolver, tmp_path, h1, h2, rot):
+    """Broad cones ((|N1|+|N2|)/(A1+A2) > 0.88) become a neck closed by a
+    septum: spokes paired by angle (also with the second cone turned), the
+    ring halfway between their midpoints, the quads split along p - r_q."""
+    path = _double_cone(tmp_path / "dc.fe", 6, h1, h2, rot)
+    s = _same_as_reference(evolver, path, "o\n" + TAIL + "g 10", tmp_path, 1e-7)
+    assert s.surface.nv == 31
+
+
+def test_broad_cones_of_unequal_counts_are_refused_unchanged(tmp_path):
+    path = _double_cone(tmp_path / "dc.fe", 6, 0.3, 0.3, 0.0, n2=5)
     s = Session.load(path, out=io.StringIO())
     before = s.surface
-    with pytest.raises(PyEvolverError, match="broad cones"):
+    with pytest.raises(PyEvolverError, match="unequal facet counts"):
         s.run("o")
     assert s.surface is before
 
