@@ -278,17 +278,19 @@ def _merge_cones(s, v, cones):
     best = min(range(n), key=lambda sh: -float(np.sum(unit[0] * np.roll(unit[1], -sh, axis=0))))
     pair_b = [U[1][0][(j + best) % n] for j in range(n)]
     cells = _cells(s, v, sp, fs, XL)
-    side_of = {}
-    for i, c in enumerate(cells):
-        for f, sd in c:
-            side_of[(f, sd)] = i
+    F = s.F
+
+    def inside(k, c):
+        """Whether cell ``c`` lies inside cone k (on the side of its axis)."""
+        f, sd = c[0]
+        a, b, d = XL[F[f, 0]], XL[F[f, 1]], XL[F[f, 2]]
+        return sd * float(np.cross(b - a, d - a) @ vec[k].mean(axis=0)) > 0
     conef = [set(cf) for _, cf in cones]
-    caps = [next(i for i, c in enumerate(cells) if all(f in conef[k] for f, _ in c))
-            for k in range(2)]
+    caps = [next(i for i, c in enumerate(cells) if all(f in conef[k] for f, _ in c)
+                 and inside(k, c)) for k in range(2)]
+    # the manual: no septum when both insides are one body; REF 2.70 puts
+    # one there too (a double cone whose two insides are one body), as here
     septum = True
-    if s.bodies.n:
-        b0, b1 = (_region_body(s, cells[c]) for c in caps)
-        septum = not (b0 == b1 and b0 >= 0)
     m = len(fs)
     ring_par = [int(U[0][1][j]) for j in range(n)]
     e_par = [int(f) for f in fs] + ring_par + ([ring_par[0]] * n if septum else [])
