@@ -253,8 +253,8 @@ def _merge_cones(s, v, cones):
     paired with the nearest spoke of the second, going round both in the
     same sense; each pair meets at a ring point halfway between their
     midpoints; the cones' facets lose their corners (as in the sphere pop)
-    and, unless the two cones' insides are the same body, a fan from the
-    ring's mean closes the neck (the septum)."""
+    and a fan from the ring's mean closes the neck (the septum; REF 2.70
+    puts it even when both insides are one body)."""
     vid = int(s.ids("vertex")[v])
     if len(cones[0][0]) != len(cones[1][0]):
         raise UnsupportedError("popping a vertex where two broad cones of unequal facet counts "
