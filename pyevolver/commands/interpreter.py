@@ -23,7 +23,7 @@ from ..limits import MAX_ARRAY_ENTRIES, MAX_NESTING
 # the families register their commands when imported (refused last: its
 # fallbacks only take names no other family has)
 from . import (constraints, eigen, element_attrs, elements, evolution, extensions, files,  # noqa: F401
-               fixing, model_order, output, remesh, toggles)
+               fixing, model_order, output, popping, remesh, toggles)
 from . import refused  # noqa: F401
 from . import simplex
 from . import registry, variables

@@ -307,6 +307,9 @@ class _CmdTransformer(ExprTransformer):
     def delete(self, _r, gen):
         return ("delete", gen)
 
+    def pop(self, _r, gen):
+        return ("pop", gen)
+
     def break_(self, _b, n=None):
         return ("break", n)
 

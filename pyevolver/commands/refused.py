@@ -13,7 +13,6 @@ LETTER_LATER = {
     "g": "g (iteration) comes with the evolve issue",
     "U": "U (conjugate gradient) comes with the evolve issue",
     "m": "m (fixed scale) comes with the evolve issue",
-    "o": "o (vertex popping)",
     "G": "G (gravity) comes with the evolve issue",
     "e": "e (extrapolation)", "i": "i (information)", "Q": "Q (quantities)",
     "C": "C (consistency check)", "c": "c (counts)", "N": "N",
@@ -23,7 +22,6 @@ LETTER_LATER = {
 WORD_LATER = {
     "hessian_menu", "move",
     "vertex_average", "raw_vertex_average", "rawest_vertex_average",
-    "pop",
     "t1_edgeswap", "dissolve", "optimize", "optimise",
     "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
     "conj_grad_later", "fix", "unfix", "burchard", "zoom",

@@ -193,8 +193,9 @@ def _pop_one(s, e, first):
     return t, fr
 
 
-def pop_edges(s):
-    """``O``: pop every edge with four facets (in id order).
+def pop_edges(s, which=None):
+    """``O``: pop every edge with four facets (in id order); ``which``
+    (edge indices, ``pop edge[...]``) restricts the candidates.
 
     Returns
     -------
@@ -206,7 +207,12 @@ def pop_edges(s):
     if s.nf == 0:
         raise UnsupportedError("O (edge popping) in the string model")
     val = _valence(s)
-    cand = np.nonzero(val >= 4)[0]
+    ok = val >= 4
+    if which is not None:
+        keep = np.zeros(s.ne, bool)
+        keep[np.asarray(which, np.int64)] = True
+        ok &= keep
+    cand = np.nonzero(ok)[0]
     if not len(cand):
         return s, 0
     _check(s, cand, val)

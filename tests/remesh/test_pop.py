@@ -181,8 +181,8 @@ def test_unchecked_configurations_are_refused(tmp_path):
         text = fh.read()
     fixed.write_text(text.replace("\n13  1  2\n", "\n13  1  2 fixed\n"))
     _refused(str(fixed), "O", "FIXED edge")
-    # vertex popping and autopop stay refused
-    _refused(octa, "o", "vertex popping")
+    # o refuses what O refuses (and leaves the surface as it was); autopop stays refused
+    _refused(str(fixed), "o", "FIXED edge")
     _refused(octa, "autopop", "autopop")
 
 
