@@ -510,6 +510,9 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
     s = it.surface
     if s.X.shape[1] > 3:
         raise dimension_error(s.sdim, "the Hessian")
+    if s.string:
+        from .string_hessian import check_fixed_bodies
+        check_fixed_bodies(s)
     mobile = it._mobile()
     cons = _Constraints(s)
     t = s.evaluate()
@@ -532,9 +535,15 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
             for l, gg in zip(lam, cons.gradients(tt)):
                 g = g - l * gg
         return g
-    basis, grads = tangent_basis(s, mobile, normal=normal)
-    T = basis.matrix()
-    K = lagrangian_hessian(s, cons, lam, grad_L, basis)
+    if s.string:                    # the string model's motions and energies
+        from . import string_hessian as SH
+        basis, grads = SH.string_basis(s, mobile, normal=normal)
+        T = basis.matrix()
+        K = SH.string_lagrangian_hessian(s, cons, lam, grad_L, basis)
+    else:
+        basis, grads = tangent_basis(s, mobile, normal=normal)
+        T = basis.matrix()
+        K = lagrangian_hessian(s, cons, lam, grad_L, basis)
     gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))
     Hc = constraint_curvature(s, grads, gL)
     if Hc is not None:
