@@ -180,6 +180,14 @@ def _signatures(s):
     return vsig, esig
 
 
+def _closes(enc, E, elim, keep):
+    """Whether the chain ``enc`` closes on itself once ``elim`` is ``keep``."""
+    def end(x, k):
+        v = int(E[x, k] if x >= 0 else E[~x, 1 - k])
+        return keep if v == elim else v
+    return end(enc[0], 0) == end(enc[-1], 1)
+
+
 def delete_short_edges(s, length: float):
     """``t length`` on a string: ``(new surface, number deleted)``."""
     X = s.X.copy()
@@ -229,10 +237,14 @@ def delete_short_edges(s, length: float):
                 f"t: deleting edge {int(eids[e])} would leave an edge from a vertex to itself "
                 "in the string model", "the Evolver deletes more than it reports there")
         for f, ch in enumerate(chains):
-            if len(ch) and all((x if x >= 0 else ~x) == e for x in ch):
+            rest = [x for x in ch if (x if x >= 0 else ~x) != e]
+            if len(rest) < len(ch) and len(rest) <= 2 and (
+                    not rest or _closes(rest, E, elim, keep)):
                 raise UnsupportedError(
-                    f"t: deleting edge {int(eids[e])} would leave facet "
-                    f"{int(s.ids('facet')[f])} without edges in the string model")
+                    f"t: deleting edge {int(eids[e])} would close facet "
+                    f"{int(s.ids('facet')[f])} on one or two edges in the string model",
+                    "the Evolver then dissolves the facet and merges its edges, by rules "
+                    "not measured")
         shift = None
         if ok(keep, e):
             if wrap is not None and np.any(wrap[e] != 0):
