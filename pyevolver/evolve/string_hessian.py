@@ -45,6 +45,7 @@ from ..methods import string as SM
 from ..methods.basic import edge_length_hessian
 from ..model.string import chain_points, facet_entries
 from . import gradient as GR
+from .hessian import MODEL_HESSIAN, Basis, _quantity_hessian, _sum, fd_hessian
 
 
 def check_fixed_bodies(s) -> None:
@@ -79,7 +80,6 @@ def _neighbour_vectors(s):
 def string_basis(s, mobile, normal=True):
     """The free motions of a string's vertices: ``(Basis, grads)`` as
     :func:`pyevolver.evolve.hessian.tangent_basis` returns them."""
-    from .hessian import Basis
     nv, dim = s.nv, s.sdim
     if "boundary" in s.vattr and np.any(s.vattr["boundary"][mobile]):
         raise UnsupportedError("the Hessian with parametric boundaries in the string model")
@@ -204,7 +204,6 @@ def _analytic(s, t, cons, lam, hessian=True):
     """``(parts, gradient, complete)``: the analytic Hessian parts (3nv, 3nv),
     the gradient of the same terms, and False when a quantity's method has
     no analytic Hessian (its gradient is left out of ``gradient``)."""
-    from .hessian import _quantity_hessian
     parts = []
     complete = True
     g = np.zeros((s.nv, 3))
@@ -257,7 +256,6 @@ def string_hessian_matrix(s, cons, lam, grad_fn, t=None):
     """The Hessian (3nv, 3nv) of the Lagrangian of a string surface, every
     coupling included (``grad_fn(t)`` its gradient, differentiated by
     central differences for the parts without an analytic Hessian)."""
-    from .hessian import _sum, fd_hessian
     t = s.evaluate() if t is None else t
     parts, ga, complete = _analytic(s, t, cons, lam)
     H = _sum(parts) if parts else sp.csr_matrix((3 * s.nv, 3 * s.nv))
@@ -300,3 +298,13 @@ def string_lagrangian_hessian(s, cons, lam, grad_fn, basis):
                 "vertex, by a rule not measured; vertices with one free direction "
                 "(hessian_normal in the plane) are as in the Evolver")
     return K
+
+
+class _StringModel:
+    """The string model's entry in :data:`pyevolver.evolve.hessian.MODEL_HESSIAN`."""
+    check = staticmethod(check_fixed_bodies)
+    basis = staticmethod(string_basis)
+    hessian = staticmethod(string_lagrangian_hessian)
+
+
+MODEL_HESSIAN["string"] = _StringModel()
