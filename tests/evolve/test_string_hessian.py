@@ -106,3 +106,17 @@ def test_basis_is_across_the_chord_in_the_plane():
     assert abs(basis.B[1, :, 0] @ chord) < 1e-12 and basis.B[1, 2, 0] == 0
     basis, _ = SH.string_basis(s, ~s.vattr["fixed"], normal=False)
     assert list(basis.ndof) == [0, 2, 2, 2, 0]
+
+
+def test_eigenvalue_commands_match_reference(evolver, tmp_path):
+    """ritz, eigenprobe, saddle: REF's string matrix is twice the
+    vertex blocks (its eigenvalues are twice pyevolver's blocks')."""
+    script = "ritz(0,3)\neigenprobe 1\neigenprobe 3\nsaddle\nprint last_eigenvalue\n"
+    path = os.path.join(DATA, "string_chain.fe")
+    ref = [l for l in run_reference(evolver, path, script, cwd=str(tmp_path), timeout=60)
+           if l.strip() and not l.startswith(("Converting", "Iterations:"))]
+    code, out, err = run_pyevolver(path, script + "q\n", cwd=str(tmp_path))
+    assert err == ""
+    def clean(lines):
+        return [l.replace(". Not a saddle", " Not a saddle") for l in lines if l.strip()]
+    assert _same(clean(out), clean(ref), 1e-10), (out, ref)
