@@ -155,8 +155,9 @@ def skinny(session: SessionLike, angle, echo=True):
     """``K θ``: bisect the longest edge of facets with an angle below θ."""
     s = session.surface
     if s.string:              # bisected one after the other (pyevolver.remesh.string_mesh)
-        R = SMESH.skinny_edges(s, angle)
-        session._replace_surface(SMESH.split_in_order(s, R, SM.split_edges))
+        shifts: list = []
+        R = SMESH.skinny_edges(s, angle, shifts)
+        session._replace_surface(SMESH.split_in_order(s, R, SM.split_edges, shifts))
         session.counts["refine"] = len(R)
         if echo:
             session.note(f"New edges: {len(R)}\n")

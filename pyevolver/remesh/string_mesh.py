@@ -17,8 +17,11 @@ popstr.fe, slidestr.fe and 100grain.fe:
   counting as skinny, as in the soapfilm model; a skinny facet none of
   whose three edges was chosen already has the longest of them (the last of
   equal ones) bisected.  The edges are bisected in the order chosen (so
-  the new elements are numbered that way).  Chains of one edge are refused:
-  REF's choice there depends on its internal facet-edge lists.
+  the new elements are numbered that way).  A wrapped torus edge that the
+  choosing facet runs backwards gets its midpoint as seen from its head
+  while its halves take the wraps as seen from the tail (REF's placement:
+  the halves then cross the cell, 100grain.fe).  Chains of one edge are
+  refused: REF's choice there depends on its internal facet-edge lists.
 * ``t L``: the edges are visited in id order and each that is shorter
   than ``L`` when it is visited and not FIXED is deleted, merging its head
   into its tail when the head may be eliminated (not FIXED, on exactly the
@@ -84,7 +87,7 @@ def _law_of_cosines_skinny(a, b, c, angle):
     return small or a == b == c
 
 
-def skinny_edges(s, angle: float) -> list[int]:
+def skinny_edges(s, angle: float, shifts: list | None = None) -> list[int]:
     """Edges ``K angle`` bisects in the string model, in the order REF
     bisects them: facets in id order, each bisection done before the next
     facet is looked at (so a later facet sees the halves, and an edge can be
@@ -118,17 +121,17 @@ def skinny_edges(s, angle: float) -> list[int]:
         L = [a, b, c]
         k = 2 - int(np.argmax(L[::-1]))
         e = side[k]
-        if W is not None and np.any(W[e] != 0):
-            raise UnsupportedError(
-                f"K bisecting edge {int(s.ids('edge')[e]) if e < s.ne else 'new'}, which wraps "
-                "around the torus, in the string model",
-                "the Evolver places the midpoints of wrapped edges elsewhere under K "
-                "(100grain.fe), unlike r, l, n and refine")
+        # REF: a wrapped edge its facet runs backwards gets its midpoint as
+        # seen from the head, the wraps as seen from the tail (measured)
+        back = (ch[k % len(ch)] < 0) and W is not None and bool(np.any(W[e] != 0))
+        shift = W[e].copy() if back else None
         chosen.append(e)
+        if shifts is not None:
+            shifts.append(shift)
         # bisect e: the tail half keeps e, the head half is a new edge
         d = vec(e)
         m = len(X)
-        X.append(X[E[e][0]] + 0.5 * d)
+        X.append(X[E[e][0]] + 0.5 * d - (shift if back else 0.0))
         h = len(E)
         E.append([m, E[e][1]])
         E[e] = [E[e][0], m]
@@ -144,16 +147,25 @@ def skinny_edges(s, angle: float) -> list[int]:
     return chosen
 
 
-def split_in_order(s, edges, split):
+def split_in_order(s, edges, split, shifts=None):
     """Bisect ``edges`` one after the other in the given order (an index
     may repeat, or be a half made earlier) with ``split(surface, R)``,
     which bisects distinct existing edges ``R`` numbering the new elements
-    in R's order; consecutive runs of such edges go in one call."""
+    in R's order; consecutive runs of such edges go in one call.
+    ``shifts[k]`` (None or a vector) is taken off the k-th new vertex right
+    after its run, before a later bisection can use it."""
     run: list[int] = []
+    done = 0
     for e in list(edges) + [None]:
         if e is None or e in run or e >= s.ne:
             if run:
+                nv = s.nv
                 s = split(s, np.array(run, np.int64))
+                for k in range(len(run)):
+                    sh = shifts[done + k] if shifts is not None else None
+                    if sh is not None:
+                        s.X[nv + k] -= sh
+                done += len(run)
                 run = []
         if e is not None:
             run.append(int(e))

@@ -38,6 +38,7 @@ CASES = {
     "weed_body": ("string_weed_body.fe", "t 0.1\nlist vertices\nlist edges\nlist facets\n"
                   "print body[1].volume\ng 3\n"),
     "weed_torus": ("string_weed_torus.fe", "t 0.2\nlist vertices\nlist edges\n"),
+    "skinny_torus": ("string_skinny_torus.fe", "K 1.5\nlist vertices\nlist edges\ng 2\n"),
     "skinny": ("string_skinny.fe", "K 0.6\nlist edges\nK 0.75\nlist edges\nlist vertices\n"
                "print refine_count\nK 3\nprint refine_count\n"),
 }
@@ -52,6 +53,12 @@ def test_string_mesh_commands_match_reference(evolver, tmp_path, name):
 def test_slidestr_after_g(evolver, tmp_path):
     _compare(evolver, example("slidestr.fe"),
              "g 5\nt 0.1\ng 3\nK 0.2\ng 2\nn 0.5\nlist edges\ng 3\nt 0.3\nlist vertices\ng 2\n",
+             tmp_path, rtol=1e-8)
+
+
+def test_100grain_skinny(evolver, tmp_path):
+    _compare(evolver, example("100grain.fe"),
+             "autopop off\nautochop off\nK 0.3\nlist vertices\nlist edges\ng 3\nK 0.3\ng 2\n",
              tmp_path, rtol=1e-8)
 
 
