@@ -38,6 +38,10 @@ CASES = {
     "weed_body": ("string_weed_body.fe", "t 0.1\nlist vertices\nlist edges\nlist facets\n"
                   "print body[1].volume\ng 3\n"),
     "weed_torus": ("string_weed_torus.fe", "t 0.2\nlist vertices\nlist edges\n"),
+    "dissolve": ("string_dissolve.fe", "t 0.1\nlist vertices\nlist edges\nlist facets\n"
+                 "list bodies\ng 2\n"),
+    "dissolve4": ("string_dissolve4.fe", "t 0.1\nlist vertices\nlist edges\nlist facets\n"
+                  "g 2\n"),
     "skinny_torus": ("string_skinny_torus.fe", "K 1.5\nlist vertices\nlist edges\ng 2\n"),
     "skinny": ("string_skinny.fe", "K 0.6\nlist edges\nK 0.75\nlist edges\nlist vertices\n"
                "print refine_count\nK 3\nprint refine_count\n"),
@@ -64,7 +68,7 @@ def test_100grain_skinny(evolver, tmp_path):
 
 def test_100grain_weed_and_notch(evolver, tmp_path):
     _compare(evolver, example("100grain.fe"),
-             "autopop off\nautochop off\nt 0.03\nprint total_energy\nlist vertices\nlist edges\n"
+             "autopop off\nautochop off\nt 0.06\nprint total_energy\nlist vertices\nlist edges\n"
              "list facets\ng 3\nn 1.0\nprint vertex_count\ng 2\n", tmp_path, rtol=1e-8)
 
 
@@ -88,7 +92,7 @@ def test_dihedral_is_the_angle_from_straightness(tmp_path):
 def test_weed_refuses_a_collapsing_loop(tmp_path):
     sess = _load("STRING\nSPACE_DIMENSION 2\nvertices\n1 0 0\n2 0.05 0\n3 0 1\n"
                  "edges\n1 1 2\n2 2 3\n3 3 1\n4 2 1\n", tmp_path)
-    with pytest.raises(UnsupportedError, match="from a vertex to itself"):
+    with pytest.raises(UnsupportedError, match="from a vertex to itself|one edge"):
         SMESH.delete_short_edges(sess.surface, 0.1)
 
 
