@@ -292,8 +292,8 @@ def string_lagrangian_hessian(s, cons, lam, grad_fn, basis):
         big = max(float(np.abs(np.diag(blk)).max()), 1e-300)
         if np.abs(off).max() > 1e-12 * big and np.abs(g[a:a + n]).max() > 1e-12:
             raise UnsupportedError(
-                f"hessian in the string model at vertex {int(s.ids('vertex')[v])}, free in "
-                f"{n} directions with a force on it",
+                "hessian in the string model at a vertex free in several directions",
+                f"vertex {int(s.ids('vertex')[v])}, free in {n} directions with a force on it: "
                 "the Evolver's string Hessian keeps only some of the cross terms of such a "
                 "vertex, by a rule not measured; vertices with one free direction "
                 "(hessian_normal in the plane) are as in the Evolver")

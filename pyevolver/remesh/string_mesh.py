@@ -104,8 +104,9 @@ def skinny_edges(s, angle: float, shifts: list | None = None) -> list[int]:
     n = np.diff(s.sf_ptr)
     if np.any(n == 1):
         f = int(s.ids("facet")[np.nonzero(n == 1)[0][0]])
-        raise UnsupportedError(f"K on facet {f}, a chain of one edge, in the string model",
-                               "the Evolver's choice there depends on its internal lists")
+        raise UnsupportedError("K on a facet of one edge in the string model",
+                               f"facet {f}: the Evolver's choice there depends on its "
+                               "internal lists")
     X = [row for row in s.X.copy()]
     E = [list(map(int, r)) for r in s.E]
     shift = s.wrap_shift()
@@ -266,8 +267,8 @@ def delete_short_edges(s, length: float):
         if a == b or np.any((ends == keep).any(axis=1) & (ends == elim).any(axis=1)) \
                 or np.any(ends[:, 0] == ends[:, 1]):
             raise UnsupportedError(
-                f"t: deleting edge {int(eids[e])} would leave an edge from a vertex to itself "
-                "in the string model", "the Evolver deletes more than it reports there")
+                "t leaving an edge from a vertex to itself in the string model",
+                f"deleting edge {int(eids[e])}; the Evolver deletes more than it reports there")
         collapse = []        # (facet, surviving side, removed side): REF dissolves it
         for f, ch in enumerate(chains):
             rest = [x for x in ch if (x if x >= 0 else ~x) != e]
@@ -281,9 +282,10 @@ def delete_short_edges(s, length: float):
                                          r[1] if at_elim[0] else r[0]))
                         continue
                 raise UnsupportedError(
-                    f"t: deleting edge {int(eids[e])} would close facet "
-                    f"{int(s.ids('facet')[f])} on one edge in the string model",
-                    "the Evolver then deletes more than it reports, with an internal error")
+                    "t leaving a facet of one edge in the string model",
+                    f"deleting edge {int(eids[e])} closes facet {int(s.ids('facet')[f])} on one "
+                    "edge; the Evolver then deletes more than it reports, with an internal "
+                    "error")
         shift = None
         # REF (measured): the kept vertex stays put when the facet dissolved
         # had three edges when t began, or when the edge is a side merged by
@@ -326,8 +328,8 @@ def delete_short_edges(s, length: float):
             if wrap is not None and not np.array_equal(
                     wrap[gone], wrap[keep_side] if same else -wrap[keep_side]):
                 raise UnsupportedError(
-                    f"t: deleting edge {int(eids[e])} would leave facet "
-                    f"{int(s.ids('facet')[f])} as two edges around the torus")
+                    "t leaving a facet of two edges around the torus in the string model",
+                    f"deleting edge {int(eids[e])}, facet {int(s.ids('facet')[f])}")
             new_fwd = keep_side if same else ~keep_side
             chains[f] = []
             chains = [[new_fwd if x == gone else ~new_fwd if x == ~gone else x for x in ch]
