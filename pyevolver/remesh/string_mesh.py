@@ -51,6 +51,7 @@ import numpy as np
 from ..constraints import project_to_constraints
 from ..errors import UnsupportedError
 from ..geometry.kernels import edge_vectors
+from ..methods.attributes import string_vertex_dihedral
 from .shrink import subset
 
 
@@ -59,18 +60,9 @@ from .shrink import subset
 
 
 def dihedral(s) -> np.ndarray:
-    """(nv,) REF's vertex ``dihedral`` in the string model."""
-    ev = edge_vectors(s.X, s.E, s.wrap_shift())
-    L = np.linalg.norm(ev, axis=1)
-    with np.errstate(all="ignore"):
-        u = np.where(L[:, None] > 0, ev / L[:, None], 0.0)
-    F = np.zeros((s.nv, 3))
-    for k in range(3):
-        F[:, k] = (np.bincount(s.E[:, 0], weights=u[:, k], minlength=s.nv)
-                   - np.bincount(s.E[:, 1], weights=u[:, k], minlength=s.nv))
-    deg = np.bincount(s.E.ravel(), minlength=s.nv)
-    ang = 2.0 * np.arcsin(np.minimum(np.linalg.norm(F, axis=1) / 2.0, 1.0))
-    return np.where(deg >= 2, ang, 0.0)
+    """(nv,) REF's vertex ``dihedral`` in the string model
+    (:func:`pyevolver.methods.attributes.string_vertex_dihedral`)."""
+    return string_vertex_dihedral(s, s.evaluate())
 
 
 def notch_edges(s, angle: float) -> np.ndarray:
