@@ -28,8 +28,8 @@ LANCZOS_SYNTAX = "Syntax: lanczos rexpr   or   lanczos(expr,count)"
 
 def _system(session: Any, what: str):
     """The constrained Hessian of the session's surface (hessian_system),
-    after REF's checks: not on strings, vertices, valid pressures."""
-    session.no_string(what)
+    after REF's checks: vertices, valid pressures (in the string model
+    REF's matrix: twice pyevolver.evolve.string_hessian's blocks)."""
     s = session.surface
     if s is None or s.nv == 0:
         raise CommandError(f"{what}: the surface has no vertices")
@@ -39,6 +39,8 @@ def _system(session: Any, what: str):
                            "to set pressures.")
     note_beyond(session)
     hs = hessian_system(it, normal=it.settings.hessian_normal)
+    if s.string:      # REF's string Hessian matrix holds twice the vertex blocks
+        hs.K = 2.0 * hs.K
     mix = _mix(session)
     if mix is not None:
         EG.metric(hs, s, mix)
@@ -134,6 +136,8 @@ def saddle(session: Any, max_step: float | None = None) -> Any:
     if not math.isfinite(r.value):
         session.write("No degrees of freedom.\n")
         return r
+    if session.surface.string:         # REF's matrix: twice the blocks (see _system)
+        r.value *= 2.0
     session.settings["last_eigenvalue"] = r.value
     if r.step is None:
         session.write("Lowest eigenvalue %.15g. Not a saddle point.\n" % r.value)
@@ -144,7 +148,8 @@ def saddle(session: Any, max_step: float | None = None) -> Any:
         session.write(w + "\n")
     session.write("stepsize %g\n" % r.step)
     t = session.totals
-    session.write("1. area: %#17.15g energy: %#17.15g \n" % (t.total_area, t.energy))
+    session.write("1. %s: %#17.15g energy: %#17.15g \n"
+                  % ("length" if session.surface.string else "area", t.total_area, t.energy))
     return r
 
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import CommandError, UnsupportedError
 from ..remesh import string as SM
+from ..remesh import string_mesh as SMESH
 from ..remesh import delete_edges as DEL, edge_divide as ED, equiangulate as EQ
 from ..remesh import notch as NO, pop as POP, vertex_average as VA
 from ..remesh.quadratic import refine_quadratic
@@ -143,7 +144,7 @@ def flush_counts(session: SessionLike):
 
 def _bisect(session: SessionLike, edges, echo, head_frame=()):
     n = _divide(session, edges, head_frame)
-    bump_count(session, "refine", n)                # REF: l and K accumulate, r does not
+    session.counts["refine"] = n                    # REF: each l or K sets refine_count
     if echo:
         session.note(f"New edges: {n}\n")
     return n
@@ -158,14 +159,29 @@ def edge_divide_long(session: SessionLike, length, echo=True):
 
 def skinny(session: SessionLike, angle, echo=True):
     """``K θ``: bisect the longest edge of facets with an angle below θ."""
-    session.no_string("K (skinny triangles)")
+    s = session.surface
+    if s.string:              # bisected one after the other (pyevolver.remesh.string_mesh)
+        shifts: list = []
+        R = SMESH.skinny_edges(s, angle, shifts)
+        session._replace_surface(SMESH.split_in_order(s, R, SM.split_edges, shifts))
+        session.counts["refine"] = len(R)
+        if echo:
+            session.note(f"New edges: {len(R)}\n")
+        return len(R)
     against: list = []          # edges the choosing facet runs against (torus: REF's midpoint)
-    return _bisect(session, ED.skinny_edges(session.surface, angle, against), echo, against)
+    return _bisect(session, ED.skinny_edges(s, angle, against), echo, against)
 
 
 def notch(session: SessionLike, angle, echo=True):
     """``n θ``: subdivide the facets on edges sharper than θ (spec §8)."""
-    session.no_string("notch")
+    if session.surface.string:
+        # REF: "Edges refined: N"; notch_count and refine_count set to N
+        n = session._string_split(SMESH.notch_edges(session.surface, angle))
+        if n:                 # REF: a notch refining nothing leaves the counts
+            session.counts["notch"] = session.counts["refine"] = n
+            if echo:
+                session.note(f"Edges refined: {n}\n")
+        return n
     return _replaced(session, NO.notch(session.surface, angle), "notch",
                      "Number of edges notched: {n}\n", echo)
 
@@ -185,8 +201,8 @@ def bump_count(session: SessionLike, key, n):
 
 def delete_short_edges(session: SessionLike, length, echo=True):
     """``t L`` / ``edgeweed L``: delete edges shorter than ``L`` (spec §8.4)."""
-    session.no_string("t (edge weeding)")
-    return _replaced(session, DEL.delete_short_edges(session.surface, length), "edge_delete",
+    mod = SMESH if session.surface.string else DEL
+    return _replaced(session, mod.delete_short_edges(session.surface, length), "edge_delete",
                      "Deleted edges: {n}\n", echo)
 
 

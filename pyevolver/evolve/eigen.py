@@ -527,7 +527,8 @@ def beyond_reference(surface) -> list[str]:
     if "gap" in surface.evaluate().terms:
         notes.append("pyevolver: gap energy in the Hessian by differences of its gradient "
                      "(the Evolver refuses: ERROR 1604)")
-    fixed_bodies = len(_Constraints(surface).bodies) > 0
+    # (the string model stops with REF's ERROR 3362: evolve/string_hessian.py)
+    fixed_bodies = len(_Constraints(surface).bodies) > 0 and not surface.string
     contents = [c for c in list(surface.constraints.values()) +
                 list((getattr(surface, "boundaries", None) or {}).values())
                 if getattr(c, "content", None)]

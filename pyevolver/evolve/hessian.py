@@ -43,6 +43,12 @@ from .iterate import _Constraints
 from .ordering import nested_dissection
 
 
+#: Hessians of other surface models, installed by their modules
+#: (``"string"``: :mod:`.string_hessian`): objects with ``check(s)``,
+#: ``basis(s, mobile, normal)`` and ``hessian(s, cons, lam, grad_fn, basis)``.
+MODEL_HESSIAN: dict = {}
+
+
 class Basis:
     """Per-vertex bases of the free motions: vertex ``v`` moves by
     ``B[v, :, :ndof[v]] @ dy[start[v]:start[v] + ndof[v]]``.
@@ -510,6 +516,11 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
     s = it.surface
     if s.X.shape[1] > 3:
         raise dimension_error(s.sdim, "the Hessian")
+    model = MODEL_HESSIAN.get("string") if s.string else None
+    if s.string:
+        if model is None:
+            raise UnsupportedError("hessian in the string model")
+        model.check(s)
     mobile = it._mobile()
     cons = _Constraints(s)
     t = s.evaluate()
@@ -532,9 +543,14 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
             for l, gg in zip(lam, cons.gradients(tt)):
                 g = g - l * gg
         return g
-    basis, grads = tangent_basis(s, mobile, normal=normal)
-    T = basis.matrix()
-    K = lagrangian_hessian(s, cons, lam, grad_L, basis)
+    if model is not None:           # the string model's motions and energies
+        basis, grads = model.basis(s, mobile, normal=normal)
+        T = basis.matrix()
+        K = model.hessian(s, cons, lam, grad_L, basis)
+    else:
+        basis, grads = tangent_basis(s, mobile, normal=normal)
+        T = basis.matrix()
+        K = lagrangian_hessian(s, cons, lam, grad_L, basis)
     gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))
     Hc = constraint_curvature(s, grads, gL)
     if Hc is not None:

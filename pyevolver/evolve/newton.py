@@ -43,6 +43,7 @@ from .eigen import ShiftedFactor
 from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
                       solve_bordered, tangent_basis)
 from .iterate import Iterator, StepResult, _Constraints
+from . import string_hessian  # noqa: F401  (installs the string model's Hessian)
 
 
 @dataclass

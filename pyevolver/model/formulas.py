@@ -33,6 +33,10 @@ class LocatedFormula:
         with located(self.what, self.line):
             return self.formula.gradient(*args)
 
+    def hessian(self, *args):
+        with located(self.what, self.line):
+            return self.formula.hessian(*args)
+
 
 @contextlib.contextmanager
 def located(what: str, line: int | None) -> Iterator[None]:

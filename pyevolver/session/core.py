@@ -654,7 +654,6 @@ class Session(SessionAPI):
         ``hessian_seek [max]``: a line search along the Newton direction
         (scale at most ``max``, default 1).  Returns a :class:`StepResult`
         (:func:`pyevolver.evolve.newton.hessian_step`)."""
-        self.no_string("hessian")
         if self.surface is None or self.surface.nv == 0:
             # (everything deleted; REF: "No vertices" warnings or unrelated errors)
             raise CommandError(f"{'hessian_seek' if seek else 'hessian'}: the surface has "
@@ -684,8 +683,9 @@ class Session(SessionAPI):
             if not self.toggles.get("quiet"):
                 # hessian_seek adds its scale, as REF does
                 tail = "  scale: %#g" % r.scale if seek else ""
-                self.write("%3d. area: %#17.15g energy: %#17.15g%s\n"
-                           % (1, r.area, r.energy, tail))
+                self.write("%3d. %s: %#17.15g energy: %#17.15g%s\n"
+                           % (1, "length" if self.surface.string else "area", r.area,
+                              r.energy, tail))
         return r
 
     # -- mesh upkeep ------------------------------------------------------------------

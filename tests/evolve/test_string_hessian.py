@@ -1,0 +1,122 @@
+"""The Hessian in the string model (pyevolver.evolve.string_hessian):
+the full analytic Hessian against central differences of the gradient,
+the hessian command against evolver-nox-d (REF's vertex-block Hessian),
+REF's ERROR 3362 for fixed body areas and the refusals."""
+import io
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import pyevolver
+from pyevolver.errors import CommandError, PyEvolverError
+from pyevolver.evolve import gradient as GR
+from pyevolver.evolve import string_hessian as SH
+from pyevolver.evolve.iterate import _Constraints
+from conftest import example
+from reference import run_reference
+from comparison import _same, run_pyevolver
+
+DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
+
+
+def _session(path):
+    return pyevolver.load(path, out=io.StringIO())
+
+
+def _compare(evolver, datafile, script, tmp_path, rtol=1e-9):
+    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
+    code, out, err = run_pyevolver(datafile, script + "q\n", cwd=str(tmp_path))
+    assert err == "", err
+    keep = [l for l in out if l.strip()]
+    want = [l for l in ref if l.strip() and not l.startswith("Converting to all named")]
+    assert _same(keep, want, rtol), (out, ref)
+
+
+@pytest.mark.parametrize("name", ["string_pressure.fe", "string_probe_pressure.fe",
+                                  "string_chain.fe", "string_loop3.fe", "string_ten.fe"])
+def test_full_hessian_is_the_derivative_of_the_gradient(name):
+    """Edge tension, pressure areas with content integrands, gravity,
+    constraint energies, volconst, 3-d strings: H against differences of
+    the analytic gradient."""
+    s = _session(os.path.join(DATA, name)).surface
+    cons = _Constraints(s)
+    lam = np.zeros(len(cons))
+    H = SH.string_hessian_matrix(s, cons, lam, GR.energy_gradient).toarray()
+    X0 = s.X.copy()
+    h = 1e-6
+    for v in range(min(s.nv, 8)):
+        for k in range(s.sdim):
+            cols = []
+            for d in (h, -h):
+                s.X = X0.copy()
+                s.X[v, k] += d
+                cols.append(GR.energy_gradient(s.evaluate()).ravel())
+            s.X = X0
+            fd = (cols[0] - cols[1]) / (2 * h)
+            assert np.allclose(H[:, 3 * v + k], fd, atol=1e-6 * max(1, np.abs(fd).max())), \
+                (v, k)
+    assert np.allclose(H, H.T)
+
+
+CASES = {
+    # interior vertices of a chain: one free direction each (across the chord)
+    "chain": (os.path.join(DATA, "string_chain.fe"), "hessian\nlist vertices\nhessian\n"
+              "print total_energy\n"),
+    # pressure and gravity on a closed chain
+    "pressure": (os.path.join(DATA, "string_pressure.fe"),
+                 "hessian\nlist vertices\nhessian\nprint total_energy\n"),
+    # a single free vertex at a junction of four edges in space (popstr.fe)
+    "popstr": (example("popstr.fe"), "g 5\nhessian\nlist vertices\n"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_hessian_matches_reference(evolver, tmp_path, name):
+    path, script = CASES[name]
+    _compare(evolver, path, script, tmp_path)
+
+
+def test_fixed_body_area_is_refs_error_3362(evolver, tmp_path):
+    sess = _session(example("slidestr.fe"))
+    sess.run("g 5")
+    X = sess.surface.X.copy()
+    with pytest.raises(CommandError, match="Fixed quantity body_1_vol is not connected"):
+        sess.run("hessian")
+    assert np.array_equal(sess.surface.X, X)
+    proc = subprocess.run([evolver, "-p1", example("slidestr.fe")], input="g 5\nhessian\nq\nq\n",
+                          capture_output=True, text=True, timeout=60, cwd=str(tmp_path))
+    assert "ERROR 3362: Fixed quantity body_1_vol is not connected" in proc.stdout + proc.stderr
+
+
+def test_cross_terms_at_multi_direction_vertices_are_refused():
+    sess = _session(os.path.join(DATA, "string_probe_pressure.fe"))
+    X = sess.surface.X.copy()
+    with pytest.raises(PyEvolverError, match="not supported in pyevolver: hessian .* free in 2"):
+        sess.run("hessian")
+    assert np.array_equal(sess.surface.X, X)
+
+
+def test_basis_is_across_the_chord_in_the_plane():
+    s = _session(os.path.join(DATA, "string_chain.fe")).surface
+    basis, _ = SH.string_basis(s, ~s.vattr["fixed"], normal=True)
+    assert list(basis.ndof) == [0, 1, 1, 1, 0]
+    chord = s.X[2] - s.X[0]
+    assert abs(basis.B[1, :, 0] @ chord) < 1e-12 and basis.B[1, 2, 0] == 0
+    basis, _ = SH.string_basis(s, ~s.vattr["fixed"], normal=False)
+    assert list(basis.ndof) == [0, 2, 2, 2, 0]
+
+
+def test_eigenvalue_commands_match_reference(evolver, tmp_path):
+    """ritz, eigenprobe, saddle: REF's string matrix is twice the
+    vertex blocks (its eigenvalues are twice pyevolver's blocks')."""
+    script = "ritz(0,3)\neigenprobe 1\neigenprobe 3\nsaddle\nprint last_eigenvalue\n"
+    path = os.path.join(DATA, "string_chain.fe")
+    ref = [l for l in run_reference(evolver, path, script, cwd=str(tmp_path), timeout=60)
+           if l.strip() and not l.startswith(("Converting", "Iterations:"))]
+    code, out, err = run_pyevolver(path, script + "q\n", cwd=str(tmp_path))
+    assert err == ""
+    def clean(lines):
+        return [l.replace(". Not a saddle", " Not a saddle") for l in lines if l.strip()]
+    assert _same(clean(out), clean(ref), 1e-10), (out, ref)
