@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import UnsupportedError
 from ..geometry import kernels as G
+from . import metric as MT
 from .jets import skew
 from ..model.formulas import located
 from ._common import (assemble, assemble_projected, corner_scatter, facet_points, n2_grad_dot,
@@ -97,6 +98,8 @@ def _edge_vector_integral(ctx, m, idx):
 
 def facet_area_grad(t):
     """Per-corner gradients (nf, 3, 3) of facet areas."""
+    if t.surface.metric is not None:
+        return MT.facet_area_grad(t)
     P = facet_points(t)
     N2 = t.facet_N2
     with np.errstate(all="ignore"):
@@ -196,6 +199,8 @@ class _Env:
 
 def edge_length_grad(t, idx: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Gradient (nv, 3) of ``Σ_e w_e |e|`` over the edges ``idx``."""
+    if t.surface.metric is not None:
+        return MT.edge_length_grad(t, idx, weights)
     s = t.surface
     d = t.edge_vec[idx]
     L = t.edge_length[idx]
@@ -295,6 +300,8 @@ def facet_area_hessian(t, weights, basis=None):
 
     with ε_ab = +1 if b = a+2, −1 if b = a+1 (mod 3), 0 if a = b.
     """
+    if t.surface.metric is not None:
+        return MT.facet_area_hessian(t, weights, basis)
     s = t.surface
     P = facet_points(t)
     N2 = t.facet_N2
@@ -342,6 +349,8 @@ def facet_area_hessian(t, weights, basis=None):
 
 def edge_length_hessian(t, idx, weights, basis=None):
     """Hessian of ``Σ_e w_e L_e``: blocks ``±(I − t tᵀ)/L``."""
+    if t.surface.metric is not None:
+        return MT.edge_length_hessian(t, idx, weights, basis)
     s = t.surface
     d = t.edge_vec[idx]
     L = t.edge_length[idx]

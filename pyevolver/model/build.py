@@ -12,6 +12,7 @@ from ..limits import MAX_ARRAY_ENTRIES
 from ..geometry import kernels as G
 from .formulas import located
 from .ids import IdMap, Lazy, split_midpoints
+from .metric import metric_of
 from .records import first_facets_on_load, record_edge_first_facet
 from .scene import Scene
 from .string import STRING_METHODS, init_rings
@@ -55,6 +56,7 @@ class _Builder:
         s.gravity_constant = sc.values.get("gravity_constant", 1.0)
         s.gap_constant = sc.values.get("gap_constant", 1.0)
         s.sq_curvature_modulus = float(sc.values.get("squared_curvature", 0.0))
+        s.metric = metric_of(sc)           # METRIC / CONFORMAL_METRIC / KLEIN_METRIC
         if sc.torus:
             vals = sc.values.get("_periods")
             sd = s.sdim
