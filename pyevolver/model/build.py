@@ -56,7 +56,7 @@ class _Builder:
         s.gravity_constant = sc.values.get("gravity_constant", 1.0)
         s.gap_constant = sc.values.get("gap_constant", 1.0)
         s.sq_curvature_modulus = float(sc.values.get("squared_curvature", 0.0))
-        s.metric = metric_of(sc)           # METRIC / CONFORMAL_METRIC / KLEIN_METRIC
+        s.metric = metric_of(sc, self.error)   # METRIC / CONFORMAL_METRIC / KLEIN_METRIC
         if sc.torus:
             vals = sc.values.get("_periods")
             sd = s.sdim
@@ -764,7 +764,6 @@ class _Builder:
     # -- projection -------------------------------------------------------------------
     def _project(self):
         HOOKS.require("project")(self.s, np.arange(self.s.nv))
-
 
 
 def build_surface(scene: Scene) -> Surface:

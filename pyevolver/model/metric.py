@@ -72,17 +72,24 @@ def metric_orders_refusal(sc) -> str | None:
     return None
 
 
-def metric_of(sc) -> Metric | None:
+def metric_of(sc, error=None) -> Metric | None:
     """The Scene's metric with its quadrature orders, or None; the
-    combinations pyevolver does not have are refused by name."""
+    combinations pyevolver does not have are refused by name (with
+    ``error(message, line)``, the builder's located error, when given)."""
     m = sc.values.get("_metric")
     if m is None:
         return None
-    if sc.torus:
-        raise UnsupportedError("a metric in the torus model",
-                               "lengths and areas of wrapped edges in a metric are not implemented")
-    if sc.space_dimension > 3:
-        raise UnsupportedError(f"a metric in SPACE_DIMENSION {sc.space_dimension}")
+    why = None
+    if m.kind == "klein":
+        why = "KLEIN_METRIC (REF's exact hyperbolic lengths and areas are not implemented)"
+    elif sc.torus:
+        why = "a metric in the torus model (lengths and areas of wrapped edges)"
+    elif sc.space_dimension > 3:
+        why = f"a metric in SPACE_DIMENSION {sc.space_dimension}"
+    if why is not None:
+        if error is not None:
+            raise error(f"not supported in pyevolver: {why}", m.line)
+        raise UnsupportedError(why)
     m.dim = sc.space_dimension
     m.order_1d = int(sc.values.get("integral_order_1d", 3))
     m.order_2d = int(sc.values.get("integral_order_2d", 6))

@@ -25,11 +25,10 @@ from tolerances import PRINTED, STEPS
 
 # the examples pyevolver runs, and those it refuses by name; crystal.fe is not dumped by REF (no
 # Wulff file) and simplex3.fe only after r
-SUPPORTED = ["addload_example", "cat", "catbody", "catman", "column", "cube", "mound",
-             "mylarcube", "octa", "phelanc", "popstr", "qmound", "quad", "slidestr", "sphere",
-             "relaxed", "tankex", "twointor"]
+SUPPORTED = ["addload_example", "cat", "catbody", "catman", "column", "cube", "metric", "mound",
+             "mylarcube", "octa", "phelanc", "popstr", "qmound", "quad", "quadm", "slidestr",
+             "sphere", "relaxed", "tankex", "twointor"]
 REFUSED = [("100grain", "g 3"), ("100grain", "r; g 3"), ("knotty", "g 3"), ("knotty", "r; g 3"),
-           ("metric", "g 3"), ("quadm", "g 3"),
            ("symtest", "g 3"), ("simplex3", "r; g 3")]
 PRE = ["g 3", "r; g 3"]
 
