@@ -28,11 +28,12 @@ from math import factorial
 
 import numpy as np
 
-from ..errors import UnsupportedError
+from ..errors import PyEvolverError, UnsupportedError
 from ..expr.nodes import coord_names
 from ..geometry.kernels import TRI6_B, TRI6_W
 from ..model.metric import FACET_ORDERS
 from ._common import assemble, scatter
+from .registry import register_method
 
 
 # ---------------------------------------------------------------------------
@@ -145,9 +146,62 @@ def tensor(s, P: np.ndarray, second: bool = False):
 # per-element kernels: values and gradients of the elements' own corners
 
 
+def _klein_check(*P):
+    if any(np.any(np.einsum("mi,mi->m", X, X) >= 1.0) for X in P):
+        raise PyEvolverError("Points outside unit disk in Klein model.")
+
+
+def klein_edge_kernel(X0, X1, grad=True):
+    """Hyperbolic lengths (Klein model: straight segments are geodesics)
+    ``arccosh((1 − x·y) / √((1 − |x|²)(1 − |y|²)))`` and their gradients."""
+    _klein_check(X0, X1)
+    a = 1.0 - np.einsum("mi,mi->m", X0, X1)
+    p = 1.0 - np.einsum("mi,mi->m", X0, X0)
+    q = 1.0 - np.einsum("mi,mi->m", X1, X1)
+    r = np.sqrt(p * q)
+    c = np.maximum(a / r, 1.0)
+    L = np.arccosh(c)
+    if not grad:
+        return L
+    with np.errstate(all="ignore"):
+        k = np.where(c > 1.0, 1.0 / (r * np.sqrt(c * c - 1.0)), 0.0)[:, None]
+    g0 = k * (-X1 + (a / p)[:, None] * X0)
+    g1 = k * (-X0 + (a / q)[:, None] * X1)
+    return L, g0, g1
+
+
+def klein_facet_kernel(X0, X1, X2, grad=True):
+    """Hyperbolic triangle areas by L'Huilier's formula,
+    ``tan(Δ/4) = √(Π tanh(·/2))`` over s, s − a, s − b, s − c (s the half
+    perimeter of the side lengths), and their corner gradients."""
+    la = klein_edge_kernel(X1, X2)         # side opposite corner 0
+    lb = klein_edge_kernel(X0, X2)
+    lc = klein_edge_kernel(X0, X1)
+    a, b, c = la[0], lb[0], lc[0]
+    s = 0.5 * (a + b + c)
+    u = np.maximum(np.stack([s, s - a, s - b, s - c]), 0.0)
+    P = np.prod(np.tanh(u / 2.0), axis=0)
+    A = 4.0 * np.arctan(np.sqrt(P))
+    if not grad:
+        return A
+    with np.errstate(all="ignore"):
+        inv = np.where(u > 0, 1.0 / np.sinh(u), 0.0)    # d ln tanh(u/2) / du
+        k = np.where(P > 0, 2.0 * np.sqrt(P) / (1.0 + P), 0.0)
+    dA = [k * 0.5 * (inv[0] - inv[1] + inv[2] + inv[3]),
+          k * 0.5 * (inv[0] + inv[1] - inv[2] + inv[3]),
+          k * 0.5 * (inv[0] + inv[1] + inv[2] - inv[3])]
+    dA = [np.nan_to_num(d)[:, None] for d in dA]
+    g0 = dA[1] * lb[1] + dA[2] * lc[1]
+    g1 = dA[0] * la[1] + dA[2] * lc[2]
+    g2 = dA[0] * la[2] + dA[1] * lb[2]
+    return A, g0, g1, g2
+
+
 def edge_kernel(s, X0: np.ndarray, X1: np.ndarray, grad: bool = True):
     """Metric lengths ``(m,)`` of the edges ``X0 → X1 (m, n)`` and, with
     ``grad``, their gradients ``(g0, g1)`` (m, n) at both ends."""
+    if s.metric.kind == "klein":
+        return klein_edge_kernel(X0, X1, grad)
     t, w = line_rule(s.metric.order_1d)
     d = X1 - X0
     m, n = d.shape
@@ -172,6 +226,8 @@ def edge_kernel(s, X0: np.ndarray, X1: np.ndarray, grad: bool = True):
 def facet_kernel(s, X0, X1, X2, grad: bool = True):
     """Metric areas ``(m,)`` of the triangles ``X0 X1 X2 (m, n)`` and, with
     ``grad``, their corner gradients ``(g0, g1, g2)`` (m, n)."""
+    if s.metric.kind == "klein":
+        return klein_facet_kernel(X0, X1, X2, grad)
     B, W = triangle_rule(s.metric.order_2d)
     S = np.stack([X1 - X0, X2 - X0], axis=2)                  # (m, n, 2)
     m, n, _ = S.shape
@@ -329,3 +385,72 @@ def split_fractions(s, idx: np.ndarray, max_steps: int = 60) -> np.ndarray:
         lo[dn] = t[dn]
         t[a[~ok]] = 0.5 * (lo[a[~ok]] + hi[a[~ok]])
     return t
+
+
+def segment_lengths(s, P0: np.ndarray, P1: np.ndarray) -> np.ndarray:
+    """(m,) metric lengths of the segments ``P0 → P1 (m, ≥ n)`` (remeshing
+    measures edges and facets as ``length`` and ``area`` do: REF's ``t`` and
+    ``w`` weed by the metric's)."""
+    n = _n(s)
+    return edge_kernel(s, np.atleast_2d(P0)[:, :n], np.atleast_2d(P1)[:, :n], grad=False)
+
+
+def triangle_areas(s, P0: np.ndarray, P1: np.ndarray, P2: np.ndarray) -> np.ndarray:
+    """(m,) metric areas of the triangles ``P0 P1 P2 (m, ≥ n)``."""
+    n = _n(s)
+    return facet_kernel(s, *(np.atleast_2d(P)[:, :n] for P in (P0, P1, P2)), grad=False)
+
+
+# ---------------------------------------------------------------------------
+# the named methods metric_facet_area and metric_edge_length
+
+
+def _general(t, name):
+    s = t.surface
+    if s.metric is None or s.metric.kind != "matrix":
+        # REF's ERROR 1583, also with CONFORMAL_METRIC and KLEIN_METRIC
+        raise PyEvolverError("Cannot use metric_facet_area or metric_edge_length method "
+                             "without a general metric.")
+    if name == "metric_edge_length" and not s.string:
+        raise UnsupportedError("method metric_edge_length in the soapfilm model",
+                               "REF's value there is 0, not the metric length")
+
+
+def _per(n, idx, w):
+    full = np.zeros(n)
+    np.add.at(full, np.asarray(idx, np.int64), w)
+    return full
+
+
+def _mfa_value(t, m, idx):
+    _general(t, "metric_facet_area")
+    return t.facet_area[idx]
+
+
+def _mfa_gradient(t, m, idx, w):
+    _general(t, "metric_facet_area")
+    s = t.surface
+    per = _per(s.nf, idx, w)
+    return scatter(s.nv, s.F.ravel(), (facet_area_grad(t) * per[:, None, None]).reshape(-1, 3))
+
+
+def _mfa_hessian(t, m, idx, w, basis=None):
+    return facet_area_hessian(t, _per(t.surface.nf, idx, w), basis)
+
+
+def _mel_value(t, m, idx):
+    _general(t, "metric_edge_length")
+    return t.edge_length[idx]
+
+
+def _mel_gradient(t, m, idx, w):
+    _general(t, "metric_edge_length")
+    return edge_length_grad(t, idx, w)
+
+
+def _mel_hessian(t, m, idx, w, basis=None):
+    return edge_length_hessian(t, idx, w, basis)
+
+
+register_method("metric_facet_area", "facet", _mfa_value, _mfa_gradient, _mfa_hessian)
+register_method("metric_edge_length", "edge", _mel_value, _mel_gradient, _mel_hessian)

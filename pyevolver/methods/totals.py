@@ -66,6 +66,7 @@ class Totals:
             self.facet_volume = G.facet_volumes(self.facet_x0, self.facet_S,
                                                 s.symmetric_content)
         if s.metric is not None:        # areas in the metric (volumes stay Euclidean)
+            self.euclidean_facet_area = self.facet_area
             self.facet_area = MT.facet_areas(self)
         self.total_area = float(self.facet_area.sum())
         energy = self._tension_energy()

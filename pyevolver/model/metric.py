@@ -80,9 +80,7 @@ def metric_of(sc, error=None) -> Metric | None:
     if m is None:
         return None
     why = None
-    if m.kind == "klein":
-        why = "KLEIN_METRIC (REF's exact hyperbolic lengths and areas are not implemented)"
-    elif sc.torus:
+    if sc.torus:
         why = "a metric in the torus model (lengths and areas of wrapped edges)"
     elif sc.space_dimension > 3:
         why = f"a metric in SPACE_DIMENSION {sc.space_dimension}"

@@ -32,6 +32,7 @@ import numpy as np
 from ..constraints import project_to_constraints
 from ..errors import UnsupportedError
 from ..geometry.kernels import gram_facet_areas
+from ..methods import metric as MT
 from .shrink import subset
 
 
@@ -70,6 +71,8 @@ class _Deleter:
 
     def length(self, e):
         a, b = self.E[e]
+        if self.s.metric is not None:       # REF weeds by the metric's lengths
+            return float(MT.segment_lengths(self.s, self.X[a], self.X[b])[0])
         return float(np.linalg.norm(self.X[b] - self.X[a]))
 
     def facets_of(self, e):
@@ -222,7 +225,8 @@ def delete_short_edges(s, length):
     Returns ``(new surface, number deleted)``.
     """
     d = _Deleter(s)
-    L = np.linalg.norm(s.X[s.E[:, 1]] - s.X[s.E[:, 0]], axis=1)
+    L = np.linalg.norm(s.X[s.E[:, 1]] - s.X[s.E[:, 0]], axis=1) if s.metric is None else \
+        MT.segment_lengths(s, s.X[s.E[:, 0]], s.X[s.E[:, 1]])
 
     def visit(e):
         if not d.ealive[e] or d.length(e) >= length or not d.delete(e) or not d.moved:
@@ -240,12 +244,15 @@ def weed_small_facets(s, area):
     Returns ``(new surface, number of facets weeded)``.
     """
     F = s.F
-    A = gram_facet_areas(np.stack([s.X[F[:, 1]] - s.X[F[:, 0]], s.X[F[:, 2]] - s.X[F[:, 0]]], 1))
+    A = gram_facet_areas(np.stack([s.X[F[:, 1]] - s.X[F[:, 0]], s.X[F[:, 2]] - s.X[F[:, 0]]], 1)) \
+        if s.metric is None else MT.triangle_areas(s, s.X[F[:, 0]], s.X[F[:, 1]], s.X[F[:, 2]])
     return _weed(s, np.nonzero(A < area)[0], area)
 
 
 def _facet_area(d, f):
     P = d.X[[d.E[_dec(x)][0] if x >= 0 else d.E[_dec(x)][1] for x in d.FE[f]]]
+    if d.s.metric is not None:
+        return float(MT.triangle_areas(d.s, P[0], P[1], P[2])[0])
     return float(gram_facet_areas(np.stack([P[1] - P[0], P[2] - P[0]])[None])[0])
 
 

@@ -221,3 +221,58 @@ def test_motion_is_the_coordinate_gradient(tmp_path):
     g = energy_gradient(s.surface.evaluate())
     s.run("m 0.01; g 1")
     assert np.allclose(s.surface.X, X0 - 0.01 * g, rtol=0, atol=1e-13)
+
+
+KLEIN_SOAP = SOAP.replace("1 0.1 0.2 0.3\n2 1.2 0.1 0.2\n3 0.2 1.1 0.4\n4 1.0 1.3 0.9",
+                          "1 0.05 0.1 0.15\n2 0.6 0.05 0.1\n3 0.1 0.55 0.2\n4 0.5 0.45 0.3")
+KLEIN_STRING = STRING.replace("1 1 0.2\n2 0.1 2\n3 -2 0.3\n4 0.2 -1",
+                              "1 0.5 0.1\n2 0.05 0.7\n3 -0.6 0.15\n4 0.1 -0.45")
+
+
+def test_klein_gradients_against_differences(tmp_path):
+    for text, name in ((KLEIN_SOAP, "ks.fe"), (KLEIN_STRING, "kst.fe")):
+        s = _load(tmp_path, text.format(top="KLEIN_METRIC"), name)
+        g = energy_gradient(s.surface.evaluate())
+        fd = _fd_gradient(s)
+        assert np.max(np.abs(g - fd)) < 1e-7, name
+
+
+def test_klein_closed_forms(tmp_path):
+    """Hyperbolic distance from the origin is artanh(r); a triangle's area is
+    π minus its angles (a right isosceles triangle at the origin: the angle
+    at the origin is π/2, the others from the hyperbolic law of cosines)."""
+    s = _load(tmp_path, KLEIN_SOAP.format(top="KLEIN_METRIC"))
+    surf = s.surface
+    X = np.array([[0.0, 0, 0], [0.6, 0, 0], [0, 0.6, 0]])
+    L = MT.segment_lengths(surf, X[0], X[1])[0]
+    assert abs(L - np.arctanh(0.6)) < 1e-14
+    A = MT.triangle_areas(surf, X[0], X[1], X[2])[0]
+    a = MT.segment_lengths(surf, X[1], X[2])[0]
+    b = np.arctanh(0.6)
+    # angle at X1 from cos B = (cosh a cosh c - cosh b) / (sinh a sinh c), c = b
+    cosB = (np.cosh(a) * np.cosh(b) - np.cosh(b)) / (np.sinh(a) * np.sinh(b))
+    assert abs(A - (np.pi - np.pi / 2 - 2 * np.arccos(cosB))) < 1e-13
+
+
+def test_klein_hessian_against_differences(tmp_path):
+    s = _load(tmp_path, KLEIN_SOAP.format(top="KLEIN_METRIC"))
+    surf = s.surface
+    t = surf.evaluate()
+    H = MT.facet_area_hessian(t, np.ones(surf.nf)).toarray()
+    X0 = surf.X.copy()
+
+    def grad(X):
+        surf.X = X
+        from pyevolver.methods._common import corner_scatter
+        return corner_scatter(surf.evaluate(), MT.facet_area_grad(surf.evaluate())).ravel()
+
+    h = 1e-6
+    F = np.zeros_like(H)
+    for c in range(X0.size):
+        Xp = X0.copy().ravel()
+        Xm = X0.copy().ravel()
+        Xp[c] += h
+        Xm[c] -= h
+        F[:, c] = (grad(Xp.reshape(X0.shape)) - grad(Xm.reshape(X0.shape))) / (2 * h)
+    surf.X = X0
+    assert np.max(np.abs(H - F)) < 1e-6 * max(1.0, np.max(np.abs(F)))

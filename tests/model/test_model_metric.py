@@ -12,8 +12,8 @@ from pyevolver.model.scene import Scene
 CUBE_TOP = """{top}
 vertices
 1 0.1 0.2 0.3
-2 1.2 0.1 0.2
-3 0.2 1.1 0.4
+2 0.6 0.1 0.2
+3 0.2 0.5 0.4
 edges
 1 1 2
 2 2 3
@@ -48,7 +48,6 @@ def test_integral_order_sets_both_orders(tmp_path):
 
 @pytest.mark.parametrize("top,words", [
     ("METRIC 1 0 0 0 1 0 0 0", "METRIC needs 9 components"),
-    ("KLEIN_METRIC", "not supported in pyevolver: KLEIN_METRIC"),
     ("INTEGRAL_ORDER_2D 5\nCONFORMAL_METRIC 2", "INTEGRAL_ORDER_2D 5"),
     ("INTEGRAL_ORDER_2D 7", "INTEGRAL_ORDER_2D 7"),
     ("TORUS\nPERIODS\n1 0 0\n0 1 0\n0 0 1\nCONFORMAL_METRIC 2", "torus model"),
@@ -75,6 +74,20 @@ def test_orders_refusal_reasons():
 def test_metric_of_without_a_metric_and_unlocated_refusal():
     sc = Scene()
     assert metric_of(sc) is None
-    sc.values["_metric"] = Metric("klein")
-    with pytest.raises(PyEvolverError, match="KLEIN_METRIC"):
+    sc.values["_metric"] = Metric("conformal")
+    sc.flags.add("torus")
+    with pytest.raises(PyEvolverError, match="torus model"):
         metric_of(sc)
+
+
+def test_klein(tmp_path):
+    s = _load(tmp_path, "KLEIN_METRIC").surface
+    assert s.metric.kind == "klein" and s.metric.comps == []
+
+
+def test_klein_points_outside_the_ball(tmp_path):
+    """REF: ERROR 2087 "Points outside unit disk in Klein model." at load."""
+    p = tmp_path / "k.fe"
+    p.write_text(CUBE_TOP.format(top="KLEIN_METRIC").replace("2 0.6 0.1 0.2", "2 1.6 0.1 0.2"))
+    with pytest.raises(PyEvolverError, match="Points outside unit disk in Klein model"):
+        Session.load(str(p), out=io.StringIO(), err=io.StringIO())
