@@ -49,6 +49,12 @@ class Metric:
         return [str(getattr(c, "text", "") or c.node) for c in self.comps]
 
 
+#: the named methods checked against REF under a metric: the first four stay
+#: Euclidean there, the metric_ ones measure in it, the rest do not measure
+METRIC_METHODS = {"facet_area", "edge_length", "facet_tension", "edge_tension", "facet_volume",
+                  "metric_facet_area", "metric_edge_length", "vertex_scalar_integral",
+                  "facet_vector_integral", "edge_vector_integral"}
+
 #: the facet quadrature orders whose REF rules pyevolver has
 FACET_ORDERS = (6, 7)
 
@@ -80,8 +86,18 @@ def metric_of(sc, error=None) -> Metric | None:
     if m is None:
         return None
     why = None
+    bad = sorted({md.method.lower() for q in sc.quantities.values() for md in q.methods}
+                 .union(md.method.lower() for md in sc.method_instances.values())
+                 - METRIC_METHODS)
     if sc.torus:
         why = "a metric in the torus model (lengths and areas of wrapped edges)"
+    elif bad:
+        why = (f"method {bad[0]} with a metric (whether REF measures it in the metric "
+               f"is not reproduced)")
+    elif any("convex" in c.flags for c in sc.constraints.values()):
+        why = "gap energy (CONVEX constraints) with a metric"
+    elif sc.values.get("squared_curvature"):
+        why = "SQUARED_CURVATURE with a metric"
     elif sc.space_dimension > 3:
         why = f"a metric in SPACE_DIMENSION {sc.space_dimension}"
     if why is not None:

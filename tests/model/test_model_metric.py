@@ -91,3 +91,32 @@ def test_klein_points_outside_the_ball(tmp_path):
     p.write_text(CUBE_TOP.format(top="KLEIN_METRIC").replace("2 0.6 0.1 0.2", "2 1.6 0.1 0.2"))
     with pytest.raises(PyEvolverError, match="Points outside unit disk in Klein model"):
         Session.load(str(p), out=io.StringIO(), err=io.StringIO())
+
+
+@pytest.mark.parametrize("top,words", [
+    ("CONFORMAL_METRIC 2\nquantity q energy method facet_scalar_integral global\n"
+     "scalar_integrand: x", "method facet_scalar_integral with a metric"),
+    ("CONFORMAL_METRIC 2\nconstraint 1 convex\nformula: z = 0", "gap energy"),
+    ("CONFORMAL_METRIC 2\nsquared_curvature 1", "SQUARED_CURVATURE with a metric"),
+])
+def test_unverified_combinations_refused(tmp_path, top, words):
+    with pytest.raises(PyEvolverError, match=words):
+        _load(tmp_path, top)
+
+
+def test_verified_methods_accepted(tmp_path):
+    s = _load(tmp_path, "CONFORMAL_METRIC 2\nquantity v info_only method facet_volume global")
+    assert "v" in s.surface.quantities
+
+
+def test_orders_printed_and_fixed_at_run_time(tmp_path):
+    """quadm.fe: REF prints integral_order_1d 13 and integral_order_2d 7;
+    changing them with a metric is refused by name."""
+    out = io.StringIO()
+    p = tmp_path / "m.fe"
+    p.write_text(CUBE_TOP.format(top="INTEGRAL_ORDER 7\nCONFORMAL_METRIC 2"))
+    s = Session.load(str(p), out=out, err=io.StringIO())
+    s.run("print integral_order_1d; print integral_order_2d")
+    assert out.getvalue().split()[-2:] == ["13", "7"]
+    with pytest.raises(PyEvolverError, match="integral_order_2d := ... with a metric"):
+        s.run_one("integral_order_2d := 6")
