@@ -214,7 +214,7 @@ class Totals:
         total = 0.0
         for c, idx in convex_edges(s):
             d = self.edge_vec[idx]
-            L = self.edge_length[idx]
+            L = np.sqrt(np.einsum("ij,ij->i", d, d))        # Euclidean under a metric too
             for end in (0, 1):
                 P = s.X[s.E[idx, end]]
                 g = self.constraint_gradient(c, P)

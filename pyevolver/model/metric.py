@@ -94,8 +94,9 @@ def metric_of(sc, error=None) -> Metric | None:
     elif bad:
         why = (f"method {bad[0]} with a metric (whether REF measures it in the metric "
                f"is not reproduced)")
-    elif any("convex" in c.flags for c in sc.constraints.values()):
-        why = "gap energy (CONVEX constraints) with a metric"
+    elif any(c.energy for c in list(sc.constraints.values()) + list(sc.boundaries.values())):
+        why = ("constraint or boundary ENERGY integrals with a metric (REF's motion differs "
+               "from their gradient: sphere.fe with a conformal metric)")
     elif sc.values.get("squared_curvature"):
         why = "SQUARED_CURVATURE with a metric"
     elif sc.space_dimension > 3:

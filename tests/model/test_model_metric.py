@@ -96,7 +96,8 @@ def test_klein_points_outside_the_ball(tmp_path):
 @pytest.mark.parametrize("top,words", [
     ("CONFORMAL_METRIC 2\nquantity q energy method facet_scalar_integral global\n"
      "scalar_integrand: x", "method facet_scalar_integral with a metric"),
-    ("CONFORMAL_METRIC 2\nconstraint 1 convex\nformula: z = 0", "gap energy"),
+    ("CONFORMAL_METRIC 2\nconstraint 1\nformula: z = 0\nenergy:\ne1: 0\ne2: x\ne3: 0",
+     "ENERGY integrals with a metric"),
     ("CONFORMAL_METRIC 2\nsquared_curvature 1", "SQUARED_CURVATURE with a metric"),
 ])
 def test_unverified_combinations_refused(tmp_path, top, words):

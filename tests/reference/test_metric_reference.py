@@ -246,3 +246,16 @@ def test_metric_methods_need_a_general_metric(evolver, tmp_path):
     assert "ERROR 1583" in ref.stdout + ref.stderr, ref
     with pytest.raises(pyevolver.errors.PyEvolverError, match="without a general metric"):
         _ours(path, "print mfa.value\n")
+
+
+def test_gap_energy_in_a_metric(evolver, tmp_path):
+    """Gap energy (CONVEX constraints) measures Euclidean edges under a metric,
+    as REF: tankex.fe with a conformal metric (its ENERGY integrals, refused
+    with a metric, taken out)."""
+    text = open(example("tankex.fe")).read()
+    text = re.sub(r"energy:[^\n]*\ne1:[^\n]*\ne2:[^\n]*\ne3:[^\n]*\n", "", text)
+    at = re.search(r"^\s*vertices", text, re.M | re.I).start()
+    text = text[:at] + "\nCONFORMAL_METRIC 1 + 0.1*x^2 + 0.05*y\n" + text[at:]
+    path = _write(tmp_path, "tg.fe", text)
+    _compare(evolver, path, 'printf "RESULT %.15g\\n", total_energy\ng 5\nr\ng 5\n'
+                            'printf "RESULT %.15g\\n", total_energy\n', cwd=str(tmp_path))
