@@ -259,3 +259,31 @@ def test_gap_energy_in_a_metric(evolver, tmp_path):
     path = _write(tmp_path, "tg.fe", text)
     _compare(evolver, path, 'printf "RESULT %.15g\\n", total_energy\ng 5\nr\ng 5\n'
                             'printf "RESULT %.15g\\n", total_energy\n', cwd=str(tmp_path))
+
+
+STRING_BODY = """STRING
+SPACE_DIMENSION 2
+CONFORMAL_METRIC 1 + 0.3*x^2
+vertices
+1 1 0
+2 0.2 1.5
+3 -1.2 0.1
+4 0.1 -1
+edges
+1 1 2
+2 2 3
+3 3 4
+4 4 1
+faces
+1 1 2 3 4
+bodies
+1 1 volume 3
+"""
+
+
+def test_string_body_in_a_metric(evolver, tmp_path):
+    """A string-model body keeps its Euclidean area (the constraint) while
+    the length is the metric's."""
+    path = _write(tmp_path, "sb.fe", STRING_BODY)
+    _compare(evolver, path, "g 10\nr\ng 10\n" + NUMBERS +
+             'printf "RESULT %.15g\\n", body[1].volume\n', cwd=str(tmp_path))
