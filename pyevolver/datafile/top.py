@@ -393,6 +393,9 @@ class TopSection:
             exprs = getattr(self, "_metric_exprs", [])
         if "_metric" in sc.values:
             raise self.error("a second metric declaration", self._src(sec, line))
+        if any(nesting_depth(e) > MAX_NESTING for e in exprs):
+            raise self.error(f"expression nested more than {MAX_NESTING} levels deep",
+                             self._src(sec, line))
         comps = [self._formula(e if not isinstance(e, float) else N.Num(e)) for e in exprs]
         sc.values["_metric"] = Metric(kind, comps, sc.space_dimension, line=self._src(sec, line))
 

@@ -121,3 +121,10 @@ def test_orders_printed_and_fixed_at_run_time(tmp_path):
     assert out.getvalue().split()[-2:] == ["13", "7"]
     with pytest.raises(PyEvolverError, match="integral_order_2d := ... with a metric"):
         s.run_one("integral_order_2d := 6")
+
+
+def test_deeply_nested_component_refused(tmp_path):
+    """(found by tests/robustness/test_fuzz.py: a traceback before)"""
+    deep = "sin(" * 400 + "x" + ")" * 400
+    with pytest.raises(PyEvolverError, match="nested more than"):
+        _load(tmp_path, f"METRIC\n1 {deep} 0\n0 1 0\n0 0 1")
