@@ -140,7 +140,7 @@ def warn_bare_edges(session: SessionLike, filename, scene, s):
 
 def scene_settings(session: SessionLike, scene):
     """Settings a datafile gives (scale, scale_limit, constraint_tolerance, total_time)."""
-    for k in ("scale_limit", "constraint_tolerance"):
+    for k in ("scale_limit", "constraint_tolerance", "integral_order_1d", "integral_order_2d"):
         if k in scene.values:
             session.settings[k] = scene.values[k]
     if "total_time" in scene.values:        # TOTAL_TIME: a dump goes on with its clock

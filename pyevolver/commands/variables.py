@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from ..errors import CommandError, ExpressionError
+from ..errors import CommandError, ExpressionError, UnsupportedError
 from ..expr import nodes as N
 from ..model import string as SM
 from .toggles import TOGGLE_DEFAULTS, TOGGLES
@@ -43,6 +43,9 @@ def set_variable(session: SessionLike, name, value):
     if name in session.settings or name in ("gravity_constant", "sq_curvature_modulus"):
         value = as_float(value, f"'{name}'")     # settings are numbers
     if name in session.settings:
+        if name.startswith("integral_order") and getattr(session.surface, "metric", None):
+            raise UnsupportedError(f"{name} := ... with a metric",
+                                   "the metric keeps the datafile's quadrature orders")
         if name == "random_seed":
             session.rng = np.random.default_rng(as_int(value, "random_seed") & (2**63 - 1))
         session.settings[name] = value

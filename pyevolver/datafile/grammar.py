@@ -229,6 +229,15 @@ class _TopTransformer(ExprTransformer):
     def unsupported(self, kw):
         raise _Unsupported(kw)
 
+    def metric_matrix(self, kw):
+        return ("metric", "matrix", [], kw.line)
+
+    def metric_conformal(self, kw, e):
+        return ("metric", "conformal", [e], kw.line)
+
+    def metric_klein(self, kw):
+        return ("metric", "klein", [], kw.line)
+
     # -- what the Evolver's dump writes --
     def slice_coeff(self, kw, _nums):
         return ("ignored", "slice_coeff")       # the slicing plane of the graphics

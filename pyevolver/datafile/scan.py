@@ -87,7 +87,7 @@ def _long_numeric(line):
 
 
 _SPACE_DIM_RE = re.compile(r"^[ \t]*space_dimension[ \t:]+(\d+)", re.I | re.M)
-_MATRIX_RE = re.compile(r"\b(torus_periods|periods|view_matrix|view_transforms|"
+_MATRIX_RE = re.compile(r"\b(torus_periods|periods|metric|view_matrix|view_transforms|"
                         r"view_transform_generators)\b", re.I)
 _NUMTOK_RE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)(?=\s|$)")
 

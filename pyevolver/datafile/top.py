@@ -17,6 +17,7 @@ from ..errors import PyEvolverError
 from ..expr import nodes as N
 from ..limits import MAX_ARRAY_ENTRIES, MAX_NESTING, nesting_depth
 from ..model.scene import BoundaryDecl, ConstraintDecl, MethodDecl, QuantityDecl
+from ..model.metric import Metric, metric_orders_refusal
 from .grammar import _LINE, _TOP, line_parser, top_parser
 from .located import _LocatedName, _MatrixError, _Unsupported
 from .scan import (_ARRAY_TOKEN, _ATTR_FUNCTION, _BAD_NUMBER, _INT_ATTR_TYPES, _MATRIX_RE,
@@ -75,6 +76,16 @@ class TopSection:
                 out = out[:m.end()] + re.sub(r"[^\n]", " ", out[m.end():pos]) + out[pos:]
                 if key.endswith("periods"):
                     self._period_exprs = vals
+                continue
+            if key == "metric":             # N² component formulas, any line layout
+                sd = self._peek_space_dimension(text[:m.start()])
+                vals, pos = self._matrix_exprs(text, m, sd * sd)
+                if len(vals) != sd * sd:
+                    line = text.count("\n", 0, m.start()) + 1
+                    raise _MatrixError(line, f"METRIC needs {sd * sd} components, "
+                                             f"found {len(vals)}")
+                out = out[:m.end()] + re.sub(r"[^\n]", " ", out[m.end():pos]) + out[pos:]
+                self._metric_exprs = vals
                 continue
             pos = m.end()
             if key.startswith("view_transform"):
@@ -238,6 +249,7 @@ class TopSection:
     def _fill_scene(self, decls, sec):
         sc = self.scene
         self._forward = {}
+        self._orders = []
         for d in decls:
             kind = d[0]
             try:
@@ -246,6 +258,11 @@ class TopSection:
                 raise self.error(f"undefined parameter '{exc.name}'",
                                  self._src(sec, exc.line) if exc.line else None,
                                  exc.col) from None
+        if self._orders:
+            why = metric_orders_refusal(sc)
+            if why is not None:
+                msg, line = self._orders[0]
+                raise self.error(msg + (f"; {why}" if why else ""), line)
         for name, (kind, line) in self._forward.items():
             known = sc.quantities if kind == "quantity_forward" else sc.method_instances
             if name not in known:
@@ -283,10 +300,15 @@ class TopSection:
                 default = {"integral_order_1d": 5.0, "integral_order_2d": 3.0}.get(name)
             if name == "integral_order" or (default is not None and
                                             sc.values[name] != default):
-                raise self.error(f"not supported in pyevolver: {name.upper()} "
-                                 f"{sc.values[name]:g} (edge integrals use order 3 and facet "
-                                 f"integrals order 6, the Evolver's defaults)",
-                                 self._src(sec, line))
+                # refused at the end of the top section unless a metric uses it
+                # (pyevolver.methods.metric has REF's rules for the metric's integrals)
+                self._orders.append((f"not supported in pyevolver: {name.upper()} "
+                                     f"{sc.values[name]:g} (edge integrals use order 3 and facet "
+                                     f"integrals order 6, the Evolver's defaults)",
+                                     self._src(sec, line)))
+                if name == "integral_order":    # REF: INTEGRAL_ORDER n is 2D n and 1D 2n - 1
+                    sc.values["integral_order_2d"] = sc.values[name]
+                    sc.values["integral_order_1d"] = 2 * sc.values[name] - 1
         elif kind == "constraint":
             _, cid, opts, formula, blocks, line = d
             cid = self._number_named(cid, sc.constraints, sc.constraint_names, "constraint",
@@ -372,8 +394,24 @@ class TopSection:
                 if any(not isinstance(e, (float, N.Num)) for e in exprs):
                     sc.values["_period_exprs"] = exprs
             # (plain numbers were taken by _extract_matrices)
+        elif kind == "metric":
+            self._metric_decl(d, sc, sec)
         elif kind == "ignored":
             pass
+
+    def _metric_decl(self, d, sc, sec):
+        """METRIC / CONFORMAL_METRIC / KLEIN_METRIC -> ``sc.values["_metric"]``
+        (a :class:`pyevolver.model.metric.Metric`; orders filled in by the builder)."""
+        _, kind, exprs, line = d
+        if kind == "matrix":
+            exprs = getattr(self, "_metric_exprs", [])
+        if "_metric" in sc.values:
+            raise self.error("a second metric declaration", self._src(sec, line))
+        if any(nesting_depth(e) > MAX_NESTING for e in exprs):
+            raise self.error(f"expression nested more than {MAX_NESTING} levels deep",
+                             self._src(sec, line))
+        comps = [self._formula(e if not isinstance(e, float) else N.Num(e)) for e in exprs]
+        sc.values["_metric"] = Metric(kind, comps, sc.space_dimension, line=self._src(sec, line))
 
     def _defer(self, feature, line, col=None):
         """An unsupported feature met while reading: the file is read to the

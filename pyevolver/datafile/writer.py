@@ -191,6 +191,23 @@ class _FeWriter:
                 self.refuse("bodies whose facet list differs from their facets")
 
     # -- top section -------------------------------------------------------------
+    def _metric(self, m):
+        """METRIC rows / CONFORMAL_METRIC / KLEIN_METRIC (after the
+        parameters its formulas may name), with non-default quadrature orders."""
+        if m.order_1d != 3:
+            self.w(f"INTEGRAL_ORDER_1D: {m.order_1d}")
+        if m.order_2d != 6:
+            self.w(f"INTEGRAL_ORDER_2D: {m.order_2d}")
+        if m.kind == "klein":
+            self.w("KLEIN_METRIC")
+        elif m.kind == "conformal":
+            self.w("CONFORMAL_METRIC " + expr_text(m.comps[0]))
+        else:
+            self.w("METRIC")
+            for i in range(m.dim):
+                self.w(" " + " ".join(f"({expr_text(c)})" for c in m.comps[i * m.dim:(i + 1) * m.dim]))
+        self.w()
+
     def _header(self):
         s, opts = self.s, self.opts
         name = opts.filename if opts is not None else ""
@@ -251,6 +268,8 @@ class _FeWriter:
                 continue
             self.w(f"PARAMETER {pname} = {num(v)}")
         self.w()
+        if getattr(s, "metric", None) is not None:
+            self._metric(s.metric)
         types = self.opts.attr_types if self.opts is not None else {}
         for (etype, aname), arr in self.s.extra.items():
             typ = types.get((etype, aname), "real")

@@ -101,7 +101,7 @@ def gap_energy_grad(t):
     out = np.zeros((s.nv, 3))
     for c, idx in convex_edges(s):
         d = t.edge_vec[idx]
-        L = t.edge_length[idx]
+        L = np.sqrt(np.einsum("ij,ij->i", d, d))        # Euclidean under a metric too
         params = s.param_env()
         for end in (0, 1):
             vi = s.E[idx, end]

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import UnsupportedError
 from ..geometry import kernels as G
+from . import metric as MT
 from .jets import skew
 from ..model.formulas import located
 from ._common import (assemble, assemble_projected, corner_scatter, facet_points, n2_grad_dot,
@@ -30,8 +31,21 @@ from .registry import register_method
 # values
 
 
+def _eu_area(ctx):
+    """(nf,) Euclidean facet areas: REF's named methods (``facet_area``,
+    ``edge_length``, the tensions) measure Euclidean under a METRIC, only the
+    default energy and ``metric_facet_area`` / ``metric_edge_length`` use it."""
+    return getattr(ctx, "euclidean_facet_area", ctx.facet_area)
+
+
+def _eu_length(ctx):
+    if ctx.surface.metric is None:
+        return ctx.edge_length
+    return np.sqrt(np.einsum("ij,ij->i", ctx.edge_vec, ctx.edge_vec))
+
+
 def _facet_area(ctx, m, idx):
-    return ctx.facet_area[idx]
+    return _eu_area(ctx)[idx]
 
 
 def _facet_volume(ctx, m, idx):
@@ -39,11 +53,11 @@ def _facet_volume(ctx, m, idx):
 
 
 def _edge_length(ctx, m, idx):
-    return ctx.edge_length[idx]
+    return _eu_length(ctx)[idx]
 
 
 def _facet_tension(ctx, m, idx):
-    return ctx.facet_area[idx] * ctx.surface.facet_tension[idx]
+    return _eu_area(ctx)[idx] * ctx.surface.facet_tension[idx]
 
 
 def _vertex_scalar_integral(ctx, m, idx):
@@ -91,8 +105,11 @@ def _edge_vector_integral(ctx, m, idx):
 # gradients
 
 
-def facet_area_grad(t):
-    """Per-corner gradients (nf, 3, 3) of facet areas."""
+def facet_area_grad(t, euclidean=False):
+    """Per-corner gradients (nf, 3, 3) of facet areas (in the surface's
+    metric unless ``euclidean``)."""
+    if t.surface.metric is not None and not euclidean:
+        return MT.facet_area_grad(t)
     P = facet_points(t)
     N2 = t.facet_N2
     with np.errstate(all="ignore"):
@@ -190,11 +207,14 @@ class _Env:
                 self.coords[name] = arr[rep]
 
 
-def edge_length_grad(t, idx: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """Gradient (nv, 3) of ``Σ_e w_e |e|`` over the edges ``idx``."""
+def edge_length_grad(t, idx: np.ndarray, weights: np.ndarray, euclidean=False) -> np.ndarray:
+    """Gradient (nv, 3) of ``Σ_e w_e |e|`` over the edges ``idx`` (in the
+    surface's metric unless ``euclidean``)."""
+    if t.surface.metric is not None and not euclidean:
+        return MT.edge_length_grad(t, idx, weights)
     s = t.surface
     d = t.edge_vec[idx]
-    L = t.edge_length[idx]
+    L = _eu_length(t)[idx]
     with np.errstate(all="ignore"):
         u = np.nan_to_num(d / L[:, None]) * weights[:, None]
     return scatter(s.nv, np.concatenate([s.E[idx, 0], s.E[idx, 1]]), np.concatenate([-u, u]))
@@ -281,7 +301,7 @@ def _facet_scalar_gradient(t, m, idx, w):
 # Hessians
 
 
-def facet_area_hessian(t, weights, basis=None):
+def facet_area_hessian(t, weights, basis=None, euclidean=False):
     """Hessian of ``Σ_f w_f A_f`` (3nv, 3nv).
 
     With ``N = (x1−x0)×(x2−x0)``, ``n = N/|N|`` and ``e_a`` the side opposite
@@ -291,6 +311,8 @@ def facet_area_hessian(t, weights, basis=None):
 
     with ε_ab = +1 if b = a+2, −1 if b = a+1 (mod 3), 0 if a = b.
     """
+    if t.surface.metric is not None and not euclidean:
+        return MT.facet_area_hessian(t, weights, basis)
     s = t.surface
     P = facet_points(t)
     N2 = t.facet_N2
@@ -336,11 +358,13 @@ def facet_area_hessian(t, weights, basis=None):
     return assemble(s.nv, s.F[ok], B, basis)
 
 
-def edge_length_hessian(t, idx, weights, basis=None):
+def edge_length_hessian(t, idx, weights, basis=None, euclidean=False):
     """Hessian of ``Σ_e w_e L_e``: blocks ``±(I − t tᵀ)/L``."""
+    if t.surface.metric is not None and not euclidean:
+        return MT.edge_length_hessian(t, idx, weights, basis)
     s = t.surface
     d = t.edge_vec[idx]
-    L = t.edge_length[idx]
+    L = _eu_length(t)[idx]
     ok = L > 0
     d, L, w, idx = d[ok], L[ok], np.asarray(weights)[ok], idx[ok]
     u = d / L[:, None]
@@ -451,11 +475,11 @@ def _per_facet(t, idx, w):
 
 
 def _area_gradient(t, m, idx, w):
-    return corner_scatter(t, facet_area_grad(t), _per_facet(t, idx, w))
+    return corner_scatter(t, facet_area_grad(t, True), _per_facet(t, idx, w))
 
 
 def _area_hessian(t, m, idx, w, basis=None):
-    return facet_area_hessian(t, _per_facet(t, idx, w), basis)
+    return facet_area_hessian(t, _per_facet(t, idx, w), basis, euclidean=True)
 
 
 def _volume_gradient(t, m, idx, w):
@@ -468,16 +492,17 @@ def _volume_hessian(t, m, idx, w, basis=None):
 
 
 def _length_gradient(t, m, idx, w):
-    return edge_length_grad(t, idx, w)
+    return edge_length_grad(t, idx, w, True)
 
 
 def _length_hessian(t, m, idx, w, basis=None):
-    return edge_length_hessian(t, np.asarray(idx, np.int64), w, basis)
+    return edge_length_hessian(t, np.asarray(idx, np.int64), w, basis, euclidean=True)
 
 
 def _facet_tension_gradient(t, m, idx, w):
     s = t.surface
-    return corner_scatter(t, facet_area_grad(t), _per_facet(t, idx, w * s.facet_tension[idx]))
+    return corner_scatter(t, facet_area_grad(t, True),
+                          _per_facet(t, idx, w * s.facet_tension[idx]))
 
 
 def _edge_vector_gradient(t, m, idx, w):

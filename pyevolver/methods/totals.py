@@ -10,10 +10,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..constraints import integral_edges, located
-from ..errors import PyEvolverError
+from ..errors import PyEvolverError, UnsupportedError
 from ..geometry import kernels as G
 from ..model.records import convex_edges, torus_lift_shifts
 from ..model.surface import HOOKS, Quantity, Surface
+from . import metric as MT
 from .curvature import legacy_energy
 from .registry import lookup
 
@@ -64,6 +65,9 @@ class Totals:
             self.facet_area = G.facet_areas(self.facet_N2)
             self.facet_volume = G.facet_volumes(self.facet_x0, self.facet_S,
                                                 s.symmetric_content)
+        if s.metric is not None:        # areas in the metric (volumes stay Euclidean)
+            self.euclidean_facet_area = self.facet_area
+            self.facet_area = MT.facet_areas(self)
         self.total_area = float(self.facet_area.sum())
         energy = self._tension_energy()
         self.con_energy, self.con_content = self._integrals()
@@ -117,6 +121,8 @@ class Totals:
         return G.edge_vectors(s.X, s.E, s.wrap_shift())
 
     def _make_edge_length(self):
+        if self.surface.metric is not None:
+            return MT.edge_lengths(self)
         d = self.edge_vec
         return np.sqrt(np.einsum("ij,ij->i", d, d))
 
@@ -208,7 +214,7 @@ class Totals:
         total = 0.0
         for c, idx in convex_edges(s):
             d = self.edge_vec[idx]
-            L = self.edge_length[idx]
+            L = np.sqrt(np.einsum("ij,ij->i", d, d))        # Euclidean under a metric too
             for end in (0, 1):
                 P = s.X[s.E[idx, end]]
                 g = self.constraint_gradient(c, P)
@@ -351,6 +357,8 @@ def evaluate(surface: Surface) -> Totals:
         model = "ndim"          # pyevolver.methods.ndim
     elif getattr(surface, "order", 1) == 2:
         model = "quadratic"
+    if surface.metric is not None and model not in ("string", "soapfilm"):
+        raise UnsupportedError(f"a metric in the {model} model")
     return MODEL_TOTALS[model](surface)
 
 

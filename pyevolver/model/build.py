@@ -11,6 +11,7 @@ from ..expr.nodes import Formula
 from ..limits import MAX_ARRAY_ENTRIES
 from .formulas import located
 from .ids import IdMap, Lazy, split_midpoints
+from .metric import metric_of
 from .records import first_facets_on_load, record_edge_first_facet
 from .scene import Scene
 from . import simplex as SX
@@ -57,6 +58,7 @@ class _Builder:
         s.gap_constant = sc.values.get("gap_constant", 1.0)
         s.sq_curvature_modulus = float(sc.values.get("squared_curvature", 0.0))
         s.symmetry_group = symmetry.declared(sc, s, self.error)
+        s.metric = metric_of(sc, self.error)   # METRIC / CONFORMAL_METRIC / KLEIN_METRIC
         if sc.torus or sc.symmetry_group == "torus":
             vals = sc.values.get("_periods")
             sd = s.sdim
@@ -743,7 +745,6 @@ class _Builder:
     # -- projection -------------------------------------------------------------------
     def _project(self):
         HOOKS.require("project")(self.s, np.arange(self.s.nv))
-
 
 
 def build_surface(scene: Scene) -> Surface:

@@ -42,7 +42,8 @@ from ..geometry.kernels import edge_vectors
 
 # quantity methods that make sense without facets
 STRING_METHODS = {"edge_length", "edge_tension", "edge_area", "vertex_scalar_integral",
-                  "edge_scalar_integral", "edge_vector_integral", "harmonic_energy"}
+                  "edge_scalar_integral", "edge_vector_integral", "harmonic_energy",
+                  "metric_edge_length"}
 
 
 # ---------------------------------------------------------------------------

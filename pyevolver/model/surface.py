@@ -108,6 +108,7 @@ class Surface:
         self.gravity_on = True       # the `gravity` toggle (G v sets it to v != 0)
         self.gap_constant = 1.0
         self.sq_curvature_modulus = 0.0     # legacy SQUARED_CURVATURE c
+        self.metric = None                  # a model.metric.Metric (METRIC ...) or None
         self.curvature_mode = "plain"       # toggles: effective_area -> eff, normal_curvature -> norm
         # the string model (surface dimension 1): facets are edge chains kept in
         # sf_ptr / sf_enc (pyevolver.model.string) and FE stays empty

@@ -30,7 +30,9 @@ import heapq
 import numpy as np
 
 from ..constraints import project_to_constraints
+from ..errors import UnsupportedError
 from ..geometry.kernels import edge_index, gram_facet_areas
+from ..methods import metric as MT
 from .shrink import subset
 
 
@@ -75,6 +77,9 @@ class _Deleter:
         return d if self.W is None else d + self.W[e] @ self.P
 
     def length(self, e):
+        if self.s.metric is not None:       # REF weeds by the metric's lengths
+            a, b = self.E[e]
+            return float(MT.segment_lengths(self.s, self.X[a], self.X[b])[0])
         return float(np.linalg.norm(self.vec(e)))
 
     def facets_of(self, e):
@@ -281,7 +286,8 @@ def delete_short_edges(s, length):
     Returns ``(new surface, number deleted)``.
     """
     d = _Deleter(s)
-    L = np.linalg.norm(_edge_vectors(s), axis=1)
+    L = np.linalg.norm(_edge_vectors(s), axis=1) if s.metric is None else \
+        MT.segment_lengths(s, s.X[s.E[:, 0]], s.X[s.E[:, 1]])
 
     def visit(e):
         if not d.ealive[e] or d.length(e) >= length or not d.delete(e) or not d.moved:
@@ -298,14 +304,21 @@ def weed_small_facets(s, area):
 
     Returns ``(new surface, number of facets weeded)``.
     """
-    D = _edge_vectors(s)
-    idx, sgn = edge_index(s.FE)
-    A = gram_facet_areas(np.stack([D[idx[:, 0]] * sgn[:, 0, None],
-                                   D[idx[:, 1]] * sgn[:, 1, None]], 1))
+    if s.metric is not None:
+        F = s.F
+        A = MT.triangle_areas(s, s.X[F[:, 0]], s.X[F[:, 1]], s.X[F[:, 2]])
+    else:
+        D = _edge_vectors(s)
+        idx, sgn = edge_index(s.FE)
+        A = gram_facet_areas(np.stack([D[idx[:, 0]] * sgn[:, 0, None],
+                                       D[idx[:, 1]] * sgn[:, 1, None]], 1))
     return _weed(s, np.nonzero(A < area)[0], area)
 
 
 def _facet_area(d, f):
+    if d.s.metric is not None:
+        P = d.X[[d.E[_dec(x)][0] if x >= 0 else d.E[_dec(x)][1] for x in d.FE[f]]]
+        return float(MT.triangle_areas(d.s, P[0], P[1], P[2])[0])
     sides = [d.vec(_dec(x)) * (1 if x >= 0 else -1) for x in d.FE[f][:2]]
     return float(gram_facet_areas(np.stack(sides)[None])[0])
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..methods import metric as MT
 from ..geometry import kernels as G
 from ..constraints import constrained_vertices, project_to_constraints
 from ..model.records import along_first, record_along_first, record_vertex_rings
@@ -188,7 +189,8 @@ def split_edges(s, ref, one_by_one=False):
     # -- geometry of midpoints (torus: in the tail's cell)
     wv = s.wrap_shift()
     ev = G.edge_vectors(s.X, s.E, wv)
-    t.X[nv:nv + k] = s.X[s.E[R, 0]] + 0.5 * ev[R]
+    frac = 0.5 if s.metric is None else MT.split_fractions(s, R)[:, None]
+    t.X[nv:nv + k] = s.X[s.E[R, 0]] + frac * ev[R]      # a metric's split: methods.metric
     # -- edge halves
     t.E[R, 1] = mid[R]
     t.E[half[R], 0] = mid[R]

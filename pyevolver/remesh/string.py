@@ -7,6 +7,7 @@ import copy
 
 import numpy as np
 
+from ..methods import metric as MT
 from ..constraints import constrained_vertices, project_tangent, project_to_constraints
 from ..geometry.kernels import edge_vectors
 from .grow import grow
@@ -58,7 +59,10 @@ def split_edges(s, R):
     nv, ne = s.nv, s.ne
     mid = nv + np.arange(k)
     half = ne + np.arange(k)
-    if s.periods is None:
+    if s.metric is not None:              # REF's split in a metric: methods.metric
+        t.X[mid] = s.X[s.E[R, 0]] + MT.split_fractions(s, R)[:, None] * (
+            s.X[s.E[R, 1]] - s.X[s.E[R, 0]])
+    elif s.periods is None:
         t.X[mid] = 0.5 * (s.X[s.E[R, 0]] + s.X[s.E[R, 1]])
     else:                                 # the head as seen from the tail
             t.X[mid] = s.X[s.E[R, 0]] + 0.5 * edge_vectors(s.X, s.E, s.wrap_shift())[R]

@@ -25,11 +25,10 @@ from tolerances import PRINTED, STEPS
 
 # the examples pyevolver runs, and those it refuses by name; crystal.fe is not dumped by REF (no
 # Wulff file); simplex3.fe: tests/commands/test_simplex_commands.py (REF -p1 crashes at its g)
-SUPPORTED = ["addload_example", "cat", "catbody", "catman", "column", "cube", "knotty", "mound",
-             "mylarcube", "octa", "phelanc", "popstr", "qmound", "quad", "slidestr", "sphere",
-             "relaxed", "symtest", "tankex", "twointor"]
-REFUSED = [("100grain", "g 3"), ("100grain", "r; g 3"),
-           ("metric", "g 3"), ("quadm", "g 3")]
+SUPPORTED = ["addload_example", "cat", "catbody", "catman", "column", "cube", "knotty", "metric",
+             "mound", "mylarcube", "octa", "phelanc", "popstr", "qmound", "quad", "quadm", "slidestr",
+             "sphere", "relaxed", "symtest", "tankex", "twointor"]
+REFUSED = [("100grain", "g 3"), ("100grain", "r; g 3")]
 PRE = ["g 3", "r; g 3"]
 
 SCRIPT = ('printf "R %.17g %.17g %d %d %d %d\\n", total_energy, total_area, vertex_count, '

@@ -30,7 +30,7 @@ EXPECTED_LINE = {
     "bad_number.fe": 7,             # vertex 2 '1.0.0 0.0 0.0'
     "unterminated_comment.fe": 37,  # the '/*' on the bodies line
     "undefined_parameter.fe": 12,   # vertex 7 'rad 1.0 1.0'
-    "unsupported.fe": 5,            # 'METRIC'
+    "unsupported.fe": 5,            # 'LOAD_LIBRARY'
     # resource limits and values that once gave tracebacks (issue 10)
     "deep_nesting.fe": 8,           # sin(sin(... 300 deep
     "huge_id.fe": 9,                # vertex id 10^12
@@ -51,7 +51,7 @@ EXPECTED_WORDS = {
     "bad_number.fe": [("1.0.0", "number")],
     "unterminated_comment.fe": [("comment",)],
     "undefined_parameter.fe": [("rad",)],
-    "unsupported.fe": [("not supported",), ("metric",)],
+    "unsupported.fe": [("not supported",), ("load_library",)],
     "deep_nesting.fe": [("nested",), ("200",)],
     "huge_id.fe": [("1000000000000",), ("range",)],
     "macro_bomb.fe": [("#define",), ("100000",)],
