@@ -60,11 +60,12 @@ def _replaced(session: SessionLike, result, count=None, note=None, echo=True):
     return n
 
 
-def _divide(session: SessionLike, edges):
-    """Bisect ``edges`` (the string model splits them); returns how many."""
+def _divide(session: SessionLike, edges, choosers=None):
+    """Bisect ``edges`` (the string model splits them); returns how many.
+    ``choosers`` (``K``): per edge the facet that chose it (edge_divide)."""
     if session.surface.string:
         return session._string_split(np.asarray(edges, np.int64))
-    return _replaced(session, ED.edge_divide(session.surface, edges))
+    return _replaced(session, ED.edge_divide(session.surface, edges, choosers))
 
 
 def refine_edges(session: SessionLike, edges, echo=True):
@@ -135,8 +136,8 @@ def flush_counts(session: SessionLike):
     session.pending = {"Fixed": 0, "Unfixed": 0}
 
 
-def _bisect(session: SessionLike, edges, echo):
-    n = _divide(session, edges)
+def _bisect(session: SessionLike, edges, echo, choosers=None):
+    n = _divide(session, edges, choosers)
     bump_count(session, "refine", n)                # REF: l and K accumulate, r does not
     if echo:
         session.note(f"New edges: {n}\n")
@@ -153,7 +154,10 @@ def edge_divide_long(session: SessionLike, length, echo=True):
 def skinny(session: SessionLike, angle, echo=True):
     """``K θ``: bisect the longest edge of facets with an angle below θ."""
     session.no_string("K (skinny triangles)")
-    return _bisect(session, ED.skinny_edges(session.surface, angle), echo)
+    if session.surface.string:
+        return _bisect(session, ED.skinny_edges(session.surface, angle), echo)
+    edges, by = ED.skinny_edges(session.surface, angle, choosers=True)
+    return _bisect(session, edges, echo, choosers=by)
 
 
 def notch(session: SessionLike, angle, echo=True):

@@ -6,37 +6,65 @@ import numpy as np
 from .refine import split_edges
 
 
-def edge_divide(s, edges):
+def edge_divide(s, edges, choosers=None):
     """Bisect ``edges`` (indices) of surface ``s``, ignoring NO_REFINE.
 
     Each facet on a bisected edge is cut from the midpoint to its opposite
     corner.  Edges are taken in increasing index order; when two chosen
     edges share a facet, the second is bisected after the first split (in
     a later round), as the Evolver does one edge after the other.
+    ``choosers`` (``K``: per edge the facet that chose it): the edges are
+    taken (and their new elements numbered) in the order given instead,
+    and the midpoint placed from the chooser's side (:func:`pyevolver.remesh.refine.split_edges`).
 
     Returns
     -------
     (Surface, int)
         The new surface and the number of edges bisected.
     """
-    todo = np.unique(np.asarray(edges, np.int64))
+    todo = np.asarray(edges, np.int64)
+    ordered = choosers is not None
+    if ordered:
+        by = np.asarray(choosers, np.int64)
+        first = np.sort(np.unique(todo, return_index=True)[1])
+        todo, by = todo[first], by[first]
+    else:
+        todo = np.unique(todo)
     count = len(todo)
     while len(todo):
         idx = s.topology()[0]
-        sel = np.zeros(s.ne, bool)
-        sel[todo] = True
-        # each facet is claimed by its lowest-numbered chosen side
-        cand = np.where(sel[idx], idx, np.iinfo(np.int64).max)
-        claim = cand.min(axis=1)
-        ok = np.ones(s.ne, bool)
-        bad = sel[idx] & (idx != claim[:, None])
-        ok[idx[bad]] = False
-        now = todo[ok[todo]]
+        if ordered:
+            # the longest prefix of the order whose edges share no facet:
+            # bisecting them at once is bisecting them one after the other
+            n = _free_prefix(idx, todo, s.ne)
+            now, now_by = todo[:n], by[:n]
+            todo, by = todo[n:], by[n:]
+        else:
+            sel = np.zeros(s.ne, bool)
+            sel[todo] = True
+            # each facet is claimed by its lowest-numbered chosen side
+            cand = np.where(sel[idx], idx, np.iinfo(np.int64).max)
+            claim = cand.min(axis=1)
+            ok = np.ones(s.ne, bool)
+            bad = sel[idx] & (idx != claim[:, None])
+            ok[idx[bad]] = False
+            now = todo[ok[todo]]
+            todo = todo[~ok[todo]]
         mask = np.zeros(s.ne, bool)
         mask[now] = True
-        s = split_edges(s, mask, one_by_one=True)
-        todo = todo[~ok[todo]]
+        s = split_edges(s, mask, one_by_one=True, order=now if ordered else None,
+                        choosers=now_by if ordered else None)
     return s, count
+
+
+def _free_prefix(idx, order, ne):
+    """Length of the longest prefix of ``order`` (edge indices) in which no
+    two edges lie on one facet of ``idx`` (nf, 3)."""
+    pos = np.full(ne, len(order))
+    pos[order] = np.arange(len(order))
+    p = np.sort(pos[idx], axis=1)               # per facet its chosen sides' places
+    clash = p[:, 1] < len(order)                # two chosen sides: the later one waits
+    return int(p[clash, 1].min()) if clash.any() else len(order)
 
 
 def long_edges(s, length):
@@ -44,7 +72,7 @@ def long_edges(s, length):
     return np.nonzero(s.evaluate().edge_length > length)[0]
 
 
-def skinny_edges(s, angle):
+def skinny_edges(s, angle, choosers=False):
     """``K θ``: the longest edge of every facet whose smallest angle is below
     ``angle`` (radians), as edge indices.
 
@@ -54,10 +82,13 @@ def skinny_edges(s, angle):
     equally long sides the last is the longest; and a facet with three
     exactly equal sides counts as skinny whatever ``θ`` (REF finds its
     smallest angle 0: the symmetric equilateral triangles of sphere.fe and
-    twointor.fe's hexagons are cut by any ``K``).
+    twointor.fe's hexagons are cut by any ``K``).  The edges come in the
+    order of the facets that chose them (REF numbers the new elements so).
+    ``choosers``: also return, per edge, the facet that chose it.
     """
     if s.nf == 0:
-        return np.zeros(0, np.int64)
+        none = np.zeros(0, np.int64)
+        return (none, none) if choosers else none
     t = s.evaluate()
     idx = s.topology()[0]                       # side k of facet joins corner k, k+1
     L = t.edge_length[idx]                      # (nf, 3)
@@ -72,8 +103,13 @@ def skinny_edges(s, angle):
     longest = idx[np.arange(s.nf), 2 - np.argmax(L[:, ::-1], axis=1)]
     cand = np.nonzero(skinny)[0]
     cand = cand[np.argsort(s.ids("facet")[cand], kind="stable")]
-    chosen = set()
+    chosen: list[int] = []
+    by: list[int] = []
+    seen: set[int] = set()
     for f in cand.tolist():                     # the skinny facets only
-        if not chosen.intersection(idx[f].tolist()):
-            chosen.add(int(longest[f]))
-    return np.array(sorted(chosen), np.int64)
+        if not seen.intersection(idx[f].tolist()):
+            chosen.append(int(longest[f]))
+            by.append(f)
+            seen.add(chosen[-1])
+    out = np.array(chosen, np.int64)
+    return (out, np.array(by, np.int64)) if choosers else out
