@@ -509,7 +509,8 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
     """
     s = it.surface
     if s.X.shape[1] > 3:
-        raise dimension_error(s.sdim, "the Hessian")
+        from .hessian_nd import hessian_system_nd     # SPACE_DIMENSION 4..9
+        return hessian_system_nd(it, normal)
     mobile = it._mobile()
     cons = _Constraints(s)
     t = s.evaluate()
@@ -562,5 +563,5 @@ def newton_direction(it, normal: bool = True):
     sol = solve_bordered(K, hs.B, hs.rhs, hs.d, points=hs.points)
     dy = sol[:K.shape[0]]
     lam_new = -sol[K.shape[0]:] if len(hs.cons) else hs.lam
-    dx = (hs.T @ dy).reshape(-1, 3)
+    dx = (hs.T @ dy).reshape(it.surface.X.shape)
     return dx, lam_new, hs.cons, hs.mobile
