@@ -116,14 +116,8 @@ def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
     ``order`` (the chosen edges' indices) numbers the new elements in that
     order instead of by edge id (``K``: the order of the facets that chose
     them).  ``choosers`` (``K``, with ``order``: per edge the facet that
-    chose it): the midpoint is put at the start of the chooser's side plus
-    half the side: when the chooser
-    runs along the edge backwards, in the edge's head cell (the midpoint
-    minus the edge's period shift) while the new edges keep the wraps of a
-    midpoint in the tail's cell, as evolver-nox-d does (measured on
-    twointor.fe and a two-vertex torus sheet: ``list vertices`` / ``list
-    edges`` after ``K``; the total area jumps, 3.35 to 15.12 on twointor.fe
-    after ``K 0.2``).
+    chose it) is only passed on: :func:`pyevolver.remesh.edge_divide.edge_divide`
+    moves the midpoints afterwards.
     """
     nv, ne, nf = s.nv, s.ne, s.nf
     ref = np.asarray(ref, bool)
@@ -200,10 +194,6 @@ def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
     wv = s.wrap_shift()
     ev = G.edge_vectors(s.X, s.E, wv)
     t.X[nv:nv + k] = s.X[s.E[R, 0]] + 0.5 * ev[R]
-    if wv is not None and choosers is not None and k:
-        ch = np.asarray(choosers, np.int64)
-        back = (sgn[ch] * (idx[ch] == R[:, None])).sum(axis=1) < 0
-        t.X[nv:nv + k][back] -= wv[R[back]]
     # -- edge halves
     t.E[R, 1] = mid[R]
     t.E[half[R], 0] = mid[R]
