@@ -508,9 +508,8 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
     The multipliers are those stored by the last ``g`` or ``hessian``.
     """
     s = it.surface
-    if s.X.shape[1] > 3:
-        from .hessian_nd import hessian_system_nd     # SPACE_DIMENSION 4..9
-        return hessian_system_nd(it, normal)
+    if s.X.shape[1] > 3:     # SPACE_DIMENSION 4..9: hessian_nd.system
+        raise dimension_error(s.sdim, "this Hessian")
     mobile = it._mobile()
     cons = _Constraints(s)
     t = s.evaluate()

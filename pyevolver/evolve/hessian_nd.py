@@ -25,7 +25,7 @@ from ..constraints.levelset import tangent_projectors, _names
 from ..errors import UnsupportedError
 from ..geometry import kernels as G
 from . import gradient as GR
-from .hessian import Basis, HessianSystem, distance2_coloring
+from .hessian import Basis, HessianSystem, distance2_coloring, hessian_system
 from .iterate import _Constraints
 
 
@@ -181,3 +181,11 @@ def hessian_system_nd(it, normal: bool = True) -> HessianSystem:
     K = sp.csc_matrix(K)
     rhs = -(T.T @ gE.ravel())
     return HessianSystem(K, None, rhs, None, T, basis, np.zeros(0), cons, mobile, s.X[:, :3])
+
+
+def system(it, normal: bool = True) -> HessianSystem:
+    """The Hessian system of ``hessian`` in any dimension: this module's in
+    ``d > 3``, :func:`.hessian.hessian_system` in 3."""
+    if it.surface.X.shape[1] > 3:
+        return hessian_system_nd(it, normal)
+    return hessian_system(it, normal)

@@ -39,6 +39,7 @@ import scipy.sparse as sp
 from ..constraints import restore_state, state
 from ..errors import UnsupportedError, dimension_error
 from . import gradient as GR
+from . import hessian_nd
 from .eigen import ShiftedFactor
 from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
                       solve_bordered, tangent_basis)
@@ -267,7 +268,7 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         ``totals`` the evaluation after the step.
     """
     s = it.surface
-    hs = hessian_system(it, normal)
+    hs = hessian_nd.system(it, normal)
     n = hs.K.shape[0]
     piv: list = []
     sol = solve_bordered(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, pivots=piv)
