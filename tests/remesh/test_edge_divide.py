@@ -61,6 +61,7 @@ LISTS = "print total_area\nlist vertices\nlist edges\nlist facets\n"
 
 @pytest.mark.parametrize("path, cmd", [
     (example("twointor.fe"), "K 0.2"),
+    (example("sphere.fe"), "K 0.8"),          # off the torus: the choosers' order
     (os.path.join(DATA, "torus_sheet.fe"), "K 0.4"),
     (os.path.join(DATA, "torus_sheet.fe"), "K 0.4\ng 3"),   # g: the lists within round-off
 ])
