@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import CommandError
+from ..errors import CommandError, dimension_error
 from ..evolve import eigen as EG
 from ..evolve.hessian import hessian_system
 from ..evolve.iterate import _Constraints
@@ -38,6 +38,8 @@ def _system(session: Any, what: str):
         raise CommandError("Pressures invalid. Do regular iteration before Hessian "
                            "to set pressures.")
     note_beyond(session)
+    if s.X.shape[1] > 3:
+        raise dimension_error(s.sdim, "the Hessian's eigenvalues", "need")
     hs = hessian_system(it, normal=it.settings.hessian_normal)
     if s.string:      # REF's string Hessian matrix holds twice the vertex blocks
         hs.K = 2.0 * hs.K

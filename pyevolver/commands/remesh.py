@@ -67,11 +67,12 @@ def _replaced(session: SessionLike, result, count=None, note=None, echo=True):
     return n
 
 
-def _divide(session: SessionLike, edges, head_frame=()):
-    """Bisect ``edges`` (the string model splits them); returns how many."""
+def _divide(session: SessionLike, edges, choosers=None):
+    """Bisect ``edges`` (the string model splits them); returns how many.
+    ``choosers`` (``K``): per edge the facet that chose it (edge_divide)."""
     if session.surface.string:
         return session._string_split(np.asarray(edges, np.int64))
-    return _replaced(session, ED.edge_divide(session.surface, edges, head_frame))
+    return _replaced(session, ED.edge_divide(session.surface, edges, choosers))
 
 
 def refine_edges(session: SessionLike, edges, echo=True):
@@ -142,8 +143,8 @@ def flush_counts(session: SessionLike):
     session.pending = {"Fixed": 0, "Unfixed": 0}
 
 
-def _bisect(session: SessionLike, edges, echo, head_frame=()):
-    n = _divide(session, edges, head_frame)
+def _bisect(session: SessionLike, edges, echo, choosers=None):
+    n = _divide(session, edges, choosers)
     session.counts["refine"] = n                    # REF: each l or K sets refine_count
     if echo:
         session.note(f"New edges: {n}\n")
@@ -168,8 +169,8 @@ def skinny(session: SessionLike, angle, echo=True):
         if echo:
             session.note(f"New edges: {len(R)}\n")
         return len(R)
-    against: list = []          # edges the choosing facet runs against (torus: REF's midpoint)
-    return _bisect(session, ED.skinny_edges(s, angle, against), echo, against)
+    edges, by = ED.skinny_edges(session.surface, angle, choosers=True)
+    return _bisect(session, edges, echo, choosers=by)
 
 
 def notch(session: SessionLike, angle, echo=True):

@@ -44,7 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..constraints import restore_state, state
-from ..errors import UnsupportedError
+from ..errors import UnsupportedError, dimension_error
 from .hessian import HessianSystem, _cholmod, hessian_system
 from .iterate import _Constraints
 
@@ -473,6 +473,8 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
     restored after the move as in ``g``.
     ``mix``: the eigenvector of the ``linear_metric`` with that mix.
     """
+    if it.surface.X.shape[1] > 3:
+        raise dimension_error(it.surface.sdim, "the Hessian's eigenvalues", "need")
     hs = hessian_system(it, normal)
     if mix is not None:
         metric(hs, it.surface, mix)

@@ -514,8 +514,8 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
     The multipliers are those stored by the last ``g`` or ``hessian``.
     """
     s = it.surface
-    if s.X.shape[1] > 3:
-        raise dimension_error(s.sdim, "the Hessian")
+    if s.X.shape[1] > 3:     # SPACE_DIMENSION 4..9: hessian_nd.system
+        raise dimension_error(s.sdim, "this Hessian")
     model = MODEL_HESSIAN.get("string") if s.string else None
     if s.string:
         if model is None:
@@ -578,5 +578,5 @@ def newton_direction(it, normal: bool = True):
     sol = solve_bordered(K, hs.B, hs.rhs, hs.d, points=hs.points)
     dy = sol[:K.shape[0]]
     lam_new = -sol[K.shape[0]:] if len(hs.cons) else hs.lam
-    dx = (hs.T @ dy).reshape(-1, 3)
+    dx = (hs.T @ dy).reshape(it.surface.X.shape)
     return dx, lam_new, hs.cons, hs.mobile

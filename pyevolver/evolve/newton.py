@@ -37,8 +37,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..constraints import restore_state, state
-from ..errors import UnsupportedError
+from ..errors import UnsupportedError, dimension_error
 from . import gradient as GR
+from . import hessian_nd
 from .eigen import ShiftedFactor
 from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
                       solve_bordered, tangent_basis)
@@ -122,6 +123,8 @@ def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
     -------
     NewtonResult
     """
+    if it.surface.X.shape[1] > 3:
+        raise dimension_error(it.surface.sdim, "damped Newton steps", "need")
     res = NewtonResult(energy=it.surface.evaluate().energy)
     delta = delta0 if delta0 is not None else it.newton_delta
     for k in range(1, int(n) + 1):
@@ -179,7 +182,7 @@ def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
             if pred <= rtol * max(abs(f0), 1e-300):
                 res.message, res.success = "converged (predicted decrease below rtol)", True
                 break
-            dx = (T @ dy).reshape(-1, 3)
+            dx = (T @ dy).reshape(s.X.shape)
             t1 = it._move(X0, dx, 1.0, cons, None, None, mobile, targets, None, trial=True)
             res.nfev += 1
             f1 = t1.energy
@@ -266,13 +269,13 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         ``totals`` the evaluation after the step.
     """
     s = it.surface
-    hs = hessian_system(it, normal)
+    hs = hessian_nd.system(it, normal)
     n = hs.K.shape[0]
     piv: list = []
     sol = solve_bordered(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, pivots=piv)
     cons, mobile = hs.cons, hs.mobile
     lam = -sol[n:] if len(cons) else hs.lam
-    dx = (hs.T @ sol[:n]).reshape(-1, 3)
+    dx = (hs.T @ sol[:n]).reshape(s.X.shape)
     report: list[str] = []
     if n:
         index = _index(hs, piv, eps)

@@ -95,7 +95,7 @@ def refine(s):
     return split_edges(s, ~s.eattr["no_refine"])
 
 
-def split_edges(s, ref, one_by_one=False):
+def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
     """Bisect the edges where ``ref`` (a (ne,) bool mask) is true and split
     every facet across its bisected sides (4, 3 or 2 triangles).
 
@@ -114,10 +114,16 @@ def split_edges(s, ref, one_by_one=False):
     with it, the old facet keeps the head half's triangle and starts with
     the cut.  (The order of the corners decides ``ff.vertex[1]``, hence
     e.g. ``form_factors`` set from it in mylarcube.fe.)
+
+    ``order`` (the chosen edges' indices) numbers the new elements in that
+    order instead of by edge id (``K``: the order of the facets that chose
+    them).  ``choosers`` (``K``, with ``order``: per edge the facet that
+    chose it) is only passed on: :func:`pyevolver.remesh.edge_divide.edge_divide`
+    moves the midpoints afterwards.
     """
     nv, ne, nf = s.nv, s.ne, s.nf
     ref = np.asarray(ref, bool)
-    R = np.nonzero(ref)[0]
+    R = np.nonzero(ref)[0] if order is None else np.asarray(order, np.int64)
     k = len(R)
     mid = np.full(ne, -1, np.int64)
     mid[R] = nv + np.arange(k)

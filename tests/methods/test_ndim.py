@@ -118,8 +118,8 @@ def test_bodies_are_refused_at_the_space_dimension_line(tmp_path):
 
 
 @pytest.mark.parametrize("cmd, words", [
-    ("hessian", "the Hessian needs 3 dimensions"),
-    ("saddle", "the Hessian needs 3 dimensions"),
+    ("saddle", "the Hessian's eigenvalues need 3 dimensions"),
+    ("eigenprobe 0", "the Hessian's eigenvalues need 3 dimensions"),
     ("M 2", "the quadratic model needs 3 dimensions"),
     ('export("{tmp}/a.vtu")', "mesh exports need 3 dimensions"),
     ("print vertex[1].vertex_normal[1]", "facet normals need 3 dimensions"),

@@ -66,3 +66,18 @@ def test_split_facets_at_centre_puts_vertex_at_centroid():
     assert t.evaluate().total_area == pytest.approx(6.0, rel=ROUNDOFF)
     # no facets: the same surface back
     assert split_facets_at_centre(s, []) is s
+
+
+def test_notching_in_five_dimensions(tmp_path):
+    """SPACE_DIMENSION 5: nothing to notch without two-facet edges
+    (relaxed.fe, as REF: 0); otherwise refused by name, the surface kept."""
+    from conftest import example
+    from pyevolver.errors import PyEvolverError
+    here = os.path.dirname(__file__)
+    sess = pyevolver.load(example("relaxed.fe"))
+    assert notch(sess.surface, 0.5)[1] == 0
+    sess = pyevolver.load(os.path.join(here, "..", "data", "elastic5d.fe"))
+    X0 = sess.surface.X.copy()
+    with pytest.raises(PyEvolverError, match="notching in SPACE_DIMENSION 5"):
+        sess.run("n 0.4")
+    assert np.array_equal(sess.surface.X, X0) and sess.surface.nf == 3
