@@ -1,0 +1,89 @@
+"""What ``g`` does after each move when ``autopop`` / ``autochop`` are on
+(manual: the toggles ``autopop``, ``autochop``; measured on evolver-nox-d).
+
+After the move (and the restoring), in this order:
+
+- autopop (string model): the edges whose length is now below the critical
+  length ``sqrt(2 * scale)`` are deleted (their ends merged, edge order),
+  then every vertex with more than three edges is popped as by ``o``
+  (:mod:`pyevolver.remesh.string_pop`); REF prints
+  ``Autopopped N edges, M vertices.`` when N > 0.  The threshold was
+  measured on a symmetric junction pair: the length after the move, not a
+  further prediction.
+- autochop: the edges whose predicted length after one more move with the
+  same velocity, ``|e| + scale * (e/|e|) . (v_head - v_tail)``, exceeds
+  ``autochop_length`` are bisected ("Autochopped N edges.").  The predicted
+  form was measured on a triple junction whose two edges grow (the
+  threshold is that first-order length to 8 digits, neither the current
+  length nor the exact next one).
+
+The energies of the progress line are those after both.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import UnsupportedError
+from ..remesh.edge_divide import edge_divide
+from ..remesh.string import split_edges
+from ..remesh import string_pop as SP
+
+
+def check_supported(session) -> None:
+    """Refuse by name the autopop cases not implemented (before any step)."""
+    if not session.toggles.get("autopop"):
+        return
+    s = session.surface
+    if s is not None and not s.string:
+        raise UnsupportedError("g with autopop on in the soapfilm model",
+                               "only the string model's edge deletion and vertex popping "
+                               "are implemented")
+    if session.toggles.get("autopop_quartic") or session.toggles.get("immediate_autopop"):
+        raise UnsupportedError("autopop_quartic / immediate_autopop", "not implemented")
+
+
+def _velocity(r, s):
+    m = getattr(r, "motion", None)
+    if m is None or len(m) < 4 or m[3] is None or len(m[3]) != s.nv:
+        return None
+    return m[3]
+
+
+def after_move(session, r) -> None:
+    """Autopop, then autochop, on the surface after the step ``r``."""
+    scale = float(r.scale)
+    vel = _velocity(r, session.surface)
+    if session.toggles.get("autopop") and session.surface.string and scale > 0:
+        s = session.surface
+        crit = math.sqrt(2.0 * scale)
+        if np.any(SP.after_move_lengths(s) < crit):
+            t, ned, vmap = SP.delete_short_edges(s, crit)
+            if ned:
+                t, npop = SP.pop_vertices(t)
+                session._replace_surface(t)
+                r.warnings.append(f"Autopopped {ned} edges, {npop} vertices.")
+                if vel is not None:
+                    # the survivors keep their velocity; vertices new from pops
+                    # take none (REF's rule for them was not measured)
+                    nv = np.zeros((t.nv, vel.shape[1]))
+                    ok = vmap >= 0
+                    nv[vmap[ok]] = vel[ok]
+                    vel = nv
+    L = session.settings.get("autochop_length", 0.0)
+    if session.toggles.get("autochop") and L > 0:
+        s = session.surface
+        if vel is not None and len(vel) == s.nv:
+            pred = SP.predicted_lengths(s, vel, scale)
+        else:
+            pred = SP.after_move_lengths(s)
+        chop = np.nonzero(pred > L)[0]
+        if len(chop):
+            if s.string:
+                session._replace_surface(split_edges(s, chop))
+                nch = len(chop)
+            else:
+                new, nch = edge_divide(s, chop)
+                session._replace_surface(new)
+            r.warnings.append(f"Autochopped {nch} edges.")
