@@ -229,9 +229,9 @@ def _same_cons(s, v, e):
     return True
 
 
-def delete_short_edges(s, crit):
-    """Delete the edges shorter than ``crit`` (edge order, each seeing the
-    previous deletions): ``(new surface, number deleted, old->new vertex
+def delete_short_edges(s, crit, candidates=None):
+    """Delete the edges shorter than ``crit`` (of ``candidates`` if given;
+    edge order, each seeing the previous deletions): ``(new surface, number deleted, old->new vertex
     map)``."""
     _check(s)
     X = s.X.copy()
@@ -250,7 +250,7 @@ def delete_short_edges(s, crit):
             d = d.copy()
             d[:shift.shape[1]] += wrap[e] @ shift
         return d
-    for e in range(s.ne):
+    for e in (range(s.ne) if candidates is None else np.sort(candidates).tolist()):
         if not ealive[e] or efixed[e]:
             continue
         a, b = int(E[e, 0]), int(E[e, 1])

@@ -9,7 +9,8 @@ After the move (and the restoring), in this order:
   (:mod:`pyevolver.remesh.string_pop`); REF prints
   ``Autopopped N edges, M vertices.`` when N > 0.  The threshold was
   measured on a symmetric junction pair: the length after the move, not a
-  further prediction.
+  further prediction; only edges the motion shortens (first order in the
+  velocity) are deleted: 100grain.fe's tiny growing edges stay.
 - autochop: the edges whose predicted length after one more move with the
   same velocity, ``|e| + scale * (e/|e|) . (v_head - v_tail)``, exceeds
   ``autochop_length`` are bisected ("Autochopped N edges.").  The predicted
@@ -58,8 +59,14 @@ def after_move(session, r) -> None:
     if session.toggles.get("autopop") and session.surface.string and scale > 0:
         s = session.surface
         crit = math.sqrt(2.0 * scale)
-        if np.any(SP.after_move_lengths(s) < crit):
-            t, ned, vmap = SP.delete_short_edges(s, crit)
+        now = SP.after_move_lengths(s)
+        short = now < crit
+        if vel is not None and short.any():
+            # only the edges the motion shortens (100grain.fe: its growing
+            # tiny edges stay)
+            short &= SP.predicted_lengths(s, vel, scale) < now
+        if short.any():
+            t, ned, vmap = SP.delete_short_edges(s, crit, np.nonzero(short)[0])
             if ned:
                 t, npop = SP.pop_vertices(t)
                 session._replace_surface(t)
