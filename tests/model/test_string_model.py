@@ -191,8 +191,9 @@ def test_string_torus(evolver, tmp_path):
 
 def test_unsupported_string_files(evolver, tmp_path):
     """knotty.fe's knot energies are refused by name when loaded; 100grain.fe
-    loads (its read section runs) but its g needs autopop, refused by name
-    (its area normalization is tested in tests/evolve/test_mobility.py)."""
+    loads (its read section runs) and its g runs with autopop and autochop
+    (tests/session/test_popping.py; its area normalization is tested in
+    tests/evolve/test_mobility.py)."""
     from pyevolver.errors import PyEvolverError
     with pytest.raises(PyEvolverError, match="sqcurve_string"):
         _session(example("knotty.fe"))
@@ -201,5 +202,4 @@ def test_unsupported_string_files(evolver, tmp_path):
                         cwd=str(tmp_path))
     ref = [l for l in ref if l.strip()]
     assert abs(s.totals.total_length - float(ref[0])) < 1e-12
-    with pytest.raises(PyEvolverError, match="autopop"):
-        s.run("g 1")
+    s.run("g 1")
