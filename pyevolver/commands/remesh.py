@@ -36,6 +36,10 @@ def refine(session: SessionLike, echo=True):
         session.settings["edge_divide_length"] /= 2
     if "areaweed_area" in session.settings:
         session.settings["areaweed_area"] /= 4
+    if session.settings.get("autochop_length"):
+        # REF halves the autochop length at each r (autochop on or off;
+        # not at `refine edges`): 100grain.fe 0.015 -> 0.0075
+        session.settings["autochop_length"] /= 2
     if echo:
         session.note(counts_line(session))
 
