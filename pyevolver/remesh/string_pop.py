@@ -163,9 +163,10 @@ def _check(s):
                                "only the linear model is implemented")
 
 
-def pop_vertices(s, verts=None):
+def pop_vertices(s, verts=None, parents=None):
     """Pop the vertices ``verts`` (indices; all by default) that have more
-    than three edges: ``(new surface, number of pops)``."""
+    than three edges: ``(new surface, number of pops)``; ``parents``, a
+    list, gets ``(new vertex, old vertex)`` for each pop."""
     _check(s)
     cand = np.arange(s.nv) if verts is None else np.asarray(verts, np.int64)
     n = 0
@@ -174,6 +175,8 @@ def pop_vertices(s, verts=None):
             deg = np.count_nonzero(s.E == v)
             if deg <= 3 or not _movable(s)[v]:
                 break
+            if parents is not None:
+                parents.append((s.nv, v))
             s = _pop_one(s, v)
             n += 1
     return s, n
@@ -242,6 +245,19 @@ def delete_short_edges(s, crit, candidates=None):
     fixed = s.vattr["fixed"].astype(bool)
     efixed = s.eattr["fixed"].astype(bool)
     shift = None if wrap is None else s.periods
+    efacets = None
+    if len(s.sf_ptr) > 1:
+        owner = np.repeat(np.arange(len(s.sf_ptr) - 1), np.diff(s.sf_ptr))
+        enc = s.sf_enc
+        efacets = [set() for _ in range(s.ne)]
+        for ed, f in zip(np.where(enc >= 0, enc, ~enc).tolist(), owner.tolist()):
+            efacets[ed].add(f)
+
+    def vfacets(v):
+        out = set()
+        for x in np.nonzero((E == v).any(axis=1) & ealive)[0].tolist():
+            out |= efacets[x]
+        return out
     n = 0
 
     def vec(e):
@@ -257,10 +273,18 @@ def delete_short_edges(s, crit, candidates=None):
         if a == b:
             continue
         d = vec(e)
-        if np.linalg.norm(d) >= crit:
-            continue
+        if candidates is None and np.linalg.norm(d) >= crit:
+            continue                    # (candidates: chosen before any deletion)
         can_b = not fixed[b] and _same_cons(s, b, e)
         can_a = not fixed[a] and _same_cons(s, a, e)
+        if efacets is not None:
+            # a vertex on a facet the edge is not on stays (100grain.fe after
+            # r: a junction keeps its place and absorbs the midpoint vertex);
+            # when neither end may go by that rule, the head goes
+            fa, fb = vfacets(a), vfacets(b)
+            ok_a, ok_b = fa <= efacets[e], fb <= efacets[e]
+            if can_a and can_b and (ok_a or ok_b):
+                can_a, can_b = ok_a, ok_b
         if not (can_a or can_b):
             continue
         if s.vcon and any(on[a] or on[b] for on in s.vcon.values()):

@@ -68,15 +68,24 @@ def after_move(session, r) -> None:
         if short.any():
             t, ned, vmap = SP.delete_short_edges(s, crit, np.nonzero(short)[0])
             if ned:
-                t, npop = SP.pop_vertices(t)
+                parents: list = []
+                t, npop = SP.pop_vertices(t, parents=parents)
                 session._replace_surface(t)
                 r.warnings.append(f"Autopopped {ned} edges, {npop} vertices.")
+                if npop and r.printed:
+                    # REF's line shows the energy after the deletions only when
+                    # vertices were popped too (100grain.fe r; g 10: steps 7 and 6)
+                    r.energy, r.area = session.totals.energy, session.totals.total_area
+                    if session.history:
+                        session.history[-1] = (session.history[-1][0], r.energy, r.area)
                 if vel is not None:
-                    # the survivors keep their velocity; vertices new from pops
-                    # take none (REF's rule for them was not measured)
+                    # the survivors keep their velocity, a vertex new from a
+                    # pop takes its old vertex's (100grain.fe r; g 10 as REF)
                     nv = np.zeros((t.nv, vel.shape[1]))
                     ok = vmap >= 0
                     nv[vmap[ok]] = vel[ok]
+                    for w, v in parents:
+                        nv[w] = nv[v]
                     vel = nv
     L = session.settings.get("autochop_length", 0.0)
     if session.toggles.get("autochop") and L > 0:
