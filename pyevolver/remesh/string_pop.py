@@ -232,7 +232,7 @@ def _same_cons(s, v, e):
     return True
 
 
-def delete_short_edges(s, crit, candidates=None):
+def delete_short_edges(s, crit, candidates=None, merges=None):
     """Delete the edges shorter than ``crit`` (of ``candidates`` if given;
     edge order, each seeing the previous deletions): ``(new surface, number deleted, old->new vertex
     map)``."""
@@ -291,6 +291,8 @@ def delete_short_edges(s, crit, candidates=None):
             raise UnsupportedError("autopop of an edge on a constraint",
                                    "REF's rule there was not measured")
         keep_v, gone, dv = (a, b, d) if can_b else (b, a, -d)
+        if merges is not None:
+            merges.append((keep_v, gone, bool(can_a and can_b)))
         if can_a and can_b:
             X[keep_v] = X[keep_v] + 0.5 * dv
         we = None if wrap is None else (wrap[e] if keep_v == a else -wrap[e])

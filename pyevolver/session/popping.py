@@ -52,10 +52,27 @@ def _velocity(r, s):
     return m[3]
 
 
+def _chop_candidates(session, vel, scale):
+    """Ids of the edges autochop will bisect (None when autochop is off)."""
+    L = session.settings.get("autochop_length", 0.0)
+    if not (session.toggles.get("autochop") and L > 0):
+        return None
+    s = session.surface
+    if vel is not None and len(vel) == s.nv:
+        pred = SP.predicted_lengths(s, vel, scale)
+    else:
+        pred = SP.after_move_lengths(s)
+    return s.ids("edge")[pred > L]
+
+
 def after_move(session, r) -> None:
-    """Autopop, then autochop, on the surface after the step ``r``."""
+    """Autopop, then autochop, on the surface after the step ``r``.  The
+    edges to chop are chosen before the deletions (100grain.fe ``r; g 10``:
+    an edge made long by a merge waits for the next step); those deleted
+    are passed over."""
     scale = float(r.scale)
     vel = _velocity(r, session.surface)
+    chop_ids = _chop_candidates(session, vel, scale)
     if session.toggles.get("autopop") and session.surface.string and scale > 0:
         s = session.surface
         crit = math.sqrt(2.0 * scale)
@@ -66,10 +83,9 @@ def after_move(session, r) -> None:
             # tiny edges stay)
             short &= SP.predicted_lengths(s, vel, scale) < now
         if short.any():
-            t, ned, vmap = SP.delete_short_edges(s, crit, np.nonzero(short)[0])
+            t, ned, _vmap = SP.delete_short_edges(s, crit, np.nonzero(short)[0])
             if ned:
-                parents: list = []
-                t, npop = SP.pop_vertices(t, parents=parents)
+                t, npop = SP.pop_vertices(t)
                 session._replace_surface(t)
                 r.warnings.append(f"Autopopped {ned} edges, {npop} vertices.")
                 if npop and r.printed:
@@ -78,23 +94,9 @@ def after_move(session, r) -> None:
                     r.energy, r.area = session.totals.energy, session.totals.total_area
                     if session.history:
                         session.history[-1] = (session.history[-1][0], r.energy, r.area)
-                if vel is not None:
-                    # the survivors keep their velocity, a vertex new from a
-                    # pop takes its old vertex's (100grain.fe r; g 10 as REF)
-                    nv = np.zeros((t.nv, vel.shape[1]))
-                    ok = vmap >= 0
-                    nv[vmap[ok]] = vel[ok]
-                    for w, v in parents:
-                        nv[w] = nv[v]
-                    vel = nv
-    L = session.settings.get("autochop_length", 0.0)
-    if session.toggles.get("autochop") and L > 0:
+    if chop_ids is not None and len(chop_ids):
         s = session.surface
-        if vel is not None and len(vel) == s.nv:
-            pred = SP.predicted_lengths(s, vel, scale)
-        else:
-            pred = SP.after_move_lengths(s)
-        chop = np.nonzero(pred > L)[0]
+        chop = np.nonzero(np.isin(s.ids("edge"), chop_ids))[0]
         if len(chop):
             if s.string:
                 session._replace_surface(split_edges(s, chop))
