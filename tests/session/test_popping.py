@@ -66,3 +66,45 @@ def test_100grain_g10_as_ref(evolver):
     res = sess.g(10)
     ref = [float(x) for x in re.findall(r"length:\s*(\S+)", out)]
     assert [r.energy for r in res] == pytest.approx(ref, rel=1e-10)
+
+
+def _lines(text):
+    return [(m.group(0)) for m in re.finditer(r"Autochopped \d+ edges|Autopopped \d+ edges, \d+ vertices",
+                                               text)], \
+        [float(x) for x in re.findall(r"energy:\s*(\S+)", text)]
+
+
+def test_autochop_soapfilm_mound_as_ref(evolver):
+    path = "/usr/share/doc/evolver/examples/mound.fe"
+    cmds = ["autochop on", "autochop_length := 0.6", "g 4"]
+    ref_msgs, ref_e = _lines(_ref(evolver, path, cmds))
+    sess = pyevolver.load(path)
+    for c in cmds[:2]:
+        sess.run(c)
+    res = sess.g(4)
+    ours = [w.rstrip(".") for r in res for w in r.warnings if w.startswith("Auto")]
+    assert ours == ref_msgs
+    assert [r.energy for r in res] == pytest.approx(ref_e, rel=1e-10)
+
+
+def test_r_halves_autochop_length(evolver):
+    path = "/usr/share/doc/evolver/examples/cube.fe"
+    out = _ref(evolver, path, ["autochop_length := 0.5", "r", "print autochop_length"])
+    ref = float(re.findall(r"^\s*([0-9.]+)\s*$", out, re.M)[-1])
+    sess = pyevolver.load(path)
+    sess.run("autochop_length := 0.5")
+    sess.run("r")
+    assert sess.settings["autochop_length"] == ref == 0.25
+
+
+def test_100grain_r_g4_as_ref(evolver):
+    # after r: autopop deletes edges (junctions stay, midpoint vertices go),
+    # autochop's choice made before the deletions
+    path = "/usr/share/doc/evolver/examples/100grain.fe"
+    ref_msgs, ref_e = _lines(_ref(evolver, path, ["r", "g 4"]))
+    sess = pyevolver.load(path)
+    sess.run("r")
+    res = sess.g(4)
+    ours = [w.rstrip(".") for r in res for w in r.warnings if w.startswith("Auto")]
+    assert ours == ref_msgs
+    assert [r.energy for r in res] == pytest.approx(ref_e, rel=1e-10)
