@@ -412,6 +412,7 @@ class Session(SessionAPI):
         ``rad := 1.2; recalc``), as evolver-nox-d does after a parameter
         changed."""
         s = self.surface
+        self._stale_totals = None              # (autopop: pyevolver.session.popping)
         if s is None:
             return
         if reposition:
@@ -689,7 +690,9 @@ class Session(SessionAPI):
     def refresh(self) -> None:
         """Recompute the energies after a command (unless ``autorecalc`` is off)."""
         if self.toggles.get("autorecalc", 1):
+            stale = self.__dict__.get("_stale_totals")
             self.recalc(keep_cg=True)
+            popping.keep_stale(self, stale)
 
     # -- the public API: values ----------------------------------------------------
     @property
