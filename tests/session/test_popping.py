@@ -7,6 +7,7 @@ import subprocess
 import pytest
 
 import pyevolver
+from pyevolver.session import popping
 
 JUNCTION = """STRING
 SPACE_DIMENSION 2
@@ -54,6 +55,8 @@ def test_autopop_refused_in_soapfilm(tmp_path):
     if sess is None:
         pytest.skip("examples not installed")
     sess.toggles["autopop"] = 1
+    with pytest.raises(pyevolver.errors.UnsupportedError, match="soapfilm"):
+        popping.check_supported(sess)
     with pytest.raises(pyevolver.errors.UnsupportedError, match="soapfilm"):
         sess.g(1)
 
