@@ -23,7 +23,6 @@ LETTER_LATER = {
 WORD_LATER = {
     "hessian_menu", "move",
     "vertex_average", "raw_vertex_average", "rawest_vertex_average",
-    "pop",
     "t1_edgeswap", "dissolve", "optimize", "optimise",
     "jiggle", "extrapolate", "counts", "check", "show_vol_later", "detorus", "runge_kutta",
     "conj_grad_later", "fix", "unfix", "burchard", "zoom",

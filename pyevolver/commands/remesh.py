@@ -332,6 +332,22 @@ def _o_vertices(interp, raw, arg):
     s.write(f"Vertices popped: {n}\n")
 
 
+@register("pop", usage="pop vertices [where ...] (string model)", statement="pop",
+          help="pop the given vertices (string model)", family=FAMILY)
+def _x_pop(interp, node):
+    s = interp.session
+    if not s.surface.string:
+        raise UnsupportedError("pop in the soapfilm model", "implemented in the string model only")
+    els = elements.generate(s, node[1], interp.env)
+    if any(el.kind != "vertex" for el in els):
+        raise UnsupportedError("pop of edges in the string model", "only vertices pop there")
+    new, n = SPOP.pop_vertices(s.surface, [el.i for el in els])
+    s._replace_surface(new)
+    s.counts["vertex_pop"] = n
+    if n:                                       # REF: silent when nothing popped
+        s.write(f"Vertices popped: {n}\n")
+
+
 @register("u", "equiangulate", usage="u", help="one equiangulation sweep", family=FAMILY)
 def _u(interp, raw, arg):
     linear_only(interp.session, "u (equiangulation)")

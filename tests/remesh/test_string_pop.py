@@ -132,3 +132,26 @@ def test_predicted_lengths_first_order(tmp_path):
     p = SP.predicted_lengths(s, vel, 0.01)
     assert p[0] == pytest.approx(0.05)
     assert np.allclose(p[1:3], SP.after_move_lengths(s)[1:3])   # edges away from it
+
+
+def test_pop_command_on_given_vertices(tmp_path, evolver):
+    path = _file(tmp_path, FIVE)
+    ref, out = _ref_lists(evolver, path, ["pop vertex[2]", "pop vertex[1]"])
+    assert "Vertices popped: 2" in out and out.count("Vertices popped") == 1
+    sess = pyevolver.load(path)
+    sess.run("pop vertex[2]")                   # fixed, two edges: nothing (REF silent)
+    sess.run("pop vertices where id == 1")
+    ours = _ours(sess)
+    assert sorted(ours) == sorted(ref)
+    for k in ref:
+        assert np.allclose(ours[k], ref[k], atol=1e-12)
+    assert sess.value("vertex_pop_count") == 2
+
+
+def test_pop_refused_in_soapfilm():
+    path = "/usr/share/doc/evolver/examples/cube.fe"
+    if not os.path.exists(path):
+        pytest.skip("examples not installed")
+    sess = pyevolver.load(path)
+    with pytest.raises(pyevolver.errors.CommandError, match="not supported.*pop"):
+        sess.run("pop vertex[1]")
