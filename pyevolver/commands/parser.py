@@ -295,6 +295,9 @@ class _CmdTransformer(ExprTransformer):
     def refine(self, _r, gen):
         return ("refine", gen)
 
+    def pop_gen(self, _p, gen):
+        return ("pop", gen)
+
     def edgeswap(self, _r, gen):
         return ("edgeswap", gen)
 

@@ -191,8 +191,9 @@ def toggle(interp, name, arg):
     if key == "show_all_edges" and s.surface is not None and s.surface.string:
         default = 0                         # REF: off in the string model
     old = s.toggles.get(key, default)
-    if name == "autopop" and new:
-        raise UnsupportedError("autopop", "vertex and edge popping (o, O) is not implemented")
+    if name == "autopop" and new and s.surface is not None and not s.surface.string:
+        raise UnsupportedError("autopop in the soapfilm model",
+                               "only the string model's popping is implemented")
     if key in TOGGLE_REFUSED and new:
         raise UnsupportedError(f"{name} on", TOGGLE_REFUSED[key])
     surf = s.surface

@@ -18,7 +18,7 @@ from typing import Any, Callable, TextIO
 
 import numpy as np
 
-from . import undo
+from . import popping, undo
 from .api import SessionAPI, progress_bar
 from ..commands import constraints, element_attrs, elements, files, remesh, variables
 from ..commands import interpreter as I
@@ -38,7 +38,6 @@ from ..expr import nodes as N
 from ..limits import MAX_EXPANDED_LINE
 from ..model.build import build_surface
 from ..remesh.quadratic import from_listed
-from ..remesh.edge_divide import edge_divide, long_edges
 from ..remesh.string import split_edges
 
 
@@ -63,7 +62,7 @@ def _deferred_sigint():
             signal.signal(signal.SIGINT, old)
 
 # motion options that change what g does; refused rather than ignored
-UNSUPPORTED_MOTION = ("autopop",)
+UNSUPPORTED_MOTION = ()
 
 
 class Session(SessionAPI):
@@ -413,6 +412,7 @@ class Session(SessionAPI):
         ``rad := 1.2; recalc``), as evolver-nox-d does after a parameter
         changed."""
         s = self.surface
+        self._stale_totals = None              # (autopop: pyevolver.session.popping)
         if s is None:
             return
         if reposition:
@@ -483,10 +483,7 @@ class Session(SessionAPI):
         ``progress``: a tqdm bar (True, False, or None for long runs at a
         terminal or in a notebook; never with ``echo``).
         """
-        for name in UNSUPPORTED_MOTION:
-            if self.toggles.get(name):
-                raise UnsupportedError(f"g with {name} on", "popping during g "
-                                       "is not implemented")
+        popping.check_supported(self)
         if self.toggles.get("_effective_area_motion"):
             # REF's effective_area command also changes the motion (the top-section
             # keyword EFFECTIVE_AREA changes only the squared curvature)
@@ -525,20 +522,7 @@ class Session(SessionAPI):
             if bar is not None:
                 bar.update(1)
                 bar.set_postfix(energy=f"{r.energy:.10g}", refresh=False)
-            L = self.settings.get("autochop_length", 0.0)
-            if self.toggles.get("autochop") and L > 0:
-                # autochop (spec §9.5): edges longer than autochop_length after
-                # the move are bisected ("Autochopped N edges." before the line).
-                # REF's choice of edges differs where it predicts lengths from
-                # the unrestored motion (mound.fe); equal on cube.fe
-                chop = long_edges(self.surface, L)
-                if len(chop):
-                    if self.surface.string:
-                        nch = self._string_split(chop)
-                    else:
-                        new, nch = edge_divide(self.surface, chop)
-                        self._replace_surface(new)
-                    r.warnings.append(f"Autochopped {nch} edges.")
+            popping.after_move(self, r)        # autopop, autochop
             if echo:
                 off = self.__dict__.get("suppressed_warnings") or ()
                 for w in r.warnings:
@@ -706,7 +690,9 @@ class Session(SessionAPI):
     def refresh(self) -> None:
         """Recompute the energies after a command (unless ``autorecalc`` is off)."""
         if self.toggles.get("autorecalc", 1):
+            stale = self.__dict__.get("_stale_totals")
             self.recalc(keep_cg=True)
+            popping.keep_stale(self, stale)
 
     # -- the public API: values ----------------------------------------------------
     @property

@@ -188,14 +188,14 @@ def test_string_torus(evolver, tmp_path):
 
 
 def test_unsupported_string_files(evolver, tmp_path):
-    """100grain.fe loads (its read section runs) but its g needs autopop,
-    refused by name (its area normalization is tested in
-    tests/evolve/test_mobility.py); knotty.fe runs (tests/methods/test_knots.py)."""
+    """100grain.fe loads (its read section runs) and its g runs with autopop
+    and autochop (tests/session/test_popping.py; its area normalization is
+    tested in tests/evolve/test_mobility.py); knotty.fe runs
+    (tests/methods/test_knots.py)."""
     from pyevolver.errors import PyEvolverError
     s = _session(example("100grain.fe"))
     ref = run_reference(evolver, example("100grain.fe"), 'printf "%.15g\\n", total_length',
                         cwd=str(tmp_path))
     ref = [l for l in ref if l.strip()]
     assert abs(s.totals.total_length - float(ref[0])) < 1e-12
-    with pytest.raises(PyEvolverError, match="autopop"):
-        s.run("g 1")
+    s.run("g 1")
