@@ -310,9 +310,6 @@ class _CmdTransformer(ExprTransformer):
     def delete(self, _r, gen):
         return ("delete", gen)
 
-    def pop(self, _r, gen):
-        return ("pop", gen)
-
     def break_(self, _b, n=None):
         return ("break", n)
 

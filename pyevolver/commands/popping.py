@@ -17,7 +17,7 @@ The string model's ``o`` is not handled here (:func:`string_o`).
 from __future__ import annotations
 
 from ..errors import CommandError, UnsupportedError
-from ..remesh import pop as POP, vpop as VP
+from ..remesh import pop as POP, string_pop as SPOP, vpop as VP
 from . import elements
 from .registry import register
 from .remesh import linear_only
@@ -26,9 +26,16 @@ from .values import SessionLike
 FAMILY = "mesh"
 
 
-def string_o(session: SessionLike):
-    """``o`` in the string model (not implemented in this module)."""
-    raise UnsupportedError("command o (vertex popping) in the string model")
+def string_o(session: SessionLike, items=None, echo_zero=True):
+    """``o`` / ``pop vertex ...`` in the string model: vertices with more
+    than three edges are split into triple junctions
+    (:func:`pyevolver.remesh.string_pop.pop_vertices`)."""
+    new, n = SPOP.pop_vertices(session.surface, items)
+    session._replace_surface(new)
+    session.counts["vertex_pop"] = n
+    if n or echo_zero:                          # REF: pop is silent when nothing popped
+        session.write(f"Vertices popped: {n}\n")
+    return n
 
 
 def _kraynik(session: SessionLike):
@@ -93,10 +100,13 @@ def _o(interp, raw, arg):
           help="pop the listed non-minimal vertices or edges", family=FAMILY)
 def _x_pop(interp, node):
     session = interp.session
-    if session.surface.string:
-        raise UnsupportedError("pop in the string model")
-    linear_only(session, "pop")
     els = elements.generate(session, node[1], interp.env)
+    if session.surface.string:
+        if any(el.kind != "vertex" for el in els):
+            raise UnsupportedError("pop of edges in the string model", "only vertices pop there")
+        string_o(session, [el.i for el in els], echo_zero=False)
+        return
+    linear_only(session, "pop")
     kinds = {el.kind for el in els}
     if kinds - {"vertex", "edge"}:
         raise CommandError("pop needs vertices or edges (for example: pop vertex[3])")

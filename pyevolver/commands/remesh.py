@@ -16,7 +16,7 @@ from ..errors import CommandError, UnsupportedError
 from ..remesh import string as SM
 from ..remesh import string_mesh as SMESH
 from ..remesh import delete_edges as DEL, edge_divide as ED, equiangulate as EQ
-from ..remesh import notch as NO, pop as POP, string_pop as SPOP, vertex_average as VA
+from ..remesh import notch as NO, pop as POP, vertex_average as VA
 from ..remesh.quadratic import refine_quadratic
 from ..remesh.refine import refine as _refine_all
 from ..remesh.simplex import refine as refine_simplex
@@ -341,35 +341,6 @@ def _v_average(interp, raw, arg):
 def _o(interp, raw, arg):
     linear_only(interp.session, "O (popping)")
     pop_edges(interp.session)
-
-
-@register("o", usage="o", help="pop vertices (string model: more than three edges)",
-          family=FAMILY)
-def _o_vertices(interp, raw, arg):
-    s = interp.session
-    if not s.surface.string:
-        raise UnsupportedError("command o (vertex popping) in the soapfilm model",
-                               "implemented in the string model only")
-    new, n = SPOP.pop_vertices(s.surface)
-    s._replace_surface(new)
-    s.counts["vertex_pop"] = n
-    s.write(f"Vertices popped: {n}\n")
-
-
-@register("pop", usage="pop vertices [where ...] (string model)", statement="pop",
-          help="pop the given vertices (string model)", family=FAMILY)
-def _x_pop(interp, node):
-    s = interp.session
-    if not s.surface.string:
-        raise UnsupportedError("pop in the soapfilm model", "implemented in the string model only")
-    els = elements.generate(s, node[1], interp.env)
-    if any(el.kind != "vertex" for el in els):
-        raise UnsupportedError("pop of edges in the string model", "only vertices pop there")
-    new, n = SPOP.pop_vertices(s.surface, [el.i for el in els])
-    s._replace_surface(new)
-    s.counts["vertex_pop"] = n
-    if n:                                       # REF: silent when nothing popped
-        s.write(f"Vertices popped: {n}\n")
 
 
 @register("u", "equiangulate", usage="u", help="one equiangulation sweep", family=FAMILY)

@@ -30,7 +30,6 @@ import heapq
 import numpy as np
 
 from ..constraints import project_to_constraints
-from ..errors import UnsupportedError
 from ..geometry.kernels import edge_index, gram_facet_areas
 from ..methods import metric as MT
 from .shrink import subset

@@ -93,19 +93,6 @@ def test_reference_dump_goes_on_alike(evolver, name, pre, tmp_path):
     assert _messages(ours) == _messages(ref)
 
 
-def _refusal(path, cmds="g 1"):
-    """The first error of loading ``path`` and running ``cmds``: (message
-    without its location, the full first line)."""
-    err = io.StringIO()
-    try:
-        s = Session.load(path, out=io.StringIO(), err=err)
-        s.run(cmds)
-    except PyEvolverError as exc:
-        first = str(exc).split("\n")[0]
-        return re.sub(r"^.*?:\d+(?::\d+)?: ", "", first), first
-    raise AssertionError(f"{path} was not refused; stderr: {err.getvalue()}")
-
-
 def test_reference_dump_of_100grain_goes_on_alike(evolver, tmp_path):
     """100grain.fe (autopop, autochop) dumped by REF after g 3 goes on as in
     REF (after r its autochop differs: docs/supported.md).  The g lines and
