@@ -189,7 +189,7 @@ def test_string_torus(evolver, tmp_path):
 
 def test_unsupported_string_files(evolver, tmp_path):
     """100grain.fe loads (its read section runs) and its g runs with autopop
-    and autochop (tests/session/test_popping.py; its area normalization is
+    and autochop (tests/session/test_autopop.py; its area normalization is
     tested in tests/evolve/test_mobility.py); knotty.fe runs
     (tests/methods/test_knots.py)."""
     from pyevolver.errors import PyEvolverError
