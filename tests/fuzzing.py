@@ -467,8 +467,12 @@ def check_surface(s):
     if nf:
         idx, _ = edge_index(s.FE)
         assert idx.min() >= 0 and idx.max() < ne
-    # (the string model's facets are edge chains, counted by n_facets)
-    n_facets = s.n_facets if getattr(s, "string", False) else nf
+    # (the string model's facets are edge chains and the simplex model's
+    # vertex lists, both counted by n_facets)
+    n_facets = s.n_facets if getattr(s, "string", False) or getattr(s, "simplex", 0) else nf
+    if getattr(s, "simplex", 0):
+        assert s.SF.shape == (n_facets, s.simplex + 1)
+        assert n_facets == 0 or (s.SF.min() >= 0 and s.SF.max() < nv)
     for attrs, n in ((s.vattr, nv), (s.eattr, ne), (s.fattr, n_facets)):
         for key, arr in attrs.items():
             assert len(arr) == n, (key, len(arr), n)

@@ -187,7 +187,13 @@ class Reader(TopSection, ElementSections):
             return expr
         if isinstance(expr, N.Num):
             return expr.value
-        for name in expr.names():
+        if not isinstance(expr, N.Node):       # a keyword where a number belongs
+            raise self.error(f"{what}: expected a number", line)
+        try:
+            names = expr.names()
+        except RecursionError:
+            raise self.error(f"{what}: expression nested too deeply", line) from None
+        for name in names:
             if name not in self.scene.parameters and name not in N.CONSTANTS and \
                     name not in self._named_ids():
                 col = None

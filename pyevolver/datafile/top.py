@@ -387,6 +387,9 @@ class TopSection:
             exprs = getattr(self, "_period_exprs", None)
             if exprs is not None:       # expressions: evaluated here, in order
                 line = self._src(sec, d[2])
+                if any(nesting_depth(e) > MAX_NESTING for e in exprs):
+                    raise self.error(f"expression nested more than {MAX_NESTING} levels deep",
+                                     line)
                 vals = [self._value(e, line, "PERIODS") for e in exprs]
                 if not all(math.isfinite(v) for v in vals):
                     raise self.error("PERIODS: the values must be finite", line)

@@ -251,6 +251,9 @@ class _Builder:
                 elif kw in ("bare", "original", "orientation"):
                     pass
                 elif kw == "wrap" and sc.symmetry_group is not None:
+                    if len(vals) != 1:
+                        raise self.error(f"edge {blk.ids[pos]}: wrap expects one group "
+                                         "element code", blk.lines[pos])
                     self._wrap_codes[pos] = int(vals[0])
                 elif kw == "wrap":
                     raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: WRAP "

@@ -356,6 +356,9 @@ def delete_short_edges(s, length: float):
         src.vattr["ring_head"] = head
     fkeep = np.array([len(ch) > 0 for ch in chains], bool)
     chains = [ch for ch in chains if ch]
+    if not ealive.any():
+        raise UnsupportedError("t deleting every edge of the string model",
+                               "no surface would be left")
     keep_e = int(np.nonzero(ealive)[0][0])
     t = subset(src, E, np.full((len(fkeep), 3), keep_e, np.int64), valive, ealive, fkeep)
     t.FE = np.zeros((0, 3), np.int64)

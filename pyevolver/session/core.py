@@ -193,6 +193,9 @@ class Session(SessionAPI):
             # the first evaluation failed (e.g. a method refused on this
             # surface): located at the quantity's declaration when known
             line = getattr(exc, "line", None)
+            metric = getattr(self.surface, "metric", None)
+            if line is None and metric is not None:     # e.g. a log of a negative in it
+                line = metric.line
             lines = scene.source_lines
             raise DatafileError(str(exc), filename, line, None,
                                 lines[line - 1] if line and lines and line <= len(lines)

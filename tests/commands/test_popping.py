@@ -77,10 +77,15 @@ def test_pop_vertex_on_four_facet_edges_is_refused():
     assert s.surface is before
 
 
-def test_o_in_the_string_model_is_not_handled_here():
-    s = Session.load(example("popstr.fe"), out=io.StringIO())
-    with pytest.raises(PyEvolverError, match="string model"):
-        s.run("o")
+def test_o_in_the_string_model_pops_the_four_edge_junction():
+    """popstr.fe's junction of four edges becomes two triple junctions
+    (pyevolver.remesh.string_pop; REF's positions in tests/remesh/test_string_pop.py)."""
+    out = io.StringIO()
+    s = Session.load(example("popstr.fe"), out=out)
+    nv, ne = s.surface.nv, s.surface.ne
+    s.run("o")
+    assert "Vertices popped: 1" in out.getvalue()
+    assert (s.surface.nv, s.surface.ne) == (nv + 1, ne + 1)
 
 
 def test_kraynik_toggle_default():

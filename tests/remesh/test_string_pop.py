@@ -148,10 +148,7 @@ def test_pop_command_on_given_vertices(tmp_path, evolver):
     assert sess.value("vertex_pop_count") == 2
 
 
-def test_pop_refused_in_soapfilm():
-    path = "/usr/share/doc/evolver/examples/cube.fe"
-    if not os.path.exists(path):
-        pytest.skip("examples not installed")
-    sess = pyevolver.load(path)
-    with pytest.raises(pyevolver.errors.CommandError, match="not supported.*pop"):
-        sess.run("pop vertex[1]")
+def test_pop_of_edges_refused_in_the_string_model():
+    sess = pyevolver.load("/usr/share/doc/evolver/examples/popstr.fe")
+    with pytest.raises(pyevolver.errors.CommandError, match="not supported.*pop of edges"):
+        sess.run("pop edge[1]")

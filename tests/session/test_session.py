@@ -24,8 +24,7 @@ def test_failing_command_leaves_state():
     assert s.total_energy == 6
 
 
-@pytest.mark.parametrize("cmd,word", [("o", "o"),
-                                      ("lagrange 2", "lagrange"), ("M 3", "M 3"),
+@pytest.mark.parametrize("cmd,word", [("lagrange 2", "lagrange"), ("M 3", "M 3"),
                                       ("refine vertex[1]", "refine")])
 def test_later_features_refused_by_name(cmd, word):
     s = session()
