@@ -170,8 +170,6 @@ def test_klein(evolver, tmp_path, name, script):
     """KLEIN_METRIC: lengths arccosh((1 − x·y)/√((1 − |x|²)(1 − |y|²))), areas
     by the hyperbolic L'Huilier formula, as REF to the last digit."""
     words = [ln.split()[0] for ln in script.split("\n") if ln.split()]
-    if name == "kst.fe" and "t" in words:
-        pytest.skip("t in the string model is refused (string-model weeding)")
     path = _write(tmp_path, name, KLEIN_SOAP if name == "ks.fe" else KLEIN_STRING)
     # after l the soapfilm's element numbering is not REF's (as without a metric):
     # the g lines and the final energy only
