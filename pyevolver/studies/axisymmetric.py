@@ -52,11 +52,40 @@ from scipy.optimize import BFGS, NonlinearConstraint, minimize
 BRANCHES = ("prolate", "oblate", "stomatocyte")
 
 
-class _Basis:
-    """Collocation matrices for ``K`` sine modes on ``M`` midpoints."""
+@dataclass(frozen=True)
+class Helfrich:
+    """Parameters of the bending energy, in units where ``A = 4π`` (``R0 = 1``).
 
-    def __init__(self, K: int, M: int):
+    The energy minimised is (divided by ``2κ``)
+
+        E = ∫ (H - c0/2)² dA + (π α / A) (M - 4π m0)²,   M = ∫ H dA,
+
+    with ``H = (κ1 + κ2)/2`` (a sphere of radius R has H = 1/R): the
+    spontaneous-curvature model (Seifert, Berndl & Lipowsky 1991,
+    ``F = (κ/2)∮(C1 + C2 - C0)² dA``, so ``c0 = C0·R0``) plus, for
+    ``alpha > 0``, area-difference elasticity (Miao, Seifert, Wortis &
+    Döbereiner 1994, ``(κ̄π / (2AD²))(ΔA - ΔA0)²`` with the bilayer area
+    difference ``ΔA = 2D·M``; ``alpha = κ̄/κ`` and ``m0 = ΔA0/(8πD R0)``, the
+    reduced preferred area difference, 1 for the sphere).  A Gaussian
+    modulus adds ``(κ_G/κ)·2π(1 - g)`` for genus g (Gauss–Bonnet), a constant
+    left out here.
+    """
+    c0: float = 0.0
+    alpha: float = 0.0
+    m0: float = 1.0
+
+    @property
+    def plain(self) -> bool:
+        return self.c0 == 0.0 and self.alpha == 0.0
+
+
+class _Basis:
+    """Collocation matrices for ``K`` sine modes on ``M`` midpoints; the
+    energy of ``model`` (default: ``∫H² dA``)."""
+
+    def __init__(self, K: int, M: int, model: Helfrich | None = None):
         self.K, self.M = K, M
+        self.model = model if model is not None else Helfrich()
         t = (np.arange(M) + 0.5) / M
         k = np.arange(1, K + 1)
         self.t = t
@@ -105,9 +134,32 @@ class _Basis:
         def pull(g_r, g_psi, g_dpsi):
             return self.S.T @ (g_psi - sn * (self.R.T @ g_r)) + self.C.T @ g_dpsi
 
+        zero = np.zeros_like(r)
         gW = pull(gW_r, gW_psi, gW_dpsi)
-        gv = pull(gv_r, gv_psi, np.zeros_like(r))
+        gv = pull(gv_r, gv_psi, zero)
+        md = self.model
+        if not md.plain:
+            # M = ∫H dA = π L ∫(ψ' r̃ + sin ψ) dt with L = sqrt(2/Ã) at A = 4π
+            Mt = q @ (dpsi * r + sn)
+            with np.errstate(invalid="ignore"):     # Ã < 0: a trial shape through the axis
+                root = np.sqrt(2.0 / Atil)
+            Mv = np.pi * root * Mt
+            gM = np.pi * root * (pull(q * dpsi, q * cs, q * r)
+                                 - 0.5 * Mt / Atil * pull(q, zero, zero))
+            dE_dM = -md.c0 + 2.0 * np.pi * md.alpha / (4 * np.pi) * (Mv - 4 * np.pi * md.m0)
+            W = (W - md.c0 * Mv + np.pi * md.c0 ** 2
+                 + np.pi * md.alpha / (4 * np.pi) * (Mv - 4 * np.pi * md.m0) ** 2)
+            gW = gW + dE_dM * gM
         return W, gW, clo, g_clo, v, gv, Atil, Vtil
+
+    def curvature_integrals(self, a):
+        """``(∫H² dA, ∫H dA)`` of the shape ``a`` scaled to ``A = 4π``."""
+        psi, dpsi, r = self.fields(a)
+        sn = np.sin(psi)
+        h = dpsi + sn / r
+        Atil = self.q @ r
+        return (0.5 * np.pi * self.q @ (h * h * r),
+                np.pi * np.sqrt(2.0 / Atil) * self.q @ (dpsi * r + sn))
 
 
 @dataclass
@@ -117,7 +169,8 @@ class CanhamResult:
     Attributes
     ----------
     W : float
-        Bending energy ∫H² dA (sphere: 4π).
+        The model's energy (:class:`Helfrich`; by default the bending energy
+        ∫H² dA, sphere: 4π).
     area, volume, v0 : float
         Area, enclosed volume and the prescribed reduced volume.
     L : float
@@ -130,6 +183,11 @@ class CanhamResult:
         Multipliers of (closure, reduced volume).
     descriptors : dict
         Shape-type indicators (see :func:`descriptors`).
+    willmore, mean_curvature : float
+        ``∫H² dA`` and ``∫H dA`` (the reduced area difference is
+        ``mean_curvature / 4π``).
+    model : Helfrich
+        The energy's parameters.
     """
     W: float
     area: float
@@ -146,6 +204,9 @@ class CanhamResult:
     lagrange: np.ndarray
     closure: float
     descriptors: dict = field(default_factory=dict)
+    willmore: float = float("nan")
+    mean_curvature: float = float("nan")
+    model: Helfrich = field(default_factory=Helfrich)
 
 
 def _stomatocyte_guess(K: int, beta: float = 0.9, rho: float = 0.15,
@@ -204,7 +265,9 @@ def _solve(basis: _Basis, v0: float, a0: np.ndarray, coarse: bool = True,
             return np.vstack([out[3], out[5]])
 
         nc = NonlinearConstraint(cfun, [0.0, v0], [0.0, v0], jac=cjac, hess=BFGS())
-        with warnings.catch_warnings():     # rank-deficient steps early on are harmless
+        with warnings.catch_warnings(), np.errstate(invalid="ignore"):
+            # rank-deficient steps early on are harmless; trial shapes whose
+            # r crosses the axis give NaN, which the trust region rejects
             warnings.simplefilter("ignore", UserWarning)
             res = minimize(lambda x: basis.evaluate(x)[:2], a, jac=True, hess=BFGS(),
                            method="trust-constr", constraints=[nc],
@@ -283,7 +346,8 @@ def descriptors(psi: np.ndarray, r: np.ndarray, z: np.ndarray) -> dict:
 
 
 def canham_reference(v0: float, branch: str, n: int = 48, n_profile: int = 401,
-                     coef0: np.ndarray | None = None, oversample: int = 4) -> CanhamResult:
+                     coef0: np.ndarray | None = None, oversample: int = 4,
+                     model: Helfrich | None = None) -> CanhamResult:
     """Minimal ``W = ∫H² dA`` over surfaces of revolution on one branch.
 
     Parameters
@@ -307,6 +371,9 @@ def canham_reference(v0: float, branch: str, n: int = 48, n_profile: int = 401,
         only the Newton iteration runs then.
     oversample : int
         Collocation points per mode (``M = oversample · n``).
+    model : Helfrich, optional
+        Spontaneous curvature and area-difference elasticity; default
+        ``∫H² dA`` (``c0 = 0``, no ADE).
 
     Returns
     -------
@@ -328,13 +395,14 @@ def canham_reference(v0: float, branch: str, n: int = 48, n_profile: int = 401,
     n0 = min(n, 16)
     if coef0 is None:
         a = np.zeros(n0) if v0 == 1.0 else _initial_coef(branch, v0, n0)
-        a, _ = _solve(_Basis(n0, 4 * n0), v0, a, coarse=True)
+        a, _ = _solve(_Basis(n0, 4 * n0, model), v0, a, coarse=True)
     else:
         a = np.asarray(coef0, dtype=float)
-    basis = _Basis(n, oversample * n)
+    basis = _Basis(n, oversample * n, model)
     a = np.concatenate([a[:n], np.zeros(max(0, n - len(a)))])
     a, lam = _solve(basis, v0, a, coarse=False)
     W, _, clo, _, v, _, Atil, Vtil = basis.evaluate(a)
+    willmore, mean_int = basis.curvature_integrals(a)
     L = np.sqrt(4 * np.pi / (2 * np.pi * Atil))
     # profile on a uniform grid including the poles, from the spectral interpolants
     psi_m, _, _ = basis.fields(a)
@@ -354,7 +422,8 @@ def canham_reference(v0: float, branch: str, n: int = 48, n_profile: int = 401,
     return CanhamResult(W=float(W), area=float(area), volume=float(volume), v0=v0,
                         branch=branch, n=n, L=float(L), s=L * t, r=r, z=z, psi=psi,
                         coef=a, lagrange=lam, closure=float(clo),
-                        descriptors=descriptors(psi, r, z))
+                        descriptors=descriptors(psi, r, z), willmore=float(willmore),
+                        mean_curvature=float(mean_int), model=basis.model)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -125,3 +125,47 @@ def test_cli_prints_w(capsys):
     W = float(out.splitlines()[0].split("=")[1])
     assert abs(W - canham_reference(0.85, "prolate", n=16).W) < 1e-11
     assert "type = prolate" in out
+
+
+# -- spontaneous curvature and area-difference elasticity (issue 27) -----------------------
+
+@pytest.mark.parametrize("c0", [0.5, -1.0, 1.5])
+def test_sphere_with_spontaneous_curvature(c0):
+    """v = 1 leaves only the unit sphere: ∫(H - c0/2)² dA = 4π(1 - c0/2)²."""
+    res = canham_reference(1.0, "prolate", n=8, model=ax.Helfrich(c0=c0))
+    assert abs(res.W - FOURPI * (1 - c0 / 2) ** 2) < 1e-9 * FOURPI
+    assert abs(res.willmore - FOURPI) < 1e-9 and abs(res.mean_curvature - FOURPI) < 1e-9
+
+
+def test_sphere_with_ade():
+    """ADE at v = 1: ∫H² dA + (πα/A)(M - 4π m0)², M = 4π on the unit sphere."""
+    res = canham_reference(1.0, "prolate", n=8, model=ax.Helfrich(alpha=2.0, m0=1.3))
+    assert abs(res.W - (FOURPI + np.pi * 2.0 / FOURPI * (FOURPI * 0.3) ** 2)) < 1e-9
+
+
+def test_model_gradient_matches_differences():
+    rng = np.random.default_rng(2)
+    b = ax._Basis(10, 40, ax.Helfrich(c0=0.7, alpha=1.5, m0=1.1))
+    a = 0.1 * rng.normal(size=10)
+    gW = b.evaluate(a)[1]
+    eps = 1e-6
+    for i in range(10):
+        e = np.zeros(10)
+        e[i] = eps
+        fd = (b.evaluate(a + e)[0] - b.evaluate(a - e)[0]) / (2 * eps)
+        assert abs(fd - gW[i]) < 1e-6 * max(1, abs(gW[i]))
+
+
+def test_minimum_energy_obeys_the_envelope_theorem():
+    """dE*/dc0 = ∂E/∂c0 at the minimiser = -M + 2π c0, and dE*/dm0 =
+    -(2πα/A)(M - 4π m0)·4π: the solver's minimisers are stationary (a
+    difference of two solves against the formula at the solution)."""
+    v, h = 0.8, 1e-4
+    mk = lambda c0: canham_reference(v, "prolate", n=24, model=ax.Helfrich(c0=c0))
+    mid, lo, hi = mk(0.3), mk(0.3 - h), mk(0.3 + h)
+    assert abs((hi.W - lo.W) / (2 * h) - (-mid.mean_curvature + 2 * np.pi * 0.3)) < 1e-6
+    alpha = 1.0
+    mk = lambda m0: canham_reference(v, "prolate", n=24, model=ax.Helfrich(alpha=alpha, m0=m0))
+    mid, lo, hi = mk(1.1), mk(1.1 - h), mk(1.1 + h)
+    expect = -2 * np.pi * alpha / FOURPI * (mid.mean_curvature - FOURPI * 1.1) * FOURPI
+    assert abs((hi.W - lo.W) / (2 * h) - expect) < 1e-6 * max(1, abs(expect))
