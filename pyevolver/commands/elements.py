@@ -54,6 +54,7 @@ def generate(session: SessionLike, gen, env):
             v = gen.where.ev(env)
         if is_true(v):
             out.append(el)
+    session.counts["where"] = len(out)          # where_count: the last where's hits
     return out
 
 

@@ -215,6 +215,15 @@ class Interpreter:
         els = list(elements.gen_base(sess, gen.base, self.env))
         surf0 = sess.surface
         ids = {k: surf0.ids(k) for k in {el.kind for el in els} if k != "body"}
+        hits = [0]
+        try:
+            self._foreach_loop(gen, body, els, surf0, ids, hits)
+        finally:
+            if gen.where is not None:
+                sess.counts["where"] = hits[0]      # where_count: the loop's hits
+
+    def _foreach_loop(self, gen, body, els, surf0, ids, hits):
+        sess = self.session
         for el in els:
             if sess.surface is not surf0 and el.kind in ids:
                 # the body changed the topology (r, delete, ...): the element is
@@ -231,6 +240,7 @@ class Interpreter:
                     v = gen.where.ev(self.env)
                     if not is_true(v):
                         continue
+                    hits[0] += 1
                 if not self._loop(body):
                     break
 

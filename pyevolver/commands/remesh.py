@@ -60,12 +60,14 @@ def counts_line(session: SessionLike):
 
 
 def _replaced(session: SessionLike, result, count=None, note=None, echo=True):
-    """Install the ``(new surface, n)`` a remesh operation returned; add
-    ``n`` to the count ``count`` and print ``note`` (``{n}`` filled in)."""
+    """Install the ``(new surface, n)`` a remesh operation returned; set
+    the count ``count`` to ``n`` (REF: ``notch_count``, ``edge_delete_count``
+    after ``t``, ... are the last such command's) and print ``note``
+    (``{n}`` filled in)."""
     new, n = result
     session._replace_surface(new)
     if count is not None:
-        bump_count(session, count, n)
+        set_count(session, count, n)
     if echo and note is not None:
         session.note(note.format(n=n))
     return n
@@ -83,8 +85,10 @@ def refine_edges(session: SessionLike, edges, echo=True):
     """``refine edges where ...``: bisect the given edges (spec §8)."""
     edges = np.asarray(edges, np.int64)
     n = _divide(session, np.unique(edges) if session.surface.string else edges)
-    if echo:
-        session.report("Edges refined", n)
+    # refine_count follows edge_refine_count here, restarting with it
+    restart = session.counts.get("reported edge_refine") and "Edges refined" not in session.pending
+    session.counts["refine"] = (0 if restart else session.counts.get("refine", 0)) + n
+    add_reported(session, "edge_refine", "Edges refined", n, echo)
 
 
 def refine_facets(session: SessionLike, facets, echo=True):
@@ -93,8 +97,7 @@ def refine_facets(session: SessionLike, facets, echo=True):
     session.no_string("refine facets")
     f = np.unique(np.asarray(facets, np.int64))
     session._replace_surface(NO.split_facets_at_centre(session.surface, f))
-    if echo:
-        session.report("Facets refined", len(f))
+    add_reported(session, "facet_refine", "Facets refined", len(f), echo)
 
 
 def equiangulate(session: SessionLike, echo=True):
@@ -149,7 +152,8 @@ def flush_counts(session: SessionLike):
 
 def _bisect(session: SessionLike, edges, echo, choosers=None):
     n = _divide(session, edges, choosers)
-    session.counts["refine"] = n                    # REF: each l or K sets refine_count
+    if n or choosers is not None:                   # REF: each K (and l refining
+        session.counts["refine"] = n                # something) sets refine_count
     if echo:
         session.note(f"New edges: {n}\n")
     return n
@@ -158,6 +162,8 @@ def _bisect(session: SessionLike, edges, echo, choosers=None):
 def edge_divide_long(session: SessionLike, length, echo=True):
     """``l L``: bisect every edge longer than ``L`` once (spec §8)."""
     n = _bisect(session, ED.long_edges(session.surface, length), echo)
+    if n:                     # REF: l sets edge_refine_count too (a report's
+        session.counts["edge_refine"] = n           # restart still pending)
     session.settings["edge_divide_length"] = length
     return n
 
@@ -199,9 +205,27 @@ def pop_edges(session: SessionLike, echo=True):
     return n
 
 
-def bump_count(session: SessionLike, key, n):
-    """Add ``n`` to the count ``key`` (``edge_delete_count``, ``notch_count``, ...)."""
+def set_count(session: SessionLike, key, n):
+    """Set the count ``key`` (``notch_count``, ...) to ``n``."""
+    session.counts[key] = n
+    session.counts.pop("reported " + key, None)
+
+
+def add_reported(session: SessionLike, key, word, n, echo=True):
+    """A count REF reports when the command ends (``Edges refined: N``,
+    ``Edges deleted: N``): within a command the counts add up (as they do
+    onto a value another command set, e.g. ``l`` for ``edge_refine_count``);
+    the first such command after the report starts again from 0; the
+    report prints the total (measured on evolver-nox-d: ``refine edges where
+    id < 5; refine edges where id < 9`` prints "Edges refined: 12" once, and
+    a later command's count starts at 0)."""
+    flag = "reported " + key
+    if session.counts.get(flag) and word not in session.pending:
+        session.counts[key] = 0
     session.counts[key] = session.counts.get(key, 0) + n
+    session.counts[flag] = 1
+    if echo:
+        session.pending[word] = session.counts[key]
 
 
 def delete_short_edges(session: SessionLike, length, echo=True):
@@ -216,7 +240,7 @@ def delete_elements(session: SessionLike, kind, items, echo=True):
     per facet, its shortest deletable side) as ``t`` / ``w`` do."""
     session.no_string("delete")
     fn = DEL.delete_edges if kind == "edge" else DEL.delete_facets
-    return _replaced(session, fn(session.surface, items), "edge_delete")
+    return _replaced(session, fn(session.surface, items))
 
 
 def jiggle(session: SessionLike, temperature=None, echo=True):
@@ -250,7 +274,8 @@ def weed(session: SessionLike, area, echo=True):
     deleting one of their edges, shortest first (spec §8.4)."""
     if session.surface.string:
         raise CommandError("Can only do area weed on soapfilm model.")   # REF's ERROR 1339
-    return _replaced(session, DEL.weed_small_facets(session.surface, area), "edge_delete",
+    # REF: w counts into facet_delete_count (edge_delete_count is t's)
+    return _replaced(session, DEL.weed_small_facets(session.surface, area), "facet_delete",
                      "Skinny triangles weeded: {n}\n", echo)
 
 
@@ -409,6 +434,7 @@ def _x_delete(interp, node):
         # `delete edges where cond`: like the Evolver, visit the elements
         # in id order and test cond when each is reached, on the surface
         # the earlier deletions left (a merge can make a later edge short)
+        hits = 0
         for eid in s.surface.ids(gen.kind).tolist():
             hit = np.nonzero(s.surface.ids(gen.kind) == eid)[0]
             if not len(hit):
@@ -417,5 +443,8 @@ def _x_delete(interp, node):
             with interp.env.element(el, gen.var):
                 v = gen.where.ev(interp.env)
             if is_true(v):
+                hits += 1
                 n += delete_elements(s, gen.kind, [el.i])
-    s.report(f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted", n)
+        s.counts["where"] = hits
+    add_reported(s, f"{gen.kind}_delete", f"{'Edges' if gen.kind == 'edge' else 'Facets'} deleted",
+                 n)

@@ -94,3 +94,44 @@ def test_read_sections_run(evolver, name, tmp_path):
     assert len(ref) == len(ours)
     for a, b in zip(ours, ref):
         assert abs(a - b) <= 1e-12 * max(1.0, abs(b)), (name, ours, ref)
+
+
+# The counters (notch_count, edge_delete_count, ..., where_count): REF 2.70
+# keeps the last command's count for n and t, adds up within a command (and
+# onto l's count) the ones it reports when the command ends ("Edges refined:
+# 12") and starts them again after the report; w counts into
+# facet_delete_count.  Each script prints labelled values in both programs.
+COUNTER_SCRIPTS = {
+    "notch": "g 5\nn 0.3\nprintf \"A %d\\n\", notch_count\nn 0.3; printf \"B %d\\n\", notch_count\n"
+             "n 0.3; n 0.3; printf \"C %d\\n\", notch_count\nprintf \"D %d\\n\", notch_count\n",
+    "refine": "refine edges where id < 5; printf \"A %d\\n\", edge_refine_count; "
+              "refine edges where id < 9; printf \"B %d\\n\", edge_refine_count\n"
+              "printf \"C %d %d\\n\", edge_refine_count, refine_count\n"
+              "refine edges where id < 3\nprintf \"D %d %d\\n\", edge_refine_count, refine_count\n"
+              "l 0.4\nprintf \"E %d %d\\n\", edge_refine_count, refine_count\n"
+              "refine edges where id < 4\nprintf \"F %d %d\\n\", edge_refine_count, refine_count\n"
+              "refine facets where id < 3; refine facets where id < 2\n"
+              "printf \"G %d\\n\", facet_refine_count\n",
+    "delete": "r\ng 5\nn 0.3\nt 0.02\nprintf \"A %d\\n\", edge_delete_count\n"
+              "t 0.04\nprintf \"B %d %d\\n\", edge_delete_count, delete_count\n"
+              "w 0.0005\nprintf \"C %d %d %d\\n\", edge_delete_count, facet_delete_count, "
+              "delete_count\n",
+    "where": "list edges where id < 10\nprintf \"A %d\\n\", where_count\n"
+             "foreach vertex vv where z > 0.5 do print vv.id\nprintf \"B %d\\n\", where_count\n"
+             "set facet color red where id < 4\nprintf \"C %d\\n\", where_count\n"
+             "print sum(edge where length > 0.3, 1)\nprintf \"D %d\\n\", where_count\n"
+             "list vertices where id > 100\nprintf \"E %d\\n\", where_count\n",
+}
+
+
+@pytest.mark.parametrize("name", sorted(COUNTER_SCRIPTS))
+def test_counters_match_reference(evolver, name, tmp_path):
+    script = COUNTER_SCRIPTS[name]
+    ref = run_reference(evolver, example("cube.fe"), script, cwd=str(tmp_path))
+    code, out, err = run_pyevolver(example("cube.fe"), script + "q\n", cwd=str(tmp_path))
+    assert code == 0 and err == "", err
+    def labelled(text):
+        lines = text.splitlines() if isinstance(text, str) else text
+        return [ln.strip() for ln in lines if re.match(r"^[A-G] ", ln.strip())]
+
+    assert labelled(ref) and labelled(out) == labelled(ref)
