@@ -12,6 +12,7 @@ import pytest
 from comparison import _same
 from reference import run_reference
 from conftest import EXAMPLES
+from finite_differences import assert_gradient, assert_hessian_columns, central_gradient, method_energy
 from tolerances import FD, PRINTED, ROUNDOFF, STEPS
 
 import pyevolver
@@ -152,19 +153,7 @@ def test_gradient_matches_central_differences(tmp_path, name):
         _, branch, _, _, _ = EL._relaxed(t, idx, name)
         assert set(branch.tolist()) == {0, 1, 2}, branch
     grad = m.gradient(t, None, idx, w)
-    X0 = s.X.copy()
-    h = 1e-6
-    num = np.zeros_like(grad)
-    for i in range(s.nv):
-        for k in range(3):
-            e = []
-            for sg in (1, -1):
-                s.X = X0.copy()
-                s.X[i, k] += sg * h
-                e.append(float(w @ m.value(s.evaluate(), None, idx)))
-            num[i, k] = (e[0] - e[1]) / (2 * h)
-    s.X = X0
-    assert np.abs(grad - num).max() <= FD * max(1.0, np.abs(grad).max())
+    assert_gradient(grad, central_gradient(s, method_energy(m, idx, w)))
 
 
 def test_mylarcube_agrees_with_the_evolver(evolver, tmp_path):
@@ -191,18 +180,7 @@ def test_hessian_matches_differences_of_the_gradient(name):
     w = np.array([1.5, 0.7])
     D = m.hessian(s.evaluate(), None, idx, w).toarray()
     assert np.abs(D - D.T).max() <= 1e-12 * max(1.0, np.abs(D).max())
-    X0 = s.X.copy()
-    h = 1e-6
-    for i in range(s.nv):
-        for k in range(3):
-            g = []
-            for sg in (1, -1):
-                s.X = X0.copy()
-                s.X[i, k] += sg * h
-                g.append(m.gradient(s.evaluate(), None, idx, w).ravel())
-            col = (g[0] - g[1]) / (2 * h)
-            assert np.abs(D[:, 3 * i + k] - col).max() <= FD * max(1.0, np.abs(col).max())
-    s.X = X0
+    assert_hessian_columns(s, D, lambda s: m.gradient(s.evaluate(), None, idx, w))
 
 
 def test_the_evolvers_dump_loads_with_the_same_energy(evolver, tmp_path):

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from comparison import _same
 from reference import run_reference
+from finite_differences import central_gradient, method_energy
 from tolerances import FD, PRINTED, STEPS
 
 from pyevolver.methods import knots as KN
@@ -116,18 +117,7 @@ TRUE = {"uniform_knot_energy": KN.uniform_knot_gradient,
 def _fd(s, entry, w, h=1e-6):
     idx = np.arange(s.nv if entry.etype == "vertex" else s.ne)
     grad = TRUE.get(entry.name, entry.gradient)(s.evaluate(), None, idx, w)
-    X0 = s.X.copy()
-    num = np.zeros_like(grad)
-    for i in range(s.nv):
-        for k in range(3):
-            e = []
-            for sg in (1, -1):
-                s.X = X0.copy()
-                s.X[i, k] += sg * h
-                e.append(float(w @ entry.value(s.evaluate(), None, idx)))
-            num[i, k] = (e[0] - e[1]) / (2 * h)
-    s.X = X0
-    return grad, num
+    return grad, central_gradient(s, method_energy(entry, idx, w), h)
 
 
 @pytest.mark.parametrize("method", METHODS)

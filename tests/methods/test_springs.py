@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from comparison import _same
 from reference import run_reference
-from tolerances import FD, PRINTED, ROUNDOFF, STEPS
+from finite_differences import assert_gradient, assert_hessian_columns, central_gradient, method_energy
+from tolerances import PRINTED, ROUNDOFF, STEPS
 
 import pyevolver
 from pyevolver.methods import springs as SP
@@ -124,18 +125,7 @@ def test_closed_forms(tmp_path):
 def _fd_check(s, m, w, h=1e-6):
     idx = np.arange(s.ne)
     grad = m.gradient(s.evaluate(), None, idx, w)
-    X0 = s.X.copy()
-    num = np.zeros_like(grad)
-    for i in range(s.nv):
-        for k in range(3):
-            e = []
-            for sg in (1, -1):
-                s.X = X0.copy()
-                s.X[i, k] += sg * h
-                e.append(float(w @ m.value(s.evaluate(), None, idx)))
-            num[i, k] = (e[0] - e[1]) / (2 * h)
-    s.X = X0
-    assert np.abs(grad - num).max() <= FD * max(1.0, np.abs(grad).max())
+    assert_gradient(grad, central_gradient(s, method_energy(m, idx, w), h))
 
 
 @pytest.mark.parametrize("method,params", [
@@ -167,18 +157,7 @@ def test_hooke_hessians_match_differences_of_the_gradient(tmp_path, method, para
     w = np.linspace(0.5, 2.0, s.ne)
     D = m.hessian(s.evaluate(), None, idx, w).toarray()
     assert np.abs(D - D.T).max() <= ROUNDOFF * 10
-    X0 = s.X.copy()
-    h = 1e-6
-    for i in range(s.nv):
-        for k in range(3):
-            g = []
-            for sg in (1, -1):
-                s.X = X0.copy()
-                s.X[i, k] += sg * h
-                g.append(m.gradient(s.evaluate(), None, idx, w).ravel())
-            col = (g[0] - g[1]) / (2 * h)
-            assert np.abs(D[:, 3 * i + k] - col).max() <= FD * max(1.0, np.abs(col).max())
-    s.X = X0
+    assert_hessian_columns(s, D, lambda s: m.gradient(s.evaluate(), None, idx, w))
 
 
 def test_dihedral_hooke_refuses_triple_edges(tmp_path):

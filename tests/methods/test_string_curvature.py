@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from comparison import _same
 from reference import run_reference
-from tolerances import FD, PRINTED, STEPS
+from finite_differences import assert_gradient, central_gradient, method_energy
+from tolerances import PRINTED, STEPS
 
 from pyevolver.errors import UnsupportedError
 from pyevolver.methods import string_curvature as SC
@@ -153,19 +154,7 @@ def test_gradients_against_central_differences(tmp_path, name, p):
     idx = np.arange(s.nv)
     fn = SC.sqcurve2_full_gradient if name == "sqcurve2_string" else entry.gradient
     grad = fn(s.evaluate(), m, idx, w)
-    X0 = s.X.copy()
-    num = np.zeros_like(grad)
-    h = 1e-6
-    for i in range(s.nv):
-        for k in range(3):
-            e = []
-            for sg in (1, -1):
-                s.X = X0.copy()
-                s.X[i, k] += sg * h
-                e.append(float(w @ entry.value(s.evaluate(), m, idx)))
-            num[i, k] = (e[0] - e[1]) / (2 * h)
-    s.X = X0
-    assert np.abs(grad - num).max() <= FD * max(1.0, np.abs(grad).max())
+    assert_gradient(grad, central_gradient(s, method_energy(entry, idx, w, m)))
 
 
 def test_sqcurve2_gradient_refused_in_space(tmp_path):
