@@ -66,6 +66,23 @@ def _run_both(evolver, datafile, script, tmp_path):
     return dirs, ref, out, err
 
 
+def run_both_in_process(evolver, datafile, script, tmp_path):
+    """REF's transcript of ``script`` and pyevolver's (a Session in this
+    process: faster than a child), as lists of lines, and pyevolver's stderr."""
+    import io
+    from pyevolver.session.core import Session
+    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
+    out, err = io.StringIO(), io.StringIO()
+    sess = Session.load(datafile, out=out, err=err)
+    sess.run(script)
+    return ref, out.getvalue().rstrip("\n").split("\n"), err.getvalue()
+
+
+def number_lines(lines):
+    """The lines that start with a number (printed values)."""
+    return [ln for ln in lines if ln.strip() and (ln.strip()[0] in "-0123456789")]
+
+
 def consistent(s):
     """Assert the invariants every operation must keep."""
     assert s.E.shape == (s.ne, 2) and s.FE.shape == (s.nf, 3)

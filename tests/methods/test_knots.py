@@ -7,8 +7,7 @@ import os
 
 import numpy as np
 import pytest
-from comparison import _same
-from reference import run_reference
+from comparison import _same, number_lines, run_both_in_process
 from finite_differences import central_gradient, method_energy
 from tolerances import FD, PRINTED, STEPS
 
@@ -39,16 +38,8 @@ def _octagon(tmp_path, methods, decl="", tension=1):
     return str(p)
 
 
-def _run_both(evolver, datafile, script, tmp_path):
-    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
-    out, err = io.StringIO(), io.StringIO()
-    sess = Session.load(datafile, out=out, err=err)
-    sess.run(script)
-    return ref, out.getvalue().rstrip("\n").split("\n"), err.getvalue()
-
-
-def _numbers(lines):
-    return [ln for ln in lines if ln.strip() and (ln.strip()[0] in "-0123456789")]
+_run_both = run_both_in_process
+_numbers = number_lines
 
 
 @pytest.mark.parametrize("power", [2, 3])
