@@ -36,9 +36,10 @@ zero energy.
 Gradients are analytic: ``dw = tr(M dF)`` with ``M = (QC + k Tr C Q) / (2(1+ν))``,
 ``k = ν/(1−ν)``, and for the uniaxial branch ``d(λ₁²/2) = (λ₁/2) yᵀ dF y`` with
 ``y = L r``, ``Q = L Lᵀ`` and ``r`` the unit eigenvector of ``Lᵀ F L``.
-``linear_elastic`` and ``dirichlet_elastic`` have analytic Hessians; the
-relaxed ones are taken by finite differences of the gradient (the registry's
-fallback).
+``linear_elastic``, ``dirichlet_elastic`` and the three-dimensional relaxed
+methods have analytic Hessians (the relaxed ones branch by branch); the
+five-dimensional ones are taken by finite differences of the gradient (the
+registry's fallback).
 """
 from __future__ import annotations
 
@@ -278,6 +279,55 @@ def _relaxed_gradient(t, idx, w, name, which):
     return _gradient_from_M(t, idx, P, M)
 
 
+def _relaxed_hessian(t, idx, w, name, which, basis=None):
+    """Analytic Hessian of ``Σ w_f E_f`` for the three-dimensional relaxed
+    methods, branch by branch (the branch held fixed): the linear density's
+    (:func:`linear_elastic_hessian`) where both stresses are positive; for
+    ``λ₁²/2`` with ``λ₁ = (μ₁ − 1)/2``, ``μ₁ ≥ μ₂`` the eigenvalues of
+    ``Lᵀ F L`` (unit eigenvectors ``r₁, r₂``, ``y = L r₁``, ``z = L r₂``):
+    ``d²(λ₁²/2) = (yᵀdF y)²/4 + λ₁ (yᵀdF z)²/(μ₁ − μ₂)``; zero elsewhere."""
+    idx = np.asarray(idx, np.int64)
+    P = _strain(t, idx, name)
+    n = len(idx)
+    ok = P["A0"] > 0
+    Q = np.where(ok[:, None, None], P["Q"], np.eye(2))
+    L = np.linalg.cholesky(Q)
+    mu, r = np.linalg.eigh(np.swapaxes(L, 1, 2) @ P["F"] @ L)
+    lam = 0.5 * (mu - 1.0)
+    l1, l2 = lam[:, 1], lam[:, 0]
+    nu = P["nu"]
+    k = nu / (1.0 - nu)
+    branch = np.zeros(n, np.int64)
+    branch[l1 > 0] = 1
+    branch[(l1 + k * (l1 + l2) > 0) & (l2 + k * (l1 + l2) > 0)] = 2
+    branch[~ok] = 0
+    if which:
+        branch = np.where(branch == which, branch, 0)
+    c = np.asarray(w, float) * P["A0"] * _lebweight(t, idx)
+    # the linear branch
+    M2 = _linear_M(P)
+    EQ = np.einsum("jab,nbc->njac", _E, P["Q"])
+    tr2 = np.einsum("niab,njba->nij", EQ, EQ)
+    tr1 = np.einsum("niaa->ni", EQ)
+    H2 = (tr2 + k[:, None, None] * tr1[:, :, None] * tr1[:, None, :]) \
+        / (4.0 * (1.0 + nu))[:, None, None]
+    # the uniaxial branch
+    y = np.einsum("nij,nj->ni", L, r[:, :, 1])
+    z = np.einsum("nij,nj->ni", L, r[:, :, 0])
+    M1 = (0.5 * l1)[:, None, None] * np.einsum("ni,nj->nij", y, y)
+    u = np.einsum("na,jab,nb->nj", y, _E, y)
+    v = np.einsum("na,jab,nb->nj", y, _E, z)
+    gap = mu[:, 1] - mu[:, 0]
+    one = branch == 1
+    g1 = np.where(one, l1 / np.where(gap > 0, gap, 1.0), 0.0)
+    H1 = 0.25 * np.einsum("ni,nj->nij", u, u) + g1[:, None, None] * np.einsum("ni,nj->nij", v, v)
+    sel2, sel1 = (branch == 2)[:, None, None], one[:, None, None]
+    M = np.where(sel2, M2, np.where(sel1, M1, 0.0)) * c[:, None, None]
+    Hf = np.where(sel2, H2, np.where(sel1, H1, 0.0)) * c[:, None, None]
+    gf = np.stack([M[:, 0, 0], M[:, 0, 1] + M[:, 1, 0], M[:, 1, 1]], 1)
+    return _hessian_from_f(t, idx, P, gf, Hf, basis)
+
+
 def _register_relaxed(name: str, which: int) -> None:
     def values(t, m, idx):
         return _relaxed_values(t, idx, name, which)
@@ -285,9 +335,13 @@ def _register_relaxed(name: str, which: int) -> None:
     def gradient(t, m, idx, w):
         return _relaxed_gradient(t, idx, w, name, which)
 
+    def hessian(t, m, idx, w, basis=None):
+        return _relaxed_hessian(t, idx, w, name, which, basis)
+
     values.__doc__ = f"Per-facet ``{name}`` energy, shape (len(idx),)."
     gradient.__doc__ = f"Gradient (nv, 3) of ``Σ w_f E_f`` for ``{name}``."
-    register_method(name, "facet", values, gradient)
+    hessian.__doc__ = f"Analytic Hessian of ``Σ w_f E_f`` for ``{name}`` (:func:`_relaxed_hessian`)."
+    register_method(name, "facet", values, gradient, None if _is_b(name) else hessian)
 
 
 def _ff_strain(t, idx, name):

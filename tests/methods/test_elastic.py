@@ -13,7 +13,7 @@ from comparison import _same
 from reference import run_reference
 from conftest import EXAMPLES
 from finite_differences import assert_gradient, assert_hessian_columns, central_gradient, method_energy
-from tolerances import FD, PRINTED, ROUNDOFF, STEPS
+from tolerances import PRINTED, ROUNDOFF, STEPS
 
 import pyevolver
 from pyevolver.methods import elastic as EL
@@ -241,20 +241,8 @@ def test_five_dimensional_gradient_matches_central_differences(tmp_path, name):
         assert set(branch.tolist()) >= {1, 2}, branch
     grad = m.gradient(t, None, idx, w)
     assert grad.shape == (9, 5)
-    X0 = s.X.copy()
-    h = 1e-6
-    num = np.zeros_like(grad)
-    for i in range(s.nv):
-        for k in range(5):
-            e = []
-            for sg in (1, -1):
-                s.X = X0.copy()
-                s.X[i, k] += sg * h
-                e.append(float(w @ m.value(s.evaluate(), None, idx)))
-            num[i, k] = (e[0] - e[1]) / (2 * h)
-    s.X = X0
     assert np.abs(grad[:, 3:]).max() > 1e-3          # the reference plane is pulled too
-    assert np.abs(grad - num).max() <= FD * max(1.0, np.abs(grad).max())
+    assert_gradient(grad, central_gradient(s, method_energy(m, idx, w), dims=5))
 
 
 def test_five_dimensional_methods_agree_with_the_three_dimensional_ones(tmp_path):
@@ -290,9 +278,10 @@ def test_five_dimensional_methods_need_space_dimension_5(tmp_path):
 
 @pytest.mark.parametrize("method", ["linear_elastic", "relaxed_elastic_A"])
 def test_hessian_step_with_one_free_vertex_as_the_evolver(evolver, tmp_path, method):
-    """With one free vertex REF's elastic Hessian is exact: its `hessian`
-    steps are pyevolver's.  (With two free vertices on one facet REF's matrix
-    is not the Hessian: docs/differences.md, tests/data/elastic_two_free.fe.)"""
+    """With one free vertex REF's elastic Hessian is exact even with its
+    worker thread (-p1): its `hessian` steps are pyevolver's.  (With two free
+    vertices on one facet REF's threaded matrix is not the Hessian:
+    docs/differences.md, tests/reference/test_elastic_hessian_reference.py.)"""
     from comparison import run_pyevolver
     from reference import run_reference
     here = os.path.dirname(os.path.dirname(__file__))
@@ -307,3 +296,26 @@ def test_hessian_step_with_one_free_vertex_as_the_evolver(evolver, tmp_path, met
     rc, out, err = run_pyevolver(str(p), script)
     assert [float(v) for v in out[-1].split()] == pytest.approx(
         [float(v) for v in ref[-1].split()], abs=1e-9)
+
+
+@pytest.mark.parametrize("name", ["relaxed_elastic_a", "relaxed_elastic1_a", "relaxed_elastic2_a"])
+def test_relaxed_hessian_matches_differences_of_the_gradient(name):
+    """The relaxed methods' analytic Hessian, branch by branch: facet 0 is
+    stretched in one direction and compressed in the other (λ₁²/2), facet 1
+    stretched in both (the linear density), facet 2 compressed (zero)."""
+    rng = np.random.default_rng(8)
+    X = np.array([[0, 0, 0], [1.3, 0, 0.05], [0.05, 0.8, 0], [1.25, 1.2, 0.1], [-0.1, 0.9, 0.0],
+                  [0.6, 1.2, 0.05]]) + 0.02 * rng.standard_normal((6, 3))
+    s = pyevolver.Surface.from_arrays(X, np.array([[0, 1, 2], [1, 3, 2], [2, 5, 4]]))
+    s.extra[("facet", "form_factors")] = np.array([[1.0, 0.05, 1.0], [1.0, -0.3, 0.8],
+                                                  [0.8, 0.1, 0.9]])
+    s.extra[("facet", "poisson_ratio")] = np.array([0.3, 0.25, 0.4])
+    idx = np.arange(s.nf)
+    _, branch, _, _, _ = EL._relaxed(s.evaluate(), idx, name)
+    assert branch.tolist() == [1, 2, 0]
+    m = lookup(name)
+    w = np.array([1.5, 0.7, 1.1])
+    D = m.hessian(s.evaluate(), None, idx, w).toarray()
+    assert np.abs(D).max() > 0.1
+    assert np.abs(D - D.T).max() <= 1e-12 * max(1.0, np.abs(D).max())
+    assert_hessian_columns(s, D, lambda s: m.gradient(s.evaluate(), None, idx, w))
