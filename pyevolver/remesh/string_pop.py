@@ -332,6 +332,14 @@ def after_move_lengths(s):
     return np.linalg.norm(_edge_vecs(s), axis=1)
 
 
+def stretch_rates(s, vel):
+    """``e . (vel[head] - vel[tail])`` per edge, ``e`` the edge vector
+    (torus wraps included): the sign of autopop's test."""
+    ev = _edge_vecs(s)
+    dv = vel[s.E[:, 1]] - vel[s.E[:, 0]]
+    return np.einsum("ij,ij->i", ev[:, :dv.shape[1]], dv[:, :ev.shape[1]])
+
+
 def predicted_lengths(s, vel, scale):
     """The edge lengths one more move ``scale * vel`` would give, to first
     order (REF's autochop test, measured on a junction whose edges grow):

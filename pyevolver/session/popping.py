@@ -92,9 +92,10 @@ def after_move(session, r) -> None:
         now = SP.after_move_lengths(s)
         short = now < crit
         if vel is not None and short.any():
-            # only the edges the motion shortens (100grain.fe: its growing
-            # tiny edges stay)
-            short &= SP.predicted_lengths(s, vel, scale) < now
+            # only the edges the motion does not lengthen: e . (v_head - v_tail)
+            # <= 0 with e the edge after the move (100grain.fe: its growing
+            # tiny edges stay, its still ones inside a straight chain go)
+            short &= SP.stretch_rates(s, vel) <= 0.0
         if short.any():
             t, ned, _vmap = SP.delete_short_edges(s, crit, np.nonzero(short)[0])
             if ned:
