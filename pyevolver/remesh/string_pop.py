@@ -314,10 +314,11 @@ def delete_short_edges(s, crit, candidates=None, merges=None):
         if efacets is not None:
             # a vertex on a facet the edge is not on stays (100grain.fe after
             # r: a junction keeps its place and absorbs the midpoint vertex);
-            # when neither end may go by that rule, the head goes
+            # when neither end may go by that rule, the head goes; only on an
+            # edge of two facets, as t (string_dissolve4.fe)
             fa, fb = vfacets(a), vfacets(b)
             ok_a, ok_b = fa <= efacets[e], fb <= efacets[e]
-            if can_a and can_b and (ok_a or ok_b):
+            if can_a and can_b and (ok_a or ok_b) and len(efacets[e]) >= 2:
                 can_a, can_b = ok_a, ok_b
         if not (can_a or can_b):
             continue
