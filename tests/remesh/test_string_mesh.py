@@ -113,3 +113,9 @@ def test_split_in_order_matches_one_by_one(tmp_path):
         b = split_edges(b, np.array([e]))
     assert np.array_equal(a.E, b.E) and np.allclose(a.X, b.X)
     assert np.array_equal(a.sf_enc, b.sf_enc)
+
+
+def test_100grain_t_after_autochop(evolver, tmp_path):
+    # after g 5 the cells' sides are chains of chopped edges: deleting an
+    # edge between a junction and a chain vertex leaves the junction in place
+    _compare(evolver, example("100grain.fe"), "g 5\nt 0.02\ng 3\n", tmp_path)
