@@ -299,7 +299,10 @@ def delete_short_edges(s, crit, candidates=None, merges=None):
             h = h.copy()
             h[:shift.shape[1]] += wrap[e] @ shift
         return h
-    for e in (range(s.ne) if candidates is None else np.sort(candidates).tolist()):
+    eorder = np.argsort(s.ids("edge"), kind="stable")     # REF visits in id order
+    if candidates is not None:
+        eorder = eorder[np.isin(eorder, candidates)]
+    for e in eorder.tolist():
         if not ealive[e] or efixed[e]:
             continue
         a, b = int(E[e, 0]), int(E[e, 1])
