@@ -390,7 +390,8 @@ def _dissolve(f, chains, fdrop, efacets, ealive, E, wrap, gone_sides):
         return
     if (r0 in gone_sides) == (r1 in gone_sides):
         raise UnsupportedError("autopop leaving a facet of two edges with no side at the "
-                               "eliminated vertex", "REF's choice of the side kept was not measured")
+                               "eliminated vertex",
+                               "REF's choice of the side kept was not measured")
     keep_side, dead = (r0, r1) if r0 in gone_sides else (r1, r0)
     same = E[dead, 0] == E[keep_side, 0]
     if wrap is not None and not np.array_equal(wrap[dead], wrap[keep_side] if same

@@ -4,19 +4,23 @@
 After the move (and the restoring), in this order:
 
 - autopop (string model): the edges whose length is now below the critical
-  length ``sqrt(2 * scale)`` are deleted (their ends merged, edge order),
-  then every vertex with more than three edges is popped as by ``o``
+  length ``sqrt(2 * scale)`` and that the motion does not lengthen,
+  ``e . (v_head - v_tail) <= 0`` with ``e`` the edge after the move (found
+  per edge on 100grain.fe ``r; r; g 1``: the still edges inside straight
+  chains go, the growing tiny edges stay), are deleted (their ends merged,
+  id order), cells left with two sides dissolved, then every vertex with
+  more than three edges is popped as by ``o``
   (:mod:`pyevolver.remesh.string_pop`); REF prints
-  ``Autopopped N edges, M vertices.`` when N > 0.  The threshold was
-  measured on a symmetric junction pair: the length after the move, not a
-  further prediction; only edges the motion shortens (first order in the
-  velocity) are deleted: 100grain.fe's tiny growing edges stay.
+  ``Autopopped N edges, M vertices.`` when N > 0.
 - autochop: the edges whose predicted length after one more move with the
   same velocity, ``|e| + scale * (e/|e|) . (v_head - v_tail)``, exceeds
   ``autochop_length`` are bisected ("Autochopped N edges.").  The predicted
   form was measured on a triple junction whose two edges grow (the
   threshold is that first-order length to 8 digits, neither the current
-  length nor the exact next one).
+  length nor the exact next one).  The count printed is that of the
+  chosen edges, those autopop deleted included; after a step that
+  dissolved a cell the new elements take the freed ids as REF's
+  (:func:`_chop_reusing_ids`).
 
 The energies of the progress line are those after both.
 """
