@@ -64,6 +64,7 @@ class IterateSettings:
     ribiere: bool = True               # Polak-Ribiere, else Fletcher-Reeves
     check_increase: bool = False
     hessian_normal: bool = True        # ``hessian``: normal motion only
+    hessian_backtrack: bool = False    # ``hessian``: halve a step that raises the energy
     area_normalization: bool = False   # mobility 1 / (star area / 3) (evolve.mobility)
     normal_motion: bool = False        # velocity projected on the vertex normal
     runge_kutta: bool = False          # a fixed-scale step by RK4
@@ -86,6 +87,7 @@ class IterateSettings:
                    ribiere=bool(toggles.get("ribiere", 1)),
                    check_increase=bool(toggles.get("check_increase", 0)),
                    hessian_normal=bool(toggles.get("hessian_normal", 1)),
+                   hessian_backtrack=bool(toggles.get("hessian_backtrack", 0)),
                    area_normalization=bool(toggles.get("area_normalization", 0)),
                    normal_motion=bool(toggles.get("normal_motion", 0)),
                    runge_kutta=bool(toggles.get("runge_kutta", 0)),
