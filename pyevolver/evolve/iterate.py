@@ -17,6 +17,7 @@ import numpy as np
 from ..constraints import (displace, project_tangent, project_to_constraints, release_one_sided,
                        restore_state, state)
 from ..errors import UnsupportedError
+from ..threads import blas_limited
 from . import gradient as GR
 from . import optparams as OP
 from ..errors import ConstraintError
@@ -427,6 +428,7 @@ class Iterator:
         return t
 
     # -- the step --------------------------------------------------------------------
+    @blas_limited
     def step(self, settings: IterateSettings | None = None) -> StepResult:
         """One ``g`` step: the motion, the line search (or the fixed
         scale) and the restoring of the fixed values.

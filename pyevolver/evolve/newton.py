@@ -44,7 +44,9 @@ from .eigen import ShiftedFactor
 from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
                       solve_bordered, tangent_basis)
 from .iterate import Iterator, StepResult, _Constraints
+from . import symfactor as SF
 from .symfactor import newton_solve
+from ..threads import blas_limited
 from . import string_hessian  # noqa: F401  (installs the string model's Hessian)
 
 
@@ -263,6 +265,7 @@ def _no_rise(E, e0, scale, fallbacks):
     return 0.0
 
 
+@blas_limited
 def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = None,
                  normal: bool = True, eps: float = 1e-10) -> StepResult:
     """The ``hessian`` command: one Newton step on the constrained problem
@@ -290,8 +293,10 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     n = hs.K.shape[0]
     got = None
     piv: list = []
-    if n:
+    if n > SF.ND_MIN:
         # one LDLᵀ of K + δI gives the index and, refined, the step with K
+        # (small systems: the direct solve and, when its pivots find negative
+        # ones, a second factorization for the index; they cost nothing there)
         delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
         got = newton_solve(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, delta=delta)
     if got is not None:
