@@ -22,6 +22,11 @@ are printed too.
     PYTHONPATH=. python benchmarks/bench_hessian.py [--levels 4 6] [--repeat 3]
         [--pyevolver ROOT] [--label after] [--doc docs/performance.md]
 
+``--solvers`` times instead one factorization and solve of the shifted
+Hessian ``K + δI`` of each surface (largest level) with each sparse solver
+that is installed (SuperLU as pyevolver uses it, scikit-sparse's CHOLMOD,
+qdldl, cholespy), in one child, and writes that table (label ``solvers``).
+
 ``--pyevolver ROOT`` runs the pyevolver found at ROOT (a checkout; default
 this one), so that a before/after table comes from one script; ``--doc``
 writes the table into that Markdown file between the markers
@@ -65,6 +70,84 @@ def _popen_wait4(cmd, stdin, env):
     if p.returncode != 0:
         raise SystemExit(f"{cmd[0]} failed: {out[-800:]}")
     return ru.ru_utime + ru.ru_stime, ru.ru_maxrss / 1024.0, out
+
+
+SOLVERS = r"""
+import io, sys, time
+import numpy as np, scipy.sparse as sp
+from pyevolver import Session
+from pyevolver.evolve import hessian_nd, symfactor as SF
+from pyevolver.evolve.ordering import nested_dissection
+s = Session.load(sys.argv[1], out=io.StringIO())
+s.run(sys.argv[2])
+hs = hessian_nd.system(s.iterator, True)
+K = hs.K.tocsc()
+n = K.shape[0]
+A = (K + 1e-8 * float(np.abs(K.diagonal()).mean()) * sp.identity(n, format="csc")).tocsc()
+perm = nested_dissection(hs.points, A)
+Ap = A.tocsr()[perm][:, perm].tocsc()
+
+
+def superlu():
+    return SF.LDL(A, perm).solve(hs.rhs)
+
+
+def cholmod():
+    from sksparse import cholmod as C
+    f = C.cholesky(Ap, mode="simplicial", ordering_method="natural")
+    x = np.empty(n)
+    x[perm] = f(hs.rhs[perm])
+    return x
+
+
+def qdldl():
+    import qdldl as Q
+    return Q.Solver(sp.triu(A, format="csc")).solve(hs.rhs)
+
+
+def cholespy():
+    import cholespy as C
+    c = Ap.tocoo()
+    f = C.CholeskySolverD(n, c.row.astype(np.int32), c.col.astype(np.int32), c.data,
+                          C.MatrixType.COO)
+    b = np.ascontiguousarray(hs.rhs[perm][:, None])
+    x = np.zeros_like(b)
+    f.solve(b, x)
+    out = np.empty(n)
+    out[perm] = x[:, 0]
+    return out
+
+
+for name, fn in [("SuperLU, symmetric mode, ND order (pyevolver)", superlu),
+                 ("CHOLMOD simplicial LDLT, ND order (scikit-sparse)", cholmod),
+                 ("qdldl (LDLT, its AMD order)", qdldl),
+                 ("cholespy (CHOLMOD supernodal Cholesky, ND order)", cholespy)]:
+    t0 = time.process_time()
+    try:
+        x = fn()
+        res = np.linalg.norm(A @ x - hs.rhs) / np.linalg.norm(hs.rhs)
+        print("SOLVER", name, "|", f"{time.process_time() - t0:.2f}", "|", f"residual {res:.0e}")
+    except ImportError:
+        print("SOLVER", name, "|", "-", "|", "not installed")
+    except Exception as exc:
+        print("SOLVER", name, "|", f"{time.process_time() - t0:.2f}", "|",
+              "fails: " + str(exc).splitlines()[0][:60])
+"""
+
+
+def solvers(files, env):
+    """Markdown table: CPU seconds of one factorization and solve of K + δI."""
+    lines = ["| surface | factorization | CPU [s] | result |", "|---|---|---|---|"]
+    for case, f in files:
+        p = subprocess.run([sys.executable, "-c", SOLVERS, f, PREFIX], capture_output=True,
+                           text=True, env=env, timeout=3600)
+        for ln in p.stdout.splitlines():
+            if ln.startswith("SOLVER "):
+                name, cpu, what = ln[7:].split(" | ")
+                lines.append(f"| {case} | {name} | {cpu} | {what} |")
+        if p.returncode:
+            raise SystemExit(p.stderr[-800:])
+    return "\n".join(lines)
 
 
 def result(out):
@@ -125,11 +208,21 @@ def main():
     ap.add_argument("--pyevolver", default=REPO, help="checkout whose pyevolver runs")
     ap.add_argument("--label", default="after")
     ap.add_argument("--doc", default=None, help="Markdown file to write the table into")
+    ap.add_argument("--solvers", action="store_true",
+                    help="instead: time the sparse factorizations on the largest level")
     a = ap.parse_args()
     env = dict(os.environ)
     env["PYTHONPATH"] = os.path.abspath(a.pyevolver)
     programs = {"py": ([sys.executable, "-m", "pyevolver"], env),
                 "ref": ([a.evolver, "-p1"], None)}
+    if a.solvers:
+        lev = max(a.levels)
+        text = solvers([(f"area, {20 * 4 ** lev:,} facets", icosphere_file(lev)),
+                        (f"bending, {20 * 4 ** lev:,} facets", bending_file(lev))], env)
+        print(text)
+        if a.doc:
+            write_doc(a.doc, "solvers", text)
+        return
     rows = []
     for lev in a.levels:
         for case in a.cases:

@@ -250,7 +250,7 @@ def _index(hs, piv, eps):
 
 
 _SCALED = ("hessian: the Newton step raised the energy; "
-           "step scaled by %g (pyevolver; see docs/differences.md)\n")
+           "step scaled by %g (pyevolver's hessian_backtrack)\n")
 
 
 def _no_rise(E, e0, scale, fallbacks):
