@@ -244,7 +244,8 @@ def _index(hs, piv, eps):
             return 0
     delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
     try:
-        return ShiftedFactor(hs.K, hs.B, -delta, 0.0, nudge=True).inertia().below
+        return ShiftedFactor(hs.K, hs.B, -delta, 0.0, nudge=True,
+                             points=hs.points).inertia().below
     except UnsupportedError:       # (singular where it cannot be resolved: no warning)
         return 0
 
@@ -299,6 +300,10 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         # ones, a second factorization for the index; they cost nothing there)
         delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
         got = newton_solve(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, delta=delta)
+        if got is None:          # an eigenvalue near −δ: factor K itself
+            got = newton_solve(hs.K, hs.B, hs.rhs, hs.d, points=hs.points)
+            if got is not None:
+                got = (got[0], None)     # (K's pivots are not the index's)
     if got is not None:
         sol, index = got
     else:

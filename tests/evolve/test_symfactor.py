@@ -138,3 +138,29 @@ def test_hessian_step_same_with_and_without_the_cache(monkeypatch):
     before = set(cache)
     e.hessian(echo=False)
     assert len(set(cache) - before) == 1
+
+
+def test_unshifted_solve_and_pivots():
+    K = _laplacian(50, 0.2)
+    r = np.random.default_rng(3).standard_normal(50)
+    sol, index = SF.newton_solve(K, None, r, None)
+    assert np.allclose(K @ sol, r, atol=1e-12)
+    assert index == int(np.sum(np.linalg.eigvalsh(K.toarray()) < 0))
+
+
+def test_shifted_factor_in_the_nd_order_agrees(monkeypatch):
+    """eigen.ShiftedFactor given the unknowns' positions factors in the cached
+    ND order: same inertia and the same bordered solve as without."""
+    from pyevolver.evolve.eigen import ShiftedFactor
+    monkeypatch.setattr(SF, "ND_MIN", 10)
+    monkeypatch.setattr(SF, "ORDER_CACHE", type(SF.ORDER_CACHE)())
+    n = 80
+    K = _laplacian(n, 0.1)
+    B = np.random.default_rng(5).standard_normal((n, 2))
+    pts = np.column_stack([np.arange(n), np.zeros(n), np.zeros(n)]).astype(float)
+    x = np.random.default_rng(6).standard_normal(n)
+    a = ShiftedFactor(K, B, 0.05, 1e-12)
+    b = ShiftedFactor(K, B, 0.05, 1e-12, points=pts)
+    assert len(SF.ORDER_CACHE) == 1
+    assert a.inertia() == b.inertia()
+    assert np.allclose(a.op(x), b.op(x), rtol=1e-10, atol=1e-12)
