@@ -320,7 +320,7 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
             report.append(f"WARNING 1825: Hessian not positive definite. Index: {index}\n")
     targets = cons.targets(s)
     X0 = state(s)
-    e0 = s.evaluate().energy
+    e0 = (hs.totals if hs.totals is not None else s.evaluate()).energy
 
     def E(scale, report=None):
         e = it._move(X0, dx, scale, cons, None, None, mobile, targets, report).energy
