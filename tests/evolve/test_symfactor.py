@@ -164,3 +164,33 @@ def test_shifted_factor_in_the_nd_order_agrees(monkeypatch):
     assert len(SF.ORDER_CACHE) == 1
     assert a.inertia() == b.inertia()
     assert np.allclose(a.op(x), b.op(x), rtol=1e-10, atol=1e-12)
+
+
+def test_large_hessian_step_and_index_as_the_evolver(evolver, tmp_path):
+    """Above ND_MIN unknowns (a 5,120-facet icosphere, 2,562 vertices) the step
+    comes from symfactor: made prolate with its target volume, `g 2;
+    hessian` prints REF's warning with REF's index and REF's energy, and the
+    body volume drifts from its target as REF's does."""
+    import os
+    import subprocess
+    import sys
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    fe = str(tmp_path / "ico.fe")
+    subprocess.run([sys.executable, os.path.join(root, "benchmarks", "make_icosphere.py"),
+                    "--level", "4", "--out", fe], check=True, capture_output=True)
+    script = ("set vertex z z*1.5\nset body target body[1].volume\ng 2\nhessian\n"
+              'printf "R %.15g %.15g %.15g\\n", total_energy, body[1].volume, body[1].target\n'
+              "q\nq\n")
+    runs = []
+    env = dict(os.environ, PYTHONPATH=root)
+    for cmd in ([evolver, "-p1", fe], [sys.executable, "-m", "pyevolver", fe]):
+        p = subprocess.run(cmd, input=script, capture_output=True, text=True, timeout=300,
+                           cwd=str(tmp_path), env=env)
+        r = [ln for ln in p.stdout.splitlines() if ln.startswith("R ")][-1].split()[1:]
+        runs.append(([float(x) for x in r], p.stdout + p.stderr))
+    (ref, ref_out), (got, out) = runs
+    warn = "WARNING 1825: Hessian not positive definite. Index: 1"
+    assert warn in ref_out and warn in out
+    assert got[0] == pytest.approx(ref[0], rel=1e-11)
+    drift_ref, drift = abs(ref[1] - ref[2]) / ref[2], abs(got[1] - got[2]) / got[2]
+    assert drift == pytest.approx(drift_ref, rel=1e-3)
