@@ -75,6 +75,7 @@ def _popen_wait4(cmd, stdin, env):
 SOLVERS = r"""
 import io, sys, time
 import numpy as np, scipy.sparse as sp
+import scipy.sparse.linalg            # (imported before the clocks start)
 from pyevolver import Session
 from pyevolver.evolve import hessian_nd, symfactor as SF
 from pyevolver.evolve.ordering import nested_dissection
@@ -125,8 +126,12 @@ for name, fn in [("SuperLU, symmetric mode, ND order (pyevolver)", superlu),
     t0 = time.process_time()
     try:
         x = fn()
+        cpu = time.process_time() - t0
+        t0 = time.process_time()
+        x = fn()                                  # the better of two runs
+        cpu = min(cpu, time.process_time() - t0)
         res = np.linalg.norm(A @ x - hs.rhs) / np.linalg.norm(hs.rhs)
-        print("SOLVER", name, "|", f"{time.process_time() - t0:.2f}", "|", f"residual {res:.0e}")
+        print("SOLVER", name, "|", f"{cpu:.2f}", "|", f"residual {res:.0e}")
     except ImportError:
         print("SOLVER", name, "|", "-", "|", "not installed")
     except Exception as exc:
