@@ -5,6 +5,7 @@ exit codes.
 """
 from __future__ import annotations
 
+import difflib
 import os
 import sys
 import traceback
@@ -81,7 +82,6 @@ def excerpt_window(line: str, column: int | None = None,
 def did_you_mean(word: str, names) -> str:
     """``"; did you mean 'x'?"`` (or two or three names) for the names
     closest to ``word`` (difflib, case-insensitive), or ``""``."""
-    import difflib
     pool = {str(n).lower(): str(n) for n in names if n and str(n) != word}
     close = difflib.get_close_matches(str(word).lower(), list(pool), n=3, cutoff=0.75)
     if not close:

@@ -72,13 +72,14 @@ class SessionAPI:
                                     settings=DumpSettings(self.filename, self.settings,
                                                           self.toggles, self.attr_types))
 
-    def snapshot(self, path: str, field: str | None = "mean_curvature", view=None,
+    def snapshot(self, path: str, field: str | None = "auto", view=None,
                  **kwargs) -> str:
         """Render the surface to an image file, headless
-        (:func:`pyevolver.io.render.snapshot`; the camera is the session's
-        ``view_matrix`` unless ``view`` is given)."""
+        (:func:`pyevolver.io.render.snapshot`; the camera looks along the
+        session's ``view_matrix``, turned oblique while it has no rotation,
+        unless ``view`` is given; framed on the surface every time)."""
         if view is None:
-            view = self.arrays.get("view_matrix")
+            view = render.oblique(self.arrays.get("view_matrix"))
         return render.snapshot(self.surface, path, field=field, view=view, **kwargs)
 
     def plot_history(self, path: str, **kwargs) -> str:

@@ -13,7 +13,8 @@ import pytest
 
 from pyevolver import Session
 from pyevolver.errors import CommandError
-from pyevolver.io.viewer import clipped_range, facet_colors, viewer_data, write_viewer
+from pyevolver.io.fields import clipped_range, facet_colors
+from pyevolver.io.viewer import viewer_data, write_viewer
 
 CUBE = os.path.join(os.path.dirname(__file__), "..", "..", "datafiles", "cube.fe")
 
