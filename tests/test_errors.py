@@ -58,3 +58,27 @@ def test_unknown_datafile_keywords_get_a_suggestion(tmp_path):
     p.write_text("vertices\n1 0 0 0 fixd\n2 1 0 0\nedges\n1 1 2\n")
     with pytest.raises(DatafileError, match="undefined parameter 'fixd'; did you mean 'fixed'"):
         Session.load(str(p), out=io.StringIO())
+
+
+def test_no_internal_vocabulary_in_messages():
+    """No string literal a user can see (docstrings and comments aside)
+    speaks of the project's work items ("the evolve issue", "issue 23")."""
+    import re
+    import tokenize
+    root = os.path.join(os.path.dirname(__file__), "..", "pyevolver")
+    bad = []
+    skip = (tokenize.INDENT, tokenize.NEWLINE, tokenize.NL, tokenize.ENCODING, tokenize.DEDENT)
+    for folder, _, files in os.walk(root):
+        for name in files:
+            if not name.endswith(".py"):
+                continue
+            path = os.path.join(folder, name)
+            with open(path, "rb") as fh:
+                toks = list(tokenize.tokenize(fh.readline))
+            for i, t in enumerate(toks):
+                if t.type != tokenize.STRING or not re.search(r"\bissues?\b", t.string, re.I):
+                    continue
+                if toks[i - 1].type in skip and toks[i + 1].type == tokenize.NEWLINE:
+                    continue                                  # a docstring
+                bad.append(f"{os.path.relpath(path, root)}:{t.start[0]}: {t.string[:60]}")
+    assert not bad, bad
