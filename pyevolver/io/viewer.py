@@ -70,12 +70,23 @@ def viewer_data(surface: Surface) -> dict:
     return data
 
 
+def viewer_html(surface: Surface, title: str = "pyevolver") -> str:
+    """The viewer page of ``surface`` (one self-contained HTML text)."""
+    data = json.dumps(viewer_data(surface), separators=(",", ":")).replace("</", "<\\/")
+    return _PAGE.replace("__TITLE__", html.escape(title)).replace("__DATA__", data)
+
+
+def notebook_html(surface: Surface, title: str = "pyevolver", height: int = 520) -> str:
+    """The viewer in an ``<iframe srcdoc>`` (a notebook cell's display)."""
+    page = viewer_html(surface, title)
+    return (f'<iframe srcdoc="{html.escape(page, quote=True)}" width="100%" '
+            f'height="{int(height)}" style="border:0"></iframe>')
+
+
 def write_viewer(surface: Surface, path: str, title: str = "pyevolver") -> str:
     """Write the HTML viewer of ``surface`` to ``path`` (atomically); returns
     ``path``."""
-    data = viewer_data(surface)
-    page = (_PAGE.replace("__TITLE__", html.escape(title))
-            .replace("__DATA__", json.dumps(data, separators=(",", ":"))))
+    page = viewer_html(surface, title)
     try:
         with atomic_path(path, ".html") as tmp:
             with open(tmp, "w", encoding="utf-8") as fh:

@@ -133,3 +133,15 @@ def test_a_headless_browser_draws_the_mesh(tmp_path):
         assert drv.execute_script(_PIXELS)[0] > 0.1 * total
     finally:
         drv.quit()
+
+
+def test_a_session_displays_itself_in_a_notebook():
+    import html as H
+
+    from pyevolver.io.viewer import viewer_html
+    s = _cube()
+    frame = s._repr_html_()
+    assert frame.startswith('<iframe srcdoc="') and frame.endswith("</iframe>")
+    page = H.unescape(frame[len('<iframe srcdoc="'):frame.index('" width=')])
+    assert page == viewer_html(s.surface, title=repr(s))
+    assert "<canvas" in page and "&lt;Session" in page
