@@ -5,13 +5,32 @@ exit codes.
 """
 from __future__ import annotations
 
+import difflib
 import os
 import sys
 import traceback
 
 
+#: The page that lists what is supported and what is refused (every refusal names it).
+DOCS_PAGE = "docs/supported.md"
+_REFUSAL = "not supported in pyevolver"
+
+
+def _with_docs(message):
+    """A refusal's message with the docs page named (once)."""
+    if isinstance(message, str) and _REFUSAL in message and DOCS_PAGE not in message:
+        return f"{message}; see {DOCS_PAGE}"
+    return message
+
+
 class PyEvolverError(Exception):
-    """Base class of every pyevolver error."""
+    """Base class of every pyevolver error (a refusal's message names
+    :data:`DOCS_PAGE`)."""
+
+    def __init__(self, *args):
+        if args:
+            args = (_with_docs(args[0]),) + args[1:]
+        super().__init__(*args)
 
 
 class DatafileError(PyEvolverError):
@@ -22,7 +41,7 @@ class DatafileError(PyEvolverError):
     """
 
     def __init__(self, message, filename=None, line=None, column=None, excerpt=None):
-        self.message = message
+        self.message = message = _with_docs(message)
         self.filename = filename
         self.line = line
         self.column = column
@@ -60,8 +79,21 @@ def excerpt_window(line: str, column: int | None = None,
     return pre + cut + post, (None if column is None else c - start + len(pre))
 
 
+def did_you_mean(word: str, names) -> str:
+    """``"; did you mean 'x'?"`` (or two or three names) for the names
+    closest to ``word`` (difflib, case-insensitive), or ``""``."""
+    pool = {str(n).lower(): str(n) for n in names if n and str(n) != word}
+    close = difflib.get_close_matches(str(word).lower(), list(pool), n=3, cutoff=0.75)
+    if not close:
+        return ""
+    quoted = [f"'{pool[c]}'" for c in close]
+    text = quoted[0] if len(quoted) == 1 else ", ".join(quoted[:-1]) + " or " + quoted[-1]
+    return f"; did you mean {text}?"
+
+
 class UnsupportedError(PyEvolverError):
-    """An Evolver feature that pyevolver recognises but refuses by name."""
+    """An Evolver feature that pyevolver recognises but refuses by name:
+    ``not supported in pyevolver: FEATURE (why); see docs/supported.md``."""
 
     def __init__(self, feature, detail=""):
         self.feature = feature

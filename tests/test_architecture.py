@@ -27,7 +27,8 @@ PKG = ROOT / "pyevolver"
 # costs 0.4 s and 11 MB, for the elliptic functions and one quadrature rule;
 # scipy.sparse.linalg 0.1 s and 8 MB, for the hessian's and newton's solves)
 OPTIONAL = {"matplotlib", "tqdm", "prompt_toolkit", "sksparse", "dask", "distributed",
-            "h5py", "PIL", "threadpoolctl", "tomli", "tomllib", "readline", "pexpect"}
+            "h5py", "PIL", "threadpoolctl", "tomli", "tomllib", "readline", "pexpect",
+            "pyvista", "vtk"}
 HEAVY = {"scipy.special", "scipy.sparse.linalg"}
 MAX_LINES = 800
 

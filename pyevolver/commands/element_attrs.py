@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from ..errors import CommandError, ExpressionError, UnsupportedError
+from ..errors import CommandError, ExpressionError, UnsupportedError, did_you_mean
 from ..expr import nodes as N
 from ..geometry import kernels
 from ..model import records as MS
@@ -22,6 +22,15 @@ from .values import _KIND, ElemRef, QRef, SessionLike, as_float, as_int
 
 # the coordinates past the third (SPACE_DIMENSION > 3), by column
 _HIGH_COORDS = {"w": 3, "x4": 3, "x5": 4, "x6": 5, "x7": 6, "x8": 7, "x9": 8}
+
+
+#: The built-in attribute names of :func:`get_attr` (for "did you mean").
+ATTRIBUTE_NAMES = (
+    "area", "backbody", "backcolor", "color", "colour", "density", "edge_vector", "fixed",
+    "frontbody", "frontcolor", "hit_constraint", "id", "length", "no_refine", "oid",
+    "on_boundary", "on_constraint", "on_method_instance", "on_quantity", "orientation",
+    "original", "p1", "p2", "pressure", "show", "target", "tension", "valence",
+    "vertex_normal", "vertexnormal", "volconst", "volume", "x", "y", "z")
 
 
 def get_attr(session: SessionLike, base, name, idx):
@@ -215,7 +224,9 @@ def get_attr(session: SessionLike, base, name, idx):
         return subs[j - 1]
     if name in s.quantities and k in ("vertex", "edge", "facet"):
         return A.element_quantity_value(session, base, name)
-    raise ExpressionError(f"{k} has no attribute '{name}'")
+    known = list(ATTRIBUTE_NAMES) + list(_KIND) + list(s.quantities) + [
+        a for (kk, a) in s.extra if kk == k]
+    raise ExpressionError(f"{k} has no attribute '{name}'" + did_you_mean(name, known))
 
 
 def attr_pos(k, name, arr, idx):

@@ -67,7 +67,7 @@ def _export(session, args):
                   max_args=2)
 def _snapshot(session, args):
     path, *field = _strings("snapshot", _usage("snapshot"), args)
-    session.snapshot(path, field=field[0] if field else "mean_curvature")
+    session.snapshot(path, field=field[0] if field else "auto")
     session.write(f"Snapshot written to {path}.\n")
 
 

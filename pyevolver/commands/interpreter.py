@@ -17,13 +17,15 @@ import time
 import numpy as np
 
 from ..atomic import atomic_write
-from ..errors import CommandError, ExpressionError, PyEvolverError, UnsupportedError
+from ..errors import (CommandError, ExpressionError, PyEvolverError, UnsupportedError,
+                      did_you_mean)
 from ..expr import nodes as N
 from ..limits import MAX_ARRAY_ENTRIES, MAX_NESTING
 # the families register their commands when imported (refused last: its
 # fallbacks only take names no other family has)
 from . import (constraints, eigen, element_attrs, elements, evolution, extensions, files,  # noqa: F401
                fixing, model_order, output, popping, remesh, toggles)
+from . import display  # noqa: F401  (after toggles: s, show, P, geomview)
 from . import refused  # noqa: F401
 from . import simplex
 from . import registry, variables
@@ -656,7 +658,8 @@ class Interpreter:
             return
         if name in s.variables and arg is None:
             raise CommandError(f"'{raw}' is a variable, not a command (use print {raw})")
-        raise CommandError(f"unknown command '{raw}'")
+        names = [w for w in registry.words() if len(w) > 1] + list(s.commands)
+        raise CommandError(f"unknown command '{raw}'" + did_you_mean(name, names))
 
     # -- expressions ------------------------------------------------------------
     def value(self, expr):

@@ -10,10 +10,10 @@ from ..errors import CommandError, UnsupportedError
 from .registry import register
 
 LETTER_LATER = {
-    "g": "g (iteration) comes with the evolve issue",
-    "U": "U (conjugate gradient) comes with the evolve issue",
-    "m": "m (fixed scale) comes with the evolve issue",
-    "G": "G (gravity) comes with the evolve issue",
+    "g": "g (iteration)",
+    "U": "U (conjugate gradient)",
+    "m": "m (fixed scale)",
+    "G": "G (gravity)",
     "e": "e (extrapolation)", "i": "i (information)", "Q": "Q (quantities)",
     "C": "C (consistency check)", "c": "c (counts)", "N": "N",
     "b": "b (interactive body targets)", "p": "p (ideal gas)", "y": "y (torus duplication)",

@@ -160,11 +160,16 @@ TOGGLE_REFUSED = {
 }
 
 
+_DISPLAY = {"s", "show", "P", "geomview", "gv", "oogl"}
+
+
 def graphics_toggle(tok):
     """A display word of the command grammar that is also a toggle
     (``transforms off``, ``clipped on``, ``ps_colorflag``): the toggle command,
     or None for a graphics command."""
     words = str(tok).split()
+    if words and (words[0].lower() == "geomview" or words == ["show"]):
+        return ("bare", words[0].lower(), None)      # pyevolver.commands.display
     if not words or words[0].lower() not in TOGGLES or len(words) > 2:
         return None
     if len(words) == 2 and words[1].lower() not in ("on", "off"):
@@ -275,8 +280,9 @@ def _graphics(interp, raw, arg):
     return
 
 
-register(*sorted(n for n in GRAPHICS if len(n) > 1), "s", "S", "P",
-         usage="s | show | geomview | ...", help="graphics (nothing is drawn)",
+# s, show, P, geomview, gv and oogl: pyevolver.commands.display
+register(*sorted(n for n in GRAPHICS if len(n) > 1 and n not in _DISPLAY), "S",
+         usage="show_expr | postscript | ...", help="graphics (nothing is drawn)",
          family="toggles")(_graphics)
 
 

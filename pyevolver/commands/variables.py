@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from ..errors import CommandError, ExpressionError, UnsupportedError
+from ..errors import CommandError, ExpressionError, UnsupportedError, did_you_mean
 from ..expr import nodes as N
 from ..model import string as SM
 from .toggles import TOGGLE_DEFAULTS, TOGGLES
@@ -138,7 +138,9 @@ def internal(session: SessionLike, name):
     }
     fn = simple.get(name)
     if fn is None:
-        raise ExpressionError(f"undefined name '{name}'")
+        known = list(simple) + list(session.variables) + list(session.settings) + list(
+            s.quantities) + list(TOGGLES)
+        raise ExpressionError(f"undefined name '{name}'" + did_you_mean(name, known))
     v = fn()
     return v if isinstance(v, str) else float(v)
 

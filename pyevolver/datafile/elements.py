@@ -14,11 +14,11 @@ import re
 import numpy as np
 from lark.exceptions import UnexpectedInput, VisitError
 
-from ..errors import PyEvolverError
+from ..errors import PyEvolverError, did_you_mean
 from ..expr import nodes as N
 from ..limits import MAX_FACE_EDGES, MAX_ID, MAX_NESTING, nesting_depth
 from .grammar import _LINE, line_parser
-from .located import _LocatedName
+from .located import _LocatedName, _keywords
 from .scan import (_BAD_NUMBER, _KW_INTEGER, _KW_NEEDS_VALUE, _LONG, _NUMERIC_HEAD,
                    _NUMERIC_LINE, _binary_minus_in_parens, _long_numeric, _plain_tail)
 
@@ -190,7 +190,9 @@ class ElementSections:
         if exc.name in getattr(self, "_functions", ()):
             return self.error(f"not supported in pyevolver: calling the user function "
                               f"{exc.name} in a datafile element line", srcline, exc.col)
-        return self.error(f"undefined parameter '{exc.name}'", srcline, exc.col)
+        words = set(self.scene.parameters) | {w for ws in _keywords().values() for w in ws}
+        return self.error(f"undefined parameter '{exc.name}'" + did_you_mean(exc.name, words),
+                          srcline, exc.col)
 
 
     def _unknown_words(self, etype, eid, items, qnames, srcline):

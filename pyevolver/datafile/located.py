@@ -4,9 +4,13 @@ scanners and transformers, which the reader turns into a
 the wording of a parser's "expected ..." list."""
 from __future__ import annotations
 
+import functools
+import os
 import re
 
 from lark.exceptions import UnexpectedCharacters, UnexpectedToken
+
+from ..errors import did_you_mean
 
 
 class _Unsupported(Exception):
@@ -53,6 +57,27 @@ def _expected(exp):
     return ", ".join(names)
 
 
+_TERMINAL_LINE = re.compile(r"^([A-Z][A-Z0-9_]*)(?:\.\d+)?:\s*(.*)$", re.M)
+
+
+@functools.lru_cache(maxsize=1)
+def _keywords() -> dict:
+    """``{terminal: keywords it matches}`` of the datafile grammars' keyword
+    terminals (the words of their regular expressions; for "did you mean")."""
+    out: dict = {}
+    here = os.path.dirname(os.path.abspath(__file__))
+    for name in ("fe_top.lark", "fe_elements.lark"):
+        try:
+            with open(os.path.join(here, name), encoding="utf-8") as fh:
+                text = fh.read()
+        except OSError:
+            continue
+        for term, pattern in _TERMINAL_LINE.findall(text):
+            words = re.findall(r"(?<![\\\w])[a-z][a-z0-9_]{2,}", pattern.replace("\\b", " "))
+            out.setdefault(term, set()).update(words)
+    return out
+
+
 def describe(exc: Exception, text: str) -> str:
     """The message for a parse error ``exc`` of ``text`` (without location)."""
     if isinstance(exc, UnexpectedCharacters):
@@ -68,5 +93,7 @@ def describe(exc: Exception, text: str) -> str:
             exp = _expected(exc.expected)
             return f"unexpected end of line: expected {exp}"
         exp = _expected(exc.expected)
-        return f"unexpected '{tok}': expected {exp}"
+        words = [w for e in exc.expected for w in _keywords().get(e, ())]
+        hint = did_you_mean(str(tok), words) if re.fullmatch(r"[A-Za-z_]\w*", str(tok)) else ""
+        return f"unexpected '{tok}': expected {exp}{hint}"
     return str(exc).split("\n")[0]

@@ -118,3 +118,42 @@ def surface_fields(surface, totals=None) -> tuple[dict, dict]:
     if "boundary" in s.fattr:
         f["boundary"] = np.asarray(s.fattr["boundary"], np.int32)
     return v, f
+
+
+#: The Evolver's 16 colours (BLACK .. WHITE, manual "Colors"), as RGB in [0, 1].
+EVOLVER_COLORS = np.array([
+    [0, 0, 0], [0, 0, 1], [0, 0.5, 0], [0, 1, 1], [1, 0, 0], [1, 0, 1], [0.6, 0.4, 0.2],
+    [0.75, 0.75, 0.75], [0.5, 0.5, 0.5], [0.5, 0.5, 1], [0.5, 1, 0.5], [0.5, 1, 1],
+    [1, 0.5, 0.5], [1, 0.5, 1], [1, 1, 0], [1, 1, 1]], float)
+
+
+def facet_colors(surface) -> np.ndarray | None:
+    """(nf, 3) RGB of the facets' colours when the datafile (or a ``set
+    facet color``) gives them more than one colour; None otherwise."""
+    c = surface.fattr.get("frontcolor")
+    if c is None:
+        c = surface.fattr.get("color")
+    if c is None:
+        return None
+    c = np.asarray(c, float)
+    if c.shape != (surface.nf,) or len(np.unique(c)) < 2:
+        return None
+    idx = np.clip(np.nan_to_num(c), 0, 15).astype(int)
+    return EVOLVER_COLORS[idx]
+
+
+def clipped_range(values: np.ndarray, lo: float = 2.0, hi: float = 98.0) -> tuple:
+    """A colour range that a few extreme values cannot stretch: the
+    ``lo``-th and ``hi``-th percentiles of the finite ``values``, narrowed
+    to Tukey's far-out fences (quartiles ∓ 3 interquartile ranges: the mean
+    curvature at a fixed boundary, say, is left out), widened when flat."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return 0.0, 1.0
+    a, b, q1, q3 = (float(x) for x in np.percentile(v, [lo, hi, 25, 75]))
+    a, b = max(a, q1 - 3 * (q3 - q1)), min(b, q3 + 3 * (q3 - q1))
+    if b <= a:
+        pad = max(abs(a) * 1e-6, 1e-12)
+        a, b = a - pad, b + pad
+    return a, b

@@ -1,16 +1,22 @@
-"""Headless pictures of a surface and of its energy history (matplotlib,
-imported only when a picture is drawn; the Agg canvas, no pyplot and no
-display).
+"""Headless pictures of a surface and of its energy history.
+
+Surfaces are drawn with PyVista/VTK off-screen when it is installed (the
+``view`` extra: smooth shading, :mod:`.render_vtk`) for PNG and JPEG files,
+else with matplotlib (imported only when a picture is drawn; the Agg canvas,
+no pyplot and no display; also for PDF and SVG).
 
 The camera is the Evolver's view matrix (manual, "The View Matrix"): a
 homogeneous (4, 4) matrix applied to the coordinates; after it the first
 coordinate points towards the viewer, the second to the right and the third
-up (as in the Evolver's ``povray.cmd``: camera on the +x axis, z up), and
-the picture shows the square [-1.4, 1.4]² of the other two, projected
-orthographically.  A session's ``view_matrix`` starts by fitting the
-surface's bounding box into [-1, 1]³ at load and then stays fixed: pictures
-taken along an evolution share one camera.  ``view_matrix[i][j] := ...``
-moves it from the command language, :func:`camera` builds one from angles.
+up (as in the Evolver's ``povray.cmd``: camera on the +x axis, z up),
+projected orthographically.  Only its direction is used: every picture is
+framed on the surface's projected extent, so a surface that moves or grows
+stays in the picture.  A view matrix without rotation (the Evolver's
+initial one) is turned to the oblique :data:`OBLIQUE` view;
+``view_matrix[i][j] := ...`` sets another from the command language,
+:func:`camera` builds one from angles.  Colour ranges are clipped at
+percentiles (:func:`pyevolver.io.fields.clipped_range`); the datafile's
+facet colours are drawn when it sets them (``field="auto"``).
 """
 from __future__ import annotations
 
@@ -22,11 +28,22 @@ import numpy as np
 from ..atomic import atomic_path
 from ..errors import CommandError, UnsupportedError, dimension_error
 from ..model.surface import Surface
-from .fields import curvature_method, surface_fields
+from . import render_vtk
+from .fields import clipped_range, curvature_method, facet_colors, surface_fields
 
-#: Half-width of the picture in view coordinates: the initial view's
-#: [-1, 1] with a margin for a surface that grows.
-HALF_WIDTH = 1.4
+#: The default direction of a picture: (azimuth, elevation) in degrees.
+OBLIQUE = (-35.0, 25.0)
+
+
+def oblique(view: np.ndarray | None) -> np.ndarray | None:
+    """``view`` turned to the :data:`OBLIQUE` direction when it has no
+    rotation (a diagonal 3×3 part: the Evolver's initial view matrix)."""
+    if view is None:
+        return None
+    M = np.asarray(view, float)
+    if M.shape == (4, 4) and np.count_nonzero(M[:3, :3] - np.diag(np.diag(M[:3, :3]))) == 0:
+        return camera(np.zeros((0, 3)), *OBLIQUE) @ M
+    return M
 
 
 def _matplotlib():
@@ -61,26 +78,28 @@ def camera(X: np.ndarray, azimuth: float = 0.0, elevation: float = 0.0,
     return R @ M
 
 
-def _facet_values(s, field):
-    """Per-facet values of ``field`` (a facet field, or a vertex field
-    averaged over each facet's corners) and its label."""
+def _field_values(s, field):
+    """``(vertex values or None, facet values, label)`` of ``field`` (a
+    facet field, or a vertex field and its facet averages)."""
     v, f = surface_fields(s)
     if field in f:
-        return np.asarray(f[field], float), f"facet {field}"
+        return None, np.asarray(f[field], float), f"facet {field}"
     if field in v:
         label = f"vertex {field}"
         if field == "mean_curvature":
             label = f"mean curvature ({curvature_method(s)})"
-        return np.asarray(v[field], float)[s.F].mean(axis=1), label
+        vals = np.asarray(v[field], float)
+        return vals, vals[s.F].mean(axis=1), label
     names = sorted(set(v) | set(f))
-    raise CommandError(f"snapshot: no field '{field}' (known: {', '.join(names)}, none)")
+    raise CommandError(f"snapshot: no field '{field}' (known: {', '.join(names)}, "
+                       f"colors, auto, none)")
 
 
-def snapshot(surface: Surface | None, path: str, field: str | None = "mean_curvature",
+def snapshot(surface: Surface | None, path: str, field: str | None = "auto",
              view: np.ndarray | None = None, size: int = 600, cmap: str = "viridis",
              edges: bool | None = None, clim: tuple | None = None,
-             title: str | None = None) -> str:
-    """Draw ``surface`` into an image file (png, pdf, svg: by the
+             title: str | None = None, backend: str | None = None) -> str:
+    """Draw ``surface`` into an image file (png, jpg, pdf, svg: by the
     extension), written atomically.
 
     Parameters
@@ -88,19 +107,24 @@ def snapshot(surface: Surface | None, path: str, field: str | None = "mean_curva
     surface : Surface
         Its vertices ``X`` (nv, 3) and triangles ``F`` (nf, 3) are drawn.
     field : str or None
-        Colour facets by this field of :func:`pyevolver.io.fields.surface_fields`
-        (vertex fields averaged over each facet) with a colour bar; ``None``
-        or ``"none"`` for a plain grey surface.  Facets are shaded by the
-        angle of their normal to the viewing direction.
+        Colour by this field of :func:`pyevolver.io.fields.surface_fields`
+        with a labelled colour bar; ``"colors"`` for the datafile's facet
+        colours; ``"auto"`` (default) for the facet colours when the datafile
+        sets them, else the mean curvature; ``None`` or ``"none"`` for a
+        plain grey surface.
     view : (4, 4) array, optional
-        The view matrix (a session passes its ``view_matrix``); default
-        :func:`camera` of the vertices.
+        The view matrix (its direction; a session passes its
+        ``view_matrix``); default the :data:`OBLIQUE` view.
     size : int
-        Width of the picture in pixels (the height is the same).
+        Width and height of the picture in pixels (a colour bar takes the
+        right fifth).
     edges : bool, optional
         Draw facet edges (default: when there are at most 5000 facets).
     clim : (lo, hi), optional
-        Colour range (default: the field's range).
+        Colour range (default: the field's range clipped at percentiles,
+        :func:`pyevolver.io.fields.clipped_range`).
+    backend : "vtk" or "matplotlib", optional
+        Default: VTK when PyVista is installed and the file is .png or .jpg.
 
     Returns
     -------
@@ -109,16 +133,53 @@ def snapshot(surface: Surface | None, path: str, field: str | None = "mean_curva
     """
     if surface is not None and surface.X.shape[1] > 3:
         raise dimension_error(surface.sdim, "pictures", "need")
-    mpl, Figure, FigureCanvasAgg = _matplotlib()
-    from matplotlib.collections import PolyCollection
     s = surface
     if s is None or s.nf == 0:
         raise CommandError("snapshot: no facets to draw")
-    if view is None:
-        view = camera(s.X)
-    M = np.asarray(view, float)
+    M = camera(s.X, *OBLIQUE) if view is None else np.asarray(view, float)
     if M.shape != (4, 4):
         raise CommandError(f"snapshot: the view matrix must be 4x4, not {M.shape}")
+    rgb = None
+    if field == "auto":
+        rgb = facet_colors(s)
+        field = "mean_curvature" if rgb is None else "colors"
+    if field == "colors":
+        rgb = facet_colors(s)
+        if rgb is None:
+            rgb = np.tile([0.78, 0.80, 0.84], (s.nf, 1))
+    vvals = fvals = None
+    label = ""
+    if field not in (None, "none", "colors"):
+        vvals, fvals, label = _field_values(s, field)
+        if clim is None:
+            clim = clipped_range(vvals if vvals is not None else fvals)
+        lo, hi = clim
+        if not np.isfinite(lo) or not np.isfinite(hi):
+            lo, hi = 0.0, 1.0
+        if hi <= lo:
+            lo, hi = lo - 0.5, hi + 0.5
+        clim = (float(lo), float(hi))
+    draw_edges = s.nf <= 5000 if edges is None else edges
+    ext = os.path.splitext(os.fspath(path))[1].lower()
+    if backend is None:
+        backend = "vtk" if ext in (".png", ".jpg", ".jpeg") and render_vtk.available() \
+            else "matplotlib"
+    if backend == "vtk":
+        X3 = np.zeros((s.nv, 3))
+        X3[:, :s.X.shape[1]] = s.X
+        return render_vtk.render_png(path, X3, s.F, M, size, point_values=vvals,
+                                     cell_values=fvals if vvals is None else None, clim=clim,
+                                     label=label, cmap=cmap, rgb=rgb, edges=draw_edges,
+                                     title=title)
+    if backend != "matplotlib":
+        raise CommandError(f"snapshot: no renderer '{backend}' (vtk or matplotlib)")
+    return _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, title)
+
+
+def _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, title):
+    """matplotlib: facets in painter's order, flat shading."""
+    mpl, Figure, FigureCanvasAgg = _matplotlib()
+    from matplotlib.collections import PolyCollection
     P = s.X @ M[:3, :3].T + M[:3, 3]                    # (nv, 3) view coordinates
     w = s.X @ M[3, :3] + M[3, 3]
     with np.errstate(all="ignore"):
@@ -131,31 +192,28 @@ def snapshot(surface: Surface | None, path: str, field: str | None = "mean_curva
     shade = 0.45 + 0.55 * lam
     fig = Figure(figsize=(size / 100.0, size / 100.0), dpi=100)
     FigureCanvasAgg(fig)
-    ax = fig.add_axes([0.0, 0.0, 0.8 if field not in (None, "none") else 1.0, 1.0])
-    if field in (None, "none"):
-        rgb = np.tile([0.78, 0.80, 0.84], (s.nf, 1))
-    else:
-        vals, label = _facet_values(s, field)
-        lo, hi = clim if clim is not None else (np.nanmin(vals), np.nanmax(vals))
-        if not np.isfinite(lo) or not np.isfinite(hi):
-            lo, hi = 0.0, 1.0
-        if hi <= lo:
-            lo, hi = lo - 0.5, hi + 0.5
-        norm = mpl.colors.Normalize(lo, hi)
+    bar = fvals is not None
+    ax = fig.add_axes([0.0, 0.0, 0.8 if bar else 1.0, 1.0])
+    if bar:
+        norm = mpl.colors.Normalize(*clim)
         cm = mpl.colormaps[cmap]
-        rgb = cm(norm(np.nan_to_num(vals)))[:, :3]
-        cax = fig.add_axes([0.8, 0.1, 0.03, 0.8])
+        rgb = cm(norm(np.nan_to_num(fvals)))[:, :3]
+        cax = fig.add_axes([0.82, 0.1, 0.03, 0.8])
         cb = fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cm), cax=cax,
-                          format=mpl.ticker.FormatStrFormatter("%.6g"))
+                          format=mpl.ticker.FormatStrFormatter("%.4g"))
         cb.set_label(label)
+    elif rgb is None:
+        rgb = np.tile([0.78, 0.80, 0.84], (s.nf, 1))
     rgb = np.clip(rgb * shade[:, None], 0.0, 1.0)
-    draw_edges = s.nf <= 5000 if edges is None else edges
     pc = PolyCollection(C[order][:, :, 1:], facecolors=rgb[order],
                         edgecolors=(0.1, 0.1, 0.1, 0.6) if draw_edges else "face",
                         linewidths=0.3 if draw_edges else 0.0)
     ax.add_collection(pc)
-    ax.set_xlim(-HALF_WIDTH, HALF_WIDTH)
-    ax.set_ylim(-HALF_WIDTH, HALF_WIDTH)
+    # framed on the surface, every picture
+    lo, hi = P[:, 1:].min(axis=0), P[:, 1:].max(axis=0)
+    mid, half = (lo + hi) / 2, 0.53 * max(float(np.max(hi - lo)), 1e-12)
+    ax.set_xlim(mid[0] - half, mid[0] + half)
+    ax.set_ylim(mid[1] - half, mid[1] + half)
     ax.set_aspect("equal")
     ax.set_axis_off()
     if title:

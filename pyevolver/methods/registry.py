@@ -121,7 +121,7 @@ def lookup(name: str, model: str = "linear") -> Method:
     except KeyError:
         if name in CURVATURE_METHODS:
             raise UnsupportedError(f"method {name}", _NOT_YET.get(
-                name, "curvature energies come with the Willmore issue")) from None
+                name, "this curvature energy is not implemented")) from None
         raise UnsupportedError(f"method {name}") from None
 
 

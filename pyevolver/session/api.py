@@ -22,7 +22,7 @@ from typing import Any
 
 from ..datafile.writer import DumpSettings
 from ..errors import UnsupportedError
-from ..io import meshio_plugin, render
+from ..io import meshio_plugin, render, viewer
 
 #: ``progress=None`` shows a bar for runs of at least this many steps.
 PROGRESS_MIN_STEPS = 100
@@ -72,14 +72,23 @@ class SessionAPI:
                                     settings=DumpSettings(self.filename, self.settings,
                                                           self.toggles, self.attr_types))
 
-    def snapshot(self, path: str, field: str | None = "mean_curvature", view=None,
+    def snapshot(self, path: str, field: str | None = "auto", view=None,
                  **kwargs) -> str:
         """Render the surface to an image file, headless
-        (:func:`pyevolver.io.render.snapshot`; the camera is the session's
-        ``view_matrix`` unless ``view`` is given)."""
+        (:func:`pyevolver.io.render.snapshot`; the camera looks along the
+        session's ``view_matrix``, turned oblique while it has no rotation,
+        unless ``view`` is given; framed on the surface every time)."""
         if view is None:
-            view = self.arrays.get("view_matrix")
+            view = render.oblique(self.arrays.get("view_matrix"))
         return render.snapshot(self.surface, path, field=field, view=view, **kwargs)
+
+    def _repr_html_(self) -> str | None:
+        """In a notebook a session shows its surface in the viewer of
+        :mod:`pyevolver.io.viewer` (None where it has no facets to draw)."""
+        surf = getattr(self, "surface", None)
+        if surf is None or surf.nf == 0 or surf.X.shape[1] > 3:
+            return None
+        return viewer.notebook_html(surf, title=repr(self))
 
     def plot_history(self, path: str, **kwargs) -> str:
         """Plot the energy of every ``g`` step so far

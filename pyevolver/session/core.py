@@ -20,6 +20,7 @@ import numpy as np
 
 from . import popping, undo
 from .api import SessionAPI, progress_bar
+from .result import GResult
 from ..commands import constraints, element_attrs, elements, files, remesh, variables
 from ..commands import interpreter as I
 from ..commands.variables import DEFAULTS, READ_ONLY  # noqa: F401 (READ_ONLY: re-exported)
@@ -478,8 +479,9 @@ class Session(SessionAPI):
             self._iterator.cg_history = None
 
     def g(self, n: int = 1, callback: Callable[[Any], Any] | None = None, echo: bool = False,
-          progress: Any = None) -> list:
-        """Run ``n`` iteration steps; returns the list of step results.
+          progress: Any = None) -> GResult:
+        """Run ``n`` iteration steps; returns a :class:`~.result.GResult`: the
+        list of step results with the final energy, area, scale and pressures.
 
         ``callback(result)`` is called after each step; returning True stops
         the run.  With ``echo`` the Evolver's progress lines are printed.
@@ -492,17 +494,17 @@ class Session(SessionAPI):
             # keyword EFFECTIVE_AREA changes only the squared curvature)
             raise UnsupportedError("g with effective_area on", "the effective-area motion "
                                    "is not implemented")
-        results: list = []
+        results = GResult()
         if self.surface.nv == 0:                # e.g. after `t` removed everything (REF)
             self.write("WARNING 1051: No vertices. Did you forget to load a surface?\n\n")
-            return results
+            return results.finish(self)
         bar = None if echo else progress_bar(n, progress, "g")
         try:
             self._steps(n, callback, echo, results, bar)
         finally:
             if bar is not None:
                 bar.close()
-        return results
+        return results.finish(self)
 
     def _steps(self, n, callback, echo, results, bar):
         for k in range(n, 0, -1):

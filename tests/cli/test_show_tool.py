@@ -27,7 +27,7 @@ def png_size(path):
 def test_defaults():
     a = args(CUBE, "-o", "x.png")
     assert (a.field, a.azimuth, a.elevation, a.size, a.commands) == \
-        ("mean_curvature", 0.0, 0.0, 600, "")
+        ("auto", 0.0, 0.0, 600, "")
 
 
 def test_renders_png_of_the_requested_width(tmp_path, capsys):

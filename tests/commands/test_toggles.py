@@ -88,5 +88,8 @@ def test_graphics_toggle():
     assert graphics_toggle("transforms off")[:2] == ("bare", "transforms")
     assert graphics_toggle("transforms off")[2].name == "off"
     assert graphics_toggle("clipped") == ("bare", "clipped", None)
-    assert graphics_toggle("geomview") is None          # a graphics command, not a toggle
+    assert graphics_toggle("show_expr facets where 1") is None   # a graphics command
+    # geomview and a bare show are commands of pyevolver.commands.display
+    assert graphics_toggle("geomview on") == ("bare", "geomview", None)
+    assert graphics_toggle("show") == ("bare", "show", None)
     assert graphics_toggle("transforms 3") is None

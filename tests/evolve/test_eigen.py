@@ -183,24 +183,14 @@ def test_linear_metric_on_the_uniform_grid(tmp_path):
     assert abs(low.values[0] - EG.nearest(hs, -1.0, 1).values[0]) < 1e-9
 
 
-@pytest.mark.parametrize("cholmod", [True, False])
+@pytest.mark.parametrize("cholmod", [pytest.param(True, marks=pytest.mark.cholmod), False])
 def test_hessian_index_with_and_without_the_steps_pivots(monkeypatch, cholmod):
     """newton._index, REF's "Index" of warning 1825: from the solve's LDLᵀ
     pivots (CHOLMOD) or, without them, one factorization; the constrained
     circulant shifted by −c has as many negative eigenvalues as exact < c."""
-    import os
-
     from pyevolver.evolve import newton
     from pyevolver.evolve.hessian import solve_bordered
-    if cholmod:
-        try:
-            import sksparse.cholmod  # noqa: F401
-        except ImportError:
-            if os.environ.get("CI", "").lower() == "true":
-                pytest.fail("scikit-sparse is not installed: .ci/run must install "
-                            "pyevolver[cholmod]")
-            pytest.skip("the CHOLMOD pivots need scikit-sparse (the cholmod extra)")
-    else:
+    if not cholmod:
         monkeypatch.setattr(EG, "_cholmod", lambda: None)
         monkeypatch.setattr(newton, "_cholmod", lambda: None)
     K, B, exact = _circulant(30)

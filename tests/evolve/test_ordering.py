@@ -1,6 +1,5 @@
 """Geometric nested dissection for the hessian's factorization
 (pyevolver/evolve/ordering.py)."""
-import os
 
 import numpy as np
 import pytest
@@ -47,16 +46,11 @@ def test_small_problems_keep_their_order():
     assert np.array_equal(nested_dissection(X, sp.identity(10), leaf=64), np.arange(10))
 
 
+@pytest.mark.cholmod
 def test_cholmod_in_this_order_solves_the_bordered_system():
     """An indefinite K (graph Laplacian shifted by -0.37) bordered by two
     dense columns: CHOLMOD in the nested-dissection order and SuperLU on the
     whole bordered matrix give the same solution."""
-    try:
-        import sksparse.cholmod  # noqa: F401
-    except ImportError:
-        if os.environ.get("CI", "").lower() == "true":
-            pytest.fail("scikit-sparse is not installed: .ci/run must install pyevolver[cholmod]")
-        pytest.skip("scikit-sparse not installed")
     X, L = _graph_laplacian(4)
     assert L.shape[0] > H._ND_MIN
     K = (L - 0.37 * sp.identity(L.shape[0])).tocsc()
