@@ -15,7 +15,7 @@ from pyevolver.evolve import gradient as GR
 from pyevolver.evolve import string_hessian as SH
 from pyevolver.evolve.iterate import _Constraints
 from conftest import example
-from reference import run_reference
+from reference import run_reference, reference_args
 from comparison import _same, run_pyevolver
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
@@ -85,7 +85,8 @@ def test_fixed_body_area_is_refs_error_3362(evolver, tmp_path):
     with pytest.raises(CommandError, match="Fixed quantity body_1_vol is not connected"):
         sess.run("hessian")
     assert np.array_equal(sess.surface.X, X)
-    proc = subprocess.run([evolver, "-p1", example("slidestr.fe")], input="g 5\nhessian\nq\nq\n",
+    proc = subprocess.run(reference_args(evolver, example("slidestr.fe"), "hessian"),
+                          input="g 5\nhessian\nq\nq\n",
                           capture_output=True, text=True, timeout=60, cwd=str(tmp_path))
     assert "ERROR 3362: Fixed quantity body_1_vol is not connected" in proc.stdout + proc.stderr
 
