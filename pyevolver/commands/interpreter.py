@@ -311,7 +311,7 @@ class Interpreter:
                                f"{len(args)}")
         self.tick()
         if len(self.env.scopes) > MAX_NESTING:
-            raise CommandError(f"'{proc.name}': calls nested more than {MAX_NESTING} deep")
+            raise CommandError(f"'{proc.name}': calls nested too deep (more than {MAX_NESTING})")
         scope = {name: v for (_, name), v in zip(proc.params, args)}
         self.env.scopes.append(scope)
         try:

@@ -64,8 +64,8 @@ def split_edges(s, R):
             s.X[s.E[R, 1]] - s.X[s.E[R, 0]])
     elif s.periods is None:
         t.X[mid] = 0.5 * (s.X[s.E[R, 0]] + s.X[s.E[R, 1]])
-    else:                                 # the head as seen from the tail
-            t.X[mid] = s.X[s.E[R, 0]] + 0.5 * edge_vectors(s.X, s.E, s.wrap_shift())[R]
+    else:       # the mean of the tail and the head as seen from the tail (REF's rounding)
+        t.X[mid] = 0.5 * (s.X[s.E[R, 0]] + (s.X[s.E[R, 1]] + s.wrap_shift()[R]))
     if "wrap" in t.eattr:
         t.eattr["wrap"][R] = 0.0          # the tail half stays in the tail's cell
     t.E[half, 0] = mid

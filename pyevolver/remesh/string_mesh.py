@@ -37,8 +37,10 @@ popstr.fe, slidestr.fe and 100grain.fe:
   other's place in the other chains; the kept vertex does not move when
   that facet had three edges when ``t`` began, nor when the deleted edge is
   such a merged side.  A deletion that would leave an edge from a vertex
-  to itself, or a facet of one edge, is refused by name (REF deletes more
-  than it reports there, with an internal error).  Matches REF on
+  to itself leaves it there: REF deletes such an edge at its own visit,
+  counted, the vertex unchanged, and a facet left without edges goes (one
+  made after its own visit, and a facet left with two sides that do not
+  meet at the eliminated vertex, are refused by name).  Matches REF on
   100grain.fe up to ``t 0.06``; from 0.07 on REF's cascades of dissolved
   cells differ (not measured further).
 """
@@ -192,6 +194,16 @@ def _signatures(s):
     return vsig, esig
 
 
+def _facets_at(chains, e, E, ealive, v):
+    """The facets through edge ``e`` (``v`` None) or through the live edges
+    at vertex ``v``."""
+    if v is None:
+        return {f for f, ch in enumerate(chains) if e in ch or ~e in ch}
+    at = set(np.nonzero(ealive & (E == v).any(axis=1))[0].tolist())
+    return {f for f, ch in enumerate(chains)
+            if any((x if x >= 0 else ~x) in at for x in ch)}
+
+
 def _drop_edge(ch, e, E):
     """Chain ``ch`` without edge ``e``; REF starts a closed chain that loses
     its first edge, run backwards, at the edge before it (100grain.fe ``t``)."""
@@ -247,20 +259,37 @@ def delete_short_edges(s, length: float):
         if not np.linalg.norm(d) < length:
             continue
         a, b = int(E[e, 0]), int(E[e, 1])
-        if ok(b, e):
+        if a == b:
+            # REF (measured, tests/remesh/test_string_mesh.py): an edge from a
+            # vertex to itself left by earlier merges goes at its visit, counted,
+            # the vertex unchanged; a facet left without edges goes
+            ealive[e] = False
+            chains = [_drop_edge(ch, e, E) for ch in chains]
+            if rings and head[a] == e:
+                at = np.nonzero(ealive & (E == a).any(axis=1))[0]
+                tt = np.where(E[at, 0] == a, times[at, 0], times[at, 1])
+                head[a] = at[np.argmax(tt)] if len(at) else -1
+            count += 1
+            continue
+        go_a, go_b = ok(a, e), ok(b, e)
+        if go_a and go_b and any(chains):
+            # REF (as autopop): an end on a facet the edge is not on stays and
+            # absorbs the other (100grain.fe g 5; t 0.01: a junction keeps its
+            # place, the chain vertex goes), where the edge is on two facets
+            # (string_dissolve4.fe: an edge of one cell, the junction moves)
+            fe_ = _facets_at(chains, e, E, ealive, None)
+            sa, sb = _facets_at(chains, e, E, ealive, a), _facets_at(chains, e, E, ealive, b)
+            stay_a, stay_b = not sa <= fe_, not sb <= fe_
+            if len(fe_) >= 2 and stay_a != stay_b:
+                go_a, go_b = not stay_a, not stay_b
+        if go_b:
             keep, elim, sgn = a, b, 1.0       # elim = keep + the edge vector
-        elif ok(a, e):
+        elif go_a:
             keep, elim, sgn = b, a, -1.0
         else:
             continue
         others = np.nonzero(ealive & (E == elim).any(axis=1))[0]
         others = others[others != e]
-        ends = E[others]
-        if a == b or np.any((ends == keep).any(axis=1) & (ends == elim).any(axis=1)) \
-                or np.any(ends[:, 0] == ends[:, 1]):
-            raise UnsupportedError(
-                "t leaving an edge from a vertex to itself in the string model",
-                f"deleting edge {int(eids[e])}; the Evolver deletes more than it reports there")
         collapse = []        # (facet, surviving side, removed side): REF dissolves it
         for f, ch in enumerate(chains):
             rest = [x for x in ch if (x if x >= 0 else ~x) != e]
@@ -273,16 +302,18 @@ def delete_short_edges(s, length: float):
                         collapse.append((f, r[0] if at_elim[0] else r[1],
                                          r[1] if at_elim[0] else r[0]))
                         continue
+                if len(rest) < 2:
+                    continue        # a loop edge left: deleted at its own visit
                 raise UnsupportedError(
-                    "t leaving a facet of one edge in the string model",
-                    f"deleting edge {int(eids[e])} closes facet {int(s.ids('facet')[f])} on one "
-                    "edge; the Evolver then deletes more than it reports, with an internal "
-                    "error")
+                    "t leaving a facet of two sides not met at the eliminated vertex in the "
+                    "string model",
+                    f"deleting edge {int(eids[e])} closes facet {int(s.ids('facet')[f])} on two "
+                    "sides; which side REF keeps there was not measured")
         shift = None
         # REF (measured): the kept vertex stays put when the facet dissolved
         # had three edges when t began, or when the edge is a side merged by
         # an earlier dissolve of this t; else it moves as usual
-        if ok(keep, e) and not any(n0[f] == 3 for f, _, _ in collapse) and e not in merged:
+        if go_a and go_b and not any(n0[f] == 3 for f, _, _ in collapse) and e not in merged:
             if wrap is not None and np.any(wrap[e] != 0):
                 # REF: a tail outside the unit cell ends at the midpoint as
                 # seen from the head (measured: tests/remesh/test_string_mesh.py)
@@ -345,6 +376,11 @@ def delete_short_edges(s, length: float):
         count += 1
     if not count:
         return s, 0
+    if np.any(ealive & (E[:, 0] == E[:, 1])):
+        loop = int(eids[np.nonzero(ealive & (E[:, 0] == E[:, 1]))[0][0]])
+        raise UnsupportedError("t leaving an edge from a vertex to itself in the string model",
+                               f"edge {loop} became one after its own visit; REF's handling "
+                               "there was not measured")
     src = copy.copy(s)
     src.X = X
     src.eattr = dict(s.eattr)

@@ -25,6 +25,7 @@ import numpy as np
 from ..errors import UnsupportedError
 from ..geometry.kernels import edge_vectors
 from .grow import grow, remap_quantities
+from .shrink import subset
 
 #: the new vertex of a pop lies this fraction of the shorter moved edge off
 POP_FRACTION = 0.1
@@ -32,6 +33,11 @@ POP_FRACTION = 0.1
 
 def _dec(x):
     return x if x >= 0 else ~x
+
+
+def edge_vecs(s):
+    """Edge vectors (torus wraps included)."""
+    return _edge_vecs(s)
 
 
 def _edge_vecs(s):
@@ -69,16 +75,39 @@ def _ends_at(E, v):
     return [(int(e), 1 if c == 0 else -1) for e, c in zip(rows, cols)]
 
 
+def _facet_pairs(s, v):
+    """The pairs of edges (indices) that follow each other in a facet chain
+    through vertex ``v``."""
+    enc, ptr = s.sf_enc, s.sf_ptr
+    pairs = set()
+    for f in range(len(ptr) - 1):
+        chain = [int(x) for x in enc[ptr[f]:ptr[f + 1]]]
+        m = len(chain)
+        closed = m > 1 and _head(s, chain[-1]) == _tail(s, chain[0])
+        for k in range(m if closed else m - 1):
+            x, y = chain[k], chain[(k + 1) % m]
+            if _head(s, x) == v and _dec(x) != _dec(y):
+                pairs.add(frozenset((_dec(x), _dec(y))))
+    return pairs
+
+
 def _pop_one(s, v):
-    """Split one pair of edges off vertex ``v``: a new surface."""
+    """Split one pair of edges off vertex ``v``: a new surface.  The pair:
+    the smallest angle among the pairs that follow each other in a facet
+    (cell) at ``v`` (all pairs when no facet passes ``v``): on a tangled
+    100grain.fe (``m 0.05; g 1``) REF passes over a smaller angle between
+    two edges of no common cell."""
     ends = _ring_order(s, v, _ends_at(s.E, v))
     ev = _edge_vecs(s)
     out = np.array([ev[e] * sg for e, sg in ends])          # from v outwards
     lens = np.linalg.norm(out, axis=1)
     units = out / lens[:, None]
+    fp = _facet_pairs(s, v)
     best, pair = -np.inf, (0, 1)
     for i in range(len(ends)):
         for j in range(i + 1, len(ends)):
+            if fp and frozenset((ends[i][0], ends[j][0])) not in fp:
+                continue
             c = float(out[i] @ out[j]) / float(lens[i] * lens[j])
             if c > best:
                 best, pair = c, (i, j)
@@ -253,6 +282,10 @@ def delete_short_edges(s, crit, candidates=None, merges=None):
         for ed, f in zip(np.where(enc >= 0, enc, ~enc).tolist(), owner.tolist()):
             efacets[ed].add(f)
 
+    nfac = len(s.sf_ptr) - 1
+    chains = [[int(x) for x in s.sf_enc[s.sf_ptr[f]:s.sf_ptr[f + 1]]] for f in range(nfac)]
+    fdrop = np.zeros(nfac, bool)
+
     def vfacets(v):
         out = set()
         for x in np.nonzero((E == v).any(axis=1) & ealive)[0].tolist():
@@ -260,19 +293,23 @@ def delete_short_edges(s, crit, candidates=None, merges=None):
         return out
     n = 0
 
-    def vec(e):
-        d = X[E[e, 1]] - X[E[e, 0]]
+    def head(e):
+        h = X[E[e, 1]]
         if wrap is not None:
-            d = d.copy()
-            d[:shift.shape[1]] += wrap[e] @ shift
-        return d
-    for e in (range(s.ne) if candidates is None else np.sort(candidates).tolist()):
+            h = h.copy()
+            h[:shift.shape[1]] += wrap[e] @ shift
+        return h
+    eorder = np.argsort(s.ids("edge"), kind="stable")     # REF visits in id order
+    if candidates is not None:
+        eorder = eorder[np.isin(eorder, candidates)]
+    for e in eorder.tolist():
         if not ealive[e] or efixed[e]:
             continue
         a, b = int(E[e, 0]), int(E[e, 1])
         if a == b:
             continue
-        d = vec(e)
+        hx = head(e)
+        d = hx - X[a]
         if candidates is None and np.linalg.norm(d) >= crit:
             continue                    # (candidates: chosen before any deletion)
         can_b = not fixed[b] and _same_cons(s, b, e)
@@ -280,21 +317,22 @@ def delete_short_edges(s, crit, candidates=None, merges=None):
         if efacets is not None:
             # a vertex on a facet the edge is not on stays (100grain.fe after
             # r: a junction keeps its place and absorbs the midpoint vertex);
-            # when neither end may go by that rule, the head goes
+            # when neither end may go by that rule, the head goes; only on an
+            # edge of two facets, as t (string_dissolve4.fe)
             fa, fb = vfacets(a), vfacets(b)
             ok_a, ok_b = fa <= efacets[e], fb <= efacets[e]
-            if can_a and can_b and (ok_a or ok_b):
+            if can_a and can_b and (ok_a or ok_b) and len(efacets[e]) >= 2:
                 can_a, can_b = ok_a, ok_b
         if not (can_a or can_b):
             continue
         if s.vcon and any(on[a] or on[b] for on in s.vcon.values()):
             raise UnsupportedError("autopop of an edge on a constraint",
                                    "REF's rule there was not measured")
-        keep_v, gone, dv = (a, b, d) if can_b else (b, a, -d)
+        keep_v, gone = (a, b) if can_b else (b, a)
         if merges is not None:
             merges.append((keep_v, gone, bool(can_a and can_b)))
-        if can_a and can_b:
-            X[keep_v] = X[keep_v] + 0.5 * dv
+        if can_a and can_b:             # the midpoint, rounded as REF's
+            X[a] = 0.5 * (X[a] + hx)    # (both may go: the tail is kept)
         we = None if wrap is None else (wrap[e] if keep_v == a else -wrap[e])
         ealive[e] = False
         at = np.nonzero((E == gone).any(axis=1) & ealive)[0]
@@ -309,11 +347,19 @@ def delete_short_edges(s, crit, candidates=None, merges=None):
                     wrap[x] = wrap[x] - we
         valive[gone] = False
         n += 1
+        if efacets is not None:
+            for f in sorted(efacets[e]):
+                _dissolve(f, chains, fdrop, efacets, ealive, E, wrap, set(at.tolist()))
     if not n:
         return s, 0, np.arange(s.nv)
     t = grow(s)
     t.X = X
     t.E = E
+    if fdrop.any():
+        t.sf_enc = np.array([x for f, ch in enumerate(chains) if not fdrop[f] for x in ch],
+                            np.int64)
+        t.sf_ptr = np.concatenate([[0], np.cumsum(
+            [0 if fdrop[f] else len(ch) for f, ch in enumerate(chains)])]).astype(np.int64)
     if wrap is not None:
         t.eattr["wrap"] = wrap
     if "ring_time" in t.eattr:
@@ -324,12 +370,64 @@ def delete_short_edges(s, crit, candidates=None, merges=None):
                 at = np.nonzero((E == v).any(axis=1) & ealive)[0]
                 head[v] = at[0] if len(at) else -1
     t, nv_ = _compact(t, valive, ealive)
+    if fdrop.any():
+        t = _drop_facets(t, ~fdrop)
     return t, n, nv_
+
+
+def _dissolve(f, chains, fdrop, efacets, ealive, E, wrap, gone_sides):
+    """A facet left with two sides between the same two vertices goes
+    (REF: 100grain.fe ``m 0.05; g 2``, facet_count 98): the side that was
+    at the eliminated vertex stays and takes the other's place in the
+    other chains."""
+    if fdrop[f]:
+        return
+    rest = [x for x in chains[f] if ealive[_dec(x)]]
+    if len(rest) != 2:
+        return
+    r0, r1 = _dec(rest[0]), _dec(rest[1])
+    if r0 == r1 or sorted(E[r0].tolist()) != sorted(E[r1].tolist()):
+        return
+    if (r0 in gone_sides) == (r1 in gone_sides):
+        raise UnsupportedError("autopop leaving a facet of two edges with no side at the "
+                               "eliminated vertex",
+                               "REF's choice of the side kept was not measured")
+    keep_side, dead = (r0, r1) if r0 in gone_sides else (r1, r0)
+    same = E[dead, 0] == E[keep_side, 0]
+    if wrap is not None and not np.array_equal(wrap[dead], wrap[keep_side] if same
+                                               else -wrap[keep_side]):
+        raise UnsupportedError("autopop leaving a facet of two edges around the torus",
+                               "REF's handling was not measured")
+    fwd = keep_side if same else ~keep_side
+    fdrop[f] = True
+    for g in efacets[dead]:
+        chains[g] = [fwd if x == dead else ~fwd if x == ~dead else x for x in chains[g]]
+    efacets[keep_side] |= efacets[dead] - {f}
+    ealive[dead] = False
+
+
+def _drop_facets(s, fkeep):
+    """The string surface ``s`` without the facets not in ``fkeep``."""
+    chains = [s.sf_enc[s.sf_ptr[f]:s.sf_ptr[f + 1]] for f in range(len(fkeep)) if fkeep[f]]
+    dummy = np.zeros((len(fkeep), 3), np.int64)
+    t = subset(s, s.E, dummy, np.ones(s.nv, bool), np.ones(s.ne, bool), fkeep)
+    t.FE = np.zeros((0, 3), np.int64)
+    t.sf_enc = np.concatenate(chains).astype(np.int64) if chains else np.zeros(0, np.int64)
+    t.sf_ptr = np.concatenate([[0], np.cumsum([len(c) for c in chains])]).astype(np.int64)
+    return t
 
 
 def after_move_lengths(s):
     """Edge lengths (torus wraps included)."""
     return np.linalg.norm(_edge_vecs(s), axis=1)
+
+
+def stretch_rates(s, vel):
+    """``e . (vel[head] - vel[tail])`` per edge, ``e`` the edge vector
+    (torus wraps included): the sign of autopop's test."""
+    ev = _edge_vecs(s)
+    dv = vel[s.E[:, 1]] - vel[s.E[:, 0]]
+    return np.einsum("ij,ij->i", ev[:, :dv.shape[1]], dv[:, :ev.shape[1]])
 
 
 def predicted_lengths(s, vel, scale):

@@ -1,7 +1,8 @@
 """The Hessian in the string model (pyevolver.evolve.string_hessian):
 the full analytic Hessian against central differences of the gradient,
 the hessian command against evolver-nox-d (REF's vertex-block Hessian),
-REF's ERROR 3362 for fixed body areas and the refusals."""
+REF's ERROR 3362 for fixed body areas and whole vertex blocks where a
+vertex moves in several directions."""
 import io
 import os
 import subprocess
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 import pyevolver
-from pyevolver.errors import CommandError, PyEvolverError
+from pyevolver.errors import CommandError
 from pyevolver.evolve import gradient as GR
 from pyevolver.evolve import string_hessian as SH
 from pyevolver.evolve.iterate import _Constraints
@@ -91,12 +92,39 @@ def test_fixed_body_area_is_refs_error_3362(evolver, tmp_path):
     assert "ERROR 3362: Fixed quantity body_1_vol is not connected" in proc.stdout + proc.stderr
 
 
-def test_cross_terms_at_multi_direction_vertices_are_refused():
-    sess = _session(os.path.join(DATA, "string_probe_pressure.fe"))
-    X = sess.surface.X.copy()
-    with pytest.raises(PyEvolverError, match="not supported in pyevolver: hessian .* free in 2"):
-        sess.run("hessian")
-    assert np.array_equal(sess.surface.X, X)
+TWO_JUNCTIONS = """STRING
+SPACE_DIMENSION 2
+vertices
+1 0.04 -0.03
+2 1.07 0.05
+3 -0.55 0.74 fixed
+4 -0.46 -0.83 fixed
+5 1.63 0.77 fixed
+6 1.45 -0.66 fixed
+edges
+1 1 3
+2 4 1
+3 2 5
+4 6 2
+5 1 2
+"""
+
+
+@pytest.mark.parametrize("script", ["hessian\nlist vertices\nhessian\nprint total_energy\n",
+                                    "hessian_normal off\nhessian\nlist vertices\n"])
+def test_whole_blocks_at_junctions_and_ends_as_ref(evolver, tmp_path, script):
+    """Vertices free in two directions (a junction, a free end, two
+    junctions joined by an edge) keep their whole block, as REF's step."""
+    f = tmp_path / "two.fe"
+    f.write_text(TWO_JUNCTIONS)
+    _compare(evolver, str(f), script, tmp_path)
+    _compare(evolver, os.path.join(DATA, "string_probe_pressure.fe"),
+             "hessian\nlist vertices\nhessian\nprint total_energy\n", tmp_path)
+
+
+@pytest.mark.slow
+def test_100grain_hessian_as_ref(evolver, tmp_path):
+    _compare(evolver, example("100grain.fe"), "g 5\nhessian\nprint total_energy\n", tmp_path)
 
 
 def test_basis_is_across_the_chord_in_the_plane():

@@ -1,5 +1,7 @@
 """Direct tests of pyevolver.remesh.string (string model): ``split_edges``
 (r) and ``vertex_average`` (V, rawv, rawestv)."""
+import re
+
 import numpy as np
 import pytest
 
@@ -108,3 +110,21 @@ def test_split_on_a_boundary_agrees_with_the_evolver(evolver, tmp_path):
     a = np.array([[float(x) for x in ln.split()] for ln in ref])
     b = np.array([[float(x) for x in ln.split()] for ln in ours])
     assert np.abs(a - b).max() <= 1e-12
+
+
+def test_torus_midpoints_rounded_as_ref(evolver, tmp_path):
+    # REF's midpoint of a wrapped edge is (tail + (head + shift)) / 2: after
+    # r; r on 100grain.fe every coordinate equals REF's to the last bit
+    import subprocess
+    path = "/usr/share/doc/evolver/examples/100grain.fe"
+    cmd = 'foreach vertex vv do printf "%d %.17g %.17g\\n", vv.id, vv.x, vv.y'
+    out = subprocess.run([evolver, "-p1", path], input=f"r\nr\n{cmd}\nq\nq\n", capture_output=True,
+                         text=True, timeout=60, cwd=str(tmp_path)).stdout
+    ref = {int(m[0]): (float(m[1]), float(m[2]))
+           for m in re.findall(r"^(\d+) (\S+) (\S+)$", out, re.M)}
+    sess = pyevolver.load(path)
+    sess.run("r")
+    sess.run("r")
+    s = sess.surface
+    ours = {int(i): (float(x[0]), float(x[1])) for i, x in zip(s.ids("vertex"), s.X)}
+    assert len(ref) == 1100 and ours == ref
