@@ -33,3 +33,19 @@ def test_bench_load_runs(evolver, tmp_path):
 def test_bench_scripts_run(evolver, tmp_path, script, args):
     out = _run([os.path.join(BENCH, script)] + args, tmp_path)
     assert "ratio" in out.lower()
+
+
+def test_bench_hessian_runs(evolver, tmp_path):
+    """Both programs on the level-1 prolate icosphere (80 facets), the table
+    written into a Markdown file between its markers; the solver table."""
+    doc = tmp_path / "perf.md"
+    doc.write_text("intro\n<!-- bench_hessian t -->\nold\n<!-- /bench_hessian t -->\nend\n")
+    out = _run([os.path.join(BENCH, "bench_hessian.py"), "--levels", "1", "--repeat", "1",
+                "--cases", "area", "--label", "t", "--doc", str(doc)], tmp_path)
+    assert out.count("| area |") == 2
+    text = doc.read_text()
+    assert text.startswith("intro\n") and text.endswith("end\n") and "old" not in text
+    assert "| area | 80 | `hessian_seek` |" in text
+    out = _run([os.path.join(BENCH, "bench_hessian.py"), "--levels", "1", "--solvers"],
+               tmp_path)
+    assert "SuperLU, symmetric mode, ND order (pyevolver)" in out

@@ -26,6 +26,7 @@ TOGGLES = {
     "h_inverse_metric", "jiggle", "break_after_warning", "full_bounding_box",
     "show_all_quantities", "show_inner", "show_outer", "colormap", "bezier_basis",
     "volgrads_every", "zener_drag", "backcull", "debug", "autodisplay",
+    "hessian_backtrack",     # pyevolver's own: hessian halves a step that raises the energy
 }
 GRAPHICS = {"s", "P", "show", "show_expr", "transform_expr", "geomview",
             "postscript", "showq", "view_transforms", "ps", "oogl", "gv", "screen"}

@@ -46,6 +46,7 @@ import scipy.sparse as sp
 from ..constraints import restore_state, state
 from ..errors import UnsupportedError, dimension_error
 from .hessian import HessianSystem, _cholmod, hessian_system
+from . import symfactor as SF
 
 #: below this many unknowns the eigenvalues come from the dense matrix
 DENSE_MAX = 800
@@ -83,11 +84,23 @@ class EigenResult:
         return np.asarray(self.system.T @ self.vectors[:, j]).reshape(-1, 3)
 
 
-def _ldl(A):
+def _ldl(A, points=None):
     """``(solve, pivots)`` of an LDLᵀ factorization of the symmetric sparse
     ``A`` without off-diagonal pivoting (CHOLMOD's simplicial LDLᵀ, or
     SuperLU in symmetric mode as :func:`.newton._factor`), or None when a
-    pivot is zero."""
+    pivot is zero.  With ``points`` (n, 3), the positions of the unknowns,
+    and more than :data:`.symfactor.ND_MIN` of them: SuperLU in the cached
+    nested-dissection order of :mod:`.symfactor` (faster on large surfaces)."""
+    if points is not None and A.shape[0] > SF.ND_MIN:
+        try:
+            f = SF.LDL(A, SF.ordering(A, points))
+        except RuntimeError:                  # exactly singular
+            return None
+        if f.pivots is not None:
+            d = np.asarray(f.pivots)
+            if np.all(np.isfinite(d)) and np.all(d != 0):
+                return f.solve, d
+            return None
     chol = _cholmod()
     if chol is not None:
         try:
@@ -118,16 +131,19 @@ class ShiftedFactor:
     eigenvalue of K to machine precision) and too large for the dense
     fallback, unless ``nudge``: then σ is moved by up to 1e-4 of K's mean
     diagonal until it factors (``self.sigma``), for shift-and-invert.
+    ``points`` (n, d), where each unknown sits, lets large systems be
+    factored in :mod:`.symfactor`'s nested-dissection order.
     """
 
-    def __init__(self, K, B, sigma: float, eps: float, M=None, nudge: bool = False):
+    def __init__(self, K, B, sigma: float, eps: float, M=None, nudge: bool = False,
+                 points=None):
         n = K.shape[0]
         Mm = sp.identity(n, format="csc") if M is None else M
         self.n, self.B, self.eps = n, B, eps
         self.solve: Callable
         self.pivots = None
         A = (K - sigma * Mm).tocsc()
-        got = _ldl(A)
+        got = _ldl(A, points)
         if got is None and nudge and n:
             # σ an eigenvalue to machine precision (a rigid motion at 0): for
             # shift-and-invert any shift this near does, so move it a little
@@ -135,7 +151,7 @@ class ShiftedFactor:
             for k in range(1, 4):
                 sigma += 1e-10 * 100 ** k * scale
                 A = (K - sigma * Mm).tocsc()
-                got = _ldl(A)
+                got = _ldl(A, points)
                 if got is not None:
                     break
         self.sigma = sigma
@@ -246,7 +262,7 @@ def _near(hs: HessianSystem, shift: float, m: int, eps: float, dense_max: int, s
         w, V = _dense(hs)
         return _order(w, V, shift, m)
     import scipy.sparse.linalg as spla   # when first used (start-up time)
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True)
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True, points=hs.points)
     v0 = fac.op(np.random.default_rng(seed).standard_normal(n))
     op = spla.LinearOperator((n, n), matvec=fac.op, dtype=float)
     if hs.M is None:
@@ -296,7 +312,8 @@ def inertia(hs: HessianSystem, shift: float, eps: float = 1e-10,
     pts = np.sort(np.concatenate([[shift - rmax, shift - eps], vals[vals < shift - eps]]))
     gap = int(np.argmax(np.diff(pts)))
     sigma = 0.5 * (pts[gap] + pts[gap + 1])
-    below = ShiftedFactor(hs.K, hs.B, sigma, 0.0, hs.M, nudge=True).inertia().below
+    below = ShiftedFactor(hs.K, hs.B, sigma, 0.0, hs.M, nudge=True,
+                          points=hs.points).inertia().below
     below += int(np.sum((vals >= sigma) & (vals < shift - eps)))
     return Inertia(below, equal, max(dim - below - equal, 0))
 
@@ -376,7 +393,7 @@ def inverse_iteration(hs: HessianSystem, shift: float, maxit: int, eps: float = 
     n = hs.K.shape[0]
     if n == 0:
         return ProbeResult(Inertia(0, 0, 0), math.nan, np.zeros(0), 0, [], hs)
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True)
+    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True, points=hs.points)
     inert = inertia(hs, shift, eps)
     Mx = (lambda v: v) if hs.M is None else (lambda v: hs.M @ v)
     rng = np.random.default_rng(seed)

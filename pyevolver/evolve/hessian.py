@@ -258,14 +258,15 @@ def _quantity_hessian(t, q, weight):
     return out
 
 
-def lagrangian_hessian(s, cons, lam, grad_fn, basis=None):
+def lagrangian_hessian(s, cons, lam, grad_fn, basis=None, t=None):
     """Sparse Hessian of E − Σ λ_i g_i (level-set terms excluded): (3nv, 3nv),
-    or ``Tᵀ H T`` on a :class:`Basis`."""
+    or ``Tᵀ H T`` on a :class:`Basis`; ``t`` the surface's current
+    evaluation when the caller has it."""
     if getattr(s, "order", 1) == 2:         # the quadratic model's hook
         raise UnsupportedError("the Hessian in the quadratic model",
                                "REF fails there too (cube.fe: M 2; g 5; hessian gives "
                                "ERROR 3362); M 1 returns to the linear model")
-    t = s.evaluate()
+    t = s.evaluate() if t is None else t
     H, _, complete = _analytic_parts(s, t, cons, lam, basis, gradient=False)
     if complete:
         return H
@@ -294,7 +295,7 @@ def _triple_edges(s):
     return np.nonzero(np.bincount(idx.ravel(), minlength=s.ne) >= 3)[0]
 
 
-def tangent_basis(s, mobile, normal=True):
+def tangent_basis(s, mobile, normal=True, t=None):
     """The free motions of the vertices as a :class:`Basis`.
 
     Unconstrained vertices move freely (3 dof), or with ``normal`` (the
@@ -313,7 +314,7 @@ def tangent_basis(s, mobile, normal=True):
     B = np.zeros((nv, 3, 3))
     ndof_v = np.where(mobile, 3 - np.minimum(ncon, 3), 0)
     if normal:
-        t = s.evaluate()
+        t = s.evaluate() if t is None else t
         nrm = vertex_normals(s, t)
         trip = _triple_edges(s)
         jcnt = np.bincount(s.E[trip].ravel(), minlength=nv)
@@ -503,6 +504,7 @@ class HessianSystem:
         self.points = np.repeat(X, basis.ndof, axis=0)   # (n, 3) where each unknown sits
         self.M = None               # the eigenvalue metric (n, n); None: the identity
         self.M_floor = 1.0          # a lower bound of the eigenvalues of M
+        self.totals = None          # the evaluation K was formed at, when kept
 
 
 def hessian_system(it, normal: bool = True) -> HessianSystem:
@@ -548,9 +550,9 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
         T = basis.matrix()
         K = model.hessian(s, cons, lam, grad_L, basis)
     else:
-        basis, grads = tangent_basis(s, mobile, normal=normal)
+        basis, grads = tangent_basis(s, mobile, normal=normal, t=t)
         T = basis.matrix()
-        K = lagrangian_hessian(s, cons, lam, grad_L, basis)
+        K = lagrangian_hessian(s, cons, lam, grad_L, basis, t=t)
     gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))
     Hc = constraint_curvature(s, grads, gL)
     if Hc is not None:
@@ -562,7 +564,9 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
         Cm = np.stack([g.ravel() for g in gs], axis=1)          # (3nv, k)
         B = np.asarray(T.T @ Cm)
         d = cons.targets(s) - cons.values(t)
-    return HessianSystem(K, B, rhs, d, T, basis, lam, cons, mobile, s.X)
+    hs = HessianSystem(K, B, rhs, d, T, basis, lam, cons, mobile, s.X)
+    hs.totals = t
+    return hs
 
 
 def newton_direction(it, normal: bool = True):

@@ -17,6 +17,7 @@ import numpy as np
 from ..constraints import (displace, project_tangent, project_to_constraints, release_one_sided,
                        restore_state, state)
 from ..errors import UnsupportedError
+from ..threads import blas_limited
 from . import gradient as GR
 from . import optparams as OP
 from ..errors import ConstraintError
@@ -64,6 +65,7 @@ class IterateSettings:
     ribiere: bool = True               # Polak-Ribiere, else Fletcher-Reeves
     check_increase: bool = False
     hessian_normal: bool = True        # ``hessian``: normal motion only
+    hessian_backtrack: bool = False    # ``hessian``: halve a step that raises the energy
     area_normalization: bool = False   # mobility 1 / (star area / 3) (evolve.mobility)
     normal_motion: bool = False        # velocity projected on the vertex normal
     runge_kutta: bool = False          # a fixed-scale step by RK4
@@ -86,6 +88,7 @@ class IterateSettings:
                    ribiere=bool(toggles.get("ribiere", 1)),
                    check_increase=bool(toggles.get("check_increase", 0)),
                    hessian_normal=bool(toggles.get("hessian_normal", 1)),
+                   hessian_backtrack=bool(toggles.get("hessian_backtrack", 0)),
                    area_normalization=bool(toggles.get("area_normalization", 0)),
                    normal_motion=bool(toggles.get("normal_motion", 0)),
                    runge_kutta=bool(toggles.get("runge_kutta", 0)),
@@ -425,6 +428,7 @@ class Iterator:
         return t
 
     # -- the step --------------------------------------------------------------------
+    @blas_limited
     def step(self, settings: IterateSettings | None = None) -> StepResult:
         """One ``g`` step: the motion, the line search (or the fixed
         scale) and the restoring of the fixed values.

@@ -44,6 +44,9 @@ from .eigen import ShiftedFactor
 from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
                       solve_bordered, tangent_basis)
 from .iterate import Iterator, StepResult, _Constraints
+from . import symfactor as SF
+from .symfactor import newton_solve
+from ..threads import blas_limited
 from . import string_hessian  # noqa: F401  (installs the string model's Hessian)
 
 
@@ -241,11 +244,29 @@ def _index(hs, piv, eps):
             return 0
     delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
     try:
-        return ShiftedFactor(hs.K, hs.B, -delta, 0.0, nudge=True).inertia().below
+        return ShiftedFactor(hs.K, hs.B, -delta, 0.0, nudge=True,
+                             points=hs.points).inertia().below
     except UnsupportedError:       # (singular where it cannot be resolved: no warning)
         return 0
 
 
+_SCALED = ("hessian: the Newton step raised the energy; "
+           "step scaled by %g (pyevolver's hessian_backtrack)\n")
+
+
+def _no_rise(E, e0, scale, fallbacks):
+    """``scale`` when the move there does not raise the energy above ``e0``,
+    else the first of ``fallbacks`` that does not, else 0 (no move).
+    ``E(scale)`` moves from the start and restores the fixed values; a rise
+    within round-off (1e-13 relative) is no rise."""
+    top = e0 + 1e-13 * abs(e0)
+    for s in [scale] + list(fallbacks):
+        if s > 0 and E(s) <= top:
+            return s
+    return 0.0
+
+
+@blas_limited
 def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = None,
                  normal: bool = True, eps: float = 1e-10) -> StepResult:
     """The ``hessian`` command: one Newton step on the constrained problem
@@ -271,19 +292,35 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     s = it.surface
     hs = hessian_nd.system(it, normal)
     n = hs.K.shape[0]
+    got = None
     piv: list = []
-    sol = solve_bordered(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, pivots=piv)
+    if n > SF.ND_MIN:
+        # one LDLᵀ of K + δI gives the index and, refined, the step with K
+        # (small systems: the direct solve and, when its pivots find negative
+        # ones, a second factorization for the index; they cost nothing there)
+        delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
+        got = newton_solve(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, delta=delta)
+        if got is None:          # an eigenvalue near −δ: factor K itself
+            got = newton_solve(hs.K, hs.B, hs.rhs, hs.d, points=hs.points)
+            if got is not None:
+                got = (got[0], None)     # (K's pivots are not the index's)
+    if got is not None:
+        sol, index = got
+    else:
+        sol = solve_bordered(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, pivots=piv)
+        index = None
+    if index is None and n:
+        index = _index(hs, piv, eps)
     cons, mobile = hs.cons, hs.mobile
     lam = -sol[n:] if len(cons) else hs.lam
     dx = (hs.T @ sol[:n]).reshape(s.X.shape)
     report: list[str] = []
     if n:
-        index = _index(hs, piv, eps)
         if index:
             report.append(f"WARNING 1825: Hessian not positive definite. Index: {index}\n")
     targets = cons.targets(s)
     X0 = state(s)
-    e0 = s.evaluate().energy
+    e0 = (hs.totals if hs.totals is not None else s.evaluate()).energy
 
     def E(scale, report=None):
         e = it._move(X0, dx, scale, cons, None, None, mobile, targets, report).energy
@@ -291,7 +328,12 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     scale = 1.0
     if seek:
         smax = 1.0 if max_scale is None else max_scale
-        scale, _, _ = it._line_search(E, smax, smax)
+        scale, _, best = it._line_search(E, smax, smax)
+        scale = _no_rise(E, e0, scale, [best])
+    elif it.settings.hessian_backtrack and not it.settings.check_increase:
+        scale = _no_rise(E, e0, 1.0, [0.5 ** k for k in range(1, 41)])
+        if scale != 1.0:
+            report.append(_SCALED % scale)
     t = it._move(X0, dx, scale, cons, None, None, mobile, targets, report)
     if not math.isfinite(t.energy):
         restore_state(s, X0)

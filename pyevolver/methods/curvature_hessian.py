@@ -170,32 +170,54 @@ def vertex_energy_hessian(s, A, F, N, name, m=None):
     return M
 
 
+#: facets per chunk of :func:`star_hessian`: the jets' (m, 9, 9) temporaries of a
+#: chunk stay a few MB (the whole surface at once: about 0.8 GB at 81,920 facets)
+CHUNK = 4096
+
+
 def star_hessian(t, M, dA, dF, dN, basis=None):
     """Hessian of ``Σ_v φ_v(A_v, F_v, N_v)`` given the per-vertex Hessians
-    M (nv, 7, 7) and first derivatives ``dA`` (nv,), ``dF``, ``dN`` (nv, 3)."""
+    M (nv, 7, 7) and first derivatives ``dA`` (nv,), ``dF``, ``dN`` (nv, 3).
+
+    The facet terms and the Jacobian rows are computed over chunks of
+    :data:`CHUNK` facets (both are sums over facets) and assembled once."""
     s = t.surface
-    nv, Fc = s.nv, s.F
-    P = facet_points(t)
-    nf = len(P)
-    x, N2, L, Aj = _facet_jets(P)
-    # curvature of the star sums: α A_f + Σ_c λ_c · ∇_c A_f + ½ Λ · N_f
-    lam = dF[Fc]                                                  # (nf, 3, 3)
-    e = [x[2] - x[1], x[0] - x[2], x[1] - x[0]]
-    w = J.cross_const(e[0], lam[:, 0]) + J.cross_const(e[1], lam[:, 1]) \
-        + J.cross_const(e[2], lam[:, 2])
-    psi = J.dot(N2, w) * _inverse(L * 2.0)
-    H = (Aj.H * dA[Fc].sum(axis=1)[:, None, None] + psi.H
-         + 0.5 * N2.hc(dN[Fc].sum(axis=1)))
-    H2 = _elements(nv, Fc, H, basis)
-    # Gauss–Newton part through the Jacobian of (A_v, F_v, N_v)
-    blocks = np.empty((nf, 3, 7, 9))
-    blocks[:, :, 0, :] = Aj.g[:, None, :]
-    for c in range(3):
-        blocks[:, c, 1:4, :] = Aj.H[:, 3 * c:3 * c + 3, :]      # ∂F_c/∂x = ∂²A/∂x_c∂x
-    blocks[:, :, 4:7, :] = 0.5 * N2.J[:, None]
-    ridx = (7 * Fc[:, :, None] + np.arange(7)).reshape(nf, 21)
-    Jm = _rows(7 * nv, ridx, Fc, blocks.reshape(nf, 21, 3, 3), nv, basis)
-    return _gauss_newton(Jm, M) + H2
+    nv, Fall = s.nv, s.F
+    Pall = facet_points(t)
+    nf = len(Pall)
+    H2parts, Jparts = [], []
+    for lo in range(0, max(nf, 1), CHUNK):
+        Fc, P = Fall[lo:lo + CHUNK], Pall[lo:lo + CHUNK]
+        m = len(Fc)
+        x, N2, L, Aj = _facet_jets(P)
+        # curvature of the star sums: α A_f + Σ_c λ_c · ∇_c A_f + ½ Λ · N_f
+        lam = dF[Fc]                                                  # (m, 3, 3)
+        e = [x[2] - x[1], x[0] - x[2], x[1] - x[0]]
+        w = J.cross_const(e[0], lam[:, 0]) + J.cross_const(e[1], lam[:, 1]) \
+            + J.cross_const(e[2], lam[:, 2])
+        psi = J.dot(N2, w) * _inverse(L * 2.0)
+        H = (Aj.H * dA[Fc].sum(axis=1)[:, None, None] + psi.H
+             + 0.5 * N2.hc(dN[Fc].sum(axis=1)))
+        H2parts.append(_elements(nv, Fc, H, basis))
+        # Gauss–Newton part through the Jacobian of (A_v, F_v, N_v)
+        blocks = np.empty((m, 3, 7, 9))
+        blocks[:, :, 0, :] = Aj.g[:, None, :]
+        for c in range(3):
+            blocks[:, c, 1:4, :] = Aj.H[:, 3 * c:3 * c + 3, :]      # ∂F_c/∂x = ∂²A/∂x_c∂x
+        blocks[:, :, 4:7, :] = 0.5 * N2.J[:, None]
+        ridx = (7 * Fc[:, :, None] + np.arange(7)).reshape(m, 21)
+        Jparts.append(_rows(7 * nv, ridx, Fc, blocks.reshape(m, 21, 3, 3), nv, basis))
+    return _gauss_newton(_add(Jparts), M) + _add(H2parts)
+
+
+def _add(parts):
+    """Sum of sparse matrices of one shape (COO entries concatenated, one conversion)."""
+    if len(parts) == 1:
+        return parts[0].tocsr()
+    coo = [p.tocoo() for p in parts]
+    return sp.csr_matrix((np.concatenate([c.data for c in coo]),
+                          (np.concatenate([c.row for c in coo]),
+                           np.concatenate([c.col for c in coo]))), shape=coo[0].shape)
 
 
 def vertex_hessian(t, m, idx, w, basis=None):

@@ -142,3 +142,46 @@ def test_factor_without_cholmod_refuses_indefinite_matrices_as_cholmod_does(monk
             assert f is not None and np.allclose(M @ f(b), b)
         else:
             assert f is None
+
+
+_CHAIN = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "string_chain.fe")
+
+
+def _chain(*cmds):
+    out = io.StringIO()
+    s = Session.load(_CHAIN, out=out)
+    e0 = s.total_energy
+    for c in cmds:
+        s.run(c + "\n")
+    return s, e0, out.getvalue()
+
+
+def test_hessian_takes_the_rising_newton_step_as_the_evolver():
+    """string_chain.fe: REF's (and so pyevolver's) plain Newton step raises
+    the energy (tests/evolve/test_string_hessian.py compares it with REF)."""
+    s, e0, _ = _chain("hessian")
+    assert s.total_energy > e0 + 0.1
+
+
+def test_hessian_backtrack_halves_a_rising_step():
+    s, e0, out = _chain("hessian_backtrack on", "hessian")
+    assert s.total_energy <= e0
+    assert "hessian: the Newton step raised the energy; step scaled by 0.5" in out
+    plain, _, _ = _chain("hessian")
+    assert s.total_energy < plain.total_energy
+
+
+def test_check_increase_undoes_a_rising_step_even_with_backtrack():
+    """(REF's WARNING 1596 goes to stderr; the energy tells the step was undone.)"""
+    s, e0, out = _chain("check_increase on", "hessian_backtrack on", "hessian")
+    assert s.total_energy == pytest.approx(e0, rel=1e-14)
+    assert "step scaled" not in out
+
+
+def test_hessian_seek_never_rises():
+    s, e0, _ = _chain("hessian_seek")
+    assert s.total_energy <= e0
+    for _ in range(3):
+        e = s.total_energy
+        s.run("hessian_seek\n")
+        assert s.total_energy <= e * (1 + 1e-13)

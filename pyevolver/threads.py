@@ -1,0 +1,74 @@
+"""BLAS threads in the engine's hot paths.
+
+numpy and scipy call OpenBLAS (or MKL), which by default starts one thread
+per core for every product or factorization.  The engine's products are
+small (3×3 blocks, a few columns of constraint gradients) and its sparse
+work is single-threaded, so on a machine shared with other processes those
+threads mostly wait for each other: a ``g`` step at 81,920 facets spent
+1.3× the CPU time of one thread (docs/performance.md).  While a ``g`` or
+``hessian`` step runs, the BLAS libraries are therefore limited (with
+threadpoolctl) to :func:`setting` threads, one by default; outside the steps
+the user's setting is untouched.
+
+The environment variable ``PYEVOLVER_BLAS_THREADS`` sets the number: a
+positive integer, or ``0`` / ``off`` to leave BLAS alone (then
+``OPENBLAS_NUM_THREADS`` and friends decide, as for any numpy program).
+"""
+from __future__ import annotations
+
+import functools
+import os
+from contextlib import nullcontext
+from typing import Any, Callable, TypeVar
+
+ENV = "PYEVOLVER_BLAS_THREADS"
+DEFAULT = 1
+
+_controller: Any = None
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def setting() -> int | None:
+    """The BLAS thread limit of the steps (None: no limit)."""
+    raw = os.environ.get(ENV, "").strip().lower()
+    if raw == "":
+        return DEFAULT
+    if raw in ("0", "off", "none", "no"):
+        return None
+    try:
+        n = int(raw)
+    except ValueError:
+        return DEFAULT
+    return n if n > 0 else None
+
+
+def _control():
+    """A threadpoolctl controller of the BLAS libraries loaded now (made once;
+    None without threadpoolctl)."""
+    global _controller
+    if _controller is None:
+        try:
+            from threadpoolctl import ThreadpoolController
+        except ImportError:
+            _controller = False
+        else:
+            _controller = ThreadpoolController()
+    return _controller or None
+
+
+def limited():
+    """Context manager: BLAS limited to :func:`setting` threads inside."""
+    n = setting()
+    ctl = _control() if n is not None else None
+    if ctl is None:
+        return nullcontext()
+    return ctl.limit(limits=n, user_api="blas")
+
+
+def blas_limited(fn: F) -> F:
+    """Decorator: run ``fn`` under :func:`limited`."""
+    @functools.wraps(fn)
+    def run(*args, **kwargs):
+        with limited():
+            return fn(*args, **kwargs)
+    return run  # type: ignore[return-value]

@@ -1,0 +1,60 @@
+"""BLAS thread control (pyevolver.threads): the setting from
+PYEVOLVER_BLAS_THREADS, the limit inside the steps and the user's
+setting restored after them."""
+import io
+
+import pytest
+from threadpoolctl import threadpool_info
+
+from conftest import example
+from pyevolver import Session
+from pyevolver import threads as TH
+
+
+def _blas_threads():
+    return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+
+
+@pytest.mark.parametrize("raw,want", [(None, 1), ("", 1), ("2", 2), ("0", None),
+                                      ("off", None), ("-3", None), ("many", 1)])
+def test_setting(monkeypatch, raw, want):
+    if raw is None:
+        monkeypatch.delenv(TH.ENV, raising=False)
+    else:
+        monkeypatch.setenv(TH.ENV, raw)
+    assert TH.setting() == want
+
+
+def test_limit_inside_and_restored_after(monkeypatch):
+    import numpy  # noqa: F401  (loads the BLAS)
+    before = _blas_threads()
+    if not before:
+        pytest.skip("no BLAS library that threadpoolctl knows")
+    monkeypatch.delenv(TH.ENV, raising=False)
+    with TH.limited():
+        assert set(_blas_threads()) == {1}
+    assert _blas_threads() == before
+    monkeypatch.setenv(TH.ENV, "off")
+    with TH.limited():
+        assert _blas_threads() == before
+
+
+def test_g_and_hessian_run_limited(monkeypatch):
+    seen = []
+
+    @TH.blas_limited
+    def probe():
+        return _blas_threads()
+    assert probe.__name__ == "probe"
+    real = TH.limited
+
+    def spy():
+        seen.append(1)
+        return real()
+    monkeypatch.setattr(TH, "limited", spy)
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.g(2)
+    assert len(seen) == 2                       # each g step
+    s.hessian(echo=False)
+    assert len(seen) == 3
+    assert set(probe()) <= {1}
