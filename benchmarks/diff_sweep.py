@@ -214,13 +214,27 @@ def _failing_step(text, ref, script, fe):
     return None, None
 
 
+#: Hessian commands: REF assembles their matrix wrongly with worker threads
+#: (with -p1 a method quantity's matrix loses the terms between vertices and
+#: FIXED global quantities stop with ERROR 3362); without -p it is exact, so
+#: a script using them runs REF single-threaded (docs/differences.md).
+_HESSIAN = re.compile(r"\b(hessian\w*|saddle|ritz|eigenprobe|lanczos)\b", re.I)
+
+
+def ref_cmd(script_path, fe):
+    """REF's command line for ``script_path`` on ``fe``: ``-p1`` (bit-for-bit
+    repeatable) unless the script uses a Hessian command."""
+    with open(script_path, encoding="utf-8", errors="replace") as f:
+        hess = bool(_HESSIAN.search(f.read()))
+    return ["evolver-nox-d"] + ([] if hess else ["-p1"]) + ["-f", script_path, fe]
+
+
 def _both(fe, script, timeout, tree, cwd=None):
     env = dict(os.environ, PYTHONPATH=tree, PYTHONUNBUFFERED="1")
     cwd = cwd or os.path.dirname(fe)
     pout, perr, ptime = run([sys.executable, "-m", "pyevolver", "-f", script, fe], cwd,
                             timeout, env, merge=True)
-    rout, rerr, rtime = run(["evolver-nox-d", "-p1", "-f", script, fe], cwd, timeout,
-                            merge=True)
+    rout, rerr, rtime = run(ref_cmd(script, fe), cwd, timeout, merge=True)
     return (pout, ptime), (rout, rtime)
 
 
@@ -327,7 +341,7 @@ def _stepwise(fe, seq, timeout, tree, tmp):
         rpre = os.path.join(tmp, f"rpre{k}.cmd")
         with open(rpre, "w") as f:
             f.write("\n".join(cmds[:k] + [COORDS]) + "\n")
-        rout, _, rt = run(["evolver-nox-d", "-p1", "-f", rpre, fe], cwd, timeout, merge=True)
+        rout, _, rt = run(ref_cmd(rpre, fe), cwd, timeout, merge=True)
         a, b = _coords(pout), _coords(rout)
         if pt or rt or not a or a.keys() != b.keys() or not os.path.exists(dmp):
             continue
@@ -341,7 +355,7 @@ def _stepwise(fe, seq, timeout, tree, tmp):
         _script(rest, cmds[k:])
         full = os.path.join(tmp, "s.cmd")
         (p_full, _), _ = _both(fe, full, timeout, tree)
-        rout2, _, rt2 = run(["evolver-nox-d", "-p1", "-f", rest, dmp], cwd, timeout, merge=True)
+        rout2, _, rt2 = run(ref_cmd(rest, dmp), cwd, timeout, merge=True)
         p, r = parse(p_full, False), parse(rout2, True)
         if rt2 or p is None or r is None or p["energy"] is None or r["energy"] is None:
             continue
