@@ -221,12 +221,35 @@ def _failing_step(text, ref, script, fe):
 _HESSIAN = re.compile(r"\b(hessian\w*|saddle|ritz|eigenprobe|lanczos)\b", re.I)
 
 
-def ref_cmd(script_path, fe):
-    """REF's command line for ``script_path`` on ``fe``: ``-p1`` (bit-for-bit
-    repeatable) unless the script uses a Hessian command."""
+def _uses_hessian(script_path):
     with open(script_path, encoding="utf-8", errors="replace") as f:
-        hess = bool(_HESSIAN.search(f.read()))
-    return ["evolver-nox-d"] + ([] if hess else ["-p1"]) + ["-f", script_path, fe]
+        return bool(_HESSIAN.search(f.read()))
+
+
+def ref_cmd(script_path, fe, threads=None):
+    """REF's command line for ``script_path`` on ``fe``: ``-p1`` (bit-for-bit
+    repeatable) unless the script uses a Hessian command (``threads=True``
+    forces ``-p1``)."""
+    p1 = threads if threads is not None else not _uses_hessian(script_path)
+    return ["evolver-nox-d"] + (["-p1"] if p1 else []) + ["-f", script_path, fe]
+
+
+def _as_threaded_ref(fe, script, timeout, kind, p, res):
+    """REF's Hessian depends on its thread mode (docs/differences.md, "REF's
+    threaded Hessian"): a Hessian case that differs from single-threaded
+    REF is a match when pyevolver prints what REF with ``-p1`` prints."""
+    if res["cls"] not in ("small", "big") or p is None or not _uses_hessian(script):
+        return
+    rout, _, rt = run(ref_cmd(script, fe, threads=True), os.path.dirname(fe), timeout,
+                      merge=True)
+    r1 = parse(rout, True)
+    if rt or r1 is None or r1["energy"] is None:
+        return
+    worst1, _ = compare(p, r1, kind)
+    if worst1 <= MATCH:
+        res["note"] = (f"as REF -p1 (single-threaded REF differs by {res['worst']:.2e})")
+        res["cls"], res["worst"] = "match", worst1
+        res.pop("py", None), res.pop("ref", None)
 
 
 def _both(fe, script, timeout, tree, cwd=None):
@@ -300,6 +323,7 @@ def one_case(fe, seq, timeout, tree=REPO, stepwise=True):
                         res["note"] = where
                     else:
                         res["note"] = (res["note"] + "; " + where).strip("; ")
+            _as_threaded_ref(fe, script, timeout, kind, p, res)
     return res
 
 
