@@ -219,7 +219,9 @@ def main():
     env = dict(os.environ)
     env["PYTHONPATH"] = os.path.abspath(a.pyevolver)
     programs = {"py": ([sys.executable, "-m", "pyevolver"], env),
-                "ref": ([a.evolver, "-p1"], None)}
+                # REF single-threaded: with worker threads (-p1) its Hessian
+                # of a method quantity loses terms (docs/differences.md)
+                "ref": ([a.evolver], None)}
     if a.solvers:
         lev = max(a.levels)
         text = solvers([(f"area, {20 * 4 ** lev:,} facets", icosphere_file(lev)),
@@ -232,7 +234,7 @@ def main():
     for lev in a.levels:
         for case in a.cases:
             f = icosphere_file(lev) if case == "area" else bending_file(lev)
-            e0 = result(_popen_wait4([a.evolver, "-p1", f], PREFIX + PRINT + "q\nq\n",
+            e0 = result(_popen_wait4([a.evolver, f], PREFIX + PRINT + "q\nq\n",
                                      None)[2])[0]
             for command in a.commands:
                 m = measure(programs, f, command, a.repeat)

@@ -5,15 +5,30 @@ import subprocess
 _PROMPT = "Enter command: "
 
 
+#: commands whose Hessian REF assembles wrongly with worker threads: with
+#: ``-p1`` its matrix of a method quantity loses the terms between
+#: different vertices (and, by file size and thread count, some of a
+#: vertex's own block); run without ``-p`` (one thread, REF's default) its
+#: matrix is the exact one (docs/differences.md, "REF's threaded Hessian")
+_HESSIAN = re.compile(r"\b(hessian\w*|saddle|ritz|eigenprobe|lanczos)\b", re.I)
+
+
+def reference_args(exe, datafile, commands):
+    """REF's command line: ``-p1`` (one worker thread: bit-for-bit
+    repeatable), but without worker threads when ``commands`` use a Hessian."""
+    return [exe, datafile] if _HESSIAN.search(commands) else [exe, "-p1", datafile]
+
+
 def run_reference(exe, datafile, commands, timeout=60, cwd=None):
-    """Run ``evolver-nox-d -p1 datafile`` with ``commands`` on stdin.
+    """Run ``evolver-nox-d -p1 datafile`` (without ``-p1`` for Hessian
+    commands, :func:`reference_args`) with ``commands`` on stdin.
 
     Returns the list of output lines printed by the commands (the banner,
     prompts and echoed input removed).
     """
     text = commands if commands.endswith("\n") else commands + "\n"
     text += "q\nq\n"
-    proc = subprocess.run([exe, "-p1", datafile], input=text, capture_output=True,
+    proc = subprocess.run(reference_args(exe, datafile, text), input=text, capture_output=True,
                           text=True, timeout=timeout, cwd=cwd, errors="replace")
     out = proc.stdout
     blocks = out.split(_PROMPT)[1:]

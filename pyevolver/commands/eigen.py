@@ -28,8 +28,7 @@ LANCZOS_SYNTAX = "Syntax: lanczos rexpr   or   lanczos(expr,count)"
 
 def _system(session: Any, what: str):
     """The constrained Hessian of the session's surface (hessian_system),
-    after REF's checks: vertices, valid pressures (in the string model
-    REF's matrix: twice pyevolver.evolve.string_hessian's blocks)."""
+    after REF's checks: vertices, valid pressures."""
     s = session.surface
     if s is None or s.nv == 0:
         raise CommandError(f"{what}: the surface has no vertices")
@@ -41,8 +40,6 @@ def _system(session: Any, what: str):
     if s.X.shape[1] > 3:
         raise dimension_error(s.sdim, "the Hessian's eigenvalues", "need")
     hs = hessian_system(it, normal=it.settings.hessian_normal)
-    if s.string:      # REF's string Hessian matrix holds twice the vertex blocks
-        hs.K = 2.0 * hs.K
     mix = _mix(session)
     if mix is not None:
         EG.metric(hs, s, mix)
@@ -138,8 +135,6 @@ def saddle(session: Any, max_step: float | None = None) -> Any:
     if not math.isfinite(r.value):
         session.write("No degrees of freedom.\n")
         return r
-    if session.surface.string:         # REF's matrix: twice the blocks (see _system)
-        r.value *= 2.0
     session.settings["last_eigenvalue"] = r.value
     if r.step is None:
         session.write("Lowest eigenvalue %.15g. Not a saddle point.\n" % r.value)

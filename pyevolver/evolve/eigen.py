@@ -46,7 +46,6 @@ import scipy.sparse as sp
 from ..constraints import restore_state, state
 from ..errors import UnsupportedError, dimension_error
 from .hessian import HessianSystem, _cholmod, hessian_system
-from .iterate import _Constraints
 from . import symfactor as SF
 
 #: below this many unknowns the eigenvalues come from the dense matrix
@@ -539,26 +538,14 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
 def beyond_reference(surface) -> list[str]:
     """Notes for the Hessian commands where the Evolver 2.70 refuses and
     pyevolver goes on on purpose: gap energy (REF's ERROR 1604: "Cannot do
-    gap energy Hessian") and FIXED quantities of GLOBAL methods (REF's
-    ERROR 3362: "Fixed quantity ... is not connected to any mobile
-    vertices")."""
+    gap energy Hessian").  (REF's ERROR 3362 for FIXED quantities of global
+    methods, fixed volumes with content integrals or on a torus comes only
+    with worker threads, ``-p1``: without them REF converts them to named
+    quantities and steps as pyevolver does.)"""
     notes = []
     if "gap" in surface.evaluate().terms:
         notes.append("pyevolver: gap energy in the Hessian by differences of its gradient "
                      "(the Evolver refuses: ERROR 1604)")
-    # (the string model stops with REF's ERROR 3362: evolve/string_hessian.py)
-    fixed_bodies = len(_Constraints(surface).bodies) > 0 and not surface.string
-    contents = [c for c in list(surface.constraints.values()) +
-                list((getattr(surface, "boundaries", None) or {}).values())
-                if getattr(c, "content", None)]
-    if fixed_bodies and (surface.periods is not None or contents):
-        why = "on a torus" if surface.periods is not None else "with content integrals"
-        notes.append(f"pyevolver: the fixed body volumes {why} in the Hessian (the Evolver "
-                     f"makes them global quantities and refuses: ERROR 3362)")
-    for q in surface.quantities.values():
-        if q.kind == "fixed" and any(getattr(m, "is_global", False) for m, *_ in q.methods):
-            notes.append(f"pyevolver: the fixed quantity {q.name} of a global method in the "
-                         f"Hessian (the Evolver refuses: ERROR 3362)")
     return notes
 
 

@@ -264,8 +264,7 @@ def lagrangian_hessian(s, cons, lam, grad_fn, basis=None, t=None):
     evaluation when the caller has it."""
     if getattr(s, "order", 1) == 2:         # the quadratic model's hook
         raise UnsupportedError("the Hessian in the quadratic model",
-                               "REF fails there too (cube.fe: M 2; g 5; hessian gives "
-                               "ERROR 3362); M 1 returns to the linear model")
+                               "not implemented; M 1 returns to the linear model")
     t = s.evaluate() if t is None else t
     H, _, complete = _analytic_parts(s, t, cons, lam, basis, gradient=False)
     if complete:

@@ -266,6 +266,23 @@ def _no_rise(E, e0, scale, fallbacks):
     return 0.0
 
 
+#: a Newton step longer than this many times the surface's extent comes
+#: from a singular Hessian: it is not taken
+SINGULAR_STEP = 1e2
+
+
+def _absurd_step(hs, s, sol) -> bool:
+    """Is the Newton step :data:`SINGULAR_STEP` times the surface's extent?
+    A singular Hessian (motions that cost no energy while the force has a
+    part along them: 100grain.fe after ``g 5``, 101 zero eigenvalues) makes
+    it blow up; the Evolver takes such a step (100grain.fe ``g 5; hessian``:
+    length 6e13), pyevolver warns and stays."""
+    n = hs.K.shape[0]
+    extent = float(np.ptp(s.X, axis=0).max()) if s.nv else 0.0
+    return bool(n) and bool(np.abs(sol[:n]).max(initial=0.0)
+                            > SINGULAR_STEP * max(extent, 1e-300))
+
+
 @blas_limited
 def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = None,
                  normal: bool = True, eps: float = 1e-10) -> StepResult:
@@ -311,10 +328,15 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         index = None
     if index is None and n:
         index = _index(hs, piv, eps)
-    cons, mobile = hs.cons, hs.mobile
-    lam = -sol[n:] if len(cons) else hs.lam
-    dx = (hs.T @ sol[:n]).reshape(s.X.shape)
     report: list[str] = []
+    absurd = _absurd_step(hs, s, sol)
+    if absurd:
+        report.append("WARNING: the Hessian is singular (motions that cost no energy, with "
+                      "a force along them): the Newton step would move the surface "
+                      f"{np.abs(sol[:n]).max():.3g} and is not taken.\n")
+    cons, mobile = hs.cons, hs.mobile
+    lam = hs.lam if absurd or not len(cons) else -sol[n:]
+    dx = np.zeros(s.X.shape) if absurd else (hs.T @ sol[:n]).reshape(s.X.shape)
     if n:
         if index:
             report.append(f"WARNING 1825: Hessian not positive definite. Index: {index}\n")

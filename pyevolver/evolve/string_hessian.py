@@ -40,7 +40,7 @@ import scipy.sparse as sp
 
 from ..constraints import vertex_coords
 from ..geometry.kernels import edge_vectors
-from ..errors import CommandError, UnsupportedError
+from ..errors import UnsupportedError
 from ..methods import string as SM
 from ..methods.basic import edge_length_hessian
 from ..model.string import chain_points, facet_entries
@@ -49,12 +49,15 @@ from .hessian import MODEL_HESSIAN, Basis, _quantity_hessian, _sum, fd_hessian
 
 
 def check_fixed_bodies(s) -> None:
-    """REF's ERROR 3362 for a string surface with a body of fixed area."""
+    """Refuse the Hessian of a string surface with a body of fixed area."""
     b = s.bodies
     for i in range(b.n):
         if not np.isnan(b.target[i]):
-            raise CommandError(f"Fixed quantity body_{i + 1}_vol is not connected to any "
-                               "mobile vertices.")
+            raise UnsupportedError(
+                "hessian in the string model with a body of fixed area",
+                f"body {i + 1}: the Evolver (one thread) converts the area to a named "
+                "quantity and takes a step pyevolver does not reproduce yet (slidestr.fe); "
+                "with worker threads (-p1) it refuses (ERROR 3362)")
 
 
 # ---------------------------------------------------------------------------
@@ -285,7 +288,7 @@ def string_lagrangian_hessian(s, cons, lam, grad_fn, basis):
     100grain.fe with autochop off): REF's error, not followed
     (docs/differences.md)."""
     t = s.evaluate()
-    H = _vertex_blocks(string_hessian_matrix(s, cons, lam, grad_fn, t)).tocsr()
+    H = string_hessian_matrix(s, cons, lam, grad_fn, t).tocsr()
     T = basis.matrix()
     K = (T.T @ H @ T).tocsr()
     return K

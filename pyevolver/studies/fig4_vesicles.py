@@ -28,8 +28,8 @@ tension.  Two discretisations of W, each with its cure for bad triangles:
     which runs unchanged in ``evolver-nox-d``).
 ``StarPerp+recipe+Newton``
     the same cycles with the ``g`` batch shortened to 5 steps and followed by
-    two ``hessian_seek`` Newton steps (pyevolver; ``evolver-nox-d`` refuses
-    ``hessian`` with a FIXED quantity, its ERROR 3362).
+    two ``hessian_seek`` Newton steps (pyevolver; ``evolver-nox-d -p1``
+    refuses ``hessian`` with a FIXED quantity, its ERROR 3362).
 
 Both energies are Σ_v h_v² A_v/3 with ``A_v`` the star area, so a sphere
 gives 4π (not the (2H)² convention, 16π): the same normalisation as the
