@@ -432,6 +432,8 @@ def _torus_wrap(s, i):
     """The Evolver's torus wrap code of edge ``i``: per period a 6-bit field
     holding the wrap mod 32 (+x 1, -x 31, +y 64, -y 1984, +z 4096,
     -z 126976; the manual's 127040 for -z is not what REF prints)."""
+    if "wrap_code" in s.eattr:                  # the other groups' codes (model.groups)
+        return int(s.eattr["wrap_code"][i])
     w = s.eattr.get("wrap")
     if w is None or s.periods is None:
         return 0

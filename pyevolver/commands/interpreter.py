@@ -25,7 +25,7 @@ from ..limits import MAX_ARRAY_ENTRIES, MAX_NESTING
 from . import (constraints, eigen, element_attrs, elements, evolution, extensions, files,  # noqa: F401
                fixing, model_order, output, popping, remesh, toggles)
 from . import refused  # noqa: F401
-from . import simplex
+from . import group_guard, simplex
 from . import registry, variables
 from .cformat import print_value
 from .nodes import ElemIndex
@@ -117,6 +117,7 @@ class Interpreter:
         elif kind in simplex.STATEMENTS and self._simplex() and simplex.statement(self, node):
             return
         else:
+            group_guard.check(self.session, kind, statement=True)
             registry.statement(kind).handler(self, node)
 
     def _simplex(self):
@@ -642,6 +643,7 @@ class Interpreter:
         if cmd is not None:
             if self._simplex() and simplex.answer(self, raw):
                 return
+            group_guard.check(self.session, raw)
             cmd.handler(self, raw, arg)
             return
         if name in s.variables and arg is None:

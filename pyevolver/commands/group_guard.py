@@ -1,0 +1,61 @@
+"""Commands refused by name in a symmetry group other than the torus
+(pyevolver.model.groups): those whose mesh operations or second
+derivatives would need the group elements and do not know them yet.
+
+``g`` (with fixed volumes, constraints, the iteration toggles), ``r``,
+``j``, the listings, ``dump``, ``print`` / ``printf`` (``wrap_compose``,
+``wrap_inverse``, the ``wrap`` edge attribute) and the settings work; the
+rest below is refused as '`t` in SYMMETRY_GROUP "rotate" ...'.
+"""
+from __future__ import annotations
+
+import re
+
+from ..errors import UnsupportedError
+from ..model.groups import group_of
+
+#: words and letters, with why
+WORDS = {
+    **{w: "a Hessian of the group's quotient (REF converts to named quantities for it)"
+       for w in ("hessian", "hessian_seek", "hessian_menu", "saddle", "ritz", "lanczos",
+                 "eigenprobe", "newton", "bfgs", "optimise", "optimize")},
+    **{w: "a mesh operation whose new edges would need the group elements"
+       for w in ("t", "w", "o", "K", "n", "l", "u", "V", "O", "notch", "areaweed", "edgeweed",
+                 "edge_divide", "equiangulate", "rawv", "rawestv")},
+    **{w: "the quadratic and Lagrange models" for w in ("M", "quadratic", "lagrange")},
+}
+#: statements (parse-tree tags) with why
+STATEMENTS = {
+    "delete": "deleting elements (the merged edges would need the group elements)",
+    "edgeswap": "edge swaps (the new edges would need the group elements)",
+    "equiangulate": "equiangulation (the new edges would need the group elements)",
+    "pop": "popping (the new elements would need the group elements)",
+    "refine": "refining chosen edges (the new edges would need the group elements)",
+}
+
+
+#: quarter_turn: REF's products add the second z power modulo 4, its
+#: facets holding z powers are "not consistent" (WARNING 2000) whichever
+#: edge comes first, and they evolve by rules not measured
+QUARTER_TURN = {w: "REF's facets with z powers are inconsistent (WARNING 2000) and "
+                   "evolve by rules pyevolver has not measured"
+                for w in ("g", "r", "j", "U", "G")}
+
+
+def check(session, raw: str, statement: bool = False) -> None:
+    """Refuse ``raw`` (a word or a statement tag) by name when the session's
+    surface is in a group of pyevolver.model.groups and the command is not
+    group-aware."""
+    s = session.surface
+    if s is None or group_of(s) is None:
+        return
+    table = STATEMENTS if statement else WORDS
+    key = raw if len(raw) == 1 else raw.lower()
+    if re.fullmatch(r"g\d+", key):
+        key = "g"
+    why = table.get(key)
+    if why is None and s.symmetry_group == "quarter_turn":
+        why = (STATEMENTS if statement else QUARTER_TURN).get(key)
+    if why is not None:
+        name = key.rstrip("_")
+        raise UnsupportedError(f'`{name}` in SYMMETRY_GROUP "{s.symmetry_group}" ({why})')
