@@ -2,14 +2,17 @@
 (pyevolver.model.groups): those whose mesh operations or second
 derivatives would need the group elements and do not know them yet.
 
-``g`` (with fixed volumes, constraints, the iteration toggles), ``r``,
-``j``, the listings, ``dump``, ``print`` / ``printf`` (``wrap_compose``,
+``g`` (constraints, the iteration toggles; not with fixed body volumes or
+pressures), ``r``,
+``V`` (not next to an axial point), ``rawv``, ``rawestv``, ``j``, the listings, ``dump``, ``print`` / ``printf`` (``wrap_compose``,
 ``wrap_inverse``, the ``wrap`` edge attribute) and the settings work; the
 rest below is refused as '`t` in SYMMETRY_GROUP "rotate" ...'.
 """
 from __future__ import annotations
 
 import re
+
+import numpy as np
 
 from ..errors import UnsupportedError
 from ..model.groups import group_of
@@ -20,8 +23,8 @@ WORDS = {
        for w in ("hessian", "hessian_seek", "hessian_menu", "saddle", "ritz", "lanczos",
                  "eigenprobe", "newton", "bfgs", "optimise", "optimize")},
     **{w: "a mesh operation whose new edges would need the group elements"
-       for w in ("t", "w", "o", "K", "n", "l", "u", "V", "O", "notch", "areaweed", "edgeweed",
-                 "edge_divide", "equiangulate", "rawv", "rawestv")},
+       for w in ("t", "w", "o", "K", "n", "l", "u", "O", "notch", "areaweed", "edgeweed",
+                 "edge_divide", "equiangulate")},
     **{w: "the quadratic and Lagrange models" for w in ("M", "quadratic", "lagrange")},
 }
 #: statements (parse-tree tags) with why
@@ -39,7 +42,17 @@ STATEMENTS = {
 #: edge comes first, and they evolve by rules not measured
 QUARTER_TURN = {w: "REF's facets with z powers are inconsistent (WARNING 2000) and "
                    "evolve by rules pyevolver has not measured"
-                for w in ("g", "r", "j", "U", "G")}
+                for w in ("g", "r", "j", "U", "G", "V", "rawv", "rawestv")}
+
+
+_MOVES = {"g", "U", "j", "V", "rawv", "rawestv", "G"}
+
+
+def _volume_constrained(s) -> bool:
+    b = s.bodies
+    if not b.n:
+        return False
+    return bool(np.any(~np.isnan(b.target)) or np.any(~np.isnan(b.pressure)))
 
 
 def check(session, raw: str, statement: bool = False) -> None:
@@ -54,6 +67,13 @@ def check(session, raw: str, statement: bool = False) -> None:
     if re.fullmatch(r"g\d+", key):
         key = "g"
     why = table.get(key)
+    if why is None and key == "V" and not statement and any(
+            kw in s.vattr and s.vattr[kw].any() for kw in ("axial_point", "double_axial_point")):
+        why = "vertex averaging next to an axial point, whose normals REF takes by rules " \
+              "not measured"
+    if why is None and key in _MOVES and not statement and _volume_constrained(s):
+        why = "moves with fixed body volumes or pressures: REF's volume projection in " \
+              "these groups was not matched (the volumes themselves are REF's)"
     if why is None and s.symmetry_group == "quarter_turn":
         why = (STATEMENTS if statement else QUARTER_TURN).get(key)
     if why is not None:

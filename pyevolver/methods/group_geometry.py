@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import UnsupportedError
 from ..geometry import kernels as G
 
 
@@ -48,10 +49,39 @@ def corner_maps(s, group) -> tuple[np.ndarray, np.ndarray]:
     return A.reshape(c.shape + (3, 3)), b.reshape(c.shape + (3,))
 
 
+#: named-quantity methods whose values and gradients go through the corner
+#: and edge maps (the others read vertex coordinates on their own)
+METHODS = {"facet_area", "facet_volume", "edge_length", "edge_area", "edge_tension",
+           "facet_tension", "vertex_scalar_integral"}
+
+
+def check_supported(s) -> None:
+    """Refuse by name what would ignore the group elements: metrics,
+    constraint and boundary integrals, CONVEX gap energies, the quadratic
+    model and named-quantity methods outside :data:`METHODS`."""
+    where = f'in SYMMETRY_GROUP "{s.symmetry_group}"'
+    if s.metric is not None:
+        raise UnsupportedError(f"a metric {where}")
+    if s.order != 1:
+        raise UnsupportedError(f"the quadratic model {where}")
+    for kind, table in (("constraint", s.constraints), ("boundary", s.boundaries)):
+        for c in table.values():
+            if getattr(c, "energy", None) or getattr(c, "content", None):
+                raise UnsupportedError(f"{kind} ENERGY / CONTENT integrals {where}")
+            if "convex" in getattr(c, "flags", ()):
+                raise UnsupportedError(f"CONVEX constraints (gap energy) {where}")
+    for q in s.quantities.values():
+        for m, *_ in q.methods:
+            if m.method not in METHODS:
+                raise UnsupportedError(f"the quantity method {m.method} {where} (it reads "
+                                       f"vertex coordinates without the group elements)")
+
+
 def totals_geometry(t, group) -> None:
     """Set the evaluation's cached geometry (edge vectors, facet sides,
     normals, areas, contents) and the maps of ``t.surface`` in ``group``."""
     s = t.surface
+    check_supported(s)
     X = s.X
     A, b = element_maps(s, group)
     t.edge_maps = A

@@ -64,3 +64,23 @@ def test_volume_gradient_and_corners():
     g = corner_scatter(t, facet_volume_grad(t, False))
     assert np.allclose(g, _fd(s, lambda t: t.facet_volume.sum()), atol=1e-7)
     assert vol != 0 and callable(body_volume_gradients)
+
+
+def _with_top(name, line, tmp_path):
+    lines = open(os.path.join(DATA, name + ".fe")).read().split("\n")
+    path = tmp_path / "q.fe"
+    path.write_text("\n".join(lines[:4] + [line] + lines[4:]))
+    return str(path)
+
+
+def test_methods_through_the_maps_and_refusals(tmp_path):
+    """facet_area quantities go through the maps; methods, integrals and
+    metrics that read coordinates on their own are refused by name."""
+    s = pyevolver.load(_with_top("cubocta", "quantity qq energy method facet_area global",
+                                 tmp_path)).surface
+    assert s.evaluate().energy == pytest.approx(2 * s.evaluate().total_area, rel=1e-14)
+    for line in ("quantity qq energy method facet_scalar_integral scalar_integrand: x^2 global",
+                 "constraint 1\nformula: z = 0\nenergy:\ne1: 0\ne2: z\ne3: 0",
+                 "metric\n1 0 0\n0 1 0\n0 0 1"):
+        with pytest.raises(pyevolver.errors.PyEvolverError, match='in SYMMETRY_GROUP "cubocta"'):
+            pyevolver.load(_with_top("cubocta", line, tmp_path))
