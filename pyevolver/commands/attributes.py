@@ -257,6 +257,8 @@ def element_attr(session, base, name, idx):
         return float(_session_store(session).get(key, {}).get(i, GRAPHICS[(k, name)]))
     if (k, name) == ("vertex", "mid_edge") and s.order == 2:
         return float(i >= s.nv - s.ne)           # the midpoints are the last ne vertices
+    if k == "vertex" and name == "axial_point" and name in s.vattr:   # model.groups
+        return float(s.vattr[name][i])
     if (k, name) in FLAGS_DEFAULT:
         return FLAGS_DEFAULT[(k, name)]
     only = _ONLY.get(name)

@@ -50,7 +50,7 @@ _MOVES = {"g", "U", "j", "V", "rawv", "rawestv", "G"}
 
 def _volume_constrained(s) -> bool:
     b = s.bodies
-    if not b.n:
+    if not b.n or not s.eattr["wrap_code"].any():      # (no wrapped edge: the plain model)
         return False
     return bool(np.any(~np.isnan(b.target)) or np.any(~np.isnan(b.pressure)))
 

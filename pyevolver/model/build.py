@@ -341,9 +341,8 @@ class _Builder:
             st = starts[tri3]
             FE[tri3] = np.stack([enc[st], enc[st + 1], enc[st + 2]], axis=1)
         big = np.nonzero(~tri3)[0]
-        if len(big) and "wrap_code" in s.eattr:
-            raise self.error(f'not supported in pyevolver: a face of more than three edges in '
-                             f'SYMMETRY_GROUP "{s.symmetry_group}"', blk.lines[big[0]])
+        if len(big) and "wrap_code" in s.eattr:         # (model.groups: wrapped rims refused)
+            symmetry.group_face_check(s, big, starts, lengths, eidx, blk, self.error)
         new_X = []
         new_E = []
         new_F = []            # (FE row, parent face position)
@@ -437,6 +436,9 @@ class _Builder:
                 s.eattr["boundary"] = np.concatenate([eb, fbnd[spar]])
             if "wrap" in s.eattr:
                 s.eattr["wrap"] = np.vstack([s.eattr["wrap"], np.zeros((nnew_e, 3))])
+            if "wrap_code" in s.eattr:
+                s.eattr["wrap_code"] = np.concatenate([s.eattr["wrap_code"],
+                                                       np.zeros(nnew_e, np.int64)])
             for cid in list(s.econ):
                 add = fcon[cid][spar].astype(np.int8) if cid in fcon else np.zeros(nnew_e, np.int8)
                 if "global" in s.constraints[cid].flags:

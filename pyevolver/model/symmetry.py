@@ -111,3 +111,14 @@ def torus_face_centers(s, big, starts, lengths, enc) -> None:
             # spoke from rim m (at offset offs[m]) to centre (offset 0)
             wrap[ne_spoke + m] = -offs[m]
         ne_spoke += n
+
+
+def group_face_check(s, big, starts, lengths, eidx, blk, error) -> None:
+    """A face of more than three edges in a group of pyevolver.model.groups
+    is split about the mean of its rim, which needs every rim edge unwrapped
+    (code 0): refuse the others by name."""
+    codes = s.eattr["wrap_code"]
+    for k in big:
+        if np.any(codes[eidx[starts[k]:starts[k] + lengths[k]]] != 0):
+            raise error(f"not supported in pyevolver: a face of more than three edges with "
+                        f'wrapped edges in SYMMETRY_GROUP "{s.symmetry_group}"', blk.lines[k])

@@ -96,3 +96,9 @@ def test_vertex_averaging_next_to_an_axial_point_is_refused():
     with pytest.raises(PyEvolverError, match="axial point"):
         sess.run("V")
     sess.run("rawv")
+
+
+def test_axial_point_attribute_and_listing(evolver):
+    path = _path("rotate_axial")
+    script = "print vertex[1].axial_point\nprint vertex[2].axial_point\nlist vertices\n"
+    assert _same(_ours(path, script), _ref(evolver, path, script), 1e-12)
