@@ -3,8 +3,8 @@
 derivatives would need the group elements and do not know them yet.
 
 ``g`` (constraints, the iteration toggles; not with fixed body volumes or
-pressures), ``r``,
-``V`` (not next to an axial point), ``rawv``, ``rawestv``, ``j``, the listings, ``dump``, ``print`` / ``printf`` (``wrap_compose``,
+pressures), ``r``, ``u``, ``V``, ``rawv``, ``rawestv`` (not next to an axial
+point), ``j``, the listings, ``dump``, ``print`` / ``printf`` (``wrap_compose``,
 ``wrap_inverse``, the ``wrap`` edge attribute) and the settings work; the
 rest below is refused as '`t` in SYMMETRY_GROUP "rotate" ...'.
 """
@@ -23,8 +23,8 @@ WORDS = {
        for w in ("hessian", "hessian_seek", "hessian_menu", "saddle", "ritz", "lanczos",
                  "eigenprobe", "newton", "bfgs", "optimise", "optimize")},
     **{w: "a mesh operation whose new edges would need the group elements"
-       for w in ("t", "w", "o", "K", "n", "l", "u", "O", "notch", "areaweed", "edgeweed",
-                 "edge_divide", "equiangulate")},
+       for w in ("t", "w", "o", "K", "n", "l", "O", "notch", "areaweed", "edgeweed",
+                 "edge_divide")},
     **{w: "the quadratic and Lagrange models" for w in ("M", "quadratic", "lagrange")},
 }
 #: statements (parse-tree tags) with why
@@ -67,9 +67,9 @@ def check(session, raw: str, statement: bool = False) -> None:
     if re.fullmatch(r"g\d+", key):
         key = "g"
     why = table.get(key)
-    if why is None and key == "V" and not statement and any(
+    if why is None and key in ("V", "rawv", "rawestv") and not statement and any(
             kw in s.vattr and s.vattr[kw].any() for kw in ("axial_point", "double_axial_point")):
-        why = "vertex averaging next to an axial point, whose normals REF takes by rules " \
+        why = "vertex averaging next to an axial point, whose moves REF takes by rules " \
               "not measured"
     if why is None and key in _MOVES and not statement and _volume_constrained(s):
         why = "moves with fixed body volumes or pressures: REF's volume projection in " \

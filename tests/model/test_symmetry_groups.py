@@ -1,8 +1,8 @@
 """The symmetry groups of pyevolver.model.groups on hand-written datafiles
 (tests/data/symmetry_groups: annulus sectors whose last side is the first
 one carried by a group element, and a wedge about an axial point), against
-evolver-nox-d run live: `g`, `r` (the new edges' codes in `list edges`),
-`list vertices`, `V`, energies and dumps both ways; the commands refused
+evolver-nox-d run live: `g`, `r` and `u` (the new edges' codes in `list
+edges`), `list vertices`, `V`, energies and dumps both ways; the commands refused
 by name."""
 import os
 
@@ -20,6 +20,7 @@ EVOLVING = ["rotate_axial", "screw_symmetry", "cubocta", "cubelat",
             pytest.param("central_symmetry", marks=SLOW), pytest.param("xyz", marks=SLOW)]
 SCRIPT = ("g 10\nprint total_energy\nr\nlist edges\ng 5\nlist vertices\nlist facets\n"
           "print total_energy\nprint vertex_count + edge_count + facet_count\n")
+EQUI = "u\nlist edges\nlist facets\ng 3\nprint total_energy\n"
 AVERAGE = "V\ng 3\nrawv\nrawestv\nlist vertices\nprint total_energy\n"
 
 
@@ -42,7 +43,7 @@ def _ours(path, script):
 @pytest.mark.parametrize("name", EVOLVING)
 def test_evolve_and_refine_as_the_evolver(evolver, name):
     path = _path(name)
-    script = SCRIPT + ("" if name == "rotate_axial" else AVERAGE)
+    script = SCRIPT + EQUI + ("" if name == "rotate_axial" else AVERAGE)
     ref = _ref(evolver, path, script)
     out = _ours(path, script)
     assert len(ref) > 100
@@ -73,7 +74,7 @@ def test_dumps_both_ways(evolver, tmp_path, name):
         assert _same(_ours(str(dump), check), _ref(evolver, str(dump), check), 1e-9), dump.name
 
 
-@pytest.mark.parametrize("command", ["t 0.1", "u", "hessian", "o", "K 0.1", "n 0.1", "w 0.1",
+@pytest.mark.parametrize("command", ["t 0.1", "hessian", "o", "K 0.1", "n 0.1", "w 0.1",
                                      "refine edges where id < 3", "delete edge[5]",
                                      "equiangulate edge[5]", "quadratic"])
 def test_commands_without_the_group_are_refused_by_name(command):
@@ -93,9 +94,10 @@ def test_wrap_attribute_and_functions():
 
 def test_vertex_averaging_next_to_an_axial_point_is_refused():
     sess = pyevolver.load(_path("rotate_axial"))
-    with pytest.raises(PyEvolverError, match="axial point"):
-        sess.run("V")
-    sess.run("rawv")
+    for command in ("V", "rawv", "rawestv"):
+        with pytest.raises(PyEvolverError, match="axial point"):
+            sess.run(command)
+    sess.run("u")
 
 
 def test_axial_point_attribute_and_listing(evolver):
