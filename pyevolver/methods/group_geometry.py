@@ -58,7 +58,8 @@ METHODS = {"facet_area", "facet_volume", "edge_length", "edge_area", "edge_tensi
 def check_supported(s) -> None:
     """Refuse by name what would ignore the group elements: metrics,
     constraint and boundary integrals, CONVEX gap energies, the quadratic
-    model and named-quantity methods outside :data:`METHODS`."""
+    model, wrapped edges on parametric boundaries (their midpoints) and
+    named-quantity methods outside :data:`METHODS`."""
     where = f'in SYMMETRY_GROUP "{s.symmetry_group}"'
     if s.metric is not None:
         raise UnsupportedError(f"a metric {where}")
@@ -70,6 +71,9 @@ def check_supported(s) -> None:
                 raise UnsupportedError(f"{kind} ENERGY / CONTENT integrals {where}")
             if "convex" in getattr(c, "flags", ()):
                 raise UnsupportedError(f"CONVEX constraints (gap energy) {where}")
+    bnd = s.eattr.get("boundary")
+    if bnd is not None and np.any((bnd != 0) & (s.eattr["wrap_code"] != 0)):
+        raise UnsupportedError(f"a wrapped edge on a parametric boundary {where}")
     for q in s.quantities.values():
         for m, *_ in q.methods:
             if m.method not in METHODS:

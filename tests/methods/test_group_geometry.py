@@ -84,3 +84,12 @@ def test_methods_through_the_maps_and_refusals(tmp_path):
                  "metric\n1 0 0\n0 1 0\n0 0 1"):
         with pytest.raises(pyevolver.errors.PyEvolverError, match='in SYMMETRY_GROUP "cubocta"'):
             pyevolver.load(_with_top("cubocta", line, tmp_path))
+
+
+def test_wrapped_boundary_edge_refused():
+    s = _surface("cubocta")
+    s.eattr["boundary"] = (s.eattr["wrap_code"] != 0).astype(np.int64)
+    with pytest.raises(pyevolver.errors.PyEvolverError, match="parametric boundary"):
+        GG.check_supported(s)
+    s.eattr["boundary"] = np.zeros(s.ne, np.int64)
+    GG.check_supported(s)
