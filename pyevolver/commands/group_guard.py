@@ -67,8 +67,8 @@ def check(session, raw: str, statement: bool = False) -> None:
     if re.fullmatch(r"g\d+", key):
         key = "g"
     why = table.get(key)
-    if why is None and key in ("V", "rawv", "rawestv") and not statement and any(
-            kw in s.vattr and s.vattr[kw].any() for kw in ("axial_point", "double_axial_point")):
+    if why is None and key in ("V", "rawv", "rawestv") and not statement \
+            and "axial_point" in s.vattr and s.vattr["axial_point"].any():
         why = "vertex averaging next to an axial point, whose moves REF takes by rules " \
               "not measured"
     if why is None and key in _MOVES and not statement and _volume_constrained(s):

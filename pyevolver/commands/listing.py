@@ -61,9 +61,8 @@ def _list_vertex(session: SessionLike, i):
         line += "  constraints " + " ".join((constraints.constraint_label(session, c) for c in cons)) + " "
     if s.vattr["fixed"][i]:
         line += " fixed "
-    for kw in ("axial_point", "double_axial_point"):        # model.groups
-        if kw in s.vattr and s.vattr[kw][i]:
-            line += f" {kw} "
+    if "axial_point" in s.vattr and s.vattr["axial_point"][i]:         # model.groups
+        line += " axial_point "
     return line + _extra_text(session, "vertex", i)
 
 

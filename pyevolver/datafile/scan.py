@@ -33,7 +33,7 @@ _ELEM_KWS = frozenset(
     "fixed bare no_refine nodisplay no_display constraint constraints boundary tension "
     "density volume volconst actual_volume pressure color colour frontcolor frontcolour "
     "backcolor backcolour wrap orientation original opacity tag phase no_hessian_normal "
-    "hessian_normal_one axial_point double_axial_point triple_point tetra_point lagrange_multiplier "
+    "hessian_normal_one axial_point triple_point tetra_point lagrange_multiplier "
     "centerofmass".split())
 _WORD = re.compile(r"\S+")
 _PLAIN = re.compile(_NUMBER + r"\Z")

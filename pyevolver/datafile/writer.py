@@ -168,8 +168,7 @@ class _FeWriter:
     # -- what cannot be written ------------------------------------------------
     def _check(self):
         s = self.s
-        known_v = {"fixed", "original", "boundary", "params", "id", "axial_point",
-                   "double_axial_point"}
+        known_v = {"fixed", "original", "boundary", "params", "id", "axial_point"}
         known_e = {"fixed", "original", "boundary", "tension", "no_refine", "color", "wrap", "id",
                    "wrap_code"}
         if s.string:                 # the string model's own bookkeeping (rebuilt on reading)
@@ -423,8 +422,8 @@ class _FeWriter:
                 parts = [num(v) for v in s.X[k, :s.sdim]]
             if fixed is not None and fixed[k]:
                 parts.append("fixed")
-            parts += [kw for kw in ("axial_point", "double_axial_point")
-                      if kw in s.vattr and s.vattr[kw][k]]
+            if "axial_point" in s.vattr and s.vattr["axial_point"][k]:
+                parts.append("axial_point")
             c = self._cons(s.vcon, k)
             if c:
                 parts.append(c)

@@ -135,7 +135,7 @@ class _Builder:
                     self._member("vertex", pos, vals)
                 elif kw == "attribute":
                     self._attr("vertex", n, pos, vals)
-                elif kw in ("axial_point", "double_axial_point"):      # model.groups
+                elif kw == "axial_point":                       # model.groups
                     s.vattr.setdefault(kw, np.zeros(n, bool))[pos] = True
                 elif kw in ("bare", "original", "tag", "triple_point",
                             "tetra_point", "no_hessian_normal", "hessian_normal_one"):

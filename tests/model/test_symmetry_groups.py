@@ -104,3 +104,16 @@ def test_axial_point_attribute_and_listing(evolver):
     path = _path("rotate_axial")
     script = "print vertex[1].axial_point\nprint vertex[2].axial_point\nlist vertices\n"
     assert _same(_ours(path, script), _ref(evolver, path, script), 1e-12)
+
+
+def test_double_axial_point_stops_as_in_the_evolver(evolver, tmp_path):
+    """The manual's flag for flip_rotate; REF 2.70 does not read it."""
+    text = open(_path("rotate_axial")).read().replace('"rotate"', '"flip_rotate"')
+    path = tmp_path / "dax.fe"
+    path.write_text(text.replace("0.3 axial_point fixed", "0 double_axial_point"))
+    with pytest.raises(PyEvolverError, match=r"dax\.fe:\d+"):
+        pyevolver.load(str(path))
+    import subprocess
+    ref = subprocess.run([evolver, "-p1", str(path)], input="q\nq\n", stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True, timeout=60).stdout
+    assert "ERROR 2105" in ref and "double_axial_point" in ref
