@@ -257,6 +257,8 @@ def element_attr(session, base, name, idx):
         return float(_session_store(session).get(key, {}).get(i, GRAPHICS[(k, name)]))
     if (k, name) == ("vertex", "mid_edge") and s.order == 2:
         return float(i >= s.nv - s.ne)           # the midpoints are the last ne vertices
+    if k == "vertex" and name == "axial_point" and name in s.vattr:   # model.groups
+        return float(s.vattr[name][i])
     if (k, name) in FLAGS_DEFAULT:
         return FLAGS_DEFAULT[(k, name)]
     only = _ONLY.get(name)
@@ -432,6 +434,8 @@ def _torus_wrap(s, i):
     """The Evolver's torus wrap code of edge ``i``: per period a 6-bit field
     holding the wrap mod 32 (+x 1, -x 31, +y 64, -y 1984, +z 4096,
     -z 126976; the manual's 127040 for -z is not what REF prints)."""
+    if "wrap_code" in s.eattr:                  # the other groups' codes (model.groups)
+        return int(s.eattr["wrap_code"][i])
     w = s.eattr.get("wrap")
     if w is None or s.periods is None:
         return 0

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from ..errors import CommandError
 from ..evolve import optparams as OP
+from ..model.groups import group_of
 from .registry import register
 from .values import as_float
 
@@ -108,7 +109,9 @@ def _convert(interp, raw, arg):
     # REF converts at load a surface whose boundaries carry integrals
     s = interp.session
     bnd = getattr(s.surface, "boundaries", None) or {}
-    if s.toggles.get("_all_quantities") or any(b.energy or b.content for b in bnd.values()):
+    # and, in a symmetry group other than the torus (model.groups), every surface
+    if s.toggles.get("_all_quantities") or any(b.energy or b.content for b in bnd.values()) \
+            or group_of(s.surface) is not None:
         s.note("Everything already quantities.\n")
     else:
         s.toggles["_all_quantities"] = 1

@@ -27,7 +27,7 @@ from . import (constraints, eigen, element_attrs, elements, evolution, extension
                fixing, model_order, output, popping, remesh, toggles)
 from . import display  # noqa: F401  (after toggles: s, show, P, geomview)
 from . import refused  # noqa: F401
-from . import simplex
+from . import group_guard, simplex
 from . import registry, variables
 from .cformat import print_value
 from .nodes import ElemIndex
@@ -119,6 +119,7 @@ class Interpreter:
         elif kind in simplex.STATEMENTS and self._simplex() and simplex.statement(self, node):
             return
         else:
+            group_guard.check(self.session, kind, statement=True)
             registry.statement(kind).handler(self, node)
 
     def _simplex(self):
@@ -654,6 +655,7 @@ class Interpreter:
         if cmd is not None:
             if self._simplex() and simplex.answer(self, raw):
                 return
+            group_guard.check(self.session, raw)
             cmd.handler(self, raw, arg)
             return
         if name in s.variables and arg is None:

@@ -61,6 +61,8 @@ def _list_vertex(session: SessionLike, i):
         line += "  constraints " + " ".join((constraints.constraint_label(session, c) for c in cons)) + " "
     if s.vattr["fixed"][i]:
         line += " fixed "
+    if "axial_point" in s.vattr and s.vattr["axial_point"][i]:         # model.groups
+        line += " axial_point "
     return line + _extra_text(session, "vertex", i)
 
 
@@ -96,7 +98,9 @@ def _list_edge(session: SessionLike, i):
     if s.order == 2:                      # REF: "/*midpt*/  16" in the quadratic model
         line += f"  /*midpt*/ {vid[s.midv[i]]:3d} "
     w = s.eattr.get("wrap")
-    if w is not None and s.symmetry_group is not None:      # REF: the group element's code
+    if "wrap_code" in s.eattr:                  # the other groups' codes (model.groups)
+        line += f" wrap {int(s.eattr['wrap_code'][i])} "
+    elif w is not None and s.symmetry_group is not None:      # REF: the group element's code
         line += f" wrap {int(encode_torus(w[i:i + 1])[0])} "
     elif w is not None:
         line += " " + " ".join({0: "*", 1: "+", -1: "-"}.get(int(x), "?")

@@ -12,6 +12,7 @@ import numpy as np
 from ..errors import CommandError, ExpressionError, UnsupportedError, did_you_mean
 from ..expr import nodes as N
 from ..model import string as SM
+from ..model.groups import group_of
 from .toggles import TOGGLE_DEFAULTS, TOGGLES
 from .values import QRef, SessionLike, as_float, as_int
 
@@ -93,6 +94,11 @@ def internal(session: SessionLike, name):
         return float(session.toggles.get(name, TOGGLE_DEFAULTS.get(name, 0)))
     if s is None:
         raise ExpressionError(f"undefined name '{name}' (no surface loaded)")
+    if name == "__symmetry_group__":        # wrap_compose / wrap_inverse (model.groups)
+        group = group_of(s)
+        if group is None:
+            raise ExpressionError("no symmetry group other than the torus")
+        return group
     simple = {
         "total_energy": lambda: t.energy,
         "total_area": lambda: t.total_area,
@@ -126,7 +132,7 @@ def internal(session: SessionLike, name):
         "refine_count": lambda: session.counts.get("refine", 0), "where_count": lambda: session.counts.get("where", 0),
         "random": lambda: float(session.rng.random()),
         "quantity_count": lambda: len(s.quantities),
-        "symmetry_group": lambda: int(s.periods is not None),
+        "symmetry_group": lambda: int(s.periods is not None or s.symmetry_group is not None),
         "simplex_representation": lambda: 0,
         "lagrange_order": lambda: s.order, "linear": lambda: int(s.order == 1),
         "quadratic": lambda: int(s.order == 2),

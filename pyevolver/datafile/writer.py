@@ -168,8 +168,9 @@ class _FeWriter:
     # -- what cannot be written ------------------------------------------------
     def _check(self):
         s = self.s
-        known_v = {"fixed", "original", "boundary", "params", "id"}
-        known_e = {"fixed", "original", "boundary", "tension", "no_refine", "color", "wrap", "id"}
+        known_v = {"fixed", "original", "boundary", "params", "id", "axial_point"}
+        known_e = {"fixed", "original", "boundary", "tension", "no_refine", "color", "wrap", "id",
+                   "wrap_code"}
         if s.string:                 # the string model's own bookkeeping (rebuilt on reading)
             known_v = known_v | {"ring_head"}
             known_e = known_e | {"ring_time"}
@@ -421,6 +422,8 @@ class _FeWriter:
                 parts = [num(v) for v in s.X[k, :s.sdim]]
             if fixed is not None and fixed[k]:
                 parts.append("fixed")
+            if "axial_point" in s.vattr and s.vattr["axial_point"][k]:
+                parts.append("axial_point")
             c = self._cons(s.vcon, k)
             if c:
                 parts.append(c)
@@ -436,6 +439,8 @@ class _FeWriter:
         codes = None
         if wrap is not None and getattr(s, "symmetry_group", None) is not None:
             codes, wrap = encode_torus(wrap), None
+        elif "wrap_code" in ea:                     # the other groups (model.groups)
+            codes = ea["wrap_code"]
         if wrap is not None and np.any(~np.isin(wrap, (-1, 0, 1))):
             self.refuse("an edge wrapping more than one period")
         mem = self.members["edge"]

@@ -336,6 +336,10 @@ class Func(Node):
         for v in vals:
             if not is_number(v):
                 raise ExpressionError(f"{self.name}() needs a number, got {_what(v)}")
+        if self.name in ("wrap_compose", "wrap_inverse"):
+            group = _wrap_group(env)
+            if group is not None:           # a group other than the torus (model.groups)
+                return _num(group.function(self.name, *vals))
         with np.errstate(all="ignore"):
             if len(vals) == 1:
                 v = vals[0]
@@ -616,6 +620,16 @@ def canonical_coords(node: Node) -> Node:
 
 # ---------------------------------------------------------------------------
 # environments
+
+
+def _wrap_group(env):
+    """The symmetry group the environment offers as ``__symmetry_group__``
+    (None: the torus group's codes)."""
+    try:
+        g = env.lookup("__symmetry_group__")
+    except ExpressionError:
+        return None
+    return g if hasattr(g, "function") else None
 
 
 class MapEnv:

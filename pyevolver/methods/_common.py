@@ -37,7 +37,20 @@ def corner_scatter(t, per_corner: np.ndarray, weights: np.ndarray | None = None)
     s = t.surface
     if weights is not None:
         per_corner = per_corner * weights[:, None, None]
+    maps = getattr(t, "corner_maps", None)
+    if maps is not None:            # a symmetry group: back through Aᵀ (methods.group_geometry)
+        per_corner = np.einsum("fkji,fkj->fki", maps, per_corner)
     return scatter(s.nv, s.F.ravel(), per_corner.reshape(-1, 3))
+
+
+def edge_pullback(t, idx: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Gradients ``u (n, 3)`` with respect to the heads' images ``g(x_head)``
+    of the edges ``idx``, as gradients with respect to the heads (``Aᵀ u`` in
+    a symmetry group, methods.group_geometry; ``u`` otherwise)."""
+    maps = getattr(t, "edge_maps", None)
+    if maps is None:
+        return u
+    return np.einsum("nji,nj->ni", maps[idx], u)
 
 
 def assemble(nv: int, verts: np.ndarray, blocks: np.ndarray, basis=None) -> sp.coo_matrix:

@@ -23,8 +23,8 @@ from ..geometry import kernels as G
 from . import metric as MT
 from .jets import skew
 from ..model.formulas import located
-from ._common import (assemble, assemble_projected, corner_scatter, facet_points, n2_grad_dot,
-                      scatter)
+from ._common import (assemble, assemble_projected, corner_scatter, edge_pullback, facet_points,
+                      n2_grad_dot, scatter)
 from .registry import register_method
 
 # ---------------------------------------------------------------------------
@@ -217,7 +217,8 @@ def edge_length_grad(t, idx: np.ndarray, weights: np.ndarray, euclidean=False) -
     L = _eu_length(t)[idx]
     with np.errstate(all="ignore"):
         u = np.nan_to_num(d / L[:, None]) * weights[:, None]
-    return scatter(s.nv, np.concatenate([s.E[idx, 0], s.E[idx, 1]]), np.concatenate([-u, u]))
+    return scatter(s.nv, np.concatenate([s.E[idx, 0], s.E[idx, 1]]),
+                   np.concatenate([-u, edge_pullback(t, idx, u)]))
 
 
 def _facet_vector_integral_grad(t, comps, idx, w):

@@ -13,6 +13,8 @@ from ..constraints import integral_edges, located
 from ..errors import PyEvolverError, UnsupportedError
 from ..geometry import kernels as G
 from ..model.records import convex_edges, torus_lift_shifts
+from ..model.groups import group_of
+from .group_geometry import totals_geometry
 from ..model.surface import HOOKS, Quantity, Surface
 from . import metric as MT
 from .curvature import legacy_energy
@@ -49,7 +51,10 @@ class Totals:
         self.surface = s
         X = s.X
         wrap = s.wrap_shift()
-        if wrap is None and X.shape[1] == 3:
+        group = group_of(s)
+        if group is not None:           # a symmetry group's maps (methods.group_geometry)
+            totals_geometry(self, group)
+        elif wrap is None and X.shape[1] == 3:
             # corners gathered one coordinate at a time (several times faster
             # than gathering edge vectors); the torus needs the edge wraps
             P, N2T, self.facet_area, self.facet_volume = G.corner_geometry(

@@ -135,7 +135,9 @@ class _Builder:
                     self._member("vertex", pos, vals)
                 elif kw == "attribute":
                     self._attr("vertex", n, pos, vals)
-                elif kw in ("bare", "original", "tag", "axial_point", "triple_point",
+                elif kw == "axial_point":                       # model.groups
+                    s.vattr.setdefault(kw, np.zeros(n, bool))[pos] = True
+                elif kw in ("bare", "original", "tag", "triple_point",
                             "tetra_point", "no_hessian_normal", "hessian_normal_one"):
                     pass
                 else:
@@ -275,6 +277,8 @@ class _Builder:
                 w[pos, :len(wr)] = wr
             s.eattr["wrap"] = w if s.symmetry_group is None else \
                 symmetry.decode_torus(self._wrap_codes, s.sdim)
+        elif s.symmetry_group is not None:           # the other groups' codes (model.groups)
+            s.eattr["wrap_code"] = self._wrap_codes.copy()
         for cid, c in sc.constraints.items():
             if "global" in c.flags:
                 s.econ[cid] = np.ones(n, np.int8)
@@ -337,6 +341,8 @@ class _Builder:
             st = starts[tri3]
             FE[tri3] = np.stack([enc[st], enc[st + 1], enc[st + 2]], axis=1)
         big = np.nonzero(~tri3)[0]
+        if len(big) and "wrap_code" in s.eattr:         # (model.groups: wrapped rims refused)
+            symmetry.group_face_check(s, big, starts, lengths, eidx, blk, self.error)
         new_X = []
         new_E = []
         new_F = []            # (FE row, parent face position)
@@ -430,6 +436,9 @@ class _Builder:
                 s.eattr["boundary"] = np.concatenate([eb, fbnd[spar]])
             if "wrap" in s.eattr:
                 s.eattr["wrap"] = np.vstack([s.eattr["wrap"], np.zeros((nnew_e, 3))])
+            if "wrap_code" in s.eattr:
+                s.eattr["wrap_code"] = np.concatenate([s.eattr["wrap_code"],
+                                                       np.zeros(nnew_e, np.int64)])
             for cid in list(s.econ):
                 add = fcon[cid][spar].astype(np.int8) if cid in fcon else np.zeros(nnew_e, np.int8)
                 if "global" in s.constraints[cid].flags:

@@ -17,8 +17,8 @@ from ``TORUS`` (REF's rules, measured on symtest.fe against twointor.fe):
   the cell and its choice of the cell multiple;
 * ``list edges`` and ``dump`` write ``wrap code`` instead of ``* + -``.
 
-The other groups (transformations other than translations: rotations,
-reflections, hyperbolic translations) are refused by name, with the reason.
+The other Euclidean groups (rotations, reflections, screw motions) are
+``pyevolver.model.groups``; the hyperbolic ones are refused by name.
 """
 from __future__ import annotations
 
@@ -30,19 +30,12 @@ from ..geometry.kernels import edge_index
 #: not got them (the torus group is supported)
 GROUPS = {
     "torus": None,
-    "rotate": "rotations in the x-y plane (the element's transform is not a translation)",
-    "flip_rotate": "rotations with a flip of z (the element's transform is not a translation)",
-    "cubocta": "the point group of the cube (the element's transform is not a translation)",
-    "cubelat": "the cubic lattice's point group (the element's transform is not a "
-               "translation)",
-    "xyz": "the cube's rotation group (the element's transform is not a translation)",
-    "genus2": "a hyperbolic quotient needing the Klein metric",
-    "dodecahedron": "a hyperbolic quotient needing the Klein metric",
-    "central_symmetry": "inversion through the origin (the element's transform is not a "
-                        "translation)",
-    "screw_symmetry": "screw motions (the element's transform is not a translation)",
-    "quarter_turn": "a torus with a quarter turn (the element's transform is not a "
-                    "translation)",
+    "rotate": None, "flip_rotate": None, "cubocta": None, "cubelat": None, "xyz": None,
+    "central_symmetry": None, "screw_symmetry": None, "quarter_turn": None,  # model/groups.py
+    "genus2": "a hyperbolic quotient in the Klein metric whose element encoding REF "
+              "does not document",
+    "dodecahedron": "a hyperbolic quotient in the Klein metric; the manual documents no "
+                    "encoding",
 }
 
 _FIELD = 6
@@ -53,7 +46,7 @@ def refusal(name: str) -> str | None:
     if name in GROUPS and GROUPS[name] is None:
         return None
     why = GROUPS.get(name, "not one of the Evolver's built-in groups")
-    return f'SYMMETRY_GROUP "{name}" ({why}; pyevolver has the "torus" group)'
+    return f'SYMMETRY_GROUP "{name}" ({why})'
 
 
 def decode_torus(codes: np.ndarray, sdim: int = 3) -> np.ndarray:
@@ -86,6 +79,9 @@ def declared(scene, surface, error) -> str | None:
     if why is None and (scene.torus or surface.string or surface.sdim != 3):
         why = f'SYMMETRY_GROUP "{name}" with TORUS, in the string model or in ' \
               f'{surface.sdim} dimensions'
+    if why is None and name == "quarter_turn" and "quarter_turn_period" not in scene.parameters:
+        raise error('SYMMETRY_GROUP "quarter_turn" needs the parameter quarter_turn_period '
+                    '(REF: ERROR 4008)', scene.decl_lines.get("symmetry_group"))
     if why is not None:
         raise error(f"not supported in pyevolver: {why}", scene.decl_lines.get("symmetry_group"))
     return name
@@ -115,3 +111,14 @@ def torus_face_centers(s, big, starts, lengths, enc) -> None:
             # spoke from rim m (at offset offs[m]) to centre (offset 0)
             wrap[ne_spoke + m] = -offs[m]
         ne_spoke += n
+
+
+def group_face_check(s, big, starts, lengths, eidx, blk, error) -> None:
+    """A face of more than three edges in a group of pyevolver.model.groups
+    is split about the mean of its rim, which needs every rim edge unwrapped
+    (code 0): refuse the others by name."""
+    codes = s.eattr["wrap_code"]
+    for k in big:
+        if np.any(codes[eidx[starts[k]:starts[k] + lengths[k]]] != 0):
+            raise error(f"not supported in pyevolver: a face of more than three edges with "
+                        f'wrapped edges in SYMMETRY_GROUP "{s.symmetry_group}"', blk.lines[k])

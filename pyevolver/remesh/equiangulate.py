@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from ..geometry import kernels as G
+from ..model.groups import group_of
 from ..model.records import along_first, edge_facets, record_along_first, record_vertex_rings
 from .rings import Rings
 
@@ -131,6 +132,13 @@ def _signature(s):
     return ek, fk
 
 
+def _group_vectors(t, group, idx):
+    """``g(x_head) - x_tail`` of the edges ``idx`` in a symmetry group."""
+    A, b = group.affine(t.eattr["wrap_code"][idx])
+    E = t.E[idx]
+    return np.einsum("eij,ej->ei", A, t.X[E[:, 1]]) + b - t.X[E[:, 0]]
+
+
 def equiangulate(s, threshold=-0.001, only=None):
     """One equiangulation pass; returns ``(new surface, number of flips)``.
 
@@ -152,7 +160,12 @@ def equiangulate(s, threshold=-0.001, only=None):
     ef, ekk, val = edge_facets(t)
     first = along_first(s)
     wv = t.wrap_shift()
-    lengths = np.linalg.norm(G.edge_vectors(t.X, E, wv), axis=1)
+    group = group_of(t)
+    if group is None:
+        lengths = np.linalg.norm(G.edge_vectors(t.X, E, wv), axis=1)
+    else:                       # a symmetry group's codes (model.groups): sequential pass
+        wrap = t.eattr["wrap_code"] = s.eattr["wrap_code"].copy()
+        lengths = np.linalg.norm(_group_vectors(t, group, np.arange(t.ne)), axis=1)
     tension = t.fattr["tension"]
     esig, fsig = _signature(t)
 
@@ -285,7 +298,13 @@ def equiangulate(s, threshold=-0.001, only=None):
         pairs.discard(min(p, q) * nv + max(p, q))
         pairs.add(key)
         al = bool(first[ed])
-        if wrap is not None:
+        if group is not None:
+            def o(x):
+                return wrap[x] if x >= 0 else int(group.inverse(wrap[~x]))
+            # through p: s -> p -> r when the new edge runs s -> r, else r -> p -> s
+            wrap[ed] = int(group.compose(group.inverse(o(b2)), group.inverse(o(c1)))) if al \
+                else int(group.compose(o(c1), o(b2)))
+        elif wrap is not None:
             def w(x):
                 return wrap[x] if x >= 0 else -wrap[~x]
             wrap[ed] = (-1 if al else 1) * (w(c1) + w(b2))       # through p
@@ -306,7 +325,10 @@ def equiangulate(s, threshold=-0.001, only=None):
                     efl[2 * i] = new
                 if efl[2 * i + 1] == old:
                     efl[2 * i + 1] = new
-        if wv is None:
+        if group is not None:
+            E[ed] = (El[2 * ed], El[2 * ed + 1])
+            lengths[ed] = float(np.linalg.norm(_group_vectors(t, group, np.array([ed]))[0]))
+        elif wv is None:
             dx = Xl.item(r, 0) - Xl.item(sv, 0)
             dy = Xl.item(r, 1) - Xl.item(sv, 1)
             dz = Xl.item(r, 2) - Xl.item(sv, 2)

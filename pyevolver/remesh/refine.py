@@ -14,6 +14,8 @@ from ..methods import metric as MT
 from ..geometry import kernels as G
 from ..constraints import constrained_vertices, project_to_constraints
 from ..model.records import along_first, record_along_first, record_vertex_rings
+from ..model.groups import group_of
+from . import group_refine as GR
 from .grow import grow, reorder_new_edges
 from .rings import Rings, rounds
 
@@ -194,7 +196,8 @@ def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
 
     # -- geometry of midpoints (torus: in the tail's cell)
     wv = s.wrap_shift()
-    ev = G.edge_vectors(s.X, s.E, wv)
+    group = group_of(s)
+    ev = G.edge_vectors(s.X, s.E, wv) if group is None else GR.edge_vectors(s, group)
     frac = 0.5 if s.metric is None else MT.split_fractions(s, R)[:, None]
     t.X[nv:nv + k] = s.X[s.E[R, 0]] + frac * ev[R]      # a metric's split: methods.metric
     # -- edge halves
@@ -276,6 +279,8 @@ def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
         for eidx, f, p, q in new_edges:
             t.eattr["wrap"][eidx] = offset(q[0], q[1], f) - offset(p[0], p[1], f)
 
+    if group is not None:                   # a symmetry group's codes (remesh.group_refine)
+        GR.new_edge_codes(s, t, group, R, I, FW, new_edges)
     _split_rings(s, t, R, half, None if perm is None else np.sort(base1))
     _split_loops(s, t, R, half)
     new_v = np.arange(nv, nv + k)

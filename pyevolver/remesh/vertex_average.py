@@ -22,6 +22,11 @@ numerically against ``evolver-nox-d``:
   smooth star), and on constrained vertices is
   projected onto the constraint tangent space before and after;
 * ``x_v += D / 4``; constrained vertices are projected back.
+
+In a symmetry group (pyevolver.model.groups) the head of an edge sees its
+tail at ``-Aᵀ d`` (``d = g(x_head) - x_tail``); the normals of ``V`` are
+the facets' area vectors as they are, in each facet's frame (measured:
+turning them into the vertex's frame does not give REF's moves).
 """
 from __future__ import annotations
 
@@ -59,7 +64,8 @@ def vertex_average(s, mode="V"):
     # each edge seen from both ends: vertex v, edge e, vector x_e - x_v
     v = np.concatenate([ends[:, 0], ends[:, 1]])
     e = np.concatenate([np.arange(ne), np.arange(ne)])
-    vec = np.concatenate([d, -d])
+    maps = getattr(t, "edge_maps", None)        # a symmetry group: the tail seen from the head
+    vec = np.concatenate([d, -d if maps is None else -np.einsum("eji,ej->ei", maps, d)])
     if mode == "rawest":
         use = np.ones(len(v), bool)
         w = area_w[e]

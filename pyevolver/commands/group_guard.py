@@ -1,0 +1,81 @@
+"""Commands refused by name in a symmetry group other than the torus
+(pyevolver.model.groups): those whose mesh operations or second
+derivatives would need the group elements and do not know them yet.
+
+``g`` (constraints, the iteration toggles; not with fixed body volumes or
+pressures), ``r``, ``u``, ``V``, ``rawv``, ``rawestv`` (not next to an axial
+point), ``j``, the listings, ``dump``, ``print`` / ``printf`` (``wrap_compose``,
+``wrap_inverse``, the ``wrap`` edge attribute) and the settings work; the
+rest below is refused as '`t` in SYMMETRY_GROUP "rotate" ...'.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from ..errors import UnsupportedError
+from ..model.groups import group_of
+
+#: words and letters, with why
+WORDS = {
+    **{w: "a Hessian of the group's quotient (REF converts to named quantities for it)"
+       for w in ("hessian", "hessian_seek", "hessian_menu", "saddle", "ritz", "lanczos",
+                 "eigenprobe", "newton", "bfgs", "optimise", "optimize")},
+    **{w: "a mesh operation whose new edges would need the group elements"
+       for w in ("t", "w", "o", "K", "n", "l", "O", "notch", "areaweed", "edgeweed",
+                 "edge_divide")},
+    **{w: "the quadratic and Lagrange models" for w in ("M", "quadratic", "lagrange")},
+}
+#: statements (parse-tree tags) with why
+STATEMENTS = {
+    "delete": "deleting elements (the merged edges would need the group elements)",
+    "edgeswap": "edge swaps (the new edges would need the group elements)",
+    "equiangulate": "equiangulation (the new edges would need the group elements)",
+    "pop": "popping (the new elements would need the group elements)",
+    "refine": "refining chosen edges (the new edges would need the group elements)",
+}
+
+
+#: quarter_turn: REF's products add the second z power modulo 4, its
+#: facets holding z powers are "not consistent" (WARNING 2000) whichever
+#: edge comes first, and they evolve by rules not measured
+QUARTER_TURN = {w: "REF's facets with z powers are inconsistent (WARNING 2000) and "
+                   "evolve by rules pyevolver has not measured"
+                for w in ("g", "r", "j", "U", "G", "V", "rawv", "rawestv")}
+
+
+_MOVES = {"g", "U", "j", "V", "rawv", "rawestv", "G"}
+
+
+def _volume_constrained(s) -> bool:
+    b = s.bodies
+    if not b.n or not s.eattr["wrap_code"].any():      # (no wrapped edge: the plain model)
+        return False
+    return bool(np.any(~np.isnan(b.target)) or np.any(~np.isnan(b.pressure)))
+
+
+def check(session, raw: str, statement: bool = False) -> None:
+    """Refuse ``raw`` (a word or a statement tag) by name when the session's
+    surface is in a group of pyevolver.model.groups and the command is not
+    group-aware."""
+    s = session.surface
+    if s is None or group_of(s) is None:
+        return
+    table = STATEMENTS if statement else WORDS
+    key = raw if len(raw) == 1 else raw.lower()
+    if re.fullmatch(r"g\d+", key):
+        key = "g"
+    why = table.get(key)
+    if why is None and key in ("V", "rawv", "rawestv") and not statement \
+            and "axial_point" in s.vattr and s.vattr["axial_point"].any():
+        why = "vertex averaging next to an axial point, whose moves REF takes by rules " \
+              "not measured"
+    if why is None and key in _MOVES and not statement and _volume_constrained(s):
+        why = "moves with fixed body volumes or pressures: REF's volume projection in " \
+              "these groups was not matched (the volumes themselves are REF's)"
+    if why is None and s.symmetry_group == "quarter_turn":
+        why = (STATEMENTS if statement else QUARTER_TURN).get(key)
+    if why is not None:
+        name = key.rstrip("_")
+        raise UnsupportedError(f'`{name}` in SYMMETRY_GROUP "{s.symmetry_group}" ({why})')
