@@ -253,9 +253,9 @@ class _Builder:
                 elif kw in ("bare", "original", "orientation"):
                     pass
                 elif kw == "wrap" and sc.symmetry_group is not None:
-                    if len(vals) != 1:
+                    if len(vals) != 1 or not abs(vals[0]) < 2.0 ** 63:
                         raise self.error(f"edge {blk.ids[pos]}: wrap expects one group "
-                                         "element code", blk.lines[pos])
+                                         "element code (an integer)", blk.lines[pos])
                     self._wrap_codes[pos] = int(vals[0])
                 elif kw == "wrap":
                     raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: WRAP "

@@ -143,3 +143,13 @@ def test_volume_gradient_against_differences():
         down = s.evaluate().volumes[0]
         assert (up - down) / (2 * h) == pytest.approx(g[v, k], abs=1e-8)
     s.X = X0
+
+
+@pytest.mark.parametrize("code", ["1e300", "nan", "-1e30"])
+def test_a_wrap_code_that_is_no_integer_is_a_located_error(code, tmp_path):
+    """(found by the datafile fuzzer: a huge code overflowed the code array)"""
+    p = tmp_path / "w.fe"
+    p.write_text('symmetry_group "torus"\nvertices\n1 0 0 0\n2 0.5 0 0\nedges\n'
+                 f"1 1 2 wrap {code}\n")
+    with pytest.raises(PyEvolverError, match=r"w.fe:6: edge 1: wrap expects one group element"):
+        pyevolver.load(str(p), out=io.StringIO())
