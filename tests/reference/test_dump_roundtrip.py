@@ -409,7 +409,8 @@ _REF_ODD = {"circular_arc_draw", "force_deletion", "rotate_lights", "squared_gra
             "star_finagling", "jiggle", "interp_normals", "sobolev_mode", "metric_convert",
             "hessian_diff", "blas_flag", "debug", "memdebug", "sqgauss"}
 # pyevolver's names that REF does not take as toggles
-_NOT_IN_REF = {"approximate_curvature", "brief", "keep_macros", "calculate_in_3d"}
+_NOT_IN_REF = {"approximate_curvature", "brief", "keep_macros", "calculate_in_3d",
+               "hessian_backtrack"}
 
 
 @pytest.mark.parametrize("name", sorted(TOGGLES))
