@@ -8,6 +8,8 @@ import re
 
 from lark.exceptions import UnexpectedCharacters, UnexpectedToken
 
+from ..limits import clip
+
 
 class _Unsupported(Exception):
     """A keyword the grammar knows and pyevolver refuses (the token)."""
@@ -59,7 +61,7 @@ def describe(exc: Exception, text: str) -> str:
         ch = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
         word = re.match(r"[A-Za-z_]\w*", text[exc.pos_in_stream:])
         if word:
-            return (f"unexpected '{word.group(0)}': not a keyword, parameter or "
+            return (f"unexpected '{clip(word.group(0))}': not a keyword, parameter or "
                     f"value allowed here")
         return f"unexpected character {ch!r}"
     if isinstance(exc, UnexpectedToken):
@@ -68,5 +70,5 @@ def describe(exc: Exception, text: str) -> str:
             exp = _expected(exc.expected)
             return f"unexpected end of line: expected {exp}"
         exp = _expected(exc.expected)
-        return f"unexpected '{tok}': expected {exp}"
+        return f"unexpected '{clip(tok)}': expected {exp}"
     return str(exc).split("\n")[0]
