@@ -79,7 +79,7 @@ class Session(SessionAPI):
         self.total_time = 0.0
         # seconds one top-level command may run (None: no limit); a command
         # that runs longer stops with an error and leaves the surface as it was
-        self.time_limit = None
+        self.time_limit: float | None = None
         self.history: list[tuple] = []         # (iteration, energy, area) of each g step
         self.command_history: list = []       # (number, text) of `history`, `!!` (REF: last 100)
         self.command_count = 0
