@@ -42,7 +42,9 @@ def run(inputs: int, reduced: bool, jobs: int) -> tuple[int, dict, str]:
     for m in re.finditer(r"^(hostile \w+ \(deep\)): (\d+) in ([\d.]+) s \(([\d.]+) s CPU\)",
                          proc.stdout, re.M):
         counts[m.group(1)] = (int(m.group(2)), float(m.group(3)), float(m.group(4)))
-    failures = re.findall(r"^FAILED .*$", proc.stdout, re.M)
+    failures = re.findall(r"^(?:FAILED|ERROR) .*$", proc.stdout, re.M)
+    if proc.returncode and not failures:
+        failures = (proc.stdout + proc.stderr).strip().splitlines()[-30:]
     return proc.returncode, counts, "\n".join(failures)
 
 

@@ -151,8 +151,8 @@ def _exec_fuzz(target, datafiles, nightly=False):
 
     def session(rng):
         s = Session.load(rng.choice(names), out=io.StringIO(), err=io.StringIO())
-        s.time_limit = 0.02
         s.run(F.PRELUDE)
+        s.time_limit = 0.02         # (after the prelude: the limit is wall-clock time)
         return s
 
     def body(rng):
@@ -227,8 +227,8 @@ def _hostile_bodies():
     def interp(rng):
         if "s" not in state or rng.random() < 0.05 or state["s"].surface.nf > 1000:
             s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
-            s.time_limit = 0.05
             s.run(F.PRELUDE)
+            s.time_limit = 0.05
             state["s"] = s
         try:
             F.check_commands(state["s"], F.hostile_command(rng), "hostile")
