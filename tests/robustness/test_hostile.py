@@ -92,3 +92,15 @@ def test_syntax_error_in_long_line_quotes_around_the_column():
     msg = str(e.value)
     assert ":1:100009:" in msg and len(msg) < 600
     assert msg.rstrip().endswith("^")
+
+
+@pytest.mark.parametrize("text,where", [
+    (CUBE.replace("vertices\n", "vertices\n" + "1" * 5000 + "a 0 0\n"), "long.fe:2:1:"),
+    ("constraint " + "1" * 5000 + "\nformula: x = 0\n" + CUBE, "long.fe:1:12:"),
+    ("boundary 1 parameters " + "2" * 5000 + "\nx1: p1\nx2: 0\nx3: 0\n" + CUBE, "long.fe:1:23:"),
+])
+def test_ids_beyond_pythons_int_conversion_are_located(text, where):
+    # (Python refuses int() of more than 4,300 digits: it was a traceback)
+    with pytest.raises(DatafileError) as e:
+        read_datafile("long.fe", text)
+    assert str(e.value).startswith(where) and "too large" in str(e.value)
