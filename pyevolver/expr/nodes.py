@@ -143,7 +143,7 @@ class Index(Node):
     def ev(self, env):
         base = np.asarray(env.lookup(self.name), dtype=float)
         k = self.index.ev(env)
-        if np.ndim(k) or k != int(k):
+        if np.ndim(k) or not np.isfinite(k) or k != int(k):
             raise ExpressionError(f"{self.name}[...]: the index must be one integer")
         size = base.shape[-1] if base.ndim else 0
         if not 1 <= int(k) <= size:

@@ -104,3 +104,15 @@ def test_ids_beyond_pythons_int_conversion_are_located(text, where):
     with pytest.raises(DatafileError) as e:
         read_datafile("long.fe", text)
     assert str(e.value).startswith(where) and "too large" in str(e.value)
+
+
+@pytest.mark.parametrize("index", ["1e400", "-1e400", "(1e400-1e400)"])
+def test_array_index_that_is_not_finite_is_located(index):
+    # found by the deep hostile fuzz: int(inf) escaped as OverflowError
+    text = ("space_dimension 4\ndefine vertex attribute rc real[2]\n"
+            f"constraint 1 formula: x4 = rc[{index}]\n"
+            "vertices\n1 0 0 0 0 constraint 1 rc 0 0\n2 1 0 0 0\n3 0 1 0 0\n"
+            "edges\n1 1 2\n2 2 3\n3 3 1\nfaces\n1 1 2 3\n")
+    with pytest.raises(DatafileError) as e:
+        Session.load("idx.fe", out=io.StringIO(), err=io.StringIO(), text=text)
+    assert str(e.value).startswith("idx.fe:") and "index must be one integer" in str(e.value)
