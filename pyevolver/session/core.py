@@ -300,7 +300,7 @@ class Session(SessionAPI):
         try:
             with deadline.alarm(self.time_limit if outer else None):
                 interp.execute(ast)
-            health.check(self, snap[15])    # refresh; non-finite values fail; zero areas warn
+            health.check(self, snap[15], snap[-1][6])   # refresh; non-finite fails
             checked = True
         except (I.Quit, I.Interrupted):
             self.refresh()

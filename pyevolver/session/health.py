@@ -3,8 +3,8 @@ the command fail (the session restores the state before it); degenerate
 facets are reported with the Evolver's warning.
 
 The Evolver prints ``WARNING! Zero area for facet N.`` when its motion meets
-a facet of zero area; pyevolver prints the same text after the command (and
-after loading) that left such facets, once for each new set of them.
+a facet of zero area; pyevolver prints the same text after a command that
+ran iterations and left such facets, once for each new set of them.
 """
 from __future__ import annotations
 
@@ -18,12 +18,15 @@ from ..errors import CommandError
 MAX_NAMED = 10
 
 
-def check(session: Any, before: Any = None) -> None:
+def check(session: Any, before: Any = None, motion: Any = None) -> None:
     """Recompute the energies (as after every command) and fail when the
     command made coordinates or the energy infinite or NaN.
 
     ``before``: the totals before the command (an energy already infinite
-    before the command is not the command's fault).
+    before the command is not the command's fault); ``motion``: the last
+    motion of ``g`` before it (``Session._last_motion``).  The warnings of zero-area facets and
+    unconverged projections come after a command that ran iterations (``g``,
+    ``hessian``, ...), as the Evolver prints them from its motion.
     """
     s = session.surface
     if s is None:
@@ -40,8 +43,12 @@ def check(session: Any, before: Any = None) -> None:
             raise CommandError(f"the command would make the total energy {_word(e)} "
                                f"(an overflow, or a formula out of its domain); "
                                f"the surface is as it was before it")
-    warn_zero_area(session)
-    warn_unconverged(session)
+    if session.__dict__.get("_last_motion") is not motion:   # REF warns in its motion
+        warn_zero_area(session, before)             # the facets the motion started from
+        warn_zero_area(session)
+        warn_unconverged(session)
+    elif s.__dict__.pop("_unconverged", None) is not None:
+        pass                          # (a projection outside an iteration: REF's own rules)
 
 
 def warn_unconverged(session: Any) -> None:
@@ -77,10 +84,13 @@ def _word(v: float) -> str:
     return "NaN" if np.isnan(v) else "infinite"
 
 
-def warn_zero_area(session: Any) -> None:
-    """``WARNING! Zero area for facet N.`` for the facets of zero area, when
-    that set changed since the last warning."""
-    s, t = session.surface, session.totals
+def warn_zero_area(session: Any, totals: Any = None) -> None:
+    """``WARNING! Zero area for facet N.`` for the facets of zero area (in
+    ``totals``, default the session's), when that set changed since the
+    last warning."""
+    s, t = session.surface, totals if totals is not None else session.totals
+    if getattr(t, "surface", s) is not s:
+        return
     area = getattr(t, "facet_area", None)
     if s is None or area is None or not len(area):
         return
@@ -119,4 +129,3 @@ def check_loaded(session: Any, scene: Any) -> None:
     elif t is not None and not np.isfinite(getattr(t, "energy", 0.0)):
         session.write_err(f"{where}: warning: the total energy is {_word(t.energy)} "
                           f"(an overflow: coordinates or parameters too large)\n")
-    warn_zero_area(session)

@@ -38,7 +38,8 @@ def _counters(session) -> tuple:
     steps, the counts (``equi_count``, ...), the iteration counter and
     total time, the random generator's state, the CG iterator object."""
     return (list(session.history), dict(session.counts), session.iteration_counter,
-            session.total_time, session.rng.bit_generator.state, session._iterator)
+            session.total_time, session.rng.bit_generator.state, session._iterator,
+            session.__dict__.get("_last_motion"))
 
 
 def restore(session, snap: tuple) -> None:
@@ -47,7 +48,11 @@ def restore(session, snap: tuple) -> None:
     (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
      fattr, vcon, surface, totals, it_state, more, filename, attr_store, counters) = snap
     (history, counts, session.iteration_counter, session.total_time, rng_state,
-     session._iterator) = counters
+     session._iterator, motion) = counters
+    if motion is not None:
+        session._last_motion = motion
+    else:
+        session.__dict__.pop("_last_motion", None)
     session.history[:] = history
     session.counts.clear()
     session.counts.update(counts)
