@@ -40,6 +40,7 @@ workers must import pyevolver and share the output folder's filesystem).
 from __future__ import annotations
 
 import csv
+import ctypes
 import dataclasses
 import hashlib
 import io
@@ -47,6 +48,7 @@ import json
 import math
 import os
 import signal
+import threading
 import time
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from typing import Any, Callable
@@ -366,9 +368,7 @@ def _end_with_parent(parent: int) -> None:
     the kernel sends SIGTERM (``prctl(PR_SET_PDEATHSIG)``); everywhere a
     daemon thread checks the parent every second and exits when it is gone
     (a point half done leaves no ``result.json``: it is run again on resume)."""
-    import threading
     try:
-        import ctypes
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(1, signal.SIGTERM, 0, 0, 0)          # PR_SET_PDEATHSIG
     except (OSError, AttributeError):
