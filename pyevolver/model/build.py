@@ -251,9 +251,10 @@ class _Builder:
                 elif kw in ("bare", "original", "orientation"):
                     pass
                 elif kw == "wrap" and sc.symmetry_group is not None:
-                    if len(vals) != 1:
+                    if len(vals) != 1 or not 0 <= vals[0] < 2**31 or vals[0] != int(vals[0]):
                         raise self.error(f"edge {blk.ids[pos]}: wrap expects one group "
-                                         "element code", blk.lines[pos])
+                                         "element code (an integer from 0 to 2^31-1)",
+                                         blk.lines[pos])
                     self._wrap_codes[pos] = int(vals[0])
                 elif kw == "wrap":
                     raise self.error(f"edge {blk.ids[pos]}: not supported in pyevolver: WRAP "
