@@ -40,13 +40,26 @@ MAX_STRING = 10_000_000
 MAX_EXPANDED_LINE = 100_000
 
 
-def nesting_depth(tree: Any, limit: int = MAX_NESTING) -> int:
+#: longest piece of user text an error message quotes
+MAX_QUOTE = 60
+
+
+def clip(text: str, limit: int = MAX_QUOTE) -> str:
+    """``text`` cut to ``limit`` characters with ``...`` (a 200,000-digit
+    token is named in a message by its first characters)."""
+    text = str(text)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def nesting_depth(tree: Any, limit: int = MAX_NESTING, flat: Any = None) -> int:
     """Depth of a parsed expression or command (an iterative walk: a tree
     too deep for Python's recursion is measured without recursing).
 
     ``tree`` may mix expression nodes (anything with ``children()``),
     tuples, lists and objects with ``_nested()``; strings and numbers are
-    leaves.  The walk stops at ``limit + 1``.
+    leaves.  The walk stops at ``limit + 1``.  ``flat``: a node class whose
+    left operand (``.a``) counts at the node's own depth (a binary operator
+    evaluated iteratively along left-deep chains: ``1+2+...+n`` is flat).
     """
     deepest = 0
     stack = [(tree, 1)]
@@ -56,7 +69,10 @@ def nesting_depth(tree: Any, limit: int = MAX_NESTING) -> int:
             deepest = d
             if deepest > limit:
                 return deepest
-        if isinstance(obj, (tuple, list)):
+        if flat is not None and isinstance(obj, flat):
+            stack.append((obj.a, d))
+            kids = (obj.b,)
+        elif isinstance(obj, (tuple, list)):
             kids = obj
         elif hasattr(obj, "children") and callable(obj.children):
             try:

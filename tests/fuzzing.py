@@ -619,3 +619,87 @@ def limit(name, value):
         yield
     finally:
         setattr(limits, name, old)
+
+
+# ---------------------------------------------------------------------------
+# hostile input (issue 25): long tokens, deep and flat nesting, huge counts
+
+#: longest hostile token or flat chain (the deep run: 200,000; CI: 2,000)
+HOSTILE_MAX = 2_000
+
+
+def _long(rng):
+    """A length: mostly short, now and then up to :data:`HOSTILE_MAX`."""
+    if rng.random() < 0.03:
+        return rng.choice([n for n in (1000, 10_000, 50_000, 200_000) if n <= HOSTILE_MAX]
+                          or [HOSTILE_MAX])
+    return rng.randrange(1, 200)
+
+
+def long_token(rng):
+    """A digit run ended by a letter, a dot or an exponent, a long name, a
+    long string, a long comment, a long run of one punctuation character."""
+    n = _long(rng)
+    k = rng.randrange(8)
+    if k == 0:
+        return "1" * n + rng.choice(["a", ".", "e", "e+", "..", "d-", "x", ""])
+    if k == 1:
+        return "." + "5" * n + rng.choice([".", "e", "q"])
+    if k == 2:
+        return "a" * n
+    if k == 3:
+        return '"' + "s" * n + rng.choice(['"', ""])
+    if k == 4:
+        return "/*" + "*" * n + rng.choice(["*/", ""])
+    if k == 5:
+        return rng.choice("+-*/(){}[],;:=<>!&|#\\") * n
+    if k == 6:
+        return " \t" * n + "1"
+    return "1e" * (n // 2 + 1)
+
+
+def flat_chain(rng):
+    """A flat expression of up to 100,000 terms (``1+1+...``, mixed operators)."""
+    n = rng.choice([n for n in (1000, 10_000, 100_000) if n <= HOSTILE_MAX] or [HOSTILE_MAX]) \
+        if rng.random() < 0.02 else rng.randrange(2, 300)
+    ops = rng.choice([["+"], ["-"], ["*", "/"], ["+", "-", "*"], ["^"], ["==", "<"], ["&&"]])
+    return "1" + "".join(rng.choice(ops) + "1" for _ in range(n))
+
+
+HUGE_COUNTS = ["1e9", "1e18", "2^62", "1e308", "99999999999", "-1e9", "1e400", "0"]
+
+
+def hostile_command(rng):
+    """A command with a long token, deep or flat nesting or a huge count."""
+    k = rng.randrange(6)
+    if k == 0:
+        return f"print {long_token(rng)}"
+    if k == 1:
+        return f"print {flat_chain(rng)}"
+    if k == 2:
+        return f"print {_deep(rng)}" if rng.random() < 0.5 else _deep(rng)
+    if k == 3:
+        c = rng.choice(HUGE_COUNTS)
+        return rng.choice([f"g {c}", f"r {c}", f"define arr real[{c}]", f"define arr real[{c}][{c}]",
+                           f"u {c}", f"V {c}", f"hessian_seek {c}", f"{{ aa := 1 }} {c}",
+                           f"vertex[{c}].x := 1", f"refine edge[{c}]", f"list vertex[{c}]",
+                           f"printf \"%{c}d\", 1", f"print sprintf(\"%.{c}f\", 1)",
+                           f"aa := {c}; while aa > 0 do aa := aa - 1"])
+    if k == 4:
+        return f"aa := {long_token(rng)}" if rng.random() < 0.5 else \
+            f"{long_token(rng)} := 1"
+    return random_command(rng) + " " + long_token(rng)
+
+
+def hostile_datafile(text, rng):
+    """``text`` with a long token, deep or flat nesting or a huge count put
+    at a random token."""
+    toks = tokens(text)
+    words = _words(toks) or [0]
+    k = rng.choice(words) if toks else 0
+    pick = rng.randrange(4)
+    piece = [long_token, flat_chain, _deep, lambda r: r.choice(HUGE_COUNTS)][pick](rng)
+    if not toks:
+        return piece
+    toks[k] = piece if rng.random() < 0.7 else toks[k] + piece
+    return "".join(toks)

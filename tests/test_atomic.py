@@ -6,7 +6,8 @@ import os
 
 import pytest
 
-from pyevolver.atomic import NotRegularFile, atomic_path, atomic_write, check_regular
+from pyevolver.atomic import (NotRegularFile, atomic_append, atomic_path, atomic_write,
+                              check_regular)
 from pyevolver.errors import CommandError
 from pyevolver.session.core import Session
 
@@ -176,3 +177,49 @@ def test_export_is_atomic(tmp_path, monkeypatch, name):
     monkeypatch.undo()
     s.run(f'export "{out}"')
     assert out.read_text() != "previous export\n" and sorted(os.listdir(tmp_path)) == [name]
+
+
+def test_append_redirect_opens_in_append_mode(tmp_path, monkeypatch):
+    """``>>`` appends to the file itself (same inode, nothing copied): the
+    cost is what is written; 2,000 appends keep every line in order."""
+    monkeypatch.chdir(tmp_path)
+    s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
+    s.run('print 0 >> "app.txt"')
+    inode = os.stat(tmp_path / "app.txt").st_ino
+    s.run('for (ii := 1; ii <= 2000; ii += 1) { printf "%d\\n", ii >> "app.txt" }')
+    assert os.stat(tmp_path / "app.txt").st_ino == inode
+    assert (tmp_path / "app.txt").read_text().split() == [str(i) for i in range(2001)]
+    with pytest.raises(CommandError, match="not a regular file"):
+        s.run('print 1 >> "/dev/zero"')
+    with pytest.raises(CommandError, match="not a regular file"):
+        s.run(f'print 1 >> "{tmp_path}"')
+    assert _leftovers(tmp_path) == []
+
+
+def test_atomic_append_all_or_nothing(tmp_path, monkeypatch):
+    p = tmp_path / "a.txt"
+    p.write_text("old\n")
+    with pytest.raises(RuntimeError):
+        with atomic_append(str(p)) as fh:
+            fh.write("half\n")
+            raise RuntimeError
+    assert p.read_text() == "old\n"
+    new = tmp_path / "new.txt"
+    with pytest.raises(RuntimeError):
+        with atomic_append(str(new)) as fh:
+            raise RuntimeError
+    assert not new.exists()                      # a file it created is removed again
+    real_write = os.write
+
+    def short_then_full(fd, data):
+        real_write(fd, bytes(data[:2]))
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(os, "write", short_then_full)
+    with pytest.raises(OSError):
+        with atomic_append(str(p)) as fh:
+            fh.write("more text\n")
+    monkeypatch.undo()
+    assert p.read_text() == "old\n"              # cut back to its old length
+    with atomic_append(str(p)) as fh:
+        fh.write("x\n")
+    assert p.read_text() == "old\nx\n"

@@ -49,3 +49,15 @@ def test_bench_hessian_runs(evolver, tmp_path):
     out = _run([os.path.join(BENCH, "bench_hessian.py"), "--levels", "1", "--solvers"],
                tmp_path)
     assert "SuperLU, symmetric mode, ND order (pyevolver)" in out
+
+
+def test_deep_fuzz_writes_its_counts(tmp_path):
+    """benchmarks/deep_fuzz.py: a reduced deep run (50 inputs per target)
+    and the table of counts it writes (docs/fuzzing.md is this table)."""
+    doc = tmp_path / "fuzzing.md"
+    out = _run([os.path.join(BENCH, "deep_fuzz.py"), "--inputs", "50", "--reduced",
+                "--doc", str(doc)], tmp_path)
+    text = doc.read_text()
+    assert "result: passed" in text and "wrote" in out
+    for target in ("reader", "parser", "interpreter"):
+        assert f"| hostile {target} (deep) | 50 | 0 | 0 |" in text

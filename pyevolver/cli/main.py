@@ -18,6 +18,7 @@ from .. import __version__
 from ..commands import interpreter as I
 from ..commands.variables import READ_ONLY
 from ..errors import InternalError, PyEvolverError
+from ..session import deadline
 from ..session.core import Session
 from .tools import SUBCOMMANDS, main as tool_main
 
@@ -62,8 +63,9 @@ def _find_datafile(name):
 
 
 # exit status after Ctrl-C (SIGINT) in batch mode, as a shell reports a
-# process ended by SIGINT
+# process ended by SIGINT (and by SIGTERM)
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
 
 
 def main(argv=None):
@@ -83,6 +85,9 @@ def main(argv=None):
         # Ctrl-C outside a command (loading, reading input) or in batch mode:
         # files are written atomically, so nothing is left half-written
         _flush_quietly()
+        if deadline.terminated["hit"]:
+            sys.stderr.write("\nTerminated.\n")
+            return EXIT_TERMINATED
         sys.stderr.write("\nInterrupted.\n")
         return EXIT_INTERRUPTED
 
@@ -100,6 +105,7 @@ def _main(argv=None):
         return tool_main(argv)
     args = build_parser().parse_args(argv)
     np.seterr(all="ignore")        # overflows are reported as Evolver warnings, not numpy's
+    deadline.handle_sigterm()      # SIGTERM: as Ctrl-C (the command undone, exit 143)
     path = _find_datafile(args.datafile)
     if path is None:
         sys.stderr.write(f"pyevolver: cannot open datafile '{args.datafile}': no such file\n")
@@ -113,6 +119,9 @@ def _main(argv=None):
         return 1
     except MemoryError:
         sys.stderr.write(f"{path}: out of memory while loading the datafile\n")
+        return 1
+    except deadline.Alarm:          # (the alarm passed in the last instant of loading)
+        sys.stderr.write(f"{path}: {deadline.message(session, 'loading the datafile')}\n")
         return 1
     except (I.Quit, I.Interrupted, KeyboardInterrupt):
         raise

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from ..atomic import atomic_write
+from ..atomic import atomic_append, atomic_write
 from ..errors import (CommandError, ExpressionError, PyEvolverError, UnsupportedError,
                       did_you_mean)
 from ..expr import nodes as N
@@ -594,9 +594,9 @@ class Interpreter:
         # failing or interrupted command leaves it as it was
         with contextlib.ExitStack() as stack:
             try:
-                fh = stack.enter_context(atomic_write(name, "w" if op == ">>>" else "a",
-                                                      durable=False, encoding="latin-1",
-                                                      newline=""))
+                fh = stack.enter_context(
+                    atomic_write(name, "w", durable=False, encoding="latin-1", newline="")
+                    if op == ">>>" else atomic_append(name, encoding="latin-1", newline=""))
             except OSError as exc:
                 raise CommandError(f"cannot open '{name}' for output: "
                                    f"{exc.strerror or exc}") from None

@@ -14,7 +14,7 @@ from lark.exceptions import UnexpectedInput, VisitError
 from ..errors import CommandError, PyEvolverError
 from ..expr import nodes as N
 from ..expr.transform import ExprTransformer, expr_grammar
-from ..limits import MAX_NESTING, nesting_depth
+from ..limits import MAX_NESTING, clip, nesting_depth
 from .nodes import (Aggregate, ArrayLit, ArrayRef, Attr, ElemIndex, OnTest, Sprintf,
                     UserCall)
 from .toggles import graphics_toggle
@@ -426,11 +426,17 @@ def parse_command(text, where="<command>", line=1):
         ln = (exc.line if exc.line not in (None, -1) else 1) + line - 1
         col = exc.column if exc.column not in (None, -1) else 1
         snippet = text.split("\n")[(exc.line or 1) - 1] if text else ""
+        caret = col
+        if len(snippet) > 200:          # a very long line: the part around the column
+            lo = max(0, col - 100)
+            snippet = ("..." if lo else "") + snippet[lo:col + 100] + \
+                ("..." if col + 100 < len(snippet) else "")
+            caret = col - lo + (3 if lo else 0)
         tok = getattr(exc, "token", None)
-        what = f"unexpected '{tok}'" if tok is not None and tok.type != "$END" else \
+        what = f"unexpected '{clip(tok)}'" if tok is not None and tok.type != "$END" else \
             "unexpected end of command" if tok is not None else "unexpected character"
         raise CommandError(f"{where}:{ln}:{col}: syntax error: {what}\n    {snippet}\n    "
-                           + " " * (col - 1) + "^") from None
+                           + " " * (caret - 1) + "^") from None
     except VisitError as exc:
         if isinstance(exc.orig_exc, PyEvolverError):
             ln = getattr(exc.orig_exc, "line", None)
@@ -438,7 +444,7 @@ def parse_command(text, where="<command>", line=1):
             at = f"{line + ln - 1}:{col}" if ln and col else f"{line}"
             raise CommandError(f"{where}:{at}: {exc.orig_exc}") from None
         raise
-    if nesting_depth(ast) > MAX_NESTING:
+    if nesting_depth(ast, flat=N.Bin) > MAX_NESTING:
         raise CommandError(f"{where}:{line}: the command is nested more than {MAX_NESTING} "
                            f"levels deep (braces, control statements or expressions)")
     return ast

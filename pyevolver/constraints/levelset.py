@@ -317,6 +317,11 @@ def project_to_constraints(s: Surface, idx: np.ndarray, tol: float | None = None
             step = np.where(np.isfinite(step), step, 0.0)
             s.X[sel] = P - step
         res = np.max(np.abs(phi), axis=1)
+        stuck = ~(res <= max(tol, 1e-9))       # (NaN too) reported after the command:
+        if stuck.any():                        # pyevolver.session.health (REF's 1792)
+            k = int(np.argmax(stuck))
+            s.__dict__.setdefault("_unconverged", (int(sel[k]), active[0], float(res[k]),
+                                                   maxit, tol))
         bad = ~(np.all(np.isfinite(s.X[sel]), axis=1) & np.isfinite(res))
         # not converged and farther from the constraint than at the start: the
         # Newton iteration ran away (e.g. atan(z) = 0 from |z| > 1.39)

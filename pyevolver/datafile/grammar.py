@@ -12,7 +12,9 @@ import os
 from lark import Lark, Token, v_args
 
 from ..expr import nodes as N
-from ..expr.transform import ExprTransformer, expr_grammar
+from ..errors import ExpressionError
+from ..expr.transform import ExprTransformer, _at, expr_grammar
+from ..limits import clip
 from .located import _Unsupported
 
 _HERE = os.path.dirname(__file__)
@@ -48,10 +50,20 @@ _ETYPE = {"vertices": "vertex", "edges": "edge", "facets": "facet", "face": "fac
           "faces": "facet", "bodies": "body"}
 
 
+def _int(tok):
+    """An integer token (an id, a count): a located error when it has more
+    digits than any id may (Python refuses to convert past 4,300 digits)."""
+    s = str(tok)
+    if len(s.lstrip("+-0")) > 18:
+        raise _at(ExpressionError(f"the number {clip(s, 30)} is too large here "
+                                  f"(ids and counts are below 2^31)"), tok)
+    return int(s)
+
+
 def _cid(tok):
     """A constraint's or boundary's number, or its name (lower case)."""
     s = str(tok)
-    return int(s) if s.isdigit() else s.lower()
+    return _int(tok) if s.isdigit() else s.lower()
 
 
 @v_args(inline=True)
@@ -94,7 +106,7 @@ class _TopTransformer(ExprTransformer):
 
     def constraint_opt(self, tok, n=None):
         if n is not None:                  # CONTENT_RANK n
-            return ("content_rank", int(n), tok.line, tok.column)
+            return ("content_rank", _int(n), tok.line, tok.column)
         return str(tok).lower()
 
     def comp(self, kw, e):
@@ -135,7 +147,7 @@ class _TopTransformer(ExprTransformer):
                 blocks.append(r)
             elif isinstance(r, tuple):
                 comps.append(r)
-        return ("boundary", _cid(bid), int(nparams), opts, comps, blocks, kw.line)
+        return ("boundary", _cid(bid), _int(nparams), opts, comps, blocks, kw.line)
 
     def q_energy(self, _t):
         return ("kind", "energy", None)
@@ -266,7 +278,7 @@ class _LineTransformer(ExprTransformer):
                 flat.extend(it)
             else:
                 flat.append(it)
-        return (int(idtok), flat)
+        return (_int(idtok), flat)
 
     def braced(self, *exprs):
         return list(exprs)

@@ -11,6 +11,7 @@ import re
 from lark.exceptions import UnexpectedCharacters, UnexpectedToken
 
 from ..errors import did_you_mean
+from ..limits import clip
 
 
 class _Unsupported(Exception):
@@ -84,7 +85,7 @@ def describe(exc: Exception, text: str) -> str:
         ch = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
         word = re.match(r"[A-Za-z_]\w*", text[exc.pos_in_stream:])
         if word:
-            return (f"unexpected '{word.group(0)}': not a keyword, parameter or "
+            return (f"unexpected '{clip(word.group(0))}': not a keyword, parameter or "
                     f"value allowed here")
         return f"unexpected character {ch!r}"
     if isinstance(exc, UnexpectedToken):
@@ -95,5 +96,5 @@ def describe(exc: Exception, text: str) -> str:
         exp = _expected(exc.expected)
         words = [w for e in exc.expected for w in _keywords().get(e, ())]
         hint = did_you_mean(str(tok), words) if re.fullmatch(r"[A-Za-z_]\w*", str(tok)) else ""
-        return f"unexpected '{tok}': expected {exp}{hint}"
+        return f"unexpected '{clip(tok)}': expected {exp}{hint}"
     return str(exc).split("\n")[0]

@@ -11,8 +11,12 @@ import re
 
 import numpy as np
 
-# numbers with two decimal points or an exponent without digits
-_BAD_NUMBER = re.compile(r"(?<![\w.])(\d*\.\d*\.[\d.]*|\d+\.?\d*[eEdD][+-]?(?![\d+-]))")
+# numbers with two decimal points or an exponent without digits.  Every
+# digit run is taken whole (``(?=(\d+))\1`` is an atomic group, which Python
+# before 3.11 lacks), so a long digit run that fails cannot backtrack: the
+# search is linear in the text (a 200,000-digit number is checked at once)
+_BAD_NUMBER = re.compile(r"(?<![\w.])(?:(?=(\d*))\1\.(?=(\d*))\2\.[\d.]*"
+                         r"|(?=(\d+))\3(?:\.(?=(\d*))\4)?[eEdD][+-]?(?![\d+-]))")
 
 # an element line made of plain numbers (no alternative can match a digit
 # run in two ways, so a failing match cannot backtrack exponentially)

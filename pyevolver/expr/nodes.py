@@ -143,7 +143,7 @@ class Index(Node):
     def ev(self, env):
         base = np.asarray(env.lookup(self.name), dtype=float)
         k = self.index.ev(env)
-        if np.ndim(k) or k != int(k):
+        if np.ndim(k) or not np.isfinite(k) or k != int(k):
             raise ExpressionError(f"{self.name}[...]: the index must be one integer")
         size = base.shape[-1] if base.ndim else 0
         if not 1 <= int(k) <= size:
@@ -205,8 +205,22 @@ class Bin(Node):
         self.b = b
 
     def ev(self, env):
-        a = self.a.ev(env)
-        b = self.b.ev(env)
+        if not isinstance(self.a, Bin):
+            return self._apply(self.a.ev(env), self.b.ev(env))
+        # a long flat chain (``1+2+...``, left-deep): its left spine is walked
+        # in a loop, so 100,000 terms need no recursion (left to right, as
+        # the nested calls would evaluate them)
+        spine = []
+        node = self
+        while isinstance(node, Bin):
+            spine.append(node)
+            node = node.a
+        v = node.ev(env)
+        for node in reversed(spine):
+            v = node._apply(v, node.b.ev(env))
+        return v
+
+    def _apply(self, a, b):
         if not (is_number(a) and is_number(b)):
             raise ExpressionError(f"operator '{self.op}' needs numbers, got "
                                   f"{_what(b if is_number(a) else a)}")
@@ -224,8 +238,22 @@ class Bin(Node):
     def children(self):
         return (self.a, self.b)
 
+    def _spine(self):
+        """The operands of the left-deep chain this node ends (iteratively)."""
+        out = []
+        node = self
+        while isinstance(node, Bin):
+            out.append(node.b)
+            node = node.a
+        out.append(node)
+        return out
+
     def is_const(self):
-        return self.a.is_const() and self.b.is_const()
+        return all(c.is_const() for c in self._spine())
+
+    def _names(self, out):
+        for c in self._spine():
+            c._names(out)
 
     def __repr__(self):
         return f"Bin({self.op!r}, {self.a!r}, {self.b!r})"

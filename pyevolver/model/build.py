@@ -253,7 +253,8 @@ class _Builder:
                 elif kw in ("bare", "original", "orientation"):
                     pass
                 elif kw == "wrap" and sc.symmetry_group is not None:
-                    if len(vals) != 1 or not abs(vals[0]) < 2.0 ** 63:
+                    if (len(vals) != 1 or not abs(vals[0]) < 2.0 ** 63
+                            or vals[0] != int(vals[0])):
                         raise self.error(f"edge {blk.ids[pos]}: wrap expects one group "
                                          "element code (an integer)", blk.lines[pos])
                     self._wrap_codes[pos] = int(vals[0])

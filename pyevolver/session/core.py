@@ -9,16 +9,14 @@ The REPL, the CLI and the Python API share this object::
 """
 from __future__ import annotations
 
-import contextlib
-import signal
 import sys
-import threading
 import time
 from typing import Any, Callable, TextIO
 
 import numpy as np
 
-from . import popping, undo
+from . import deadline, health, popping, undo
+from .deadline import deferred_sigint as _deferred_sigint
 from .api import SessionAPI, progress_bar
 from .result import GResult
 from ..commands import constraints, element_attrs, elements, files, remesh, variables
@@ -41,26 +39,6 @@ from ..model.build import build_surface
 from ..remesh.quadratic import from_listed
 from ..remesh.string import split_edges
 
-
-@contextlib.contextmanager
-def _deferred_sigint():
-    """Ctrl-C (SIGINT) only sets ``flag["hit"]`` while the block runs (so a
-    ``g`` or ``bfgs`` run can stop at the end of a complete iteration); the
-    previous handler is restored after.  Outside the main thread, a no-op."""
-    flag = {"hit": False}
-    old = None
-    if threading.current_thread() is threading.main_thread():
-        def handler(signum, frame):
-            flag["hit"] = True
-        try:
-            old = signal.signal(signal.SIGINT, handler)
-        except (ValueError, OSError):
-            old = None
-    try:
-        yield flag
-    finally:
-        if old is not None:
-            signal.signal(signal.SIGINT, old)
 
 # motion options that change what g does; refused rather than ignored
 UNSUPPORTED_MOTION = ()
@@ -102,7 +80,7 @@ class Session(SessionAPI):
         self.total_time = 0.0
         # seconds one top-level command may run (None: no limit); a command
         # that runs longer stops with an error and leaves the surface as it was
-        self.time_limit = None
+        self.time_limit: float | None = None
         self.history: list[tuple] = []         # (iteration, energy, area) of each g step
         self.command_history: list = []       # (number, text) of `history`, `!!` (REF: last 100)
         self.command_count = 0
@@ -113,8 +91,8 @@ class Session(SessionAPI):
     # -- loading ---------------------------------------------------------------
     @classmethod
     def load(cls, filename: str, out: TextIO | None = None, err: TextIO | None = None,
-             run_read: bool = True,
-             text: str | None = None) -> "Session":
+             run_read: bool = True, text: str | None = None,
+             timeout: float | None = None) -> "Session":
         """A session on a datafile.
 
         Parameters
@@ -127,19 +105,28 @@ class Session(SessionAPI):
             Run the datafile's ``read`` section.
         text : str, optional
             The file's contents, when not to be read from disk.
+        timeout : float, optional
+            Seconds the loading, and then each command, may run (``time_limit``).
         """
         s = cls(out, err)
+        s.time_limit = timeout
         s.load_file(filename, run_read, text)
         return s
 
     def load_file(self, filename: str, run_read: bool = True,
                   text: str | None = None) -> "Session":
-        """Load a datafile into this session (see :meth:`load`)."""
-        scene = read_datafile(filename, text)
-        surface = build_surface(scene)
-        if "listed_midpoints" in surface.__dict__:     # QUADRATIC in the datafile
-            surface = from_listed(surface)
-        return self._install(filename, scene, surface, run_read)
+        """Load a datafile into this session (see :meth:`load`); the time
+        limit covers all of it (:mod:`pyevolver.session.deadline`)."""
+        try:
+            with deadline.limit(self):
+                scene = read_datafile(filename, text)
+                surface = build_surface(scene)
+                if "listed_midpoints" in surface.__dict__:     # QUADRATIC in the datafile
+                    surface = from_listed(surface)
+                return self._install(filename, scene, surface, run_read)
+        except (deadline.Alarm, I.TimeLimitExceeded):
+            raise I.TimeLimitExceeded(f"{filename}: " + deadline.message(
+                self, "loading the datafile")) from None
 
     def _install(self, filename, scene, surface, run_read):
         self.filename = filename
@@ -201,6 +188,7 @@ class Session(SessionAPI):
             raise DatafileError(str(exc), filename, line, None,
                                 lines[line - 1] if line and lines and line <= len(lines)
                                 else None) from None
+        health.check_loaded(self, scene)       # overflowed coordinates, zero-area facets
         for text, line in scene.top_commands:  # top-section procedures and functions
             self.run(text, where=filename, line=line, stop_on_error=False)
         for wline, msg in scene.read_warnings:
@@ -251,7 +239,7 @@ class Session(SessionAPI):
 
     # -- running commands ----------------------------------------------------------
     def run(self, text: str, where: str = "<command>", line: int = 1,
-            stop_on_error: bool = True) -> None:
+            stop_on_error: bool = True, timeout: float | None = None) -> None:
         """Run command text (any number of commands).
 
         Each complete command is parsed then executed; a failing command
@@ -266,7 +254,13 @@ class Session(SessionAPI):
         stop_on_error : bool
             Raise :class:`CommandError` at the first error (else print it
             and go on).
+        timeout : float, optional
+            Seconds each command may run (default: ``time_limit``).
         """
+        with deadline.override(self, timeout):
+            self._run(text, where, line, stop_on_error)
+
+    def _run(self, text, where, line, stop_on_error):
         for chunk, ln in I.split_commands(text):
             try:
                 self.run_one(chunk, where, line + ln - 1)
@@ -296,7 +290,7 @@ class Session(SessionAPI):
                                    f"beyond {MAX_EXPANDED_LINE} characters") from None
         ast = I.parse_command(text, where, line)
         self._remember(stripped)
-        snap = self._snapshot()
+        snap, checked = self._snapshot(), False
         scopes = self.interp.env.scopes
         depth = len(scopes)
         scopes.append({})
@@ -305,11 +299,10 @@ class Session(SessionAPI):
         if outer and self.time_limit:
             interp.deadline = time.monotonic() + self.time_limit
         try:
-            interp.execute(ast)
-            if self.surface is not None and not np.all(np.isfinite(self.surface.X)):
-                # e.g. a huge jiggle or a boundary formula out of its domain
-                raise CommandError("the command would make vertex coordinates infinite or "
-                                   "NaN")
+            with deadline.alarm(self.time_limit if outer else None):
+                interp.execute(ast)
+            health.check(self, snap[15], snap[-1][6])   # refresh; non-finite fails
+            checked = True
         except (I.Quit, I.Interrupted):
             self.refresh()
             raise
@@ -318,6 +311,9 @@ class Session(SessionAPI):
             self.refresh()
             raise I.Interrupted("Interrupted: the surface is as it was before the command.") \
                 from None
+        except deadline.Alarm:
+            self._restore(snap)
+            raise I.TimeLimitExceeded(f"{where}:{line}: {deadline.message(self)}") from None
         except (I._Break, I._Continue, I._Return, I.Loaded):
             pass
         except PyEvolverError as exc:
@@ -332,6 +328,9 @@ class Session(SessionAPI):
             self._restore(snap)
             raise CommandError(f"{where}:{line}: out of memory; the command was "
                                f"abandoned") from None
+        except (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError) as exc:
+            self._restore(snap)             # numerical failures in plain words
+            raise CommandError(f"{where}:{line}: {health.explain(exc)}") from None
         except Exception as exc:
             # a bug of pyevolver, not of the script: the session goes on, the
             # surface as it was (PYEVOLVER_TRACEBACK=1 prints the traceback)
@@ -347,7 +346,8 @@ class Session(SessionAPI):
                 self.note(f"{word}: {n}\n")
             elif n:
                 self.write(f"{word}: {n}\n")
-        self.refresh()
+        if not checked:
+            self.refresh()
 
     HISTORY_SIZE = 100
 

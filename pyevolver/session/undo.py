@@ -29,14 +29,34 @@ def snapshot(session) -> tuple:
                                     {k: m.copy() for k, m in s.fcon.items()},
                                     s.gravity_constant, s.sq_curvature_modulus),
             session.filename,
-            {k: dict(v) for k, v in session.__dict__.get("_attr_store", {}).items()})
+            {k: dict(v) for k, v in session.__dict__.get("_attr_store", {}).items()},
+            _counters(session))
+
+
+def _counters(session) -> tuple:
+    """The session's own records a command changes: the history of ``g``
+    steps, the counts (``equi_count``, ...), the iteration counter and
+    total time, the random generator's state, the CG iterator object."""
+    return (list(session.history), dict(session.counts), session.iteration_counter,
+            session.total_time, session.rng.bit_generator.state, session._iterator,
+            session.__dict__.get("_last_motion"))
 
 
 def restore(session, snap: tuple) -> None:
     """Put back the state of :func:`snapshot` (a failing or interrupted
     command leaves the session as it was)."""
     (vars_, cmds, letters, arrays, toggles, settings, X, bod, qs, extra, vattr, eattr,
-     fattr, vcon, surface, totals, it_state, more, filename, attr_store) = snap
+     fattr, vcon, surface, totals, it_state, more, filename, attr_store, counters) = snap
+    (history, counts, session.iteration_counter, session.total_time, rng_state,
+     session._iterator, motion) = counters
+    if motion is not None:
+        session._last_motion = motion
+    else:
+        session.__dict__.pop("_last_motion", None)
+    session.history[:] = history
+    session.counts.clear()
+    session.counts.update(counts)
+    session.rng.bit_generator.state = rng_state
     session.filename = filename
     session._attr_store = attr_store          # graphics-only attributes (commands.attributes)
     session.surface = surface

@@ -40,12 +40,15 @@ workers must import pyevolver and share the output folder's filesystem).
 from __future__ import annotations
 
 import csv
+import ctypes
 import dataclasses
 import hashlib
 import io
 import json
 import math
 import os
+import signal
+import threading
 import time
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from typing import Any, Callable
@@ -59,6 +62,10 @@ from ..errors import PyEvolverError
 from ..io.render import _matplotlib, _save
 from ..session.api import progress_bar
 from ..session.core import Session
+
+#: most points of one sweep (each has its own folder and process task); the
+#: grid's size is checked from the parameters' lengths before anything runs
+MAX_POINTS = 100_000
 
 SPEC_KEYS = {"datafile", "output", "commands", "record", "snapshot", "parameters",
              "continuation", "plot"}
@@ -126,6 +133,9 @@ def _values(where, name, v):
     if isinstance(v, dict) and set(v) == {"start", "stop", "num"}:
         try:
             num = int(v["num"])
+            if not 1 <= num <= MAX_POINTS:
+                raise SweepError(f"{where}: parameter '{name}': num = {v['num']} (from 1 to "
+                                 f"{MAX_POINTS:,})")
             return np.linspace(float(v["start"]), float(v["stop"]), num).tolist()
         except (TypeError, ValueError):
             pass
@@ -164,6 +174,13 @@ def spec_from_dict(raw: dict, base: str = ".", where: str = "<spec>") -> SweepSp
     if not isinstance(params, dict) or not params:
         raise SweepError(f"{where}: a [parameters] table with at least one parameter is required")
     parameters = {str(k): _values(where, k, v) for k, v in params.items()}
+    size = 1
+    for vals in parameters.values():
+        size *= len(vals)
+    if size > MAX_POINTS:
+        raise SweepError(f"{where}: the grid has {size:,} points ("
+                         f"{' x '.join(str(len(v)) for v in parameters.values())}); at most "
+                         f"{MAX_POINTS:,} (split the sweep)")
     stem = os.path.splitext(os.path.basename(where))[0] if where != "<spec>" else "sweep"
     output = os.path.join(base, raw.get("output", stem + "_out"))
     commands = raw.get("commands", "")
@@ -340,8 +357,30 @@ class SweepResult:
 
 def local_executor(workers: int | None = None) -> ProcessPoolExecutor:
     """The default executor: a process pool (``workers`` processes, default
-    the number of CPUs)."""
-    return ProcessPoolExecutor(max_workers=workers)
+    the number of CPUs) whose workers end when the main process ends, even
+    when it is killed (:func:`_end_with_parent`)."""
+    return ProcessPoolExecutor(max_workers=workers, initializer=_end_with_parent,
+                               initargs=(os.getpid(),))
+
+
+def _end_with_parent(parent: int) -> None:
+    """In a pool worker: end this process when ``parent`` ends.  On Linux
+    the kernel sends SIGTERM (``prctl(PR_SET_PDEATHSIG)``); everywhere a
+    daemon thread checks the parent every second and exits when it is gone
+    (a point half done leaves no ``result.json``: it is run again on resume)."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGTERM, 0, 0, 0)          # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != parent:                          # died before the call
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+    threading.Thread(target=watch, daemon=True, name="end-with-parent").start()
 
 
 def dask_executor(address: str) -> tuple[Executor, Any]:

@@ -31,10 +31,11 @@ def _run(args, script, cwd, timeout=60):
 
 
 def test_timeout_stops_a_runaway_command(tmp_path):
+    # (the limit covers loading too: 2 s leaves room for the parsers' first use)
     script = ("aa := 1\nwhile 1 do aa := aa + 1\nprint aa\n"
               "g 100000000\nprintf \"E=%.10g\\n\", total_energy\nq\n")
     t0 = time.monotonic()
-    p = _run(["--timeout", "0.5", CUBE], script, tmp_path)
+    p = _run(["--timeout", "2", CUBE], script, tmp_path)
     assert time.monotonic() - t0 < 30
     assert p.returncode == 0, p.stderr
     assert "Traceback" not in p.stderr
@@ -74,8 +75,9 @@ def test_sigint_in_batch_mode_exits_130_writing_nothing(tmp_path, command):
     proc.stdin.write(script)
     proc.stdin.flush()
 
-    def writing():          # the redirection's temporary file exists: the body runs
-        return any(n.endswith(".tmp") for n in os.listdir(tmp_path))
+    def writing():          # the redirection's temporary file (>>>) or the file
+        # opened for appending (>>) exists: the body runs
+        return any(n.endswith(".tmp") or n == "out.txt" for n in os.listdir(tmp_path))
     out, err = _interrupt_after(proc, tmp_path, writing)
     assert proc.returncode == 130, (out, err)
     assert "Traceback" not in err and "Interrupted" in err

@@ -151,8 +151,8 @@ def _exec_fuzz(target, datafiles, nightly=False):
 
     def session(rng):
         s = Session.load(rng.choice(names), out=io.StringIO(), err=io.StringIO())
-        s.time_limit = 0.02
         s.run(F.PRELUDE)
+        s.time_limit = 0.02         # (after the prelude: the limit is wall-clock time)
         return s
 
     def body(rng):
@@ -184,6 +184,72 @@ def test_fuzz_interpreter_nightly(small_elements, in_tmp, datafile):
         pytest.skip("the Evolver's examples are not installed")
     _exec_fuzz(f"interpreter on {datafile} (nightly)", [path] + INTERPRETER_FILES[1:],
                nightly=True)
+
+
+# ---------------------------------------------------------------------------
+# hostile input (issue 25): long tokens, deep and flat nesting, huge counts.
+# A small run in CI; the deep run (``--nightly``: HOSTILE_DEEP inputs per
+# target, at least 100,000) is run by benchmarks/deep_fuzz.py, which writes
+# its counts into docs/fuzzing.md.
+
+HOSTILE_CI = 100
+HOSTILE_DEEP = int(os.environ.get("PYEVOLVER_HOSTILE_REDUCED", "0")) or \
+    max(100_000, int(os.environ.get("PYEVOLVER_HOSTILE_INPUTS", "100000")))
+
+
+def _hostile(target, body, n, nightly=False):
+    @_settings(n, nightly)
+    @given(st.integers(0, 2**32 - 1))
+    def run(seed):
+        rng = random.Random(seed)
+        for _ in range(BATCH):
+            body(rng)
+            F.count(target)
+    before = F.COUNTS.get(target, 0)
+    t0, c0 = time.perf_counter(), time.process_time()
+    run()
+    wall, cpu = F.TIMES.get(target, (0.0, 0.0))
+    F.TIMES[target] = (wall + time.perf_counter() - t0, cpu + time.process_time() - c0)
+    assert F.COUNTS[target] - before >= n
+
+
+def _hostile_bodies():
+    seeds = [s for s in F.seed_datafiles() if len(s[1]) < 1600]
+    state = {}
+
+    def reader(rng):
+        name, text = rng.choice(seeds)
+        F.check_datafile(name, F.hostile_datafile(text, rng))
+
+    def parser(rng):
+        F.check_parse(F.hostile_command(rng), "hostile")
+
+    def interp(rng):
+        if "s" not in state or rng.random() < 0.05 or state["s"].surface.nf > 1000:
+            s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
+            s.run(F.PRELUDE)
+            s.time_limit = 0.05
+            state["s"] = s
+        try:
+            F.check_commands(state["s"], F.hostile_command(rng), "hostile")
+        finally:
+            out = state["s"].out
+            out.seek(0)
+            out.truncate()
+    return {"reader": reader, "parser": parser, "interpreter": interp}
+
+
+@pytest.mark.parametrize("target", ["reader", "parser", "interpreter"])
+def test_fuzz_hostile(small_elements, in_tmp, target):
+    _hostile(f"hostile {target}", _hostile_bodies()[target], HOSTILE_CI)
+
+
+@pytest.mark.nightly
+@pytest.mark.parametrize("target", ["reader", "parser", "interpreter"])
+def test_fuzz_hostile_deep(small_elements, in_tmp, target, monkeypatch):
+    monkeypatch.setattr(F, "HOSTILE_MAX", 200_000)
+    _hostile(f"hostile {target} (deep)", _hostile_bodies()[target], HOSTILE_DEEP,
+             nightly=True)
 
 
 # ---------------------------------------------------------------------------

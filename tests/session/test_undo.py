@@ -70,3 +70,24 @@ def test_restored_session_goes_on_like_the_evolver(evolver):
     assert s.count("facet") == numbers(evolver, CUBE, ["facet_count"])[0]
     s.run("g 3")
     assert s.total_energy == pytest.approx(e3, rel=STEPS)
+
+
+def test_failing_command_rolls_back_history_counters_and_random_state():
+    """Everything a command changes goes back with the surface when it
+    fails: the g history, the iteration counter, counts, the random stream."""
+    import io as _io
+    import os as _os
+    from pyevolver.session.core import Session as _S
+    cube = _os.path.join(_os.path.dirname(__file__), "..", "..", "datafiles", "cube.fe")
+    s = _S.load(cube, out=_io.StringIO(), err=_io.StringIO())
+    s.run("g 2")
+    hist, it = list(s.history), s.iteration_counter
+    r0 = s.rng.bit_generator.state
+    try:
+        s.run("g 3; aa := random; print vertex[999].x")
+    except Exception:
+        pass
+    else:
+        raise AssertionError("the command should fail")
+    assert s.history == hist and s.iteration_counter == it
+    assert s.rng.bit_generator.state == r0

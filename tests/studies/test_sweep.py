@@ -167,6 +167,10 @@ def test_bad_specs_are_located(tmp_path, capsys):
     bad(dict(ok, parameters={}), r"\[parameters\] table")
     bad(dict(ok, parameters={"a": "x"}), r"parameter 'a': expected a number")
     bad(dict(ok, continuation={"parameter": "zz"}), r"continuation parameter 'zz'")
+    # the grid's size is checked before anything runs (no MemoryError)
+    huge = {f"p{k}": {"start": 0, "stop": 1, "num": 1000} for k in range(4)}
+    bad(dict(ok, parameters=huge), r"spec.toml: the grid has 1,000,000,000,000 points")
+    bad(dict(ok, parameters={"a": {"start": 0, "stop": 1, "num": 10**12}}), r"num = ")
     p = tmp_path / "broken.toml"
     p.write_text('datafile = "x\n')
     assert cli_main(["sweep", str(p)]) == 1
@@ -178,3 +182,37 @@ def test_bad_specs_are_located(tmp_path, capsys):
     assert res.failed and "'nosuch' is not a parameter or variable" in res.failed[0]["error"]
     with open(os.path.join(spec.output, "p0000", "result.json")) as fh:
         assert json.load(fh)["status"] == "error"
+
+
+def test_workers_end_when_the_main_process_is_killed(tmp_path):
+    """SIGKILL of the sweep's main process (no chance to clean up): its pool
+    workers end too (PR_SET_PDEATHSIG / a watcher thread)."""
+    from pyevolver.studies import sweep as SW
+    if not os.path.isdir("/proc"):
+        pytest.skip("needs /proc to list the workers")
+    script = (
+        "import os, sys, time\n"
+        f"sys.path[:0] = {sys.path!r}\n"
+        "from pyevolver.studies.sweep import local_executor\n"
+        "ex = local_executor(2)\n"
+        "futs = [ex.submit(time.sleep, 600) for _ in range(2)]\n"
+        "time.sleep(1.0)\n"
+        "print(' '.join(str(p) for p in ex._processes), flush=True)\n"
+        "time.sleep(600)\n")
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    pids = [int(p) for p in proc.stdout.readline().split()]
+    assert len(pids) == 2 and SW.MAX_POINTS > 0
+    proc.kill()
+    proc.wait()
+    t0 = time.time()
+    while time.time() - t0 < 30 and any(_alive(p) for p in pids):
+        time.sleep(0.1)
+    assert not any(_alive(p) for p in pids)
+
+
+def _alive(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().split(")")[-1].split()[0] != "Z"
+    except OSError:
+        return False
