@@ -48,9 +48,10 @@ def _settings(n_inputs, nightly):
                     suppress_health_check=list(HealthCheck), print_blob=True)
 
 
-def _fuzz(target, body, nightly=False):
-    """Run ``body(rng)`` on ``BATCH`` inputs per hypothesis example."""
-    n = FUZZ_INPUTS * (10 if nightly else 1)
+def _fuzz(target, body, nightly=False, n=None):
+    """Run ``body(rng)`` on ``BATCH`` inputs per hypothesis example, ``n``
+    inputs in all (default :data:`FUZZ_INPUTS`, ten times that nightly)."""
+    n = n or FUZZ_INPUTS * (10 if nightly else 1)
 
     @_settings(n, nightly)
     @given(st.integers(0, 2**32 - 1))
@@ -198,19 +199,7 @@ HOSTILE_DEEP = int(os.environ.get("PYEVOLVER_HOSTILE_REDUCED", "0")) or \
 
 
 def _hostile(target, body, n, nightly=False):
-    @_settings(n, nightly)
-    @given(st.integers(0, 2**32 - 1))
-    def run(seed):
-        rng = random.Random(seed)
-        for _ in range(BATCH):
-            body(rng)
-            F.count(target)
-    before = F.COUNTS.get(target, 0)
-    t0, c0 = time.perf_counter(), time.process_time()
-    run()
-    wall, cpu = F.TIMES.get(target, (0.0, 0.0))
-    F.TIMES[target] = (wall + time.perf_counter() - t0, cpu + time.process_time() - c0)
-    assert F.COUNTS[target] - before >= n
+    _fuzz(target, body, nightly, n)
 
 
 def _hostile_bodies():
