@@ -23,6 +23,19 @@ def icosphere_file(level, jitter=0.0, vesicle=False):
     return path
 
 
+def bending_file(level):
+    """The level's vesicle icosphere without its fixed-area quantity and with
+    facet tension 1 (``bench_iterate.py --bending``, ``bench_hessian.py``)."""
+    vesicle = icosphere_file(level, vesicle=True)
+    out = vesicle.replace("_vesicle.fe", "_bending.fe")
+    if not os.path.exists(out):
+        with open(vesicle) as fh:
+            lines = [ln for ln in fh if not ln.startswith("quantity surf")]
+        with open(out, "w") as fh:
+            fh.write("".join(ln.replace("tension 0\n", "tension 1\n") for ln in lines))
+    return out
+
+
 def wall(cmd, stdin, repeat):
     """Best wall time of ``repeat`` runs of ``cmd`` with ``stdin``, and the
     last run's output; exits on a failed run."""

@@ -39,22 +39,10 @@ import statistics
 import subprocess
 import sys
 
-from _common import REPO, icosphere_file
+from _common import REPO, bending_file, icosphere_file
 
 PREFIX = "set vertex z z*1.5\nset body target body[1].volume\ng 2\n"
 PRINT = 'printf "RESULT %.17g %.17g %.17g\\n", total_energy, body[1].volume, body[1].target\n'
-
-
-def bending_file(level):
-    """The level's vesicle icosphere without its fixed-area quantity, tension 1."""
-    vesicle = icosphere_file(level, vesicle=True)
-    out = vesicle.replace("_vesicle.fe", "_bending.fe")
-    if not os.path.exists(out):
-        with open(vesicle) as fh:
-            lines = [ln for ln in fh if not ln.startswith("quantity surf")]
-        with open(out, "w") as fh:
-            fh.write("".join(ln.replace("tension 0\n", "tension 1\n") for ln in lines))
-    return out
 
 
 def _popen_wait4(cmd, stdin, env):

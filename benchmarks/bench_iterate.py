@@ -25,7 +25,7 @@ import os
 import subprocess
 import sys
 
-from _common import REPO, icosphere_file, wall
+from _common import REPO, bending_file, icosphere_file, wall
 
 CHILD = r"""
 import io, sys, time
@@ -42,17 +42,6 @@ if sys.argv[3] == "1":
 t3 = time.perf_counter()
 print((t1 - t0) / k, t3 - t2, repr(e))
 """
-
-
-def _bending_file(vesicle):
-    """The vesicle file without its fixed-area quantity and with tension 1."""
-    out = vesicle.replace("_vesicle.fe", "_bending.fe")
-    if not os.path.exists(out):
-        with open(vesicle) as fh:
-            lines = [ln for ln in fh if not ln.startswith("quantity surf")]
-        with open(out, "w") as fh:
-            fh.write("".join(ln.replace("tension 0\n", "tension 1\n") for ln in lines))
-    return out
 
 
 def main():
@@ -72,9 +61,7 @@ def main():
     env["PYTHONPATH"] = REPO + os.pathsep + env.get("PYTHONPATH", "")
     rows = []
     for lev in a.levels:
-        f = icosphere_file(lev, vesicle=a.vesicle or a.bending)
-        if a.bending:
-            f = _bending_file(f)
+        f = bending_file(lev) if a.bending else icosphere_file(lev, vesicle=a.vesicle)
         nf = 20 * 4 ** lev
         base, _ = wall([a.evolver, "-p1", f], "q\nq\n", a.repeat)
         gk, out = wall([a.evolver, "-p1", f], f"g 1\ng {a.steps}\nq\nq\n", a.repeat)
