@@ -44,7 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..constraints import restore_state, state
-from ..errors import UnsupportedError, dimension_error
+from ..errors import CommandError, UnsupportedError, dimension_error
 from .hessian import HessianSystem, _cholmod, hessian_system
 from . import symfactor as SF
 
@@ -265,13 +265,21 @@ def _near(hs: HessianSystem, shift: float, m: int, eps: float, dense_max: int, s
     fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True, points=hs.points)
     v0 = fac.op(np.random.default_rng(seed).standard_normal(n))
     op = spla.LinearOperator((n, n), matvec=fac.op, dtype=float)
-    if hs.M is None:
-        theta, V = spla.eigsh(op, k=m, which="LM", v0=v0, tol=1e-14)
-        return _order(fac.sigma + 1.0 / theta, V, shift, m)
-    # generalized shift-invert mode: OP = (K − σM)⁻¹ M on the subspace,
-    # self-adjoint in the M inner product
-    mu, V = spla.eigsh(hs.K, k=m, M=hs.M, sigma=fac.sigma, OPinv=op, which="LM", v0=v0,
-                       tol=1e-14)
+    try:
+        if hs.M is None:
+            theta, V = spla.eigsh(op, k=m, which="LM", v0=v0, tol=1e-14)
+            return _order(fac.sigma + 1.0 / theta, V, shift, m)
+        # generalized shift-invert mode: OP = (K − σM)⁻¹ M on the subspace,
+        # self-adjoint in the M inner product
+        mu, V = spla.eigsh(hs.K, k=m, M=hs.M, sigma=fac.sigma, OPinv=op, which="LM", v0=v0,
+                           tol=1e-14)
+    except spla.ArpackNoConvergence as exc:
+        got = len(np.atleast_1d(getattr(exc, "eigenvalues", np.zeros(0))))
+        raise CommandError(
+            f"the eigenvalue iteration did not converge near {shift:g} ({got} of {m} "
+            "eigenvalues found): the Hessian has many (nearly) equal eigenvalues there, "
+            "e.g. motions that cost no energy; try another shift or fewer eigenvalues") \
+            from None
     return _order(mu, V, shift, m)
 
 

@@ -201,3 +201,20 @@ def test_hessian_index_with_and_without_the_steps_pivots(monkeypatch, cholmod):
             solve_bordered(hs.K, hs.B, np.zeros(30), np.zeros(1), pivots=piv)
             assert piv
         assert newton._index(hs, piv, 1e-10) == int(np.sum(exact < c))
+
+
+def test_arpack_without_convergence_is_a_plain_error(monkeypatch):
+    """100grain.fe after `g 5` has 101 zero eigenvalues and ARPACK does not
+    converge near them: a plain message, not an internal error."""
+    import scipy.sparse.linalg as spla
+    from pyevolver.errors import CommandError
+    s = Session.load(os.path.join(os.path.dirname(__file__), "..", "..", "datafiles",
+                                  "cube.fe"), out=io.StringIO())
+    s.run("g 2")
+    hs = hessian_system(s.iterator, normal=True)
+
+    def no_convergence(*args, **kwargs):
+        raise spla.ArpackNoConvergence("no convergence", np.zeros(0), np.zeros((0, 0)))
+    monkeypatch.setattr(spla, "eigsh", no_convergence)
+    with pytest.raises(CommandError, match="did not converge near 0 .0 of 2 eigenvalues"):
+        EG._near(hs, 0.0, 2, 1e-10, dense_max=0)
