@@ -356,6 +356,11 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         scale = _no_rise(E, e0, 1.0, [0.5 ** k for k in range(1, 41)])
         if scale != 1.0:
             report.append(_SCALED % scale)
+        if scale == 0.0:        # no fraction of the step helps: the surface stays
+            restore_state(s, X0)
+            t = s.evaluate()
+            return StepResult(t.energy, t.total_area, 0.0, hs.lam, {}, True,
+                              warnings=report, totals=t)
     t = it._move(X0, dx, scale, cons, None, None, mobile, targets, report)
     if not math.isfinite(t.energy):
         restore_state(s, X0)

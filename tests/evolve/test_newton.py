@@ -178,8 +178,10 @@ def test_hessian_takes_the_rising_newton_step_as_the_evolver():
 
 def test_hessian_backtrack_halves_a_rising_step():
     s, e0, out = _cube_g2("hessian_backtrack on", "hessian")
-    # (on cube.fe after g 2 no fraction of the step lowers the area: scale 0)
+    # (on cube.fe after g 2 no fraction of the step lowers the area: scale 0,
+    # and the surface stays as it was)
     assert "hessian: the Newton step raised the energy; step scaled by 0 " in out
+    assert s.total_energy == pytest.approx(e0, rel=1e-14)
 
 
 def test_check_increase_undoes_a_rising_step_even_with_backtrack():
