@@ -294,6 +294,24 @@ def _triple_edges(s):
     return np.nonzero(np.bincount(idx.ravel(), minlength=s.ne) >= 3)[0]
 
 
+def constraint_groups(s, con, cids):
+    """The vertices ``con`` grouped by the set of level-set constraints
+    (ids ``cids``) they are on: yields ``(key, sel, active, Gm)``, ``key``
+    the on/off row of the group, ``sel`` its vertices, ``active`` its
+    constraint ids and ``Gm`` (n, 3, k) their formulas' gradients there."""
+    env = s.param_env()
+    on = np.stack([s.vcon[c][con] for c in cids], axis=1)
+    keys, inv = np.unique(on, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    for gi, key in enumerate(keys):
+        sel = con[inv == gi]
+        coords = vertex_coords(s, sel)
+        active = [c for c, k in zip(cids, key) if k]
+        Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(sel))
+                       for c in active], axis=2)
+        yield key, sel, active, Gm
+
+
 def tangent_basis(s, mobile, normal=True, t=None):
     """The free motions of the vertices as a :class:`Basis`.
 
@@ -356,16 +374,7 @@ def tangent_basis(s, mobile, normal=True, t=None):
     con = np.nonzero(mobile & (ncon > 0))[0]
     grads = {}
     if len(con):
-        env = s.param_env()
-        on = np.stack([s.vcon[c][con] for c in cids], axis=1)
-        keys, inv = np.unique(on, axis=0, return_inverse=True)
-        inv = inv.ravel()
-        for gi, key in enumerate(keys):
-            sel = con[inv == gi]
-            coords = vertex_coords(s, sel)
-            active = [c for c, k in zip(cids, key) if k]
-            Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(sel))
-                           for c in active], axis=2)            # (n, 3, k)
+        for key, sel, active, Gm in constraint_groups(s, con, cids):
             U, S_, Vt = np.linalg.svd(Gm, full_matrices=True)
             kk = len(active)
             Tb = U[:, :, kk:]                                    # (n, 3, 3-k)

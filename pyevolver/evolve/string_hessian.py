@@ -38,14 +38,14 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..constraints import vertex_coords
 from ..geometry.kernels import edge_vectors
 from ..errors import UnsupportedError
 from ..methods import string as SM
 from ..methods.basic import edge_length_hessian
 from ..model.string import chain_points, facet_entries
 from . import gradient as GR
-from .hessian import MODEL_HESSIAN, Basis, _quantity_hessian, _sum, fd_hessian
+from .hessian import (MODEL_HESSIAN, Basis, _quantity_hessian, _sum, constraint_groups,
+                      fd_hessian)
 
 
 def check_fixed_bodies(s) -> None:
@@ -119,16 +119,7 @@ def string_basis(s, mobile, normal=True):
                 raise UnsupportedError(
                     "hessian_normal at vertices on constraints of a string in space",
                     "not measured against the Evolver; hessian_normal off works")
-        env = s.param_env()
-        on = np.stack([s.vcon[c][con] for c in cids], axis=1)
-        keys, inv = np.unique(on, axis=0, return_inverse=True)
-        inv = inv.ravel()
-        for gi, key in enumerate(keys):
-            sel = con[inv == gi]
-            coords = vertex_coords(s, sel)
-            active = [c for c, k in zip(cids, key) if k]
-            Gm = np.stack([s.constraints[c].formula.gradient(env, coords, len(sel))
-                           for c in active], axis=2)                    # (n, 3, k)
+        for key, sel, active, Gm in constraint_groups(s, con, cids):
             Gm[:, dim:, :] = 0.0
             U, S_, _ = np.linalg.svd(Gm[:, :dim, :], full_matrices=True)  # (n, dim, dim)
             rank = int(min(len(active), dim))
