@@ -16,56 +16,67 @@ GL2_T = np.array([0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0)])
 GL2_W = np.array([0.5, 0.5])
 
 
-def _dunavant6():
-    """12-point degree-6 rule on the triangle (Dunavant 1985), barycentric.
+def symmetric_rule(p, centre: bool, n3: int, n6: int) -> tuple[np.ndarray, np.ndarray]:
+    """Barycentric points ``B (q, 3)`` and weights ``W (q,)`` of a fully
+    symmetric triangle rule from its parameters ``p``: the centroid's weight
+    (when ``centre``), then ``(a, w)`` for each of ``n3`` three-point orbits
+    (1 − 2a, a, a), then ``(b, c, w)`` for each of ``n6`` six-point orbits
+    (b, c, 1 − b − c)."""
+    p = list(p)
+    B, W = [], []
+    if centre:
+        B.append((1 / 3, 1 / 3, 1 / 3))
+        W.append(p.pop(0))
+    for _ in range(n3):
+        a, w = p.pop(0), p.pop(0)
+        o = 1 - 2 * a
+        B += [(o, a, a), (a, o, a), (a, a, o)]
+        W += [w] * 3
+    for _ in range(n6):
+        b, c, w = p.pop(0), p.pop(0), p.pop(0)
+        o = 1 - b - c
+        B += [(b, c, o), (c, b, o), (b, o, c), (o, b, c), (c, o, b), (o, c, b)]
+        W += [w] * 6
+    return np.array(B), np.array(W)
 
-    Returns ``(B (12, 3), W (12,))`` with weights summing to 1.  The
-    published 15-digit constants are polished to machine precision by
-    Newton's method on the moment equations for the monomials up to degree 6.
-    """
-    a1, w1 = 0.063089014491502, 0.050844906370207
-    a2, w2 = 0.249286745170910, 0.116786275726379
-    b3, c3, w3 = 0.053145049844817, 0.310352451033784, 0.082851075618374
 
-    def pts(p):
-        a1, w1, a2, w2, b3, c3, w3 = p
-        B = []
-        W = []
-        for a, w in ((a1, w1), (a2, w2)):
-            o = 1 - 2 * a
-            for t in ((o, a, a), (a, o, a), (a, a, o)):
-                B.append(t)
-                W.append(w)
-        o = 1 - b3 - c3
-        for t in ((b3, c3, o), (c3, b3, o), (b3, o, c3), (o, b3, c3), (c3, o, b3), (o, c3, b3)):
-            B.append(t)
-            W.append(w3)
-        return np.array(B), np.array(W)
-
-    mons = [(i, j) for i in range(7) for j in range(7 - i)]
+def polished_rule(p0, centre: bool, n3: int, n6: int,
+                  degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`symmetric_rule` with published constants ``p0`` polished to
+    machine precision by Newton's method on the moment equations for the
+    monomials up to ``degree`` (∫ x^i y^j over the unit triangle, as a
+    fraction of its area)."""
+    mons = [(i, j) for i in range(degree + 1) for j in range(degree + 1 - i)]
+    exact = np.array([2.0 * factorial(i) * factorial(j) / factorial(i + j + 2)
+                      for i, j in mons])
 
     def resid(p):
-        B, W = pts(p)
-        r = []
-        for i, j in mons:
-            exact = 2.0 * factorial(i) * factorial(j) / factorial(i + j + 2)
-            r.append(np.sum(W * B[:, 0] ** i * B[:, 1] ** j) * 1.0 - exact * 1.0)
-        return np.array(r)
+        B, W = symmetric_rule(p, centre, n3, n6)
+        return np.array([np.sum(W * B[:, 0] ** i * B[:, 1] ** j) for i, j in mons]) - exact
 
-    p = np.array([a1, w1, a2, w2, b3, c3, w3])
+    p = np.array(p0, dtype=float)
     for _ in range(8):
         r = resid(p)
         J = np.empty((len(r), len(p)))
-        h = 1e-7
         for k in range(len(p)):
             q = p.copy()
-            q[k] += h
-            J[:, k] = (resid(q) - r) / h
+            q[k] += 1e-7
+            J[:, k] = (resid(q) - r) / 1e-7
         step = np.linalg.lstsq(J, -r, rcond=None)[0]
         p = p + step
         if np.max(np.abs(step)) < 1e-16:
             break
-    return pts(p)
+    return symmetric_rule(p, centre, n3, n6)
+
+
+def _dunavant6():
+    """12-point degree-6 rule on the triangle (Dunavant 1985), barycentric
+    ``(B (12, 3), W (12,))`` with weights summing to 1, the published
+    15-digit constants polished (:func:`polished_rule`)."""
+    return polished_rule([0.063089014491502, 0.050844906370207,
+                          0.249286745170910, 0.116786275726379,
+                          0.053145049844817, 0.310352451033784, 0.082851075618374],
+                         centre=False, n3=2, n6=1, degree=6)
 
 
 TRI6_B, TRI6_W = _dunavant6()

@@ -24,13 +24,12 @@ assembled sparse.
 from __future__ import annotations
 
 from functools import lru_cache
-from math import factorial
 
 import numpy as np
 
 from ..errors import PyEvolverError, UnsupportedError
 from ..expr.nodes import coord_names
-from ..geometry.kernels import TRI6_B, TRI6_W
+from ..geometry.kernels import TRI6_B, TRI6_W, polished_rule
 from ..model.metric import FACET_ORDERS
 from ._common import assemble, scatter
 from .registry import register_method
@@ -50,46 +49,12 @@ def line_rule(order: int) -> tuple[np.ndarray, np.ndarray]:
 
 def _dunavant8():
     """16-point degree-8 rule on the triangle (Dunavant 1985), barycentric
-    ``(B (16, 3), W (16,))``, the published constants polished by Newton's
-    method on the moment equations up to degree 8."""
-    def pts(p):
-        w0, a1, w1, a2, w2, a3, w3, b, c, w4 = p
-        B = [(1 / 3, 1 / 3, 1 / 3)]
-        W = [w0]
-        for a, w in ((a1, w1), (a2, w2), (a3, w3)):
-            o = 1 - 2 * a
-            for t in ((o, a, a), (a, o, a), (a, a, o)):
-                B.append(t)
-                W.append(w)
-        o = 1 - b - c
-        for t in ((b, c, o), (c, b, o), (b, o, c), (o, b, c), (c, o, b), (o, c, b)):
-            B.append(t)
-            W.append(w4)
-        return np.array(B), np.array(W)
-
-    mons = [(i, j) for i in range(9) for j in range(9 - i)]
-    exact = np.array([2.0 * factorial(i) * factorial(j) / factorial(i + j + 2) for i, j in mons])
-
-    def resid(p):
-        B, W = pts(p)
-        return np.array([np.sum(W * B[:, 0] ** i * B[:, 1] ** j) for i, j in mons]) - exact
-
-    p = np.array([0.144315607677787, 0.459292588292723, 0.095091634267285,
-                  0.170569307751760, 0.103217370534718, 0.050547228317031,
-                  0.032458497623198, 0.008394777409958, 0.263112829634638,
-                  0.027230314174435])
-    for _ in range(8):
-        r = resid(p)
-        J = np.empty((len(r), len(p)))
-        for k in range(len(p)):
-            q = p.copy()
-            q[k] += 1e-7
-            J[:, k] = (resid(q) - r) / 1e-7
-        step = np.linalg.lstsq(J, -r, rcond=None)[0]
-        p = p + step
-        if np.max(np.abs(step)) < 1e-16:
-            break
-    return pts(p)
+    ``(B (16, 3), W (16,))``, the published constants polished
+    (:func:`pyevolver.geometry.kernels.polished_rule`)."""
+    return polished_rule([0.144315607677787, 0.459292588292723, 0.095091634267285,
+                          0.170569307751760, 0.103217370534718, 0.050547228317031,
+                          0.032458497623198, 0.008394777409958, 0.263112829634638,
+                          0.027230314174435], centre=True, n3=3, n6=1, degree=8)
 
 
 @lru_cache(maxsize=None)
