@@ -13,8 +13,10 @@ from pyevolver import Session
 from pyevolver.errors import PyEvolverError
 from pyevolver.evolve.gradient import energy_gradient
 from pyevolver.methods import metric as MT
+from pyevolver.methods._common import corner_scatter
 
 from conftest import example
+from finite_differences import assert_hessian_columns
 
 SOAP = """{top}
 vertices
@@ -157,25 +159,12 @@ def test_hessians_against_differences_of_the_gradient(tmp_path, kind):
     ew = np.array([0.3, 1.0, 0.7])
     H = H + MT.edge_length_hessian(t, idx, ew).toarray()
 
-    def grad(X):
-        surf.X = X
+    def grad(surf):
         tt = surf.evaluate()
-        from pyevolver.methods._common import corner_scatter
-        g = corner_scatter(tt, MT.facet_area_grad(tt), w)
-        return (g + MT.edge_length_grad(tt, idx, ew)).ravel()
+        return corner_scatter(tt, MT.facet_area_grad(tt), w) + MT.edge_length_grad(tt, idx, ew)
 
-    X0 = surf.X.copy()
-    h = 1e-6
-    F = np.zeros_like(H)
-    for c in range(X0.size):
-        Xp = X0.copy().ravel()
-        Xm = X0.copy().ravel()
-        Xp[c] += h
-        Xm[c] -= h
-        F[:, c] = (grad(Xp.reshape(X0.shape)) - grad(Xm.reshape(X0.shape))) / (2 * h)
-    surf.X = X0
     assert np.max(np.abs(H - H.T)) < 1e-12
-    assert np.max(np.abs(H - F)) < 1e-6 * max(1.0, np.max(np.abs(F)))
+    assert_hessian_columns(surf, H, grad)
 
 
 def test_split_fractions_closed_form(tmp_path):
@@ -259,20 +248,5 @@ def test_klein_hessian_against_differences(tmp_path):
     surf = s.surface
     t = surf.evaluate()
     H = MT.facet_area_hessian(t, np.ones(surf.nf)).toarray()
-    X0 = surf.X.copy()
-
-    def grad(X):
-        surf.X = X
-        from pyevolver.methods._common import corner_scatter
-        return corner_scatter(surf.evaluate(), MT.facet_area_grad(surf.evaluate())).ravel()
-
-    h = 1e-6
-    F = np.zeros_like(H)
-    for c in range(X0.size):
-        Xp = X0.copy().ravel()
-        Xm = X0.copy().ravel()
-        Xp[c] += h
-        Xm[c] -= h
-        F[:, c] = (grad(Xp.reshape(X0.shape)) - grad(Xm.reshape(X0.shape))) / (2 * h)
-    surf.X = X0
-    assert np.max(np.abs(H - F)) < 1e-6 * max(1.0, np.max(np.abs(F)))
+    assert_hessian_columns(
+        surf, H, lambda surf: corner_scatter(surf.evaluate(), MT.facet_area_grad(surf.evaluate())))
