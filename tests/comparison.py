@@ -66,6 +66,25 @@ def _run_both(evolver, datafile, script, tmp_path):
     return dirs, ref, out, err
 
 
+MEMORY = ("Element memory", "Total data memory")
+
+
+def compare_transcripts(evolver, datafile, script, tmp_path, rtol=1e-10):
+    """Run ``script`` on ``datafile`` in REF and in pyevolver (a child):
+    pyevolver writes nothing on stderr and its transcript equals REF's
+    (blank and memory-report lines aside) within ``rtol``; returns ours."""
+    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
+    code, out, err = run_pyevolver(datafile, script + "q\n", cwd=str(tmp_path))
+    assert err == "", err
+    assert _same(transcript_lines(out), transcript_lines(ref), rtol), (out, ref)
+    return out
+
+
+def transcript_lines(lines):
+    """The lines of a transcript without blank and memory-report lines."""
+    return [l for l in lines if l.strip() and not l.startswith(MEMORY)]
+
+
 def run_both_in_process(evolver, datafile, script, tmp_path):
     """REF's transcript of ``script`` and pyevolver's (a Session in this
     process: faster than a child), as lists of lines, and pyevolver's stderr."""

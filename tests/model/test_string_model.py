@@ -15,22 +15,11 @@ import pytest
 
 from conftest import EXAMPLES, example
 from reference import run_reference
-from comparison import _same, run_pyevolver
+from comparison import _same, compare_transcripts, run_pyevolver, transcript_lines
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
-MEMORY = ("Element memory", "Total data memory")
-
-
-def _lines(lines):
-    return [l for l in lines if l.strip() and not l.startswith(MEMORY)]
-
-
-def _compare(evolver, datafile, script, tmp_path, rtol=1e-10):
-    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
-    code, out, err = run_pyevolver(datafile, script + "q\n", cwd=str(tmp_path))
-    assert err == "", err
-    assert _same(_lines(out), _lines(ref), rtol), (out, ref)
-    return out
+_compare = compare_transcripts
+_lines = transcript_lines
 
 
 NAV = ('foreach facet[1].vertex vv do print vv.id\nforeach facet[-1].edge ee do print ee.oid\n'

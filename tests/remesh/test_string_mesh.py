@@ -12,23 +12,10 @@ from pyevolver.errors import UnsupportedError
 from pyevolver.remesh import string_mesh as SMESH
 from pyevolver.remesh.string import split_edges
 from conftest import example
-from reference import run_reference
-from comparison import _same, run_pyevolver
+from comparison import compare_transcripts
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data")
-MEMORY = ("Element memory", "Total data memory")
-
-
-def _lines(lines):
-    return [l for l in lines if l.strip() and not l.startswith(MEMORY)]
-
-
-def _compare(evolver, datafile, script, tmp_path, rtol=1e-10):
-    ref = run_reference(evolver, datafile, script, cwd=str(tmp_path), timeout=120)
-    code, out, err = run_pyevolver(datafile, script + "q\n", cwd=str(tmp_path))
-    assert err == "", err
-    assert _same(_lines(out), _lines(ref), rtol), (out, ref)
-    return out
+_compare = compare_transcripts
 
 
 CASES = {
