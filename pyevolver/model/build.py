@@ -557,6 +557,11 @@ class _Builder:
         s.sf_ptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
         init_rings(s)
         s.sf_enc = np.where(rev, ~eidx, eidx).astype(np.int64)
+        self.facet_attrs(blk, nface, fixed, tension, no_refine, colors)
+
+    def facet_attrs(self, blk, nface, fixed, tension, no_refine, colors):
+        """The faces' attributes, each face its own facet (no split yet)."""
+        s = self.s
         self.split_children = {}
         self.facet_parent = np.arange(nface)
         s.fattr["fixed"] = fixed

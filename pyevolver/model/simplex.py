@@ -129,11 +129,4 @@ def build_faces(builder) -> None:
                             blk.lines[rep[0]])
     s.simplex = k
     s.SF = SF
-    builder.split_children = {}
-    builder.facet_parent = np.arange(nface)
-    s.fattr["fixed"] = fixed
-    s.fattr["tension"] = tension
-    s.fattr["no_refine"] = no_refine
-    s.fattr["original"] = builder._originals(blk)
-    for key, arr in colors.items():
-        s.fattr[key] = arr
+    builder.facet_attrs(blk, nface, fixed, tension, no_refine, colors)
