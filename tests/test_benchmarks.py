@@ -61,3 +61,17 @@ def test_deep_fuzz_writes_its_counts(tmp_path):
     assert "result: passed" in text and "wrote" in out
     for target in ("reader", "parser", "interpreter"):
         assert f"| hostile {target} (deep) | 50 | 0 | 0 |" in text
+
+
+def test_bench_hostile_writes_its_table(tmp_path):
+    """benchmarks/bench_hostile.py: the first check (a 200,000-digit number
+    run into a letter: a located error) run once, its row written between
+    the markers of a Markdown file (docs/hostile.md is this table)."""
+    doc = tmp_path / "hostile.md"
+    doc.write_text("intro\n<!-- bench_hostile -->\nold\n<!-- /bench_hostile -->\nend\n")
+    _run([os.path.join(BENCH, "bench_hostile.py"), "--only", "1", "--repeat", "1",
+          "--doc", str(doc)], tmp_path)
+    text = doc.read_text()
+    assert text.startswith("intro\n") and text.endswith("end\n") and "old" not in text
+    assert "| 200,000-digit number run into a letter (datafile) |" in text
+    assert "| ≤ 5 | right: exit 1, located message |" in text

@@ -1,0 +1,167 @@
+#!/usr/bin/env python3
+"""Issue 25's limits, measured on the command line as a user meets them.
+
+Each check runs ``pyevolver`` (``python -m pyevolver`` of the checkout given
+by ``--pyevolver``) in a child process and records its wall time, its exit
+status and whether its output is right:
+
+* a datafile whose parameter is a 200,000-digit number run into a letter
+  (a located error, exit status 1);
+* 16,000 ``>>`` appends, once as one ``for`` loop and once as 16,000 lines
+  of a script (every line written);
+* ``print`` of a flat sum of 100,000 terms (prints 100000);
+* ``--timeout 1`` on loading the level-7 icosphere (327,680 facets, about
+  32 MB: exit status 1 and the time-limit message);
+* ``--timeout 3`` on three ``hessian`` steps at 81,920 facets with
+  ``star_perp_sq_mean_curvature`` (each stopped, and the message says so).
+
+The table goes between the ``<!-- bench_hostile -->`` markers of
+``--doc`` (docs/fuzzing.md keeps the deep fuzz run's counts, written by
+deep_fuzz.py; this table lives in docs/hostile.md).  Times are wall
+seconds, the best of ``--repeat`` runs; they depend on the machine's load.
+
+Usage::
+
+    python benchmarks/bench_hostile.py [--repeat 3] [--doc docs/hostile.md]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _common import REPO, bending_file, icosphere_file  # noqa: E402
+
+CUBE = os.path.join(REPO, "datafiles", "cube.fe")
+TRIANGLE = ("vertices\n1 0 0 0\n2 1 0 0\n3 0 1 0\nedges\n1 1 2\n2 2 3\n3 3 1\n"
+            "faces\n1 1 2 3\n")
+
+
+def run(tree, args, stdin, cwd):
+    """(wall seconds, exit status, stdout + stderr) of one pyevolver run."""
+    env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
+    t0 = time.perf_counter()
+    p = subprocess.run([sys.executable, "-m", "pyevolver", *args], input=stdin, cwd=cwd,
+                       env=env, capture_output=True, text=True, timeout=600)
+    return time.perf_counter() - t0, p.returncode, p.stdout + p.stderr
+
+
+def best(repeat, fn):
+    """The fastest of ``repeat`` runs of ``fn() -> (seconds, ok, note)``; ok
+    only when every run was."""
+    runs = [fn() for _ in range(repeat)]
+    t = min(r[0] for r in runs)
+    return t, all(r[1] for r in runs), runs[-1][2]
+
+
+def long_number(tree, work):
+    path = os.path.join(work, "long.fe")
+    with open(path, "w") as fh:
+        fh.write("parameter p = " + "1" * 200_000 + "a\n" + TRIANGLE)
+    t, rc, out = run(tree, [path], "q\n", work)
+    ok = rc != 0 and "long.fe:1:" in out and len(out) < 4000
+    return t, ok, f"exit {rc}, located message"
+
+
+def appends_loop(tree, work):
+    log = os.path.join(work, "loop.txt")
+    if os.path.exists(log):
+        os.remove(log)
+    cmd = ('for ( inx := 1 ; inx <= 16000 ; inx += 1 ) '
+           '{ printf "line %g\\n", inx >> "loop.txt" }\nq\n')
+    t, rc, out = run(tree, [CUBE], cmd, work)
+    with open(log) as fh:
+        lines = fh.read().splitlines()
+    ok = rc == 0 and lines == [f"line {i}" for i in range(1, 16001)]
+    return t, ok, f"{len(lines):,} lines written"
+
+
+def appends_lines(tree, work):
+    log = os.path.join(work, "lines.txt")
+    if os.path.exists(log):
+        os.remove(log)
+    cmd = "".join(f'printf "line %g\\n", {i} >> "lines.txt"\n' for i in range(1, 16001))
+    t, rc, out = run(tree, [CUBE], cmd + "q\n", work)
+    with open(log) as fh:
+        lines = fh.read().splitlines()
+    ok = rc == 0 and lines == [f"line {i}" for i in range(1, 16001)]
+    return t, ok, f"{len(lines):,} lines written"
+
+
+def flat_sum(tree, work):
+    t, rc, out = run(tree, [CUBE], "print " + "+".join(["1"] * 100_000) + "\nq\n", work)
+    ok = rc == 0 and re.search(r"^\s*100000\s*$", out, re.M) is not None
+    return t, ok, "prints 100000" if ok else out[-200:]
+
+
+def timeout_load(tree, work):
+    path = icosphere_file(7)
+    t, rc, out = run(tree, ["--timeout", "1", path], "q\n", work)
+    ok = rc != 0 and "time limit" in out
+    return t, ok, f"exit {rc}, {os.path.getsize(path) / 1e6:.0f} MB file"
+
+
+def timeout_hessians(tree, work):
+    path = bending_file(6)
+    t, rc, out = run(tree, ["--timeout", "3", path], "g 1\nhessian\nhessian\nhessian\nq\n",
+                     work)
+    stopped = len(re.findall(r"ran longer than 3 s", out))
+    return t, stopped == 3, f"{stopped} of 3 steps stopped (`g 1` and the load included)"
+
+
+CHECKS = [
+    ("200,000-digit number run into a letter (datafile)", "≤ 5", long_number),
+    ("16,000 `>>` appends, one `for` loop", "≤ 3", appends_loop),
+    ("16,000 `>>` appends, 16,000 script lines", "≤ 3", appends_lines),
+    ("`print` of a 100,000-term flat sum", "≤ 5", flat_sum),
+    ("`--timeout 1` on loading 327,680 facets", "≤ 8", timeout_load),
+    ("`--timeout 3` on three `hessian` steps, 81,920 facets, star_perp", "≤ 10",
+     timeout_hessians),
+]
+
+
+def table(rows):
+    out = ["| check | wall [s] | issue 25's limit [s] | result |", "|---|---|---|---|"]
+    for name, limit, (t, ok, note) in rows:
+        out.append(f"| {name} | {t:.2f} | {limit} | {'right' if ok else 'WRONG'}: {note} |")
+    return "\n".join(out)
+
+
+def write_doc(path, text):
+    start, end = "<!-- bench_hostile -->", "<!-- /bench_hostile -->"
+    with open(path, encoding="utf-8") as fh:
+        doc = fh.read()
+    i, j = doc.index(start), doc.index(end)
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(doc[:i + len(start)] + "\n" + text + "\n" + doc[j:])
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--pyevolver", default=REPO, help="checkout whose pyevolver runs")
+    ap.add_argument("--only", nargs="+", type=int, help="check numbers (1-based) to run")
+    ap.add_argument("--doc", default=None, help="Markdown file to write the table into")
+    a = ap.parse_args(argv)
+    rows = []
+    with tempfile.TemporaryDirectory() as work:
+        for k, (name, limit, fn) in enumerate(CHECKS, 1):
+            if a.only and k not in a.only:
+                continue
+            res = best(a.repeat, lambda: fn(a.pyevolver, work))
+            print(f"{name}: {res[0]:.2f} s, {'right' if res[1] else 'WRONG'} ({res[2]})",
+                  file=sys.stderr)
+            rows.append((name, limit, res))
+    text = table(rows)
+    print(text)
+    if a.doc:
+        write_doc(a.doc, text)
+
+
+if __name__ == "__main__":
+    main()
