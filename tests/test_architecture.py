@@ -28,7 +28,7 @@ PKG = ROOT / "pyevolver"
 # scipy.sparse.linalg 0.1 s and 8 MB, for the hessian's and newton's solves)
 OPTIONAL = {"matplotlib", "tqdm", "prompt_toolkit", "sksparse", "dask", "distributed",
             "h5py", "PIL", "threadpoolctl", "tomli", "tomllib", "readline", "pexpect",
-            "pyvista", "vtk"}
+            "pyvista", "vtk", "imageio_ffmpeg"}
 HEAVY = {"scipy.special", "scipy.sparse.linalg"}
 MAX_LINES = 800
 

@@ -44,14 +44,17 @@ def render_png(path: str, X: np.ndarray, F: np.ndarray, view: np.ndarray, size: 
                point_values: np.ndarray | None = None,
                cell_values: np.ndarray | None = None, clim: tuple | None = None,
                label: str = "", cmap: str = "viridis", rgb: np.ndarray | None = None,
-               edges: bool = False, title: str | None = None) -> str:
+               edges: bool = False, title: str | None = None,
+               frame: np.ndarray | None = None) -> str:
     """Draw the triangles ``F`` on the points ``X`` (n, 3) into ``path``
     (.png or .jpg), written atomically; returns ``path``.
 
     ``view``: the (4, 4) view matrix (its rows 0 and 2: towards the viewer
     and up).  Colours: ``point_values`` or ``cell_values`` over ``clim``
     with the colour bar ``label``, else ``rgb`` (nf, 3) per facet, else
-    plain grey."""
+    plain grey.  ``frame``: the points (k, 3) to frame the camera on
+    (default ``X``; a movie passes every frame's points, so that the camera
+    stays put and the whole run is in the picture)."""
     pv = _pyvista()
     ext = os.path.splitext(os.fspath(path))[1].lower()
     if ext not in (".png", ".jpg", ".jpeg"):
@@ -88,7 +91,8 @@ def render_png(path: str, X: np.ndarray, F: np.ndarray, view: np.ndarray, size: 
         pl.add_mesh(mesh, scalars="rgb", rgb=True, **kw)
     else:
         pl.add_mesh(mesh, color=(0.78, 0.80, 0.84), **kw)
-    _frame(pl, X, np.asarray(view, float), width / size, bar)
+    _frame(pl, X if frame is None else np.asarray(frame, float), np.asarray(view, float),
+           width / size, bar)
     if title:
         pl.add_text(title, position="upper_left", font_size=12, color="black")
     if note:

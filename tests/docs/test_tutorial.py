@@ -28,5 +28,5 @@ def test_tutorial_runs(tmp_path, monkeypatch):
         # compiled with the tutorial's file name and line, so a failure points at the doc
         exec(compile("\n" * (line - 1) + src, path, "exec"), ns)
     for name in ("cube.vtu", "cube.ply", "cube_again.fe", "cube.png", "cube_area.png",
-                 "history.png", "drops/results.csv"):
+                 "history.png", "cube.gif", "drops/results.csv"):
         assert os.path.getsize(tmp_path / name) > 0, name
