@@ -177,3 +177,25 @@ def test_fig3_5x10_continuation_regenerated(energy, tmp_path):
     assert row["W"] == pytest.approx(_f3(f"{energy}+harmonic(cont.)", "W", "5x10"), rel=1e-6)
     assert row["W_loop"] == pytest.approx(_f3(f"{energy}+harmonic(cont.)", "W_loop", "5x10"),
                                           rel=1e-6)
+
+
+@pytest.mark.parametrize("shape, branch", [("prolate", "prolate"),
+                                           ("discocyte", "oblate/discocyte")])
+def test_guide_axisymmetric_references_regenerated(shape, branch):
+    from pyevolver.studies import fig4_vesicles
+    ref = fig4_vesicles.reference(shape)
+    v0 = fig4_vesicles.SHAPES[shape][0]
+    row = (f"| {v0:.2f} | {branch} (") in _text("guide.md")
+    assert row
+    expected = f"| {ref.n} | {ref.W:.12f} | {ref.W / (4 * math.pi):.12f} |"
+    assert expected in _text("guide.md"), expected
+
+
+@pytest.mark.slow
+def test_guide_loop_torus_regenerated():
+    from pyevolver.studies.loop_torus import minimize_torus
+    out = minimize_torus(5, 9)
+    text = _text("guide.md")
+    assert f"prints W = {out['W']:.3f}" in text
+    assert f"ratio {out['ratio']:.4f}" in text
+    assert f"fixed = {out['area']:.3f} method loop_area" in text
