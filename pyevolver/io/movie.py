@@ -36,7 +36,7 @@ from ..model.surface import Surface
 from . import render, render_vtk
 from .fields import clipped_range, facet_colors
 
-__all__ = ["Movie", "ffmpeg_executable"]
+__all__ = ["Movie", "ffmpeg_executable", "picture_data", "common_range", "draw"]
 
 GREY = (0.78, 0.80, 0.84)
 
@@ -48,6 +48,68 @@ def ffmpeg_executable() -> str | None:
         return str(imageio_ffmpeg.get_ffmpeg_exe())
     except (ImportError, RuntimeError):
         return shutil.which("ffmpeg")
+
+
+def picture_data(surface: Surface, field: str | None = "auto",
+                 title: str | None = None) -> SimpleNamespace:
+    """What a picture of ``surface`` needs, copied: ``X`` (nv, 3), ``F``,
+    ``nv``, ``nf``, the colour ``vvals`` (vertex) or ``fvals`` (facet)
+    values with their ``label``, or ``rgb`` facet colours, and ``title``;
+    ``field`` as :func:`pyevolver.io.render.snapshot`'s."""
+    if surface is None or surface.nf == 0:
+        raise CommandError("picture: no facets to draw")
+    if surface.X.shape[1] > 3:
+        raise dimension_error(surface.sdim, "pictures", "need")
+    X = np.zeros((surface.nv, 3))
+    X[:, :surface.X.shape[1]] = surface.X
+    rgb, vvals, fvals, label = None, None, None, ""
+    if field == "auto":
+        rgb = facet_colors(surface)
+        field = "mean_curvature" if rgb is None else "colors"
+    if field == "colors":
+        rgb = facet_colors(surface)
+        if rgb is None:
+            rgb = np.tile(GREY, (surface.nf, 1))
+    elif field not in (None, "none"):
+        vvals, fvals, label = render._field_values(surface, field)
+    return SimpleNamespace(X=X, F=np.array(surface.F, copy=True), nv=surface.nv, nf=surface.nf,
+                           vvals=vvals, fvals=fvals, label=label, rgb=rgb, title=title)
+
+
+def common_range(pictures: list) -> tuple | None:
+    """One colour range for several :func:`picture_data`: from the lowest of
+    their clipped ranges to the highest (None when none has values)."""
+    vals = [f.vvals if f.vvals is not None else f.fvals for f in pictures]
+    vals = [v for v in vals if v is not None]
+    if not vals:
+        return None
+    ranges = np.array([clipped_range(v) for v in vals], float)   # each picture's
+    lo, hi = float(np.nanmin(ranges[:, 0])), float(np.nanmax(ranges[:, 1]))
+    if not np.isfinite(lo) or not np.isfinite(hi):
+        lo, hi = 0.0, 1.0
+    if hi <= lo:
+        lo, hi = lo - 0.5, hi + 0.5
+    return lo, hi
+
+
+def draw(pic: SimpleNamespace, path: str, view: np.ndarray, size: int, clim: tuple | None,
+         frame: np.ndarray | None = None, backend: str | None = None,
+         colorbar: bool = True, cmap: str = "viridis") -> str:
+    """Draw a :func:`picture_data` into the PNG ``path`` (VTK when PyVista
+    imports, else matplotlib), coloured over ``clim``, framed on ``frame``
+    (default its own points), with a colour bar unless ``colorbar`` is
+    False; returns ``path``."""
+    if backend is None:
+        backend = "vtk" if render_vtk.available() else "matplotlib"
+    edges = pic.nf <= 5000
+    if backend == "vtk":
+        return render_vtk.render_png(path, pic.X, pic.F, view, size, point_values=pic.vvals,
+                                     cell_values=pic.fvals if pic.vvals is None else None,
+                                     clim=clim, label=pic.label, rgb=pic.rgb, edges=edges,
+                                     title=pic.title, frame=frame, colorbar=colorbar,
+                                     cmap=cmap)
+    return render._snapshot_mpl(pic, path, view, size, cmap, pic.fvals, clim, pic.label,
+                                pic.rgb, edges, pic.title, frame=frame, colorbar=colorbar)
 
 
 class Movie:
@@ -76,38 +138,10 @@ class Movie:
 
     def add(self, surface: Surface, title: str | None = None) -> None:
         """Record the surface as it is now (copies of its arrays)."""
-        if surface is None or surface.nf == 0:
-            raise CommandError("movie: no facets to draw")
-        if surface.X.shape[1] > 3:
-            raise dimension_error(surface.sdim, "movies", "need")
-        X = np.zeros((surface.nv, 3))
-        X[:, :surface.X.shape[1]] = surface.X
-        field, rgb, vvals, fvals, label = self.field, None, None, None, ""
-        if field == "auto":
-            rgb = facet_colors(surface)
-            field = "mean_curvature" if rgb is None else "colors"
-        if field == "colors":
-            rgb = facet_colors(surface)
-            if rgb is None:
-                rgb = np.tile(GREY, (surface.nf, 1))
-        elif field not in (None, "none"):
-            vvals, fvals, label = render._field_values(surface, field)
-        self.frames.append(SimpleNamespace(X=X, F=np.array(surface.F, copy=True), nv=surface.nv,
-                                           nf=surface.nf, vvals=vvals, fvals=fvals,
-                                           label=label, rgb=rgb, title=title))
+        self.frames.append(picture_data(surface, self.field, title))
 
     def _clim(self) -> tuple | None:
-        vals = [f.vvals if f.vvals is not None else f.fvals for f in self.frames]
-        vals = [v for v in vals if v is not None]
-        if not vals:
-            return None
-        ranges = np.array([clipped_range(v) for v in vals], float)   # each frame's
-        lo, hi = float(np.nanmin(ranges[:, 0])), float(np.nanmax(ranges[:, 1]))
-        if not np.isfinite(lo) or not np.isfinite(hi):
-            lo, hi = 0.0, 1.0
-        if hi <= lo:
-            lo, hi = lo - 0.5, hi + 0.5
-        return float(lo), float(hi)
+        return common_range(self.frames)
 
     def write_frames(self, folder: str, backend: str | None = None) -> list[str]:
         """Draw every frame into ``folder`` as ``frame0000.png``, ... with one
@@ -122,16 +156,7 @@ class Movie:
         paths = []
         for k, f in enumerate(self.frames):
             path = os.path.join(folder, f"frame{k:04d}.png")
-            edges = f.nf <= 5000
-            if backend == "vtk":
-                render_vtk.render_png(path, f.X, f.F, M, self.size, point_values=f.vvals,
-                                      cell_values=f.fvals if f.vvals is None else None,
-                                      clim=clim, label=f.label, rgb=f.rgb, edges=edges,
-                                      title=f.title, frame=pts)
-            else:
-                render._snapshot_mpl(f, path, M, self.size, "viridis", f.fvals, clim, f.label,
-                                     f.rgb, edges, f.title, frame=pts)
-            paths.append(path)
+            paths.append(draw(f, path, M, self.size, clim, frame=pts, backend=backend))
         return paths
 
     def write(self, path: str, fps: float = 5.0, backend: str | None = None) -> str:

@@ -182,7 +182,7 @@ def snapshot(surface: Surface | None, path: str, field: str | None = "auto",
 
 
 def _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, title,
-                  frame=None):
+                  frame=None, colorbar=True):
     """matplotlib: facets in painter's order, flat shading."""
     mpl, Figure, FigureCanvasAgg = _matplotlib()
     from matplotlib.collections import PolyCollection
@@ -198,12 +198,13 @@ def _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, t
     shade = 0.45 + 0.55 * lam
     fig = Figure(figsize=(size / 100.0, size / 100.0), dpi=100)
     FigureCanvasAgg(fig)
-    bar = fvals is not None
+    bar = fvals is not None and colorbar
     ax = fig.add_axes([0.0, 0.0, 0.8 if bar else 1.0, 1.0])
-    if bar:
+    if fvals is not None:
         norm = mpl.colors.Normalize(*clim)
         cm = mpl.colormaps[cmap]
         rgb = cm(norm(np.nan_to_num(fvals)))[:, :3]
+    if bar:
         cax = fig.add_axes([0.82, 0.1, 0.03, 0.8])
         cb = fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cm), cax=cax,
                           format=mpl.ticker.FormatStrFormatter("%.4g"))
