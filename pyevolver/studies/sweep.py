@@ -1,6 +1,7 @@
 """Parameter sweeps: one datafile over a grid of parameter values.
 
-A sweep is described by a TOML file (``pyevolver sweep SPEC.toml``)::
+A sweep is described by a TOML file (``pyevolver sweep SPEC.toml``; every
+key is documented in docs/guide.md, "The sweep file")::
 
     datafile = "vesicle.fe"          # relative to the spec's folder
     output = "vesicle_sweep"         # default: <spec name>_out beside the spec
