@@ -117,7 +117,7 @@ def body_arrays(surface) -> dict[str, np.ndarray]:
 def _mesh_bodies(mesh, nf: int) -> list | None:
     """Bodies for :func:`surface_from_arrays` from the cell data of
     :func:`body_arrays` (None without ``frontbody``/``backbody``)."""
-    def cells(name, dtype=float):
+    def cells(name):
         blocks = mesh.cell_data.get(name)
         if blocks is None:
             return None
@@ -136,9 +136,9 @@ def _mesh_bodies(mesh, nf: int) -> list | None:
         signed = signed[np.argsort(np.abs(signed), kind="stable")]
         attrs = []
         for kw in BODY_ATTRS:
-            vals = [a[idx[side] == k] for side in idx
-                    if (a := cells(f"{side}_{kw}")) is not None]
-            vals = np.concatenate(vals) if vals else np.zeros(0)
+            parts = [a[idx[side] == k] for side in idx
+                     if (a := cells(f"{side}_{kw}")) is not None]
+            vals = np.concatenate(parts) if parts else np.zeros(0)
             vals = vals[np.isfinite(vals)]
             if len(vals) and not (kw == "density" and vals[0] == 0):
                 attrs.append((kw, [float(vals[0])]))

@@ -185,7 +185,7 @@ class Movie:
                     if ext == ".gif":
                         _gif(frames, out, fps)
                     else:
-                        _mp4(exe, tmp, out, fps)
+                        _mp4(str(exe), tmp, out, fps)
             except OSError as exc:
                 raise CommandError(f"cannot write '{path}': {exc.strerror or exc}") from None
         return path

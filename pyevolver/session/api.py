@@ -21,6 +21,8 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+import numpy as np
+
 from ..datafile.writer import DumpSettings
 from ..errors import UnsupportedError
 from ..io import meshio_plugin, render, viewer
@@ -74,8 +76,8 @@ class SessionAPI:
                                     settings=DumpSettings(self.filename, self.settings,
                                                           self.toggles, self.attr_types))
 
-    def snapshot(self, path: str, field: str | None = "auto", view=None,
-                 **kwargs) -> str:
+    def snapshot(self, path: str, field: str | None = "auto", view: np.ndarray | None = None,
+                 **kwargs: Any) -> str:
         """Render the surface to an image file, headless
         (:func:`pyevolver.io.render.snapshot`; the camera looks along the
         session's ``view_matrix``, turned oblique while it has no rotation,
@@ -85,7 +87,7 @@ class SessionAPI:
         return render.snapshot(self.surface, path, field=field, view=view, **kwargs)
 
     def movie(self, path: str, steps: int, every: int = 1, commands: str | None = None,
-              field: str | None = "auto", view=None, size: int = 400,
+              field: str | None = "auto", view: np.ndarray | None = None, size: int = 400,
               fps: float = 5.0) -> str:
         """Run ``steps`` iteration steps and write a movie of them to ``path``
         (``.gif``; ``.mp4`` with ffmpeg; a folder ending in ``/`` for the PNG
@@ -118,7 +120,7 @@ class SessionAPI:
             return None
         return viewer.notebook_html(surf, title=repr(self))
 
-    def plot_history(self, path: str, **kwargs) -> str:
+    def plot_history(self, path: str, **kwargs: Any) -> str:
         """Plot the energy of every ``g`` step so far
         (:func:`pyevolver.io.render.plot_history`)."""
         return render.plot_history(self.history, path, **kwargs)

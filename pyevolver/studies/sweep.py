@@ -60,6 +60,7 @@ from ..atomic import atomic_path, atomic_write
 from ..commands.interpreter import Quit
 from ..datafile.writer import dump
 from ..errors import PyEvolverError
+from ..io import movie
 from ..io.render import OBLIQUE, _matplotlib, _save, camera
 from ..session.api import progress_bar
 from ..session.core import Session
@@ -563,7 +564,6 @@ def _phase_pictures(spec: SweepSpec, rows: list[dict]) -> tuple[dict, tuple | No
     """The phase diagram's panels: each finished point's final surface
     (``final.fe``) drawn without a colour bar, all over one colour range;
     ``({index: temporary png}, (lo, hi) or None, the colour bar's label)``."""
-    from ..io import movie
     data = {}
     for r in rows:
         final = os.path.join(point_dir(spec, r["index"]), "final.fe")
