@@ -34,8 +34,9 @@ DOCS = os.path.normpath(os.path.join(HERE, "..", "..", "docs"))
 CLIFFORD = 2 * math.pi ** 2
 
 __all__ = ["DOCS", "BLOCKS", "read_csv", "render", "blocks_in", "update", "main",
-           "pct", "fig1_table", "fig3_table", "fig3_stages_table", "prop1_table",
-           "fig4_table", "fig4_figure", "chart_table"]
+           "pct", "fig1_table", "fig3_table", "fig3_stages_table", "fig3_loop_stages_table",
+           "prop1_table",
+           "fig4_table", "fig4_figure", "fig4_continuation_table", "chart_table"]
 
 
 def read_csv(name: str, docs: str = DOCS) -> list[dict]:
@@ -117,6 +118,40 @@ def fig3_stages_table(docs: str = DOCS, mesh: str = "10x16", rule: str = "consis
     return _table(["energy", "λ", "W", "W_Loop", "min angle"], rows)
 
 
+def fig3_loop_stages_table(docs: str = DOCS, mesh: str = "10x16") -> str:
+    """paper.md: the Loop-guided continuation's stages on ``mesh``
+    (``fig3_stages.csv``): λ: W, W_Loop (errors to 2π², the kept stage's
+    W_Loop in bold), smallest angle; runs of undone stages as one item."""
+    rows = []
+    data = [r for r in read_csv("fig3_stages.csv", docs)
+            if r["mesh"] == mesh and r.get("rule", "loop") == "loop"]
+
+    def p2(x: float) -> str:
+        return f"{100 * x:+.2f}%".replace("-", "−")
+    for energy in dict.fromkeys(r["energy"] for r in data):
+        st = [r for r in data if r["energy"] == energy]
+        healthy = [r for r in st if r["status"] == "healthy"]
+        best = min(healthy, key=lambda r: float(r["loop_w"])) if healthy else None
+        items: list[str] = []
+        undone: list[str] = []
+        for r in st + [None]:
+            if r is not None and r["status"] != "healthy":
+                undone.append(f"{float(r['lambda']):.4g}")
+                continue
+            if undone:
+                items.append(" and ".join(undone) + ": collapse (undone)")
+                undone = []
+            if r is None:
+                break
+            loop = p2(float(r["loop_w"]) / CLIFFORD - 1)
+            if r is best:
+                loop = f"**{loop}**"
+            items.append(f"{float(r['lambda']):.4g}: {p2(float(r['W']) / CLIFFORD - 1)}, "
+                         f"{loop}, {float(r['minangle']):.1f}°")
+        rows.append([mesh.replace("x", "×"), energy, " · ".join(items)])
+    return _table(["mesh", "energy", "λ: W, W_Loop, min angle"], rows)
+
+
 def prop1_table(docs: str = DOCS) -> str:
     """paper.md, Proposition 1: Bobenko's energy of the almost spherical tori
     (``fig3_prop1.csv``), one column per grid."""
@@ -177,6 +212,44 @@ def fig4_table(docs: str = DOCS) -> str:
                      f"{_depth(r['pole_depth_min'])}, {_depth(r['pole_depth_max'])}", ang, secs])
     return _table(["method", "shape", "vertices", "W", "error", "type", "height/width",
                    "pole depths", "min angle", "s"], rows)
+
+
+def _lam(x: float) -> str:
+    return f"{x:g}" if round(x, 4) == x else f"{x:.2g}"
+
+
+def _stages(text: str) -> str:
+    """``fig4_vesicles.csv``'s continuation column (``λ:W/angle deg/steps[/uFLIPS][x]``
+    per stage) as ``λ: W/angle°`` items; ``x`` marks a stage undone."""
+    out = []
+    for item in text.split():
+        lam, rest = item.split(":", 1)
+        undone = rest.endswith("x")
+        parts = rest.rstrip("x").split("/")
+        W, ang, steps = float(parts[0]), parts[1].replace("deg", "°"), parts[2]
+        flips = next((p[1:] for p in parts[3:] if p.startswith("u")), None)
+        txt = f"{_lam(float(lam))}{'x' if undone else ''}: {W:.3f}/{ang}"
+        if flips is not None:
+            txt += f" ({steps} Newton steps, {flips} flips)"
+        out.append(txt)
+    return " · ".join(out)
+
+
+def fig4_continuation_table(docs: str = DOCS) -> str:
+    """paper.md: the λ continuation of NormalCur+harmonic (and +u) per shape
+    and resolution, from ``fig4_vesicles.csv``'s continuation column."""
+    rows = []
+    data = _fig4_rows(docs)
+    plain = {(r["shape"], r["resolution"]): r["continuation"] for r in data
+             if r["method"] == "NormalCur+harmonic"}
+    for method, tag in (("NormalCur+harmonic", ""), ("NormalCur+harmonic+u", ", +u")):
+        for r in data:
+            if r["method"] != method or not r.get("continuation"):
+                continue
+            same = tag and r["continuation"] == plain.get((r["shape"], r["resolution"]))
+            rows.append([r["shape"] + tag, f"{int(r['resolution']):,}",
+                         "as without `u` (no edge flips)" if same else _stages(r["continuation"])])
+    return _table(["shape", "vertices", "continuation (λ: W / smallest angle)"], rows)
 
 
 # -- the accuracy chart --------------------------------------------------------------------------
@@ -265,8 +338,10 @@ BLOCKS: dict[str, Callable[[str], str]] = {
     "fig3": fig3_table,
     "fig3_5x10": lambda docs: fig3_table(docs, "5x10"),
     "fig3_consistency": fig3_stages_table,
+    "fig3_loop_stages": fig3_loop_stages_table,
     "prop1": prop1_table,
     "fig4": fig4_table,
+    "fig4_continuation": fig4_continuation_table,
     "chart": chart_table,
 }
 _BLOCK = re.compile(r"(<!-- doc_numbers (\w+) -->\n)(.*?)(<!-- /doc_numbers \2 -->)", re.S)
