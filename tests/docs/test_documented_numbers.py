@@ -1,8 +1,10 @@
 """Every study number in docs/ is the study's own: the tables between
 ``<!-- doc_numbers NAME -->`` markers are what pyevolver.studies.doc_numbers
 writes from the committed CSVs, the numbers the prose quotes are the CSVs'
-(CLAIMS below), and small cases of the studies are regenerated live and
-agree with the CSVs (the full regenerations are marked slow)."""
+(CLAIMS below), and cases of the studies are regenerated live and agree
+with the CSVs (in the default run Proposition 1 at 5×10 and the
+axisymmetric references; Figure 1, Figure 3 at 5×10, the 162-vertex
+prolate of Figure 4 and the Loop torus are marked slow)."""
 import math
 import os
 import re
@@ -145,6 +147,7 @@ def test_proposition1_regenerated_at_5x10():
         assert g["W_bobenko"] == pytest.approx(want, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_fig4_prolate_at_162_vertices_regenerated():
     from pyevolver.studies import fig4_vesicles
     _, rows = fig4_vesicles.run("prolate", "normal", 162)

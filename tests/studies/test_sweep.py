@@ -88,10 +88,11 @@ def test_phase_panels_share_one_colour_range_and_bar(local):
     from pyevolver.io import movie
     from pyevolver.studies.sweep import _phase_pictures
     _, spec, res = local
-    pics, clim, label = _phase_pictures(spec, res.rows)
-    assert sorted(pics) == list(range(8)) and label.startswith("mean curvature")
+    rows = [res.rows[0], res.rows[-1]]          # two panels: the lightest and the heaviest
+    pics, clim, label = _phase_pictures(spec, rows)
+    assert sorted(pics) == [0, 7] and label.startswith("mean curvature")
     ranges = []
-    for r in res.rows:
+    for r in rows:
         s = Session.load(os.path.join(spec.output, f"p{r['index']:04d}", "final.fe"),
                          out=io.StringIO())
         ranges.append(movie.common_range([movie.picture_data(s.surface, "mean_curvature")]))
