@@ -159,15 +159,15 @@ class Movie:
             paths.append(draw(f, path, M, self.size, clim, frame=pts, backend=backend))
         return paths
 
-    def write(self, path: str, fps: float = 5.0, backend: str | None = None) -> str:
-        """Write the movie to ``path``: ``.gif`` (looping), ``.mp4`` (needs
-        ffmpeg), or a folder name ending in ``/`` for the PNG frames alone.
-        Written atomically; returns ``path``."""
+    @staticmethod
+    def check_path(path: str, fps: float = 5.0) -> str | None:
+        """Refuse what :meth:`write` cannot write, before a run spends its
+        time: returns the ffmpeg program for ``.mp4``, else None."""
         path = os.fspath(path)
+        if fps <= 0:
+            raise CommandError(f"movie: fps must be positive, not {fps}")
         if path.endswith(("/", os.sep)):
-            os.makedirs(path, exist_ok=True)
-            self.write_frames(path, backend)
-            return path
+            return None
         ext = os.path.splitext(path)[1].lower()
         if ext not in (".gif", ".mp4"):
             raise CommandError(f"movie: write .gif or .mp4 (or a folder ending in /), "
@@ -176,8 +176,19 @@ class Movie:
         if ext == ".mp4" and exe is None:
             raise UnsupportedError("MP4 movies without ffmpeg",
                                    "pip install imageio-ffmpeg, or write a .gif")
-        if fps <= 0:
-            raise CommandError(f"movie: fps must be positive, not {fps}")
+        return exe
+
+    def write(self, path: str, fps: float = 5.0, backend: str | None = None) -> str:
+        """Write the movie to ``path``: ``.gif`` (looping), ``.mp4`` (needs
+        ffmpeg), or a folder name ending in ``/`` for the PNG frames alone.
+        Written atomically; returns ``path``."""
+        path = os.fspath(path)
+        exe = self.check_path(path, fps)
+        if path.endswith(("/", os.sep)):
+            os.makedirs(path, exist_ok=True)
+            self.write_frames(path, backend)
+            return path
+        ext = os.path.splitext(path)[1].lower()
         with tempfile.TemporaryDirectory(prefix="pyevolver_movie_") as tmp:
             frames = self.write_frames(tmp, backend)
             try:

@@ -98,6 +98,7 @@ class SessionAPI:
         (:class:`pyevolver.io.movie.Movie`).  Returns ``path``."""
         if every < 1 or steps < 0:
             raise ValueError(f"movie: every must be >= 1 and steps >= 0 (got {every}, {steps})")
+        Movie.check_path(path, fps)                   # refused before the run, not after
         if view is None:
             view = render.oblique(self.arrays.get("view_matrix"))
         m = Movie(field=field, view=view, size=size)
