@@ -202,3 +202,12 @@ def test_guide_loop_torus_regenerated():
     assert f"prints W = {out['W']:.3f}" in text
     assert f"ratio {out['ratio']:.4f}" in text
     assert f"fixed = {out['area']:.3f} method loop_area" in text
+
+
+def test_guide_fig4_summary_holds():
+    text = _text("guide.md")
+    assert "method with `u` are within 0.5% on all three shapes" in text
+    errs = [_f4("StarPerp+recipe+Newton", s, "rel_error") for s in D.SHAPE_ORDER]
+    errs += [_f4("NormalCur+harmonic", s, "rel_error") for s in ("prolate", "discocyte")]
+    errs.append(_f4("NormalCur+harmonic+u", "stomatocyte", "rel_error"))
+    assert max(abs(e) for e in errs) < 0.005, errs
