@@ -28,7 +28,7 @@ PKG = ROOT / "pyevolver"
 # scipy.sparse.linalg 0.1 s and 8 MB, for the hessian's and newton's solves)
 OPTIONAL = {"matplotlib", "tqdm", "prompt_toolkit", "sksparse", "dask", "distributed",
             "h5py", "PIL", "threadpoolctl", "tomli", "tomllib", "readline", "pexpect",
-            "pyvista", "vtk"}
+            "pyvista", "vtk", "imageio_ffmpeg"}
 HEAVY = {"scipy.special", "scipy.sparse.linalg"}
 MAX_LINES = 800
 
@@ -150,12 +150,19 @@ def _public_callables():
         if inspect.isclass(obj) and issubclass(obj, BaseException):
             continue
         if inspect.isclass(obj):
-            for mname, meth in vars(obj).items():
-                if mname.startswith("_") and mname != "__init__":
+            seen = set()
+            for klass in inspect.getmro(obj):          # inherited methods too (Session's mixin)
+                if not klass.__module__.startswith("pyevolver"):
                     continue
-                fn = meth.__func__ if isinstance(meth, (classmethod, staticmethod)) else meth
-                if inspect.isfunction(fn):
-                    yield f"{name}.{mname}", fn
+                for mname, meth in vars(klass).items():
+                    if (mname.startswith("_") and mname not in ("__init__", "__repr__",
+                                                                 "_repr_html_")) \
+                            or mname in seen:
+                        continue
+                    seen.add(mname)
+                    fn = meth.__func__ if isinstance(meth, (classmethod, staticmethod)) else meth
+                    if inspect.isfunction(fn):
+                        yield f"{name}.{mname}", fn
         elif inspect.isfunction(obj):
             yield name, obj
 

@@ -1,5 +1,5 @@
 """pyevolver's own commands, which the Evolver does not have, registered by
-name: ``export``, ``snapshot`` and ``plot_history``.
+name: ``export``, ``snapshot``, ``movie`` and ``plot_history``.
 
 A registered command runs as ``name "arg"`` or ``name("arg", ...)``; a
 procedure or command of the user's with the same name wins, so Evolver
@@ -76,3 +76,19 @@ def _plot_history(session, args):
     (path,) = _strings("plot_history", _usage("plot_history"), args)
     session.plot_history(path)
     session.write(f"Energy history written to {path}.\n")
+
+
+@register_command("movie", 'movie("run.gif", steps, every) or movie("run.gif", steps, every, '
+                           '"area") (.gif, .mp4 with ffmpeg)', max_args=4)
+def _movie(session, args):
+    usage = _usage("movie")
+    if len(args) < 3 or not isinstance(args[0], str) or not args[0] or \
+            any(isinstance(a, str) or float(a) != int(a) for a in args[1:3]) or \
+            (len(args) == 4 and not isinstance(args[3], str)):
+        raise CommandError(f"movie needs a file name in quotes, the number of steps and the "
+                           f"steps between pictures (usage: {usage})")
+    steps, every = int(args[1]), int(args[2])
+    if steps < 0 or every < 1:
+        raise CommandError(f"movie: steps must be >= 0 and every >= 1 (usage: {usage})")
+    session.movie(args[0], steps, every, field=args[3] if len(args) == 4 else "auto")
+    session.write(f"Movie written to {args[0]} ({steps // every + 1} frames).\n")

@@ -11,8 +11,14 @@ work like any other meshio format (meshio's own ``register_format``).
 Reading loads the datafile without running its ``read`` section and
 returns the triangles with the data of :func:`pyevolver.io.fields.surface_fields`;
 writing turns triangles into vertices, edges and faces (point data
-``fixed`` and cell data ``tension`` are kept, nothing else: no bodies) and
-writes them with the ``dump`` writer.
+``fixed`` and cell data ``tension`` are kept, and the bodies: cell data
+``frontbody``/``backbody``, the body each facet bounds with its front or
+back, 0 for none, and that body's ``frontbody_volume`` /
+``backbody_volume`` (prescribed volume, NaN for none), ``..._density`` and
+``..._pressure``: per facet, since meshio's VTU writer drops field data)
+and writes them with the ``dump`` writer.  :func:`export` writes those
+arrays for a surface with bodies, so ``.fe`` → ``.vtu`` → ``.fe`` keeps
+them.
 
 :func:`export` (the ``export "file"`` command, ``Session.export``) writes
 the current surface in any meshio format chosen by the file's extension,
@@ -78,9 +84,66 @@ def surface_mesh(surface, data: bool = True):
         v, f = surface_fields(s)             # evaluated afresh: X may have been set by hand
         point_data = v
         cell_data = {k: [a] for k, a in f.items()}
+        if s.bodies.n:
+            cell_data.update({k: [a] for k, a in body_arrays(s).items()})
     itype = np.int32 if s.nv < 2 ** 31 else np.int64      # PLY has no 64-bit integers
     return meshio.Mesh(np.array(s.X, float), [("triangle", np.array(s.F, itype))],
                        point_data=point_data, cell_data=cell_data)
+
+
+BODY_ATTRS = ("volume", "density", "pressure")
+
+
+def body_arrays(surface) -> dict[str, np.ndarray]:
+    """The bodies as cell data: per facet the body it bounds with its front
+    and with its back (``frontbody``, ``backbody``: 1-based, 0 for none;
+    int32), and those bodies' ``frontbody_volume`` / ``backbody_volume``
+    (prescribed, NaN where free or no body), ``..._density`` and
+    ``..._pressure`` (NaN where not prescribed)."""
+    b = surface.bodies
+    M = b.facet_matrix.tocoo()
+    out = {}
+    for side, pick in (("frontbody", M.data > 0), ("backbody", M.data < 0)):
+        which = np.zeros(surface.n_facets, np.int32)
+        which[M.col[pick]] = M.row[pick] + 1
+        out[side] = which
+        for kw, vals in zip(BODY_ATTRS, (b.target, b.density, b.pressure)):
+            per = np.full(surface.n_facets, np.nan)
+            per[which > 0] = np.asarray(vals, float)[which[which > 0] - 1]
+            out[f"{side}_{kw}"] = per
+    return out
+
+
+def _mesh_bodies(mesh, nf: int) -> list | None:
+    """Bodies for :func:`surface_from_arrays` from the cell data of
+    :func:`body_arrays` (None without ``frontbody``/``backbody``)."""
+    def cells(name):
+        blocks = mesh.cell_data.get(name)
+        if blocks is None:
+            return None
+        a = np.concatenate([np.asarray(x, float).reshape(-1) for x in blocks])
+        return a if len(a) == nf else None
+    sides = {k: cells(k) for k in ("frontbody", "backbody")}
+    if all(v is None for v in sides.values()):
+        return None
+    idx = {k: np.nan_to_num(v if v is not None else np.zeros(nf)).astype(np.int64)
+           for k, v in sides.items()}
+    nb = int(max(a.max(initial=0) for a in idx.values()))
+    facets = np.arange(1, nf + 1)
+    out = []
+    for k in range(1, nb + 1):
+        signed = np.concatenate([facets[idx["frontbody"] == k], -facets[idx["backbody"] == k]])
+        signed = signed[np.argsort(np.abs(signed), kind="stable")]
+        attrs = []
+        for kw in BODY_ATTRS:
+            parts = [a[idx[side] == k] for side in idx
+                     if (a := cells(f"{side}_{kw}")) is not None]
+            vals = np.concatenate(parts) if parts else np.zeros(0)
+            vals = vals[np.isfinite(vals)]
+            if len(vals) and not (kw == "density" and vals[0] == 0):
+                attrs.append((kw, [float(vals[0])]))
+        out.append((signed.tolist(), attrs))
+    return out
 
 
 def load_surface(filename: str) -> Surface:
@@ -127,6 +190,7 @@ def _mesh_surface(mesh, filename) -> Surface:
     else:
         tension = None
     return surface_from_arrays(X, F, fixed=mesh.point_data.get("fixed"), tension=tension,
+                               bodies=_mesh_bodies(mesh, len(F)),
                                filename=os.fspath(filename))
 
 

@@ -98,7 +98,8 @@ def _field_values(s, field):
 def snapshot(surface: Surface | None, path: str, field: str | None = "auto",
              view: np.ndarray | None = None, size: int = 600, cmap: str = "viridis",
              edges: bool | None = None, clim: tuple | None = None,
-             title: str | None = None, backend: str | None = None) -> str:
+             title: str | None = None, backend: str | None = None,
+             frame: np.ndarray | None = None) -> str:
     """Draw ``surface`` into an image file (png, jpg, pdf, svg: by the
     extension), written atomically.
 
@@ -125,6 +126,9 @@ def snapshot(surface: Surface | None, path: str, field: str | None = "auto",
         :func:`pyevolver.io.fields.clipped_range`).
     backend : "vtk" or "matplotlib", optional
         Default: VTK when PyVista is installed and the file is .png or .jpg.
+    frame : (k, 3) array, optional
+        Frame the picture on these points instead of the surface's
+        (:mod:`pyevolver.io.movie` passes every frame's points).
 
     Returns
     -------
@@ -170,13 +174,15 @@ def snapshot(surface: Surface | None, path: str, field: str | None = "auto",
         return render_vtk.render_png(path, X3, s.F, M, size, point_values=vvals,
                                      cell_values=fvals if vvals is None else None, clim=clim,
                                      label=label, cmap=cmap, rgb=rgb, edges=draw_edges,
-                                     title=title)
+                                     title=title, frame=frame)
     if backend != "matplotlib":
         raise CommandError(f"snapshot: no renderer '{backend}' (vtk or matplotlib)")
-    return _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, title)
+    return _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, title,
+                         frame)
 
 
-def _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, title):
+def _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, title,
+                  frame=None, colorbar=True):
     """matplotlib: facets in painter's order, flat shading."""
     mpl, Figure, FigureCanvasAgg = _matplotlib()
     from matplotlib.collections import PolyCollection
@@ -192,12 +198,13 @@ def _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, t
     shade = 0.45 + 0.55 * lam
     fig = Figure(figsize=(size / 100.0, size / 100.0), dpi=100)
     FigureCanvasAgg(fig)
-    bar = fvals is not None
+    bar = fvals is not None and colorbar
     ax = fig.add_axes([0.0, 0.0, 0.8 if bar else 1.0, 1.0])
-    if bar:
+    if fvals is not None:
         norm = mpl.colors.Normalize(*clim)
         cm = mpl.colormaps[cmap]
         rgb = cm(norm(np.nan_to_num(fvals)))[:, :3]
+    if bar:
         cax = fig.add_axes([0.82, 0.1, 0.03, 0.8])
         cb = fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cm), cax=cax,
                           format=mpl.ticker.FormatStrFormatter("%.4g"))
@@ -209,7 +216,12 @@ def _snapshot_mpl(s, path, M, size, cmap, fvals, clim, label, rgb, draw_edges, t
                         edgecolors=(0.1, 0.1, 0.1, 0.6) if draw_edges else "face",
                         linewidths=0.3 if draw_edges else 0.0)
     ax.add_collection(pc)
-    # framed on the surface, every picture
+    # framed on the surface (or on ``frame``), every picture
+    if frame is not None:
+        Q = np.asarray(frame, float)
+        wq = Q @ M[3, :3] + M[3, 3]
+        with np.errstate(all="ignore"):
+            P = (Q @ M[:3, :3].T + M[:3, 3]) / np.where(wq == 0, 1.0, wq)[:, None]
     lo, hi = P[:, 1:].min(axis=0), P[:, 1:].max(axis=0)
     mid, half = (lo + hi) / 2, 0.53 * max(float(np.max(hi - lo)), 1e-12)
     ax.set_xlim(mid[0] - half, mid[0] + half)

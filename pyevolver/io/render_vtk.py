@@ -44,14 +44,19 @@ def render_png(path: str, X: np.ndarray, F: np.ndarray, view: np.ndarray, size: 
                point_values: np.ndarray | None = None,
                cell_values: np.ndarray | None = None, clim: tuple | None = None,
                label: str = "", cmap: str = "viridis", rgb: np.ndarray | None = None,
-               edges: bool = False, title: str | None = None) -> str:
+               edges: bool = False, title: str | None = None,
+               frame: np.ndarray | None = None, colorbar: bool = True) -> str:
     """Draw the triangles ``F`` on the points ``X`` (n, 3) into ``path``
     (.png or .jpg), written atomically; returns ``path``.
 
     ``view``: the (4, 4) view matrix (its rows 0 and 2: towards the viewer
     and up).  Colours: ``point_values`` or ``cell_values`` over ``clim``
     with the colour bar ``label``, else ``rgb`` (nf, 3) per facet, else
-    plain grey."""
+    plain grey.  ``frame``: the points (k, 3) to frame the camera on
+    (default ``X``; a movie passes every frame's points, so that the camera
+    stays put and the whole run is in the picture).  ``colorbar`` False:
+    the values coloured over ``clim`` without a bar (a figure of several
+    pictures draws one bar for all)."""
     pv = _pyvista()
     ext = os.path.splitext(os.fspath(path))[1].lower()
     if ext not in (".png", ".jpg", ".jpeg"):
@@ -60,7 +65,8 @@ def render_png(path: str, X: np.ndarray, F: np.ndarray, view: np.ndarray, size: 
     F = np.asarray(F, np.int64)
     faces = np.hstack([np.full((len(F), 1), 3, np.int64), F]).ravel()
     mesh = pv.PolyData(X, faces)
-    bar = point_values is not None or cell_values is not None
+    coloured = point_values is not None or cell_values is not None
+    bar = coloured and colorbar
     width = int(size)
     pl = pv.Plotter(off_screen=True, window_size=(width, size))
     pl.set_background("white")
@@ -70,7 +76,7 @@ def render_png(path: str, X: np.ndarray, F: np.ndarray, view: np.ndarray, size: 
     if " (" in label:                     # a short bar title, the rest as a note
         label, note = label.split(" (", 1)
         note = note.rstrip(")")
-    if bar:
+    if coloured:
         vals = point_values if point_values is not None else cell_values
         if point_values is not None:
             mesh.point_data["value"] = np.asarray(vals, float)
@@ -82,13 +88,14 @@ def render_png(path: str, X: np.ndarray, F: np.ndarray, view: np.ndarray, size: 
                                          position_x=0.83, position_y=0.1, width=0.06,
                                          height=0.8, title_font_size=14,
                                          label_font_size=12, fmt="%.4g"),
-                    **kw)
+                    show_scalar_bar=bar, **kw)
     elif rgb is not None:
         mesh.cell_data["rgb"] = np.clip(np.asarray(rgb, float) * 255, 0, 255).astype(np.uint8)
         pl.add_mesh(mesh, scalars="rgb", rgb=True, **kw)
     else:
         pl.add_mesh(mesh, color=(0.78, 0.80, 0.84), **kw)
-    _frame(pl, X, np.asarray(view, float), width / size, bar)
+    _frame(pl, X if frame is None else np.asarray(frame, float), np.asarray(view, float),
+           width / size, bar)
     if title:
         pl.add_text(title, position="upper_left", font_size=12, color="black")
     if note:

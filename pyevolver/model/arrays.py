@@ -53,6 +53,7 @@ def surface_from_arrays(vertices: np.ndarray, facets: np.ndarray, *,
                         fixed: np.ndarray | None = None,
                         tension: np.ndarray | None = None,
                         body: bool = False,
+                        bodies: list | None = None,
                         filename: str = "<arrays>") -> Surface:
     """Build a Surface (soap film, 3 dimensions) from a triangle mesh.
 
@@ -71,6 +72,10 @@ def surface_from_arrays(vertices: np.ndarray, facets: np.ndarray, *,
     body : bool
         Add one body bounded by every facet (positively oriented; its
         volume is not fixed).
+    bodies : list of (facets, attributes), optional
+        Bodies instead: each the signed 1-based facet numbers bounding it
+        (negative: the facet bounds it with its back) and its datafile
+        attributes, ``[("volume", [v]), ("density", [d]), ...]``.
     filename : str
         The name error messages give.
 
@@ -95,6 +100,9 @@ def surface_from_arrays(vertices: np.ndarray, facets: np.ndarray, *,
     scene.faces = _block(sign * (idx + 1))
     if body:
         scene.bodies = _block([list(range(1, len(F) + 1))])
+    elif bodies:
+        scene.bodies = _block([[int(f) for f in facets] for facets, _ in bodies])
+        scene.bodies.attrs = {k: list(attrs) for k, (_, attrs) in enumerate(bodies) if attrs}
     s = build_surface(scene)
     if fixed is not None:
         s.vattr["fixed"] = np.asarray(fixed).reshape(-1) != 0

@@ -10,6 +10,7 @@ runs.  The values (``quantities``, ``value``) are on the Session itself::
     s.export("cube.vtu")         # any meshio format, with data arrays
     s.snapshot("cube.png", field="mean_curvature")
     s.plot_history("energy.png")
+    s.movie("cube.gif", steps=50, every=5)   # a picture every 5 steps, one camera
 
 Progress bars (tqdm) are the API's only: :meth:`Session.g` shows one for
 long runs at a terminal or in a notebook, never in the Evolver-compatible
@@ -20,9 +21,12 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+import numpy as np
+
 from ..datafile.writer import DumpSettings
 from ..errors import UnsupportedError
 from ..io import meshio_plugin, render, viewer
+from ..io.movie import Movie
 
 #: ``progress=None`` shows a bar for runs of at least this many steps.
 PROGRESS_MIN_STEPS = 100
@@ -72,8 +76,8 @@ class SessionAPI:
                                     settings=DumpSettings(self.filename, self.settings,
                                                           self.toggles, self.attr_types))
 
-    def snapshot(self, path: str, field: str | None = "auto", view=None,
-                 **kwargs) -> str:
+    def snapshot(self, path: str, field: str | None = "auto", view: np.ndarray | None = None,
+                 **kwargs: Any) -> str:
         """Render the surface to an image file, headless
         (:func:`pyevolver.io.render.snapshot`; the camera looks along the
         session's ``view_matrix``, turned oblique while it has no rotation,
@@ -81,6 +85,33 @@ class SessionAPI:
         if view is None:
             view = render.oblique(self.arrays.get("view_matrix"))
         return render.snapshot(self.surface, path, field=field, view=view, **kwargs)
+
+    def movie(self, path: str, steps: int, every: int = 1, commands: str | None = None,
+              field: str | None = "auto", view: np.ndarray | None = None, size: int = 400,
+              fps: float = 5.0) -> str:
+        """Run ``steps`` iteration steps and write a movie of them to ``path``
+        (``.gif``; ``.mp4`` with ffmpeg; a folder ending in ``/`` for the PNG
+        frames): a picture before the run and after every ``every`` steps
+        (or, with ``commands``, after each run of that command text instead
+        of ``g every``, ``steps // every`` times).  Every frame has the same
+        camera, framed on the whole run, and the same colour range
+        (:class:`pyevolver.io.movie.Movie`).  Returns ``path``."""
+        if every < 1 or steps < 0:
+            raise ValueError(f"movie: every must be >= 1 and steps >= 0 (got {every}, {steps})")
+        Movie.check_path(path, fps)                   # refused before the run, not after
+        if view is None:
+            view = render.oblique(self.arrays.get("view_matrix"))
+        m = Movie(field=field, view=view, size=size)
+        m.add(self.surface, title="step 0")
+        done = 0
+        while done + every <= steps:
+            if commands is None:
+                self.g(every, echo=False)  # type: ignore[attr-defined]
+            else:
+                self.run(commands)  # type: ignore[attr-defined]
+            done += every
+            m.add(self.surface, title=f"step {done}")
+        return m.write(path, fps=fps)
 
     def _repr_html_(self) -> str | None:
         """In a notebook a session shows its surface in the viewer of
@@ -90,7 +121,7 @@ class SessionAPI:
             return None
         return viewer.notebook_html(surf, title=repr(self))
 
-    def plot_history(self, path: str, **kwargs) -> str:
+    def plot_history(self, path: str, **kwargs: Any) -> str:
         """Plot the energy of every ``g`` step so far
         (:func:`pyevolver.io.render.plot_history`)."""
         return render.plot_history(self.history, path, **kwargs)

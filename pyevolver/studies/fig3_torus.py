@@ -73,6 +73,7 @@ import shutil
 import subprocess
 import tempfile
 import time
+from typing import Any
 import warnings
 
 import numpy as np
@@ -615,41 +616,74 @@ def main(argv: list[str] | None = None) -> int:
 
 def _plot(path, rows, stages, prop):
     try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        fig = figure(stages, prop)
     except ImportError:
         print("matplotlib not installed: no PNG")
         return
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.6))
+    import matplotlib.pyplot as plt
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def figure(stages: list, prop: list) -> Any:
+    """The study's figure (a matplotlib Figure): W and W_Loop, and the
+    smallest angle, against λ along the Loop-guided continuations
+    (``stages``), and Proposition 1 (``prop``)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
+    fig, ax = plt.subplots(1, 3, figsize=(16, 5.2))
+    marks = "os^Dv"
+    lams, errs = set(), []
     for k, ((mesh, energy), grp) in enumerate(_groups(stages).items()):
         grp = sorted(grp, key=lambda s: s["lambda"])
         lam = [s["lambda"] for s in grp]
-        c = f"C{k % 10}"
-        ax[0].semilogx(lam, [100 * (s["W"] / CLIFFORD - 1) for s in grp], "o-", color=c,
-                       label=f"{energy} {mesh}")
-        ax[0].semilogx(lam, [100 * (s["loop_w"] / CLIFFORD - 1) for s in grp], "x--", color=c)
-        ax[1].semilogx(lam, [s["minangle"] for s in grp], "o-", color=c,
-                       label=f"{energy} {mesh}")
-    ax[0].axhline(0, color="k", lw=0.5)
-    ax[0].set_xlabel("λ (healthy continuation stages)")
-    ax[0].set_ylabel("error to 2π² (%): W solid, W_Loop dashed")
-    ax[0].set_ylim(-5, 10)
-    ax[0].legend(fontsize=6)
-    ax[1].axhline(10, color="r", lw=0.5)
+        lams.update(lam)
+        c, mk = f"C{k % 10}", marks[k % len(marks)]
+        w = [100 * (s["W"] / CLIFFORD - 1) for s in grp]
+        wl = [100 * (s["loop_w"] / CLIFFORD - 1) for s in grp]
+        errs += w + wl
+        ax[0].semilogx(lam, w, "-", marker=mk, color=c, label=f"{energy} {mesh}: W",
+                       zorder=3 + k)
+        ax[0].semilogx(lam, wl, "--", marker=mk, mfc="none", color=c,
+                       label=f"{energy} {mesh}: W_Loop", zorder=3 + k)
+        ax[1].semilogx(lam, [s["minangle"] for s in grp], "-", marker=mk, color=c,
+                       label=f"{energy} {mesh}", zorder=3 + k)
+    for a in ax[:2]:                          # the stages' λ as plain tick labels
+        ticks = sorted(lams)
+        a.set_xticks(ticks)
+        a.set_xticklabels([f"{t:.3g}" for t in ticks], rotation=45, fontsize=7)
+        a.xaxis.set_minor_formatter(NullFormatter())
+        a.grid(True, alpha=0.3)
+    ax[0].axhline(0, color="k", lw=0.5, zorder=1)
+    ax[0].set_xlabel("λ")
+    ax[0].set_ylabel("error to 2π² (%)")
+    if errs:
+        lo, hi = min(errs), max(errs)
+        pad = 0.05 * (hi - lo or 1.0)
+        ax[0].set_ylim(lo - pad, hi + pad)
+    ax[0].set_title("W (solid) and W_Loop (dashed) along the continuation", fontsize=10)
+    ax[0].legend(fontsize=6, ncol=2)
+    ax[1].axhline(10, color="r", lw=0.6, zorder=1, label="10°: a stage below is undone")
     ax[1].set_xlabel("λ")
     ax[1].set_ylabel("smallest angle (°)")
+    ax[1].set_title("smallest facet angle of the healthy stages", fontsize=10)
     ax[1].legend(fontsize=6)
-    for m, n in sorted({(p["m"], p["n"]) for p in prop}):
+    grids = sorted({(p["m"], p["n"]) for p in prop})
+    for k, (m, n) in enumerate(grids):        # the grids' curves nearly coincide: all visible
         pp = [p for p in prop if (p["m"], p["n"]) == (m, n)]
-        ax[2].loglog([p["eps"] for p in pp], [p["minus_4pi"] for p in pp], "o-",
-                     label=f"{m}x{n}")
+        ax[2].loglog([p["eps"] for p in pp], [p["minus_4pi"] for p in pp],
+                     ["-", "--", ":"][k % 3], marker=marks[k % len(marks)],
+                     ms=9 - 2.5 * k, mfc="none" if k == 0 else None, lw=2.5 - 0.7 * k,
+                     label=f"{m}x{n}", zorder=3 + k)
     ax[2].set_xlabel("hole size ε")
     ax[2].set_ylabel("W_Bobenko − 4π")
-    ax[2].set_title("Proposition 1: almost spherical tori")
+    ax[2].set_title("Proposition 1: almost spherical tori", fontsize=10)
+    ax[2].grid(True, which="both", alpha=0.3)
     ax[2].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    return fig
 
 
 def _groups(stages):

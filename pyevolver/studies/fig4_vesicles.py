@@ -335,14 +335,17 @@ def plot(path: str, results: dict) -> None:
             ax.set_aspect("equal")
             ax.set_xticks([])
             ax.set_yticks([])
+            ax.set_xlabel("r (distance from the axis)", fontsize=6)
+            ax.set_ylabel("z (along the axis)", fontsize=6)
         ax = axes[i, -1]
-        for label in timed:
+        for k, label in enumerate(timed):
             item = results.get((shape, label))
             if item is None:
                 continue
             rows = item[1]
             ax.loglog([r["seconds"] for r in rows], [abs(r["rel_error"]) for r in rows],
-                      "o-" if item[0] is not None else "s--", label=label, ms=3)
+                      ["-", "--", "-.", ":"][k % 4], marker="os^Dv"[k % 5], color=f"C{k}",
+                      label=label, ms=4, zorder=3 + k)
         ax.axhline(0.01, color="0.6", lw=0.5)
         ax.set_xlabel("seconds", fontsize=7)
         ax.set_ylabel("|W - W_ref| / W_ref", fontsize=7)

@@ -1,6 +1,7 @@
 """Parameter sweeps: one datafile over a grid of parameter values.
 
-A sweep is described by a TOML file (``pyevolver sweep SPEC.toml``)::
+A sweep is described by a TOML file (``pyevolver sweep SPEC.toml``; every
+key is documented in docs/guide.md, "The sweep file")::
 
     datafile = "vesicle.fe"          # relative to the spec's folder
     output = "vesicle_sweep"         # default: <spec name>_out beside the spec
@@ -59,7 +60,8 @@ from ..atomic import atomic_path, atomic_write
 from ..commands.interpreter import Quit
 from ..datafile.writer import dump
 from ..errors import PyEvolverError
-from ..io.render import _matplotlib, _save
+from ..io import movie
+from ..io.render import OBLIQUE, _matplotlib, _save, camera
 from ..session.api import progress_bar
 from ..session.core import Session
 
@@ -525,13 +527,17 @@ def plot_phase(spec: SweepSpec, rows: list[dict]) -> str:
         raise SweepError("the phase diagram plots one or two parameters")
     from matplotlib.image import imread
     xs, ys = spec.parameters[names[0]], spec.parameters[names[1]]
-    fig = Figure(figsize=(2.2 * len(xs) + 0.8, 2.2 * len(ys) + 0.8), dpi=100)
+    pics, clim, label = _phase_pictures(spec, rows)
+    bar = clim is not None
+    fig = Figure(figsize=(2.2 * len(xs) + (1.8 if bar else 0.8), 2.2 * len(ys) + 0.8), dpi=100)
     FigureCanvasAgg(fig)
+    axes = []
     for r, v in zip(rows, vals):
         ix, iy = np.unravel_index(r["index"], (len(xs), len(ys)))
         ax = fig.add_subplot(len(ys), len(xs), (len(ys) - 1 - iy) * len(xs) + ix + 1)
-        png = os.path.join(point_dir(spec, r["index"]), "snapshot.png")
-        if r["status"] == "ok" and spec.snapshot and os.path.isfile(png):
+        axes.append(ax)
+        png = pics.get(r["index"])
+        if png is not None:
             ax.imshow(imread(png))
         ax.set_xticks([])
         ax.set_yticks([])
@@ -540,6 +546,38 @@ def plot_phase(spec: SweepSpec, rows: list[dict]) -> str:
             ax.set_xlabel(f"{names[0]} = {xs[ix]:.4g}", fontsize=8)
         if ix == 0:
             ax.set_ylabel(f"{names[1]} = {ys[iy]:.4g}", fontsize=8)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 0.86, 1) if bar else (0, 0, 1, 1))
+    if bar:                                   # one colour bar for every panel
+        import matplotlib as mpl
+        cax = fig.add_axes([0.89, 0.12, 0.025, 0.76])
+        cb = fig.colorbar(mpl.cm.ScalarMappable(norm=mpl.colors.Normalize(*clim),
+                                                cmap="viridis"), cax=cax,
+                          format=mpl.ticker.FormatStrFormatter("%.4g"))
+        cb.set_label(label or str(spec.snapshot))
     _save(fig, path)
+    for png in pics.values():
+        os.remove(png)
     return path
+
+
+def _phase_pictures(spec: SweepSpec, rows: list[dict]) -> tuple[dict, tuple | None, str]:
+    """The phase diagram's panels: each finished point's final surface
+    (``final.fe``) drawn without a colour bar, all over one colour range;
+    ``({index: temporary png}, (lo, hi) or None, the colour bar's label)``."""
+    data = {}
+    for r in rows:
+        final = os.path.join(point_dir(spec, r["index"]), "final.fe")
+        if r["status"] != "ok" or not spec.snapshot or not os.path.isfile(final):
+            continue
+        try:
+            sess = Session.load(final, out=io.StringIO())
+            data[r["index"]] = movie.picture_data(sess.surface, spec.snapshot)
+        except PyEvolverError:
+            continue
+    clim = movie.common_range(list(data.values()))
+    pics = {}
+    for k, pic in data.items():
+        path = os.path.join(point_dir(spec, k), ".phase_panel.png")
+        pics[k] = movie.draw(pic, path, camera(pic.X, *OBLIQUE), 300, clim, colorbar=False)
+    label = next((p.label for p in data.values() if p.label), "")
+    return pics, clim, label

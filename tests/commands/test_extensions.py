@@ -81,3 +81,21 @@ def test_snapshot_and_plot_history(tmp_path):
     for p in (png, hist):
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert f"Snapshot written to {png}." in s.out.getvalue()
+
+
+def test_movie_command(tmp_path, monkeypatch):
+    from pyevolver.io import render_vtk
+    monkeypatch.setattr(render_vtk, "available", lambda: False)      # matplotlib: quick
+    s = session()
+    gif = tmp_path / "run.gif"
+    s.run(f'movie("{gif}", 4, 2, "area")')
+    assert gif.read_bytes()[:6] == b"GIF89a" and len(s.history) == 4
+    assert f"Movie written to {gif} (3 frames)." in s.out.getvalue()
+    X = s.surface.X.copy()
+    for bad, msg in [(f'movie("{tmp_path / "r.avi"}", 4, 2)', "write .gif or .mp4"),
+                     (f'movie("{gif}", 4)', "movie needs a file name"),
+                     (f'movie("{gif}", 4, 0)', "every >= 1"),
+                     (f'movie("{gif}", 2.5, 1)', "movie needs")]:
+        with pytest.raises(CommandError, match=msg):
+            s.run(bad)
+    np.testing.assert_array_equal(s.surface.X, X)       # refused before any step ran

@@ -27,6 +27,13 @@ def test_tutorial_runs(tmp_path, monkeypatch):
     for line, src in code:
         # compiled with the tutorial's file name and line, so a failure points at the doc
         exec(compile("\n" * (line - 1) + src, path, "exec"), ns)
+    # the sweep's drops sit on the table: finite heights, lower where heavier
+    rows = ns["result"].rows
+    height = {(r["parameters"]["angle"], r["parameters"]["body[1].density"]):
+              r["record"]["max(vertex, z)"] for r in rows}
+    assert len(height) == 4 and all(0.3 < h < 1.5 for h in height.values()), height
+    for angle in (60, 120):
+        assert height[(angle, 1.0)] < height[(angle, 0.0)], height
     for name in ("cube.vtu", "cube.ply", "cube_again.fe", "cube.png", "cube_area.png",
-                 "history.png", "drops/results.csv"):
+                 "history.png", "cube.gif", "drops/results.csv"):
         assert os.path.getsize(tmp_path / name) > 0, name

@@ -90,7 +90,11 @@ def test_export_round_trip(tmp_path, ext):
         for k in v:
             np.testing.assert_array_equal(m.point_data[k], v[k], err_msg=k)
     if "cell" in kinds:
-        assert set(m.cell_data) == set(f)
+        from pyevolver.io.meshio_plugin import body_arrays
+        bodies = body_arrays(S)                 # the mound's drop: kept through .fe
+        assert set(m.cell_data) == set(f) | set(bodies)
+        for k in bodies:
+            np.testing.assert_array_equal(m.cell_data[k][0], bodies[k], err_msg=k)
         for k in f:
             np.testing.assert_array_equal(m.cell_data[k][0], f[k], err_msg=k)
 
@@ -136,3 +140,72 @@ def test_convert_cli(tmp_path, capsys):
     assert s.surface.nf == 24 and s.total_area == pytest.approx(6.0, abs=1e-14)
     assert cli_main(["convert", str(tmp_path / "missing.fe"), vtu]) == 1
     assert "no such file" in capsys.readouterr().err
+
+
+def _two_cells(tmp_path):
+    """Two unit cubes stacked along z sharing the square z = 1 (its facets
+    bound body 1 with their front and body 2 with their back), written as a
+    datafile: body 1 volume 1 density 2, body 2 pressure 3."""
+    from pyevolver.datafile.writer import write_fe
+    from pyevolver.model.arrays import surface_from_arrays
+    X = np.array([(x, y, z) for z in (0, 1, 2) for y in (0, 1) for x in (0, 1)], float)
+    v = {tuple(p): k for k, p in enumerate(X.astype(int).tolist())}
+
+    F, owner = [], []
+
+    def add(quad, centre):
+        for tri in ([quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]):
+            n = np.cross(X[tri[1]] - X[tri[0]], X[tri[2]] - X[tri[0]])
+            if n @ (X[tri].mean(0) - centre) < 0:
+                tri = tri[::-1]
+            F.append(tri)
+    for body, z0 in ((1, 0), (2, 1)):
+        centre = np.array([0.5, 0.5, z0 + 0.5])
+        for axis in (0, 1):
+            for c in (0, 1):
+                quad = [v[(c, a, z0 + b)] if axis == 0 else v[(b, c, z0 + a)]
+                        for a, b in ((0, 0), (1, 0), (1, 1), (0, 1))]
+                add(quad, centre)
+                owner += [body, body]
+        if body == 1:
+            add([v[(0, 0, 0)], v[(1, 0, 0)], v[(1, 1, 0)], v[(0, 1, 0)]], centre)
+            owner += [1, 1]
+            add([v[(0, 0, 1)], v[(1, 0, 1)], v[(1, 1, 1)], v[(0, 1, 1)]], centre)
+            owner += [12, 12]                       # the shared square
+        else:
+            add([v[(0, 0, 2)], v[(1, 0, 2)], v[(1, 1, 2)], v[(0, 1, 2)]], centre)
+            owner += [2, 2]
+    ids = np.arange(1, len(F) + 1)
+    owner = np.array(owner)
+    b1 = [int(i) for i in ids[(owner == 1) | (owner == 12)]]
+    b2 = [int(i) for i in ids[owner == 2]] + [-int(i) for i in ids[owner == 12]]
+    s = surface_from_arrays(X, np.array(F), bodies=[
+        (b1, [("volume", [1.0]), ("density", [2.0])]), (b2, [("pressure", [3.0])])])
+    path = str(tmp_path / "two.fe")
+    write_fe(s, path)
+    return path
+
+
+def test_convert_keeps_the_bodies(tmp_path, evolver):
+    """.fe -> .vtu -> .fe: the bodies, their facets (and sides), prescribed
+    volume, density and pressure survive, in pyevolver and in the Evolver."""
+    src = _two_cells(tmp_path)
+    vtu, back = str(tmp_path / "two.vtu"), str(tmp_path / "back.fe")
+    assert cli_main(["convert", src, vtu]) == 0
+    m = meshio.read(vtu)
+    assert sorted(set(m.cell_data["frontbody"][0].tolist())) == [1, 2]
+    assert sorted(set(m.cell_data["backbody"][0].tolist())) == [0, 2]
+    assert cli_main(["convert", vtu, back]) == 0
+    a, b = _session(src), _session(back)
+    ba, bb = a.surface.bodies, b.surface.bodies
+    assert bb.n == ba.n == 2
+    assert (bb.facet_matrix != ba.facet_matrix).nnz == 0
+    np.testing.assert_array_equal(bb.target, ba.target)          # [1, nan]
+    np.testing.assert_array_equal(bb.density, [2.0, 0.0])
+    np.testing.assert_array_equal(bb.pressure, ba.pressure)      # [nan, 3]
+    vols = [b.value("body[1].volume"), b.value("body[2].volume")]
+    assert vols == pytest.approx([1.0, 1.0], abs=1e-14)
+    assert b.total_energy == pytest.approx(a.total_energy, rel=1e-14)
+    ref = numbers(evolver, back, ["body[1].volume", "body[2].volume", "body[1].target",
+                                  "body[2].pressure", "total_energy"], cwd=str(tmp_path))
+    assert ref == pytest.approx([1.0, 1.0, 1.0, 3.0, b.total_energy], rel=1e-12)

@@ -25,5 +25,6 @@ def test_session_from_the_package_loads_the_cube(evolver):
     assert (s.count("vertex"), s.count("edge"), s.count("facet")) == (nv, ne, nf)
     assert nv - ne + nf == 2                          # a sphere's Euler characteristic
     assert s.total_area == area == 6.0
-    assert repr(s).startswith(f"<Session {CUBE}: {int(nv)} vertices, {int(ne)} edges")
+    assert repr(s) == (f"<Session {CUBE}: {int(nv)} vertices, {int(ne)} edges, {int(nf)} "
+                       f"facets, 1 body; energy {area:.10g}>")
     assert repr(Session(out=io.StringIO())) == "<Session: no surface>"

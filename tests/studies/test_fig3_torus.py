@@ -239,3 +239,33 @@ def test_study_small_writes_its_outputs(tmp_path):
         recs = list(csv.DictReader(fh))
     assert {r["method"] for r in recs} >= {"NormalCur Evolver recipe (g,V,u,n)",
                                            "EffArea+harmonic(cont.)"}
+
+
+def test_the_figure_is_readable():
+    """Titles and axis labels inside the picture (not clipped), the three
+    grids' Proposition 1 curves each in its own marker and line style (they
+    nearly coincide, none may hide another), the λ ticks plain numbers."""
+    import csv
+    import os
+    plt = pytest.importorskip("matplotlib.pyplot")
+    from pyevolver.studies.doc_numbers import DOCS
+
+    def read(name):
+        with open(os.path.join(DOCS, name)) as fh:
+            return [{k: (v if k in ("status", "mesh", "energy", "grid", "rule") else float(v))
+                     for k, v in r.items()} for r in csv.DictReader(fh)]
+    fig = F3.figure(read("fig3_stages.csv"), read("fig3_prop1.csv"))
+    fig.canvas.draw()
+    box = fig.bbox
+    for ax in fig.axes:
+        for t in (ax.title, ax.xaxis.label, ax.yaxis.label):
+            assert t.get_text()
+            e = t.get_window_extent()
+            assert box.x0 <= e.x0 and e.x1 <= box.x1 and box.y0 <= e.y0 and e.y1 <= box.y1, \
+                t.get_text()
+    lines = fig.axes[2].get_lines()
+    assert len(lines) == 3
+    assert len({(ln.get_marker(), ln.get_linestyle()) for ln in lines}) == 3
+    assert all("10^" not in t.get_text() and "times" not in t.get_text()
+               for t in fig.axes[0].get_xticklabels())
+    plt.close(fig)

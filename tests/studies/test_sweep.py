@@ -79,6 +79,35 @@ def test_local_sweep_writes_every_point(local):
                                             'body[1].volume,"max(vertex, z)"')
 
 
+def test_phase_panels_share_one_colour_range_and_bar(local):
+    """The phase diagram redraws each point without its own colour bar, all
+    over one range (the lowest to the highest of the points' ranges), and
+    draws one colour bar for the panels."""
+    import numpy as np
+    from matplotlib.image import imread
+    from pyevolver.io import movie
+    from pyevolver.studies.sweep import _phase_pictures
+    _, spec, res = local
+    rows = [res.rows[0], res.rows[-1]]          # two panels: the lightest and the heaviest
+    pics, clim, label = _phase_pictures(spec, rows)
+    assert sorted(pics) == [0, 7] and label.startswith("mean curvature")
+    ranges = []
+    for r in rows:
+        s = Session.load(os.path.join(spec.output, f"p{r['index']:04d}", "final.fe"),
+                         out=io.StringIO())
+        ranges.append(movie.common_range([movie.picture_data(s.surface, "mean_curvature")]))
+    assert clim == (min(a for a, _ in ranges), max(b for _, b in ranges))
+    for png in pics.values():
+        img = imread(png)[:, :, :3]
+        cols = np.nonzero(np.any(img[: int(0.9 * img.shape[0])] < 0.9, axis=(0, 2)))[0]
+        # no bar in the right fifth: the surface is framed on the whole width
+        assert cols.max() - cols.min() > 0.85 * img.shape[1], "a panel kept room for a bar"
+        os.remove(png)
+    big = imread(res.plot)[:, :, :3]
+    bar = big[:, int(0.88 * big.shape[1]):int(0.93 * big.shape[1])]
+    assert len(np.unique((bar.reshape(-1, 3) * 255).round(), axis=0)) > 50   # the one bar
+
+
 def test_point_agrees_with_reference(local, evolver):
     tmp, _, res = local
     r = res.rows[5]                                    # target 1.2, density 0.5

@@ -1,0 +1,213 @@
+"""Every study number in docs/ is the study's own: the tables between
+``<!-- doc_numbers NAME -->`` markers are what pyevolver.studies.doc_numbers
+writes from the committed CSVs, the numbers the prose quotes are the CSVs'
+(CLAIMS below), and cases of the studies are regenerated live and agree
+with the CSVs (in the default run Proposition 1 at 5×10 and the
+axisymmetric references; Figure 1, Figure 3 at 5×10, the 162-vertex
+prolate of Figure 4 and the Loop torus are marked slow)."""
+import math
+import os
+import re
+
+import pytest
+
+from pyevolver.studies import doc_numbers as D
+
+CLIFFORD = 2 * math.pi ** 2
+
+
+def _row(csv, **match):
+    rows = [r for r in D.read_csv(csv) if all(r.get(k) == v for k, v in match.items())]
+    assert len(rows) == 1, (csv, match, len(rows))
+    return rows[0]
+
+
+def _v(csv, column, **match):
+    return float(_row(csv, **match)[column])
+
+
+F3 = "fig3_torus.csv"
+F4 = "fig4_vesicles.csv"
+
+
+def _f3(label, column, mesh="10x16", program=None):
+    if program is None:          # the recipe runs in both programs, the rest in pyevolver
+        program = "pyevolver" if "recipe" in label else ""
+    return _v(F3, column, label=label, mesh=mesh, program=program)
+
+
+def _f4(method, shape, column, resolution="2562"):
+    return _v(F4, column, method=method, shape=shape, resolution=resolution)
+
+
+def _pct(x, spec):
+    return format(100 * x, spec) + "%"
+
+
+CONS = "{}+harmonic(W=W_Loop)"
+NC, EA = "NormalCur", "EffArea"
+# (file, text with {} for each value, the values from the CSVs, formatted)
+CLAIMS = [
+    ("paper.md", "(fit deviation {} and {}, W {} and {}, smallest angle {}° and {}°)",
+     lambda: [f"{_f3('NormalCur+harmonic(λ=1) [paper grid]', 'revolution_dev'):.2f}",
+              f"{_f3('NormalCur+harmonic(λ=0.5) [paper grid]', 'revolution_dev'):.2f}",
+              _pct(_f3('NormalCur+harmonic(λ=1) [paper grid]', 'rel_error'), "+.1f"),
+              _pct(_f3('NormalCur+harmonic(λ=0.5) [paper grid]', 'rel_error'), "+.1f"),
+              f"{_f3('NormalCur+harmonic(λ=1) [paper grid]', 'min_angle_deg'):.0f}",
+              f"{_f3('NormalCur+harmonic(λ=0.5) [paper grid]', 'min_angle_deg'):.1f}"]),
+    ("paper.md", "(deviation {} and {}, W {} and {}, angles {}° and {}°)",
+     lambda: [f"{_f3('NormalCur+harmonic(λ=1)', 'revolution_dev'):.2f}",
+              f"{_f3('NormalCur+harmonic(λ=0.5)', 'revolution_dev'):.2f}",
+              _pct(_f3('NormalCur+harmonic(λ=1)', 'rel_error'), "+.1f"),
+              _pct(_f3('NormalCur+harmonic(λ=0.5)', 'rel_error'), "+.1f"),
+              f"{_f3('NormalCur+harmonic(λ=1)', 'min_angle_deg'):.0f}",
+              f"{_f3('NormalCur+harmonic(λ=0.5)', 'min_angle_deg'):.0f}"]),
+    ("paper.md", "10×16 W {} (EffArea, λ = {}) and {} (NormalCur, λ = {}), angles {}° and {}°",
+     lambda: [_pct(_f3(CONS.format(EA), "rel_error"), "+.2f"),
+              f"{_f3(CONS.format(EA), 'lambda'):.4f}",
+              _pct(_f3(CONS.format(NC), "rel_error"), "+.2f"),
+              f"{_f3(CONS.format(NC), 'lambda'):.4f}",
+              f"{_f3(CONS.format(EA), 'min_angle_deg'):.1f}",
+              f"{_f3(CONS.format(NC), 'min_angle_deg'):.1f}"]),
+    ("paper.md", "both energies end within 1% of 2π² ({}, {}) with smallest angles {}° and {}°, "
+                 "but R/r is {} and {}, {}% and {}% below √2",
+     lambda: [_pct(_f3(CONS.format(EA), "rel_error"), "+.2f"),
+              _pct(_f3(CONS.format(NC), "rel_error"), "+.2f"),
+              f"{_f3(CONS.format(EA), 'min_angle_deg'):.1f}",
+              f"{_f3(CONS.format(NC), 'min_angle_deg'):.1f}",
+              f"{_f3(CONS.format(EA), 'R_over_r'):.3f}",
+              f"{_f3(CONS.format(NC), 'R_over_r'):.3f}",
+              f"{100 * (1 - _f3(CONS.format(EA), 'R_over_r') / math.sqrt(2)):.1f}",
+              f"{100 * (1 - _f3(CONS.format(NC), 'R_over_r') / math.sqrt(2)):.1f}"]),
+    ("paper.md", "with the Loop guide R/r is within {}% (EffArea {}) and {}% (NormalCur {}) "
+                 "but W is {} and {}.",
+     lambda: [f"{100 * (1 - _f3('EffArea+harmonic(cont.)', 'R_over_r') / math.sqrt(2)):.1f}",
+              f"{_f3('EffArea+harmonic(cont.)', 'R_over_r'):.3f}",
+              f"{100 * (1 - _f3('NormalCur+harmonic(cont.)', 'R_over_r') / math.sqrt(2)):.1f}",
+              f"{_f3('NormalCur+harmonic(cont.)', 'R_over_r'):.3f}",
+              _pct(_f3("EffArea+harmonic(cont.)", "rel_error"), "+.1f"),
+              _pct(_f3("NormalCur+harmonic(cont.)", "rel_error"), "+.1f")]),
+    ("paper.md", "round 50: {} against {}, after notching added {} and {} vertices",
+     lambda: [f"{_f3('NormalCur Evolver recipe (g,V,u,n)', 'W'):.3f}",
+              f"{_f3('NormalCur Evolver recipe (g,V,u,n)', 'W', program='evolver-nox-d'):.3f}",
+              f"{_f3('NormalCur Evolver recipe (g,V,u,n)', 'vertices') - 160:.0f}",
+              f"{_f3('NormalCur Evolver recipe (g,V,u,n)', 'vertices', program='evolver-nox-d') - 160:.0f}"]),
+    ("paper.md", "at 5×10 notching grows the mesh to {} and {} vertices in pyevolver, {} and {} "
+                 "in evolver-nox-d",
+     lambda: [f"{_f3(f'{e} Evolver recipe (g,V,u,n)', 'vertices', '5x10', p):.0f}"
+              for p in ("pyevolver", "evolver-nox-d") for e in (EA, NC)]),
+    ("paper.md", "It does not converge further at 10×16 ({} and {}).",
+     lambda: [_pct(_f3(f"{e} Evolver recipe (g,V,u,n)", "rel_error"), "+.1f") for e in (EA, NC)]),
+    ("paper.md", "shapes (right type, W within {}, {} and {}, smallest angle ≥ {}°)",
+     lambda: [_pct(_f4("StarPerp+recipe+Newton", "prolate", "rel_error"), ".2f"),
+              _pct(_f4("StarPerp+recipe+Newton", "discocyte", "rel_error"), ".2f"),
+              _pct(_f4("StarPerp+recipe+Newton", "stomatocyte", "rel_error"), ".2f"),
+              f"{math.floor(min(_f4('StarPerp+recipe+Newton', s, 'min_angle_deg') for s in D.SHAPE_ORDER))}"]),
+    ("paper.md", "NormalCur+harmonic+u meets it on all three too ({}, {} and {},",
+     lambda: [_pct(_f4("NormalCur+harmonic", "prolate", "rel_error"), ".3f"),
+              _pct(_f4("NormalCur+harmonic", "discocyte", "rel_error"), ".2f"),
+              _pct(_f4("NormalCur+harmonic+u", "stomatocyte", "rel_error"), ".3f")]),
+    ("paper.md", "stomatocyte ({}, cup too deep: height/width {} against {}).",
+     lambda: [_pct(_f4("NormalCur+harmonic", "stomatocyte", "rel_error"), "+.2f"),
+              f"{_f4('NormalCur+harmonic', 'stomatocyte', 'height_width'):.3f}",
+              f"{_v(F4, 'height_width', method='axisymmetric reference', shape='stomatocyte'):.3f}"]),
+]
+
+
+def _text(name):
+    with open(os.path.join(D.DOCS, name), encoding="utf-8") as fh:
+        return re.sub(r"\s+", " ", fh.read())
+
+
+def test_every_block_is_what_its_csv_gives():
+    assert D.update(D.DOCS, check=True) == [], "run python -m pyevolver.studies.doc_numbers"
+
+
+def test_every_block_is_used():
+    used = set()
+    for fn in os.listdir(D.DOCS):
+        if fn.endswith(".md"):
+            with open(os.path.join(D.DOCS, fn), encoding="utf-8") as fh:
+                used |= set(D.blocks_in(fh.read()))
+    assert used == set(D.BLOCKS)
+
+
+@pytest.mark.parametrize("claim", CLAIMS, ids=[c[1][:40] for c in CLAIMS])
+def test_the_prose_quotes_the_csvs(claim):
+    doc, template, values = claim
+    expected = template.format(*values())
+    assert expected in _text(doc), expected
+
+
+def test_proposition1_regenerated_at_5x10():
+    from pyevolver.studies.fig3_torus import proposition1
+    got = proposition1(grids=((5, 10),), eps=(0.5, 1e-3))
+    for g in got:
+        want = _v("fig3_prop1.csv", "W_bobenko", m="5", n="10", eps=f"{g['eps']}")
+        assert g["W_bobenko"] == pytest.approx(want, rel=1e-12)
+
+
+@pytest.mark.slow
+def test_fig4_prolate_at_162_vertices_regenerated():
+    from pyevolver.studies import fig4_vesicles
+    _, rows = fig4_vesicles.run("prolate", "normal", 162)
+    assert rows[-1]["energy"] == pytest.approx(_f4("NormalCur+harmonic", "prolate", "energy",
+                                                   "162"), rel=1e-9)
+
+
+@pytest.mark.slow
+def test_fig4_figure_is_drawn_from_the_csv(tmp_path):
+    from matplotlib.image import imread
+    png = D.fig4_figure(str(tmp_path / "fig4.png"))
+    assert imread(png).shape == imread(os.path.join(D.DOCS, "fig4_vesicles.png")).shape
+
+
+@pytest.mark.slow
+def test_fig1_regenerated():
+    from pyevolver.studies import fig1_torus
+    for label, method, minimizer in fig1_torus.RUNS:
+        _, row = fig1_torus.run(label, method, minimizer)
+        want = _row("fig1_torus.csv", label=label)
+        assert row["W"] == pytest.approx(float(want["W"]), rel=1e-6), label
+        assert row["iterations"] == int(want["iterations"]), label
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("energy", ["EffArea", "NormalCur"])
+def test_fig3_5x10_continuation_regenerated(energy, tmp_path):
+    from pyevolver.studies import fig3_torus
+    row, _ = fig3_torus.continuation_run(5, 10, energy, directory=str(tmp_path))
+    assert row["W"] == pytest.approx(_f3(f"{energy}+harmonic(cont.)", "W", "5x10"), rel=1e-6)
+    assert row["W_loop"] == pytest.approx(_f3(f"{energy}+harmonic(cont.)", "W_loop", "5x10"),
+                                          rel=1e-6)
+
+
+@pytest.mark.parametrize("shape, branch", [("prolate", "prolate"),
+                                           ("discocyte", "oblate/discocyte")])
+def test_guide_axisymmetric_references_regenerated(shape, branch):
+    from pyevolver.studies import fig4_vesicles
+    ref = fig4_vesicles.reference(shape)
+    v0 = fig4_vesicles.SHAPES[shape][0]
+    row = (f"| {v0:.2f} | {branch} (") in _text("guide.md")
+    assert row
+    expected = f"| {ref.n} | {ref.W:.12f} | {ref.W / (4 * math.pi):.12f} |"
+    assert expected in _text("guide.md"), expected
+
+
+@pytest.mark.slow
+def test_guide_loop_torus_regenerated():
+    from pyevolver.studies.loop_torus import minimize_torus
+    out = minimize_torus(5, 9)
+    text = _text("guide.md")
+    assert f"prints W = {out['W']:.3f}" in text
+    assert f"ratio {out['ratio']:.4f}" in text
+    assert f"fixed = {out['area']:.3f} method loop_area" in text
+
+
+def test_guide_fig4_summary_holds():
+    text = _text("guide.md")
+    assert "method with `u` are within 0.5% on all three shapes" in text
+    errs = [_f4("StarPerp+recipe+Newton", s, "rel_error") for s in D.SHAPE_ORDER]
+    errs += [_f4("NormalCur+harmonic", s, "rel_error") for s in ("prolate", "discocyte")]
+    errs.append(_f4("NormalCur+harmonic+u", "stomatocyte", "rel_error"))
+    assert max(abs(e) for e in errs) < 0.005, errs
