@@ -14,7 +14,9 @@ from pyevolver.io import render_vtk
 from pyevolver.io.movie import Movie
 
 DATAFILES = os.path.join(os.path.dirname(__file__), "..", "..", "datafiles")
-BACKENDS = ["vtk", "matplotlib"]
+# VTK starts in about 4 s: its frames are checked in the slow run; the
+# framing rule is the same code for both backends (io.movie)
+BACKENDS = [pytest.param("vtk", marks=pytest.mark.slow), "matplotlib"]
 
 
 def _drawn(path):
