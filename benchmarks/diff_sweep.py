@@ -461,7 +461,11 @@ def _mirror(fe, seq, timeout, tree, tmp, r_full):
     its own dump no longer prints them (REF disagrees with itself by more
     than :data:`MATCH`: its next decision turns on state the dump does not
     keep, e.g. the order of a vertex's facets, or on a sign at round-off
-    level) and pyevolver from the same dump prints what REF prints from it.
+    level) and pyevolver from the same dump prints what REF prints from it,
+    or when REF's result changes beyond :data:`MATCH` under the 1e-15 change
+    of its input between the dump's 15-digit and 17-digit coordinates.
+    Only the last split point where the states agree is judged (a later
+    command's own difference is not excused by an earlier ill-posed one).
     Returns (class or None, a note)."""
     name, cmds, kind = seq
     env = dict(os.environ, PYTHONPATH=tree, PYTHONUNBUFFERED="1")
@@ -493,7 +497,7 @@ def _mirror(fe, seq, timeout, tree, tmp, r_full):
             text15 = f.read()
         text, npatched = full_precision_dump(text15, _sdim_coords(rout), sdim)
         if npatched != len(b):
-            continue
+            return None, f"after step {k}, the last where the states agree, nothing explains it"
         rdmp15 = os.path.join(tmp, f"ref{k}_15.dmp")
         with open(rdmp, "w") as f:
             f.write(text)
@@ -506,7 +510,7 @@ def _mirror(fe, seq, timeout, tree, tmp, r_full):
         r_out, _, r_t = run(ref_cmd(rest, rdmp), cwd, timeout, merge=True)
         p, r = parse(p_out, False), parse(r_out, True)
         if p_t or r_t or p is None or r is None or p["energy"] is None or r["energy"] is None:
-            continue
+            return None, f"after step {k}, the last where the states agree, nothing explains it"
         ref_own = _rest_of(r_full, len(r["g"]))
         if ref_own is not None:
             w_own, _ = compare(p, ref_own, "evolve")
@@ -527,7 +531,7 @@ def _mirror(fe, seq, timeout, tree, tmp, r_full):
         r15_out, _, r15_t = run(ref_cmd(rest, rdmp15), cwd, timeout, merge=True)
         r15 = parse(r15_out, True)
         if r15_t or r15 is None or r15["energy"] is None:
-            continue
+            return None, f"after step {k}, the last where the states agree, nothing explains it"
         w_pert, _ = compare(r15, r, "evolve")
         if w_pert > MATCH:
             return "ill-posed", (f"after step {k} ({cmds[k - 1]}) the states agree to "
@@ -537,6 +541,8 @@ def _mirror(fe, seq, timeout, tree, tmp, r_full):
                                  f"its input changes its result by {w_pert:.1e}): REF disagrees "
                                  f"with itself; pyevolver from the 17-digit dump: "
                                  f"E={p['energy']:.9g} {p['counts']}")
+        return None, (f"after step {k}, the last where the states agree, pyevolver fed REF's "
+                      f"state does not make REF's numbers and REF reproduces itself")
     return None, "no split point where pyevolver fed REF's state makes REF's numbers"
 
 
