@@ -7,13 +7,18 @@ Hessian"), where the docs record what REF does:
   step is pyevolver's; with it on REF's matrix differs (its eigenvalues
   break the cube's symmetry) and so does its step (docs/supported.md);
 - catbody.fe ``g 5; hessian``: pyevolver's step is REF's with ``-p1``,
-  single-threaded REF steps elsewhere (docs/supported.md, ``hessian``).
+  single-threaded REF steps elsewhere (docs/supported.md, ``hessian``);
+- quadm.fe (a metric, every vertex fixed or constrained): ``g 5; hessian``
+  has no unknown, REF stops with ERROR 1837, pyevolver does nothing; after
+  ``r`` REF steps, as pyevolver (docs/differences.md).
 
 The datafiles are cube.fe with one quantity added (written at test time).
 """
 import io
 import os
 import subprocess
+
+import numpy as np
 
 import pyevolver
 from conftest import EXAMPLES
@@ -74,3 +79,20 @@ def test_catbody_hessian_as_threaded_ref(evolver, tmp_path):
     # single-threaded REF steps elsewhere (24.797 against 15.022)
     assert rel(ours, _ref(evolver, fe, cmds, cwd=str(tmp_path))) > 0.1
 
+
+
+def test_quadm_hessian(evolver, tmp_path):
+    fe = os.path.join(EXAMPLES, "quadm.fe")
+    cmds = ["r", "g 5", "hessian"]
+    assert rel(_ours(fe, cmds), _ref(evolver, fe, cmds, cwd=str(tmp_path))) < 1e-12
+    script = tmp_path / "e.cmd"
+    script.write_text("g 5\nhessian\n")
+    out = subprocess.run([evolver, "-f", str(script), fe], stdin=subprocess.DEVNULL,
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                         timeout=60).stdout
+    assert "ERROR 1837" in out
+    s = pyevolver.load(fe, out=io.StringIO(), err=io.StringIO())
+    s.run("g 5")
+    X = s.surface.X.copy()
+    s.run("hessian")
+    assert np.array_equal(X, s.surface.X)
