@@ -18,12 +18,18 @@ datafile's directory, stdin from /dev/null, under a timeout.  Compared:
 - for the query sequences (``v``, ``list``, ``print``), every number in the
   printed lines.
 
-Classes: ``match`` (max relative difference <= 1e-9), ``small`` (<= 1e-4),
+Classes: ``match`` (max relative difference <= 1e-6), ``small`` (<= 1e-4),
 ``big``, ``py-refuses`` (pyevolver's "not supported in pyevolver: NAME"),
 ``py-error`` (pyevolver printed an error message the reference did not),
 ``py-trace`` (a Python traceback: always a bug), ``py-timeout``,
 ``ref-error`` (the reference printed ERROR or did not reach the tail; a
-reference error ends its ``-f`` script), ``both-error``.
+reference error ends its ``-f`` script), ``both-error``.  A case that
+differs is ``roundoff`` when, after the last prefix where the two states
+agree, REF from pyevolver's dump prints pyevolver's numbers or pyevolver
+from REF's (full-precision) dump prints REF's, and ``ill-posed`` when REF
+disagrees with itself there (from its own dump, or under the 1e-15 change
+of its input between a 15-digit and a 17-digit dump): ``_stepwise``,
+``_mirror``.
 """
 import argparse
 import concurrent.futures as cf
@@ -322,7 +328,13 @@ def one_case(fe, seq, timeout, tree=REPO, stepwise=True):
                         res["cls"] = "roundoff"
                         res["note"] = where
                     else:
-                        res["note"] = (res["note"] + "; " + where).strip("; ")
+                        cls, why = _mirror(fe, seq, timeout, tree, tmp, r)
+                        if not cls:
+                            cls, why = _mirror_split(fe, seq, timeout, tree, tmp, r) or (cls, why)
+                        if cls:
+                            res["cls"], res["note"] = cls, why
+                        else:
+                            res["note"] = (res["note"] + "; " + where + "; " + why).strip("; ")
             _as_threaded_ref(fe, script, timeout, kind, p, res)
     return res
 
@@ -396,7 +408,179 @@ def _stepwise(fe, seq, timeout, tree, tmp):
     return False, "no split point explains it (not round-off)"
 
 
-CLASSES = ["match", "roundoff", "small", "big", "py-refuses", "py-error", "py-trace", "py-timeout",
+def _sdim_coords(text):
+    """REF's vertex coordinates with 17 digits, as strings (DS_X lines)."""
+    out = {}
+    for ln in text.split("\n"):
+        t = ln.split()
+        if len(t) > 2 and t[0] == "DS_X" and t[1].isdigit():
+            out[int(t[1])] = t[2:]
+    return out
+
+
+def full_precision_dump(dump_text, coords, sdim):
+    """REF's ``dump`` writes coordinates with 15 significant digits: put
+    back the 17-digit ones REF printed (``DS_X id x y z``) in the vertices
+    section (a dump keeps the live ids).  Vertices given by boundary
+    parameters keep the dump's text.  Returns (text, number patched)."""
+    out, sect, n = [], None, 0
+    for ln in dump_text.split("\n"):
+        s = ln.strip()
+        head = s.split()[0].lower() if s else ""
+        if head in ("vertices", "edges", "faces", "facets", "bodies", "read"):
+            sect = head
+        elif sect == "vertices" and s[:1].isdigit():
+            t = ln.split()
+            vid = int(t[0])
+            if vid in coords and "boundary" not in ln.lower() and len(t) > sdim:
+                ln = " ".join([t[0]] + coords[vid][:sdim] + t[1 + sdim:])
+                n += 1
+        out.append(ln)
+    return "\n".join(out), n
+
+
+def _sdim(fe):
+    with open(fe, errors="replace") as f:
+        m = re.search(r"^\s*space_dimension\s+(\d)", f.read(), re.M | re.I)
+    return int(m.group(1)) if m else 3
+
+
+def _rest_of(full, n_rest):
+    """The part of a parsed run that belongs to its last commands."""
+    if n_rest > len(full["g"]):
+        return None
+    return dict(full, g=full["g"][len(full["g"]) - n_rest:])
+
+
+def _mirror(fe, seq, timeout, tree, tmp, r_full):
+    """The mirror of :func:`_stepwise`: at a split point k where the states
+    agree to 1e-8, REF dumps its state (coordinates put back to 17 digits:
+    :func:`full_precision_dump`) and both programs run the rest from that
+    dump.  ``roundoff`` when pyevolver from REF's dump prints REF's own
+    numbers (those of REF's uninterrupted run); ``ill-posed`` when REF from
+    its own dump no longer prints them (REF disagrees with itself by more
+    than :data:`MATCH`: its next decision turns on state the dump does not
+    keep, e.g. the order of a vertex's facets, or on a sign at round-off
+    level) and pyevolver from the same dump prints what REF prints from it,
+    or when REF's result changes beyond :data:`MATCH` under the 1e-15 change
+    of its input between the dump's 15-digit and 17-digit coordinates.
+    Only the last split point where the states agree is judged (a later
+    command's own difference is not excused by an earlier ill-posed one).
+    Returns (class or None, a note)."""
+    name, cmds, kind = seq
+    env = dict(os.environ, PYTHONPATH=tree, PYTHONUNBUFFERED="1")
+    cwd = os.path.dirname(fe)
+    sdim = _sdim(fe)
+    coords = COORDS if sdim == 3 else (
+        'foreach vertex vv do printf "DS_X %d %.17g %.17g\\n", vv.id, vv.x, vv.y')
+    for k in range(len(cmds) - 1, 0, -1):
+        rdmp = os.path.join(tmp, f"ref{k}.dmp")
+        rpre = os.path.join(tmp, f"mref{k}.cmd")
+        with open(rpre, "w") as f:
+            f.write("\n".join(cmds[:k] + [coords, f'dump "{rdmp}"']) + "\n")
+        rout, _, rt = run(ref_cmd(rpre, fe), cwd, timeout, merge=True)
+        ppre = os.path.join(tmp, f"mpy{k}.cmd")
+        with open(ppre, "w") as f:
+            f.write("\n".join(cmds[:k] + [coords]) + "\n")
+        pout, _, pt = run([sys.executable, "-m", "pyevolver", "-f", ppre, fe], cwd, timeout, env,
+                          merge=True)
+        a, b = _coords(pout), _coords(rout)
+        if pt or rt or not a or a.keys() != b.keys() or not os.path.exists(rdmp):
+            continue
+        A = np.array([a[i] for i in sorted(a)])
+        B = np.array([b[i] for i in sorted(b)])
+        scale = max(np.abs(B).max(), 1e-300)
+        agree = np.abs(A - B).max() / scale if np.all(np.isfinite(A)) else np.inf
+        if agree > 1e-8:
+            continue
+        with open(rdmp, errors="replace") as f:
+            text15 = f.read()
+        text, npatched = full_precision_dump(text15, _sdim_coords(rout), sdim)
+        if npatched != len(b):
+            return None, f"after step {k}, the last where the states agree, nothing explains it"
+        rdmp15 = os.path.join(tmp, f"ref{k}_15.dmp")
+        with open(rdmp, "w") as f:
+            f.write(text)
+        with open(rdmp15, "w") as f:
+            f.write(text15)
+        rest = os.path.join(tmp, f"mrest{k}.cmd")
+        _script(rest, cmds[k:])
+        p_out, _, p_t = run([sys.executable, "-m", "pyevolver", "-f", rest, rdmp], cwd, timeout,
+                            env, merge=True)
+        r_out, _, r_t = run(ref_cmd(rest, rdmp), cwd, timeout, merge=True)
+        p, r = parse(p_out, False), parse(r_out, True)
+        if p_t or r_t or p is None or r is None or p["energy"] is None or r["energy"] is None:
+            return None, f"after step {k}, the last where the states agree, nothing explains it"
+        ref_own = _rest_of(r_full, len(r["g"]))
+        if ref_own is not None:
+            w_own, _ = compare(p, ref_own, "evolve")
+            if w_own <= MATCH:
+                return "roundoff", (f"after step {k} ({cmds[k - 1]}) the states agree to "
+                                    f"{agree:.1e} and pyevolver from REF's dump prints REF's "
+                                    f"numbers ({w_own:.1e}): amplified round-off")
+        w_self = compare(r, ref_own, "evolve")[0] if ref_own is not None else float("inf")
+        w_same, _ = compare(p, r, "evolve")
+        if w_self > MATCH and w_same <= MATCH:
+            return "ill-posed", (f"after step {k} ({cmds[k - 1]}) the states agree to "
+                                 f"{agree:.1e}; REF from its own dump (17-digit coordinates) "
+                                 f"differs from its uninterrupted run by {w_self:.1e}, "
+                                 f"pyevolver from that dump prints REF's numbers ({w_same:.1e}): "
+                                 f"REF disagrees with itself")
+        # REF's result under a 1e-15 change of its input: its dump's own
+        # 15-digit coordinates against the 17-digit ones
+        r15_out, _, r15_t = run(ref_cmd(rest, rdmp15), cwd, timeout, merge=True)
+        r15 = parse(r15_out, True)
+        if r15_t or r15 is None or r15["energy"] is None:
+            return None, f"after step {k}, the last where the states agree, nothing explains it"
+        w_pert, _ = compare(r15, r, "evolve")
+        if w_pert > MATCH:
+            return "ill-posed", (f"after step {k} ({cmds[k - 1]}) the states agree to "
+                                 f"{agree:.1e}; REF from its dump with 17-digit coordinates ends "
+                                 f"at E={r['energy']:.9g} {r['counts']}, with its 15-digit ones "
+                                 f"at E={r15['energy']:.9g} {r15['counts']} (a 1e-15 change of "
+                                 f"its input changes its result by {w_pert:.1e}): REF disagrees "
+                                 f"with itself; pyevolver from the 17-digit dump: "
+                                 f"E={p['energy']:.9g} {p['counts']}")
+        return None, (f"after step {k}, the last where the states agree, pyevolver fed REF's "
+                      f"state does not make REF's numbers and REF reproduces itself")
+    return None, "no split point where pyevolver fed REF's state makes REF's numbers"
+
+
+def _split_g(cmds):
+    """``g N`` (N <= 10) as N commands ``g 1``: split points inside it."""
+    out = []
+    for c in cmds:
+        m = re.fullmatch(r"\s*g\s+(\d+)\s*", c)
+        out += ["g 1"] * int(m.group(1)) if m and 1 < int(m.group(1)) <= 10 else [c]
+    return out
+
+
+def _mirror_split(fe, seq, timeout, tree, tmp, r_full):
+    """:func:`_mirror` with each ``g N`` split into ``g 1`` steps, against
+    REF's uninterrupted run of the split sequence (the note says how far
+    REF's own split run is from its unsplit one).  None when nothing is
+    split or nothing is explained."""
+    name, cmds, kind = seq
+    split = _split_g(cmds)
+    if split == list(cmds):
+        return None
+    sub = os.path.join(tmp, "split")
+    os.makedirs(sub, exist_ok=True)
+    script = os.path.join(sub, "s.cmd")
+    _script(script, split)
+    rout, _, rt = run(ref_cmd(script, fe), os.path.dirname(fe), timeout, merge=True)
+    r2 = parse(rout, True)
+    if rt or r2 is None or r2["energy"] is None:
+        return None
+    cls, why = _mirror(fe, (name, split, kind), timeout, tree, sub, r2)
+    if not cls:
+        return None
+    return cls, (f"with each g N as g 1 steps (REF's own split run ends at "
+                 f"E={r2['energy']:.9g} {r2['counts']}, its unsplit one at "
+                 f"E={r_full['energy']:.9g} {r_full['counts']}): " + why)
+
+
+CLASSES = ["match", "roundoff", "ill-posed", "small", "big", "py-refuses", "py-error", "py-trace", "py-timeout",
            "ref-error", "both-error"]
 
 
@@ -408,13 +592,16 @@ def main():
     ap.add_argument("--timeout", type=float, default=60)
     ap.add_argument("--json", help="write the results here")
     ap.add_argument("--all", action="store_true", help="every paper datafile too")
+    ap.add_argument("--examples", action="store_true",
+                    help="only the installed examples (issue 23's 25 x 17 cases)")
     ap.add_argument("--gogo", action="store_true",
                     help="only the datafiles' own gogo* commands (one case each)")
     ap.add_argument("--pyevolver", default=REPO,
                     help="the pyevolver tree to test (PYTHONPATH), this one by default")
     ap.add_argument("--quiet", action="store_true", help="only the non-matching rows")
     a = ap.parse_args()
-    files = [f for f in datafiles(a.all) if fnmatch.fnmatch(os.path.basename(f), a.files)]
+    files = [f for f in datafiles(a.all) if fnmatch.fnmatch(os.path.basename(f), a.files)
+             and (not a.examples or os.path.dirname(f) == EXAMPLES)]
     seqs = [s for s in SEQUENCES if not a.seqs or s[0] in a.seqs.split(",")]
     cases = [(f, s) for f in files for s in (gogo_sequences(f) if a.gogo else seqs)]
     results = []

@@ -39,6 +39,7 @@ from ..methods.curvature import legacy_gradient
 from ..methods.curvature_hessian import legacy_hessian
 from ..methods.registry import lookup
 from . import gradient as GR
+from . import quadratic_hessian as QH
 from .iterate import _Constraints
 from .ordering import nested_dissection
 
@@ -76,16 +77,23 @@ class Basis:
         return sp.csr_matrix((vals, (rows, cols)), shape=(3 * nv, self.n))
 
 
-def distance2_coloring(s, seed=0):
-    """Colour vertices so that no two of a colour share a facet or an edge
-    neighbour (Jones–Plassmann rounds on the square of the vertex graph).
-    Returns (nv,) colour numbers."""
+def _vertex_adjacency(s):
+    """(nv, nv) 0/1: vertices on one edge or facet, each its own neighbour."""
     nv = s.nv
     F = s.F
     r = np.concatenate([s.E[:, 0], s.E[:, 1]] + [F[:, i] for i in range(3)])
     c = np.concatenate([s.E[:, 1], s.E[:, 0]] + [F[:, (i + 1) % 3] for i in range(3)])
     A = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(nv, nv))
-    A = ((A + A.T + sp.identity(nv)) != 0).astype(np.float64)
+    return ((A + A.T + sp.identity(nv)) != 0).astype(np.float64).tocsr()
+
+
+def distance2_coloring(s, seed=0, adjacency=None):
+    """Colour vertices so that no two of a colour share a facet or an edge
+    neighbour (Jones–Plassmann rounds on the square of the vertex graph;
+    ``adjacency`` another 0/1 neighbour matrix).  Returns (nv,) colour
+    numbers."""
+    nv = s.nv
+    A = _vertex_adjacency(s) if adjacency is None else adjacency
     A2 = (A @ A).tocsr()
     A2.setdiag(0)
     A2.eliminate_zeros()
@@ -106,22 +114,18 @@ def distance2_coloring(s, seed=0):
     return color
 
 
-def fd_hessian(fun, s, h=None):
+def fd_hessian(fun, s, h=None, adjacency=None):
     """Sparse Hessian of a gradient function ``fun(X) -> (nv, 3)`` by central
-    differences over a distance-2 colouring."""
+    differences over a distance-2 colouring (of ``adjacency``, by default
+    the vertices on one edge or facet)."""
     if s.nv == 0:
         return sp.csr_matrix((0, 0))
     X0 = s.X.copy()
     scale = float(np.max(np.ptp(X0, axis=0))) if len(X0) else 1.0
     h = h if h is not None else 1e-5 * max(scale, 1e-12)
-    color = distance2_coloring(s)
-    F = s.F
-    r = np.concatenate([s.E[:, 0], s.E[:, 1]] + [F[:, i] for i in range(3)] +
-                       [np.arange(s.nv)])
-    c = np.concatenate([s.E[:, 1], s.E[:, 0]] + [F[:, (i + 1) % 3] for i in range(3)] +
-                       [np.arange(s.nv)])
-    A = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(s.nv, s.nv))
-    A = (A + A.T).tocoo()
+    A = _vertex_adjacency(s) if adjacency is None else adjacency
+    color = distance2_coloring(s, adjacency=A)
+    A = A.tocoo()
     nb_r, nb_c = A.row, A.col                   # pairs (z, u) with z near u
     rows, cols, vals = [], [], []
     try:
@@ -263,8 +267,7 @@ def lagrangian_hessian(s, cons, lam, grad_fn, basis=None, t=None):
     or ``Tᵀ H T`` on a :class:`Basis`; ``t`` the surface's current
     evaluation when the caller has it."""
     if getattr(s, "order", 1) == 2:         # the quadratic model's hook
-        raise UnsupportedError("the Hessian in the quadratic model",
-                               "not implemented; M 1 returns to the linear model")
+        return QH.lagrangian_hessian(s, grad_fn, basis, fd_hessian)
     t = s.evaluate() if t is None else t
     H, _, complete = _analytic_parts(s, t, cons, lam, basis, gradient=False)
     if complete:
@@ -285,6 +288,8 @@ def vertex_normals(s, t):
     """(nv, 3) unit vertex normals of hessian_normal: the normalized sums of
     the facet area vectors (:func:`geometry.vertex_normals` without an order;
     not the ``vertex_normal`` attribute, see there)."""
+    if getattr(s, "order", 1) == 2:
+        return QH.node_normals(s)
     return G.vertex_normals(s.F, t.facet_N2, s.nv)
 
 

@@ -28,7 +28,7 @@ def test_messages_and_variables():
 
 
 @pytest.mark.parametrize("cmd", ["u", "V", "t 0.1", "w 0.1", "K 0.1", "n 0.1", "O", "l 0.1",
-                                 "j", "g 1; hessian", "g 1; newton 1", "lagrange 2", "M 3"])
+                                 "j", "lagrange 2", "M 3"])
 def test_refused_in_the_quadratic_model(cmd):
     sess, out = _session()
     sess.run("M 2")

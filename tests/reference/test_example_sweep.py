@@ -13,6 +13,16 @@ A case is acceptable when:
   sequence the two states agree to 1e-8 and REF, continued from
   pyevolver's dump of that state, prints pyevolver's numbers (round-off
   that REF's own line search amplifies; see ``diff_sweep._stepwise``);
+- ``ill-posed``: REF disagrees with itself: after the last prefix of the
+  sequence where the two states agree to 1e-8, either REF continued from
+  its own ``dump`` of that state (coordinates put back to 17 digits) no
+  longer prints its uninterrupted numbers while pyevolver from that dump
+  prints what REF prints from it (mylarcube.fe ``g 5; r; u; V; g 5``: REF's
+  ``V`` at a cube corner turns on hidden state), or REF's result changes
+  beyond 1e-6 under the 1e-15 change of its input between its 15-digit
+  and 17-digit dumps (100grain.fe ``g 5; hessian``: a singular Hessian;
+  ``m 0.05; g 5``: autopop decisions); a ``g N`` is split into ``g 1``
+  steps to find the prefix (``diff_sweep._mirror``);
 - ``both-error``: both programs fail at the same command (REF: WULFF files
   it cannot read, ERROR 3004, ...) with the same `g` lines before it;
 - ``ref-error``: REF stops with an error where pyevolver goes on, the `g`
@@ -27,7 +37,11 @@ whole sweep (425 cases, about 15 minutes on two cores) is marked slow.
 import concurrent.futures as cf
 import glob
 import importlib.util
+import io
 import os
+import subprocess
+
+import numpy as np
 
 import pytest
 
@@ -40,7 +54,7 @@ DS = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(DS)
 
 FILES = sorted(glob.glob(os.path.join(EXAMPLES, "*.fe")))
-ACCEPTABLE = {"match", "roundoff", "both-error", "ref-error", "py-refuses"}
+ACCEPTABLE = {"match", "roundoff", "ill-posed", "both-error", "ref-error", "py-refuses"}
 MAX_REFUSED = 10
 with open(os.path.join(ROOT, "docs", "supported.md"), encoding="utf-8") as _f:
     SUPPORTED = _f.read()
@@ -88,3 +102,44 @@ def test_whole_sweep(evolver):
     assert not bad, summary + "\n" + "\n".join(bad)
     assert len(refused) <= MAX_REFUSED, summary + "\n" + "\n".join(
         f"{os.path.basename(r['file'])} {r['seq']}: {r['note']}" for r in refused)
+
+
+def test_split_g():
+    assert DS._split_g(["m 0.05", "g 3", "g 20", "hessian"]) == [
+        "m 0.05", "g 1", "g 1", "g 1", "g 20", "hessian"]
+
+
+def test_full_precision_dump(evolver, tmp_path):
+    """REF's dump writes 15 digits; with REF's 17-digit printout put back,
+    pyevolver loads REF's coordinates bit for bit (the 15-digit dump alone
+    does not give them)."""
+    import pyevolver
+    dmp = tmp_path / "cube.dmp"
+    cmd = tmp_path / "s.cmd"
+    cmd.write_text("g 4\nr\ng 2\n" + DS.COORDS + f'\ndump "{dmp}"\n')
+    out = subprocess.run([evolver, "-p1", "-f", str(cmd), os.path.join(EXAMPLES, "cube.fe")],
+                         stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                         timeout=60).stdout
+    xs = DS._sdim_coords(out)
+    text15 = dmp.read_text()
+    text, n = DS.full_precision_dump(text15, xs, 3)
+    assert n == len(xs) > 20
+    want = np.array([[float(v) for v in xs[i]] for i in sorted(xs)])
+    for body, exact in ((text, True), (text15, False)):
+        f = tmp_path / "t.dmp"
+        f.write_text(body)
+        s = pyevolver.load(str(f), out=io.StringIO())
+        ids = s.surface.ids("vertex")
+        got = s.surface.X[np.argsort(ids)]
+        assert np.array_equal(got, want) == exact
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, seq", [("mylarcube.fe", "g5_r_u_V_g5"),
+                                       ("100grain.fe", "g5_hessian"),
+                                       ("100grain.fe", "m_g5")])
+def test_ill_posed(evolver, name, seq):
+    """Issue 23's last three differing cases: REF disagrees with itself."""
+    s = next(q for q in DS.SEQUENCES if q[0] == seq)
+    res = DS.one_case(os.path.join(EXAMPLES, name), s, timeout=300, tree=ROOT)
+    assert res["cls"] == "ill-posed", res
