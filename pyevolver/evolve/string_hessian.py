@@ -226,7 +226,7 @@ def _analytic(s, t, cons, lam, hessian=True):
             if hessian:
                 parts.extend(area_hessian(s, w))
             g += SM.facet_area_gradient(s, w)
-    weighted = [(q, 1.0) for q in s.quantities.values() if q.kind == "energy"]
+    weighted = [(q, 1.0) for q in s.quantities.values() if q.kind == "energy" and q.modulus]
     weighted += [(q, -lam[len(cons.bodies) + k]) for k, q in enumerate(cons.quantities)]
     for q, wq in weighted:
         hq = _quantity_hessian(t, q, wq)

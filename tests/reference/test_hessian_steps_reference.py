@@ -19,6 +19,7 @@ import os
 import subprocess
 
 import numpy as np
+import pytest
 
 import pyevolver
 from conftest import EXAMPLES
@@ -96,3 +97,17 @@ def test_quadm_hessian(evolver, tmp_path):
     X = s.surface.X.copy()
     s.run("hessian")
     assert np.array_equal(X, s.surface.X)
+
+
+def test_knotty_hessian_skips_energies_of_modulus_zero(evolver, tmp_path):
+    """knotty.fe declares edge_knot_energy (no Hessian, REF's ERROR 1571)
+    with modulus 0: single-threaded REF leaves it out of the Hessian and
+    steps (563.907555544534), as pyevolver does; with modulus 1 both refuse."""
+    fe = os.path.join(EXAMPLES, "knotty.fe")
+    cmds = ["g 5", "hessian"]
+    assert rel(_ours(fe, cmds), _ref(evolver, fe, cmds, cwd=str(tmp_path))) < 1e-12
+    s = pyevolver.load(fe, out=io.StringIO(), err=io.StringIO())
+    s.run("insul_energy.modulus := 1")
+    s.run("g 2")
+    with pytest.raises(pyevolver.CommandError, match="edge_knot_energy"):
+        s.run("hessian")
