@@ -2,7 +2,7 @@
 (pyevolver.model.groups): those whose mesh operations or second
 derivatives would need the group elements and do not know them yet.
 
-``g`` (constraints, the iteration toggles; not with fixed body volumes or
+``g`` (constraints, the iteration toggles, fixed body volumes and
 pressures), ``r``, ``u``, ``V``, ``rawv``, ``rawestv`` (not next to an axial
 point), ``j``, the listings, ``dump``, ``print`` / ``printf`` (``wrap_compose``,
 ``wrap_inverse``, the ``wrap`` edge attribute) and the settings work; the
@@ -11,8 +11,6 @@ rest below is refused as '`t` in SYMMETRY_GROUP "rotate" ...'.
 from __future__ import annotations
 
 import re
-
-import numpy as np
 
 from ..errors import UnsupportedError
 from ..model.groups import group_of
@@ -45,16 +43,6 @@ QUARTER_TURN = {w: "REF's facets with z powers are inconsistent (WARNING 2000) a
                 for w in ("g", "r", "j", "U", "G", "V", "rawv", "rawestv")}
 
 
-_MOVES = {"g", "U", "j", "V", "rawv", "rawestv", "G"}
-
-
-def _volume_constrained(s) -> bool:
-    b = s.bodies
-    if not b.n or not s.eattr["wrap_code"].any():      # (no wrapped edge: the plain model)
-        return False
-    return bool(np.any(~np.isnan(b.target)) or np.any(~np.isnan(b.pressure)))
-
-
 def check(session, raw: str, statement: bool = False) -> None:
     """Refuse ``raw`` (a word or a statement tag) by name when the session's
     surface is in a group of pyevolver.model.groups and the command is not
@@ -71,9 +59,6 @@ def check(session, raw: str, statement: bool = False) -> None:
             and "axial_point" in s.vattr and s.vattr["axial_point"].any():
         why = "vertex averaging next to an axial point, whose moves REF takes by rules " \
               "not measured"
-    if why is None and key in _MOVES and not statement and _volume_constrained(s):
-        why = "moves with fixed body volumes or pressures: REF's volume projection in " \
-              "these groups was not matched (the volumes themselves are REF's)"
     if why is None and s.symmetry_group == "quarter_turn":
         why = (STATEMENTS if statement else QUARTER_TURN).get(key)
     if why is not None:

@@ -60,6 +60,20 @@ def test_quarter_turn_loads_as_the_evolver(evolver):
         pyevolver.load(path).run("g 1")
 
 
+def test_fixed_volume_and_pressure_as_the_evolver(evolver, tmp_path):
+    """A body in a group: the Euclidean volume of the unwrapped facets,
+    restored with REF's tolerance for bodies converted to named quantities
+    (target_tolerance times the sum of the facets' |contents|: REF's
+    itdebug "Diff"); one step at a fixed scale restores three times."""
+    path = _path("rotate_body")
+    script = "m 0.01\ng 1\nlist vertices\nm 0\ng 9\nr\ng 5\nv\nlist vertices\n"
+    assert _same(_ours(path, script), _ref(evolver, path, script), 1e-9)
+    pressure = tmp_path / "pressure.fe"
+    pressure.write_text(open(path).read().replace("volume 0.5", "pressure 1"))
+    script = "g 6\nv\nlist vertices\n"
+    assert _same(_ours(str(pressure), script), _ref(evolver, str(pressure), script), 1e-9)
+
+
 @pytest.mark.parametrize("name", ["rotate_axial", pytest.param("cubelat", marks=SLOW)])
 def test_dumps_both_ways(evolver, tmp_path, name):
     path = _path(name)
