@@ -17,9 +17,6 @@ from ..model.groups import group_of
 
 #: words and letters, with why
 WORDS = {
-    **{w: "a Hessian of the group's quotient (REF converts to named quantities for it)"
-       for w in ("hessian", "hessian_seek", "hessian_menu", "saddle", "ritz", "lanczos",
-                 "eigenprobe", "newton", "bfgs", "optimise", "optimize")},
     **{w: "a mesh operation whose new edges would need the group elements"
        for w in ("t", "w", "o", "K", "n", "l", "O", "notch", "areaweed", "edgeweed",
                  "edge_divide")},

@@ -102,3 +102,4 @@ def totals_geometry(t, group) -> None:
     t.facet_N2 = G.facet_normals(S)
     t.facet_area = G.facet_areas(t.facet_N2)
     t.facet_volume = G.facet_volumes(t.facet_x0, S, s.symmetric_content)
+

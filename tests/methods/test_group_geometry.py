@@ -83,3 +83,28 @@ def test_wrapped_boundary_edge_refused():
         GG.check_supported(s)
     s.eattr["boundary"] = np.zeros(s.ne, np.int64)
     GG.check_supported(s)
+
+
+@pytest.mark.parametrize("name", ["flip_rotate", "cubelat", "central_symmetry"])
+def test_hessians_through_the_maps(name):
+    """Area, edge-length and volume Hessians (methods._common.group_blocks:
+    ``A_aᵀ H_ab A_b``) against central differences of the gradients."""
+    from finite_differences import assert_hessian_columns
+    from pyevolver.methods._common import corner_scatter
+    from pyevolver.methods.basic import (edge_length_grad, edge_length_hessian,
+                                         facet_area_hessian, facet_volume_grad,
+                                         facet_volume_hessian)
+    s = _surface(name)
+    ne = np.arange(s.ne)
+    we = np.linspace(0.1, 0.5, s.ne)
+    wf = np.linspace(0.5, 1.5, s.nf)
+
+    def grad(s):
+        t = s.evaluate()
+        return (energy_gradient(t) + edge_length_grad(t, ne, we)
+                + corner_scatter(t, facet_volume_grad(t, False), wf))
+    t = s.evaluate()
+    H = (facet_area_hessian(t, s.facet_tension) + edge_length_hessian(t, ne, we)
+         + facet_volume_hessian(t, wf, False)).toarray()
+    assert np.abs(H).max() > 0.1
+    assert_hessian_columns(s, H, grad, h=1e-5, tol=1e-6)

@@ -74,6 +74,38 @@ def test_fixed_volume_and_pressure_as_the_evolver(evolver, tmp_path):
     assert _same(_ours(str(pressure), script), _ref(evolver, str(pressure), script), 1e-9)
 
 
+def test_hessian_matrix_as_the_evolver(evolver, tmp_path):
+    """REF converts to named quantities for its Hessian in a group: its
+    matrix (hessian_menu's dump, all three coordinates per vertex) is the
+    area Hessian plus the volume multiplier's term, each block ``A_aᵀ H_ab
+    A_b`` through the corners' maps, to round-off."""
+    import numpy as np
+    from pyevolver.evolve.hessian import hessian_system
+    from pyevolver.evolve.iterate import Iterator
+    path = _path("rotate_body")
+    base = tmp_path / "h"
+    run_reference(evolver, path, f"g 5\nhessian_normal off\nhessian_menu\n1\nD\n{base}\n0\n")
+    sess = pyevolver.load(path)
+    sess.run("g 5")
+    K = hessian_system(Iterator(sess.surface), normal=False).K.toarray()
+    R = np.zeros_like(K)
+    for ln in open(f"{base}_H.dat"):
+        i, j, v = ln.split()
+        if int(i) <= len(K) and int(j) <= len(K):       # (the border rows after)
+            R[int(i) - 1, int(j) - 1] = R[int(j) - 1, int(i) - 1] = float(v)
+    assert np.abs(K).max() > 1
+    assert np.abs(K - R).max() < 1e-9 * np.abs(K).max()
+
+
+@pytest.mark.parametrize("name", ["cubocta", pytest.param("xyz", marks=SLOW)])
+def test_hessian_steps_as_the_evolver(evolver, name):
+    """`hessian` and the eigenvalue commands (hessian_normal's normals: the
+    facets' area vectors summed as computed, without the maps, as REF)."""
+    path = _path(name)
+    script = "g 5\nhessian\nhessian\nprint total_energy\neigenprobe 1\nlanczos 1\n"
+    assert _same(_ours(path, script), _ref(evolver, path, script), 1e-9)
+
+
 @pytest.mark.parametrize("name", ["rotate_axial", pytest.param("cubelat", marks=SLOW)])
 def test_dumps_both_ways(evolver, tmp_path, name):
     path = _path(name)
@@ -88,7 +120,7 @@ def test_dumps_both_ways(evolver, tmp_path, name):
         assert _same(_ours(str(dump), check), _ref(evolver, str(dump), check), 1e-9), dump.name
 
 
-@pytest.mark.parametrize("command", ["t 0.1", "hessian", "o", "K 0.1", "n 0.1", "w 0.1",
+@pytest.mark.parametrize("command", ["t 0.1", "o", "K 0.1", "n 0.1", "w 0.1",
                                      "refine edges where id < 3", "delete edge[5]",
                                      "equiangulate edge[5]", "quadratic"])
 def test_commands_without_the_group_are_refused_by_name(command):
