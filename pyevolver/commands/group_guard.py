@@ -18,8 +18,7 @@ from ..model.groups import group_of
 #: words and letters, with why
 WORDS = {
     **{w: "a mesh operation whose new edges would need the group elements"
-       for w in ("t", "w", "o", "K", "n", "l", "O", "notch", "areaweed", "edgeweed",
-                 "edge_divide")},
+       for w in ("t", "w", "o", "n", "O", "notch", "areaweed", "edgeweed")},
     **{w: "the quadratic and Lagrange models" for w in ("M", "quadratic", "lagrange")},
 }
 #: statements (parse-tree tags) with why
@@ -28,7 +27,6 @@ STATEMENTS = {
     "edgeswap": "edge swaps (the new edges would need the group elements)",
     "equiangulate": "equiangulation (the new edges would need the group elements)",
     "pop": "popping (the new elements would need the group elements)",
-    "refine": "refining chosen edges (the new edges would need the group elements)",
 }
 
 
@@ -52,10 +50,13 @@ def check(session, raw: str, statement: bool = False) -> None:
     if re.fullmatch(r"g\d+", key):
         key = "g"
     why = table.get(key)
-    if why is None and key in ("V", "rawv", "rawestv") and not statement \
-            and "axial_point" in s.vattr and s.vattr["axial_point"].any():
+    axial = "axial_point" in s.vattr and s.vattr["axial_point"].any()
+    if why is None and key in ("V", "rawv", "rawestv") and not statement and axial:
         why = "vertex averaging next to an axial point, whose moves REF takes by rules " \
               "not measured"
+    if why is None and axial and key in (("refine",) if statement else ("K", "l", "edge_divide")):
+        why = "bisecting edges next to an axial point: REF orders the new elements there by " \
+              "rules not measured"
     if why is None and s.symmetry_group == "quarter_turn":
         why = (STATEMENTS if statement else QUARTER_TURN).get(key)
     if why is not None:

@@ -106,6 +106,19 @@ def test_hessian_steps_as_the_evolver(evolver, name):
     assert _same(_ours(path, script), _ref(evolver, path, script), 1e-9)
 
 
+@pytest.mark.parametrize("name", ["cubocta", pytest.param("rotate", marks=SLOW),
+                                  pytest.param("screw_symmetry", marks=SLOW),
+                                  pytest.param("flip_rotate", marks=SLOW)])
+def test_edge_bisection_as_the_evolver(evolver, name):
+    """`K`, `l` and `refine edges`: the new edges' codes as `r`'s; `K`'s
+    midpoint, when the choosing facet runs along the edge backwards, in the
+    head's frame (g⁻¹ of the midpoint) as REF puts it, the codes unchanged."""
+    path = _path(name)
+    for script in ("g 5\nK 0.9\nlist vertices\nlist edges\nlist facets\ng 3\n",
+                   "g 5\nl 0.2\nlist edges\ng 2\nrefine edges where id < 9\nlist edges\ng 3\n"):
+        assert _same(_ours(path, script), _ref(evolver, path, script), 1e-9), script
+
+
 @pytest.mark.parametrize("name", ["rotate_axial", pytest.param("cubelat", marks=SLOW)])
 def test_dumps_both_ways(evolver, tmp_path, name):
     path = _path(name)
@@ -120,8 +133,7 @@ def test_dumps_both_ways(evolver, tmp_path, name):
         assert _same(_ours(str(dump), check), _ref(evolver, str(dump), check), 1e-9), dump.name
 
 
-@pytest.mark.parametrize("command", ["t 0.1", "o", "K 0.1", "n 0.1", "w 0.1",
-                                     "refine edges where id < 3", "delete edge[5]",
+@pytest.mark.parametrize("command", ["t 0.1", "o", "n 0.1", "w 0.1", "delete edge[5]",
                                      "equiangulate edge[5]", "quadratic"])
 def test_commands_without_the_group_are_refused_by_name(command):
     sess = pyevolver.load(_path("rotate"))
@@ -140,7 +152,7 @@ def test_wrap_attribute_and_functions():
 
 def test_vertex_averaging_next_to_an_axial_point_is_refused():
     sess = pyevolver.load(_path("rotate_axial"))
-    for command in ("V", "rawv", "rawestv"):
+    for command in ("V", "rawv", "rawestv", "K 0.9", "l 0.2", "refine edges where id < 3"):
         with pytest.raises(PyEvolverError, match="axial point"):
             sess.run(command)
     sess.run("u")
