@@ -18,12 +18,11 @@ from ..model.groups import group_of
 #: words and letters, with why
 WORDS = {
     **{w: "a mesh operation whose new edges would need the group elements"
-       for w in ("t", "w", "o", "n", "O", "notch", "areaweed", "edgeweed")},
+       for w in ("w", "o", "n", "O", "notch", "areaweed")},
     **{w: "the quadratic and Lagrange models" for w in ("M", "quadratic", "lagrange")},
 }
 #: statements (parse-tree tags) with why
 STATEMENTS = {
-    "delete": "deleting elements (the merged edges would need the group elements)",
     "edgeswap": "edge swaps (the new edges would need the group elements)",
     "equiangulate": "equiangulation (the new edges would need the group elements)",
     "pop": "popping (the new elements would need the group elements)",
@@ -54,9 +53,10 @@ def check(session, raw: str, statement: bool = False) -> None:
     if why is None and key in ("V", "rawv", "rawestv") and not statement and axial:
         why = "vertex averaging next to an axial point, whose moves REF takes by rules " \
               "not measured"
-    if why is None and axial and key in (("refine",) if statement else ("K", "l", "edge_divide")):
-        why = "bisecting edges next to an axial point: REF orders the new elements there by " \
-              "rules not measured"
+    if why is None and axial and key in (("refine", "delete") if statement
+                                         else ("K", "l", "edge_divide", "t", "edgeweed")):
+        why = "bisecting or deleting edges next to an axial point: REF orders and places " \
+              "the new elements there by rules not measured"
     if why is None and s.symmetry_group == "quarter_turn":
         why = (STATEMENTS if statement else QUARTER_TURN).get(key)
     if why is not None:

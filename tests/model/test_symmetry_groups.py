@@ -119,6 +119,17 @@ def test_edge_bisection_as_the_evolver(evolver, name):
         assert _same(_ours(path, script), _ref(evolver, path, script), 1e-9), script
 
 
+@pytest.mark.parametrize("name", ["rotate_body", pytest.param("cubocta", marks=SLOW),
+                                  pytest.param("screw_symmetry", marks=SLOW)])
+def test_edge_deletion_as_the_evolver(evolver, name):
+    """`t` and `delete edges`: the eliminated vertex's edges' codes composed
+    with the deleted edge's; an edge whose ends another edge joins too (a
+    copy across the group: the closed tube's rings) is left, as REF."""
+    path = _path(name)
+    script = "g 5\nt 0.35\nlist vertices\nlist edges\nlist facets\ng 5\nv\n"
+    assert _same(_ours(path, script), _ref(evolver, path, script), 1e-9)
+
+
 @pytest.mark.parametrize("name", ["rotate_axial", pytest.param("cubelat", marks=SLOW)])
 def test_dumps_both_ways(evolver, tmp_path, name):
     path = _path(name)
@@ -133,7 +144,7 @@ def test_dumps_both_ways(evolver, tmp_path, name):
         assert _same(_ours(str(dump), check), _ref(evolver, str(dump), check), 1e-9), dump.name
 
 
-@pytest.mark.parametrize("command", ["t 0.1", "o", "n 0.1", "w 0.1", "delete edge[5]",
+@pytest.mark.parametrize("command", ["o", "n 0.1", "w 0.1", "delete facet[5]",
                                      "equiangulate edge[5]", "quadratic"])
 def test_commands_without_the_group_are_refused_by_name(command):
     sess = pyevolver.load(_path("rotate"))
@@ -152,7 +163,8 @@ def test_wrap_attribute_and_functions():
 
 def test_vertex_averaging_next_to_an_axial_point_is_refused():
     sess = pyevolver.load(_path("rotate_axial"))
-    for command in ("V", "rawv", "rawestv", "K 0.9", "l 0.2", "refine edges where id < 3"):
+    for command in ("V", "rawv", "rawestv", "K 0.9", "l 0.2", "refine edges where id < 3",
+                    "t 0.6", "delete edge[3]"):
         with pytest.raises(PyEvolverError, match="axial point"):
             sess.run(command)
     sess.run("u")
