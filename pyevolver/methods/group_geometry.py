@@ -81,6 +81,24 @@ def check_supported(s) -> None:
                                        f"vertex coordinates without the group elements)")
 
 
+def quarter_turn_pullback(s, group, Ac) -> np.ndarray:
+    """The maps through which REF pulls gradients back in ``quarter_turn``:
+    none at a corner whose code is not 0 (its facets' corners there add
+    nothing to the vertex's force: measured with ``v_force`` on
+    quarter_turn.fe, where every such corner's share is missing from REF's
+    forces, to 12 digits), so that `g` moves as REF's."""
+    if s.eattr.get("tension") is not None and np.any(s.eattr["tension"]):
+        raise UnsupportedError('edge tension in SYMMETRY_GROUP "quarter_turn" (REF\'s edge '
+                               'forces across its elements were not measured)')
+    for q in s.quantities.values():
+        for m, *_ in q.methods:
+            if m.method.startswith("edge_"):
+                raise UnsupportedError(f'the quantity method {m.method} in SYMMETRY_GROUP '
+                                       f'"quarter_turn" (REF\'s edge forces across its '
+                                       f'elements were not measured)')
+    return np.where((corner_codes(s, group) != 0)[:, :, None, None], 0.0, Ac)
+
+
 def totals_geometry(t, group) -> None:
     """Set the evaluation's cached geometry (edge vectors, facet sides,
     normals, areas, contents) and the maps of ``t.surface`` in ``group``."""
@@ -93,6 +111,8 @@ def totals_geometry(t, group) -> None:
     F = s.topology()[2]
     Ac, bc = corner_maps(s, group)
     t.corner_maps = Ac
+    if group.name == "quarter_turn":
+        t.corner_maps = quarter_turn_pullback(s, group, Ac)
     P = np.einsum("fkij,fkj->fki", Ac, X[F]) + bc if len(F) else np.zeros((0, 3, 3))
     t.facet_x0 = P[:, 0]
     S = np.empty((len(F), 2, 3))

@@ -108,3 +108,18 @@ def test_hessians_through_the_maps(name):
          + facet_volume_hessian(t, wf, False)).toarray()
     assert np.abs(H).max() > 0.1
     assert_hessian_columns(s, H, grad, h=1e-5, tol=1e-6)
+
+
+def test_quarter_turn_forces_leave_out_wrapped_corners():
+    """REF's forces in quarter_turn (measured with v_force): a facet's corner
+    whose code is not 0 adds nothing to its vertex; edge tension refused."""
+    from pyevolver.errors import UnsupportedError
+    s = _surface("quarter_turn")
+    t = s.evaluate()
+    codes = GG.corner_codes(s, group_of(s))
+    assert (codes != 0).any()
+    assert not t.corner_maps[codes != 0].any()
+    assert np.allclose(t.corner_maps[codes == 0], np.eye(3))
+    s.eattr["tension"] = np.full(s.ne, 0.5)
+    with pytest.raises(UnsupportedError, match="edge tension"):
+        s.evaluate()
