@@ -18,7 +18,10 @@ from ..model.groups import group_of
 #: words and letters, with why
 WORDS = {
     **{w: "a mesh operation whose new edges would need the group elements"
-       for w in ("w", "o", "n", "O", "notch", "areaweed")},
+       for w in ("o", "n", "O", "notch")},
+    **{w: "weeding facets: REF weeds, after a merge, facets whose areas across the wrapped "
+          "sides are above the threshold (measured on xyz.fe, `w 0.03`)"
+       for w in ("w", "areaweed")},
     **{w: "the quadratic and Lagrange models" for w in ("M", "quadratic", "lagrange")},
 }
 #: statements (parse-tree tags) with why
