@@ -19,8 +19,8 @@ from ..model.groups import group_of
 WORDS = {
     **{w: "a mesh operation whose new edges would need the group elements"
        for w in ("o", "n", "O", "notch")},
-    **{w: "weeding facets: REF weeds, after a merge, facets whose areas across the wrapped "
-          "sides are above the threshold (measured on xyz.fe, `w 0.03`)"
+    **{w: "weeding facets: REF's choice of facets after a merge is not the one the areas "
+          "across the wrapped sides give (measured on xyz.fe, `w 0.03`)"
        for w in ("w", "areaweed")},
     **{w: "the quadratic and Lagrange models" for w in ("M", "quadratic", "lagrange")},
 }

@@ -348,9 +348,9 @@ def _weed(s, facets, area):
     made smaller than ``area``, and only while they still are)."""
     if group_of(s) is not None:
         raise UnsupportedError(f'weeding or deleting facets in SYMMETRY_GROUP '
-                               f'"{s.symmetry_group}" (REF weeds, after a merge, facets '
-                               f'whose areas across the wrapped sides are above the '
-                               f'threshold: xyz.fe, `w 0.03`)')
+                               f'"{s.symmetry_group}" (REF\'s choice of facets after a '
+                               f'merge is not the one the areas across the wrapped sides '
+                               f'give: xyz.fe, `w 0.03`)')
     d = _Deleter(s)
     weeded = [0]
 
