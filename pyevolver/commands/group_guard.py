@@ -26,8 +26,6 @@ WORDS = {
 }
 #: statements (parse-tree tags) with why
 STATEMENTS = {
-    "edgeswap": "edge swaps (the new edges would need the group elements)",
-    "equiangulate": "equiangulation (the new edges would need the group elements)",
     "pop": "popping (the new elements would need the group elements)",
 }
 
