@@ -61,6 +61,11 @@ def check_supported(s) -> None:
     model, wrapped edges on parametric boundaries (their midpoints) and
     named-quantity methods outside :data:`METHODS`."""
     where = f'in SYMMETRY_GROUP "{s.symmetry_group}"'
+    tension = s.eattr.get("tension")
+    if tension is not None and np.any(tension):
+        raise UnsupportedError(f"edge TENSION {where} (REF leaves it out of the energy when "
+                               f"it converts to named quantities: measured on flip_rotate.fe; "
+                               f"a quantity with METHOD edge_length works)")
     if s.metric is not None:
         raise UnsupportedError(f"a metric {where}")
     if s.order != 1:
@@ -87,9 +92,6 @@ def quarter_turn_pullback(s, group, Ac) -> np.ndarray:
     nothing to the vertex's force: measured with ``v_force`` on
     quarter_turn.fe, where every such corner's share is missing from REF's
     forces, to 12 digits), so that `g` moves as REF's."""
-    if s.eattr.get("tension") is not None and np.any(s.eattr["tension"]):
-        raise UnsupportedError('edge tension in SYMMETRY_GROUP "quarter_turn" (REF\'s edge '
-                               'forces across its elements were not measured)')
     for q in s.quantities.values():
         for m, *_ in q.methods:
             if m.method.startswith("edge_"):

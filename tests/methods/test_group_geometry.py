@@ -25,11 +25,25 @@ def _fd(s, f, h=1e-6):
 
 @pytest.mark.parametrize("name", ["rotate", "flip_rotate", "screw_symmetry", "cubelat", "xyz",
                                   "central_symmetry"])
-def test_area_and_edge_tension_gradients(name):
+def test_area_and_edge_length_gradients(name):
+    from pyevolver.methods.basic import edge_length_grad
     s = _surface(name)
-    s.eattr["tension"] = np.linspace(0.1, 0.5, s.ne)       # edge lengths through g too
+    ne, w = np.arange(s.ne), np.linspace(0.1, 0.5, s.ne)     # edge lengths through g too
     t = s.evaluate()
-    assert np.allclose(energy_gradient(t), _fd(s, lambda t: t.energy), atol=1e-7)
+
+    def energy(t):
+        return t.energy + w @ np.linalg.norm(t.edge_vec, axis=1)
+    g = energy_gradient(t) + edge_length_grad(t, ne, w)
+    assert np.allclose(g, _fd(s, energy), atol=1e-7)
+
+
+def test_edge_tension_attribute_refused():
+    """REF leaves the edges' TENSION out of the energy in these groups."""
+    from pyevolver.errors import UnsupportedError
+    s = _surface("flip_rotate")
+    s.eattr["tension"] = np.full(s.ne, 0.3)
+    with pytest.raises(UnsupportedError, match="edge TENSION"):
+        s.evaluate()
 
 
 def test_volume_gradient_and_corners():
@@ -121,5 +135,5 @@ def test_quarter_turn_forces_leave_out_wrapped_corners():
     assert not t.corner_maps[codes != 0].any()
     assert np.allclose(t.corner_maps[codes == 0], np.eye(3))
     s.eattr["tension"] = np.full(s.ne, 0.5)
-    with pytest.raises(UnsupportedError, match="edge tension"):
+    with pytest.raises(UnsupportedError, match="edge TENSION"):
         s.evaluate()

@@ -122,11 +122,17 @@ def test_hessian_matrix_as_the_evolver(evolver, tmp_path):
 
 
 @SLOW
-@pytest.mark.parametrize("name", ["cubocta", "xyz"])
-def test_hessian_steps_as_the_evolver(evolver, name):
+@pytest.mark.parametrize("name", ["cubocta", "xyz", "flip_rotate"])
+def test_hessian_steps_as_the_evolver(evolver, name, tmp_path):
     """`hessian` and the eigenvalue commands (hessian_normal's normals: the
-    facets' area vectors summed as computed, without the maps, as REF)."""
+    facets' area vectors summed as computed, without the maps, as REF);
+    flip_rotate with an edge_length energy quantity (the edges' maps)."""
     path = _path(name)
+    if name == "flip_rotate":
+        text = open(path).read().replace(
+            '"flip_rotate"', '"flip_rotate"\nquantity qel energy modulus 0.3 method edge_length global')
+        path = str(tmp_path / "fr.fe")
+        open(path, "w").write(text)
     script = "g 5\nhessian\nhessian\nprint total_energy\neigenprobe 1\nlanczos 1\n"
     assert _same(_ours(path, script), _ref(evolver, path, script), 1e-9)
 
