@@ -164,8 +164,11 @@ class _Constraints:
             self.redundant = self.bodies[0]
             self.bodies = self.bodies[1:]
         self.quantities = [q for q in s.quantities.values() if q.kind == "fixed"]
+        # REF converts bodies to named quantities when a boundary carries
+        # integrals, and in every symmetry group but the torus
         self.named_bodies = any(bd.content is not None or bd.energy is not None
-                                for bd in s.boundaries.values())
+                                for bd in s.boundaries.values()) \
+            or s.symmetry_group not in (None, "torus")
 
     def __len__(self):
         return len(self.bodies) + len(self.quantities)

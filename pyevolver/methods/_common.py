@@ -53,6 +53,35 @@ def edge_pullback(t, idx: np.ndarray, u: np.ndarray) -> np.ndarray:
     return np.einsum("nji,nj->ni", maps[idx], u)
 
 
+def group_blocks(t, blocks: np.ndarray, sel=None, edges=None) -> np.ndarray:
+    """Hessian blocks (m, k, k, 3, 3) with respect to the unwrapped corners
+    as blocks with respect to the vertices: ``A_aᵀ H_ab A_b`` with the
+    corners' linear parts ``A`` in a symmetry group (methods.group_geometry;
+    the translations drop out of second derivatives), unchanged otherwise.
+    ``sel`` picks the facets (or ``edges`` the edges: tail I, head A) the
+    blocks belong to."""
+    if edges is not None:
+        emaps = getattr(t, "edge_maps", None)
+        if emaps is None:
+            return blocks
+        maps = np.zeros((len(edges), 2, 3, 3))
+        maps[:, 0] = np.eye(3)
+        maps[:, 1] = emaps[edges]
+    else:
+        maps = getattr(t, "corner_maps", None)
+        if maps is None:
+            return blocks
+        if sel is not None:
+            maps = maps[sel]
+    return np.einsum("maip,mabij,mbjq->mabpq", maps, blocks, maps, optimize=True)
+
+
+def has_group_maps(t) -> bool:
+    """Whether the evaluation carries a symmetry group's maps (the
+    hessian_normal shortcuts then take the general path)."""
+    return getattr(t, "corner_maps", None) is not None
+
+
 def assemble(nv: int, verts: np.ndarray, blocks: np.ndarray, basis=None) -> sp.coo_matrix:
     """Sparse matrix from per-element blocks, in COO form with the elements'
     entries not yet summed (``evolve.hessian._sum`` adds all parts in one conversion).

@@ -24,7 +24,7 @@ from . import metric as MT
 from .jets import skew
 from ..model.formulas import located
 from ._common import (assemble, assemble_projected, corner_scatter, edge_pullback, facet_points,
-                      n2_grad_dot, scatter)
+                      group_blocks, has_group_maps, n2_grad_dot, scatter)
 from .registry import register_method
 
 # ---------------------------------------------------------------------------
@@ -322,7 +322,7 @@ def facet_area_hessian(t, weights, basis=None, euclidean=False):
     P, N2, L, w = P[ok], N2[ok], L[ok], weights[ok]
     n = N2 / L[:, None]
     e = np.stack([P[:, 2] - P[:, 1], P[:, 0] - P[:, 2], P[:, 1] - P[:, 0]], 1)
-    if basis is not None and basis.B.shape[2] == 1:
+    if basis is not None and basis.B.shape[2] == 1 and not has_group_maps(t):
         # one free direction u_v per vertex: contract in closed form,
         # u_aᵀ H_ab u_b = ½ ε_ab u_a·(n × u_b) + (w_a·w_b − (n·w_a)(n·w_b)) / (2|N|)
         # with w_a = e_a × u_a
@@ -356,7 +356,7 @@ def facet_area_hessian(t, weights, basis=None, euclidean=False):
         eps[a, (a + 1) % 3] = -1.0
     B += 0.5 * eps[None, :, :, None, None] * nx[:, None, None]
     B *= w[:, None, None, None, None]
-    return assemble(s.nv, s.F[ok], B, basis)
+    return assemble(s.nv, s.F[ok], group_blocks(t, B, ok), basis)
 
 
 def edge_length_hessian(t, idx, weights, basis=None, euclidean=False):
@@ -371,7 +371,7 @@ def edge_length_hessian(t, idx, weights, basis=None, euclidean=False):
     u = d / L[:, None]
     K = (np.eye(3)[None] - u[:, :, None] * u[:, None, :]) * (w / L)[:, None, None]
     B = np.stack([np.stack([K, -K], 1), np.stack([-K, K], 1)], 1)
-    return assemble(s.nv, s.E[idx], B, basis)
+    return assemble(s.nv, s.E[idx], group_blocks(t, B, edges=idx), basis)
 
 
 def facet_volume_hessian(t, weights, symmetric, basis=None):
@@ -379,7 +379,7 @@ def facet_volume_hessian(t, weights, symmetric, basis=None):
     s = t.surface
     P = facet_points(t)
     m = len(P)
-    if basis is not None and basis.B.shape[2] == 1:
+    if basis is not None and basis.B.shape[2] == 1 and not has_group_maps(t):
         # one free direction u_v per vertex: second directional derivatives
         U = basis.B[s.F][:, :, :, 0]                                 # (m, 3, 3)
         K = np.zeros((m, 3, 3))
@@ -430,7 +430,7 @@ def facet_volume_hessian(t, weights, symmetric, basis=None):
                 B[:, a, b, 0, 2] = dcz[:, a, 0] / 6.0
                 B[:, a, b, 1, 2] = dcz[:, a, 1] / 6.0
     B *= np.asarray(weights)[:, None, None, None, None]
-    return assemble(s.nv, s.F, B, basis)
+    return assemble(s.nv, s.F, group_blocks(t, B), basis)
 
 
 def facet_gravity_hessian(t, weights, basis=None):
@@ -460,7 +460,7 @@ def facet_gravity_hessian(t, weights, basis=None):
             B[:, a, b, 1, 2] = dS[:, b] * dcz[:, a, 1]
             B[:, a, b, 2, 2] = (2.0 if a == b else 1.0) * cz
     B *= (np.asarray(weights) / 24.0)[:, None, None, None, None]
-    return assemble(s.nv, s.F, B, basis)
+    return assemble(s.nv, s.F, group_blocks(t, B), basis)
 
 
 

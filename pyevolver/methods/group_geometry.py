@@ -61,6 +61,11 @@ def check_supported(s) -> None:
     model, wrapped edges on parametric boundaries (their midpoints) and
     named-quantity methods outside :data:`METHODS`."""
     where = f'in SYMMETRY_GROUP "{s.symmetry_group}"'
+    tension = s.eattr.get("tension")
+    if tension is not None and np.any(tension):
+        raise UnsupportedError(f"edge TENSION {where} (REF leaves it out of the energy when "
+                               f"it converts to named quantities: measured on flip_rotate.fe; "
+                               f"a quantity with METHOD edge_length works)")
     if s.metric is not None:
         raise UnsupportedError(f"a metric {where}")
     if s.order != 1:
@@ -81,6 +86,21 @@ def check_supported(s) -> None:
                                        f"vertex coordinates without the group elements)")
 
 
+def quarter_turn_pullback(s, group, Ac) -> np.ndarray:
+    """The maps through which REF pulls gradients back in ``quarter_turn``:
+    none at a corner whose code is not 0 (its facets' corners there add
+    nothing to the vertex's force: measured with ``v_force`` on
+    quarter_turn.fe, where every such corner's share is missing from REF's
+    forces, to 12 digits), so that `g` moves as REF's."""
+    for q in s.quantities.values():
+        for m, *_ in q.methods:
+            if m.method.startswith("edge_"):
+                raise UnsupportedError(f'the quantity method {m.method} in SYMMETRY_GROUP '
+                                       f'"quarter_turn" (REF\'s edge forces across its '
+                                       f'elements were not measured)')
+    return np.where((corner_codes(s, group) != 0)[:, :, None, None], 0.0, Ac)
+
+
 def totals_geometry(t, group) -> None:
     """Set the evaluation's cached geometry (edge vectors, facet sides,
     normals, areas, contents) and the maps of ``t.surface`` in ``group``."""
@@ -93,6 +113,8 @@ def totals_geometry(t, group) -> None:
     F = s.topology()[2]
     Ac, bc = corner_maps(s, group)
     t.corner_maps = Ac
+    if group.name == "quarter_turn":
+        t.corner_maps = quarter_turn_pullback(s, group, Ac)
     P = np.einsum("fkij,fkj->fki", Ac, X[F]) + bc if len(F) else np.zeros((0, 3, 3))
     t.facet_x0 = P[:, 0]
     S = np.empty((len(F), 2, 3))
@@ -102,3 +124,4 @@ def totals_geometry(t, group) -> None:
     t.facet_N2 = G.facet_normals(S)
     t.facet_area = G.facet_areas(t.facet_N2)
     t.facet_volume = G.facet_volumes(t.facet_x0, S, s.symmetric_content)
+

@@ -30,8 +30,11 @@ import heapq
 import numpy as np
 
 from ..constraints import project_to_constraints
+from ..errors import UnsupportedError
 from ..geometry.kernels import edge_index, gram_facet_areas
 from ..methods import metric as MT
+from ..model.groups import group_of
+from . import group_delete as GD
 from .shrink import subset
 
 
@@ -45,6 +48,9 @@ class _Deleter:
         # the torus model: per-edge period shifts, kept up to date as ends merge
         self.P = s.periods
         self.W = s.eattr["wrap"].copy() if s.periods is not None else None
+        # a symmetry group (model.groups): per-edge codes, composed as ends merge
+        self.group = group_of(s)
+        self.C = s.eattr["wrap_code"].copy() if self.group is not None else None
         self.X = s.X.copy()
         self.moved = []
         self.E = s.E.copy()
@@ -72,6 +78,8 @@ class _Deleter:
     def vec(self, e):
         """Edge ``e``'s vector head - tail (across the torus wrap)."""
         a, b = self.E[e]
+        if self.C is not None:
+            return GD.edge_vector(self, e)
         d = self.X[b] - self.X[a]
         return d if self.W is None else d + self.W[e] @ self.P
 
@@ -100,7 +108,9 @@ class _Deleter:
         out = {}
         for x in at.tolist():
             a, b = (int(y) for y in self.E[x])
-            if self.W is None:
+            if self.C is not None:
+                off = GD.offset(self, x, v, shift)
+            elif self.W is None:
                 off = ()
             else:
                 off = self.W[x] if a == v else -self.W[x]
@@ -128,6 +138,8 @@ class _Deleter:
             keep, elim = b, a
         else:
             return False
+        if self.C is not None and GD.parallel_edge(self, e, a, b):
+            return False
         merges = []          # (facet, side at elim, side at keep, third vertex)
         for f in self.facets_of(e):
             sides = [int(x) for x in self.FEabs[f] if x != e]
@@ -142,7 +154,9 @@ class _Deleter:
             merges.append((f, *self._survivor(eb, ea), int(c)))
         # the offset (in periods) of the eliminated vertex from the kept one
         delta = None
-        if self.W is not None:
+        if self.C is not None:
+            delta = GD.delta(self, e, keep)
+        elif self.W is not None:
             delta = self.W[e].copy() if int(self.E[e, 0]) == keep else -self.W[e]
         # a common neighbour outside those facets: its two edges become one
         nk, ne_ = self.neighbours(keep), self.neighbours(elim, delta)
@@ -154,7 +168,9 @@ class _Deleter:
             merges.append((None, *self._survivor(eb, ea), key[0]))
         E, FE = self.E, self.FE
         head = int(E[e, 1])
-        if delta is not None:
+        if self.C is not None:
+            GD.carry(self, elim, delta)
+        elif delta is not None:
             self._inside = self._in_cell(np.array([keep, elim]))
             self.W[E[:, 0] == elim] += delta
             self.W[E[:, 1] == elim] -= delta
@@ -175,7 +191,7 @@ class _Deleter:
             # (not on a parametric boundary, where the kept vertex stays put)
             self.X[keep] = 0.5 * (self.X[keep] + self.X[elim])
             self.moved.append(keep)
-            if delta is not None and self._frame_at_elim(keep, elim, head, delta):
+            if self.W is not None and self._frame_at_elim(keep, elim, head, delta):
                 self._shift(keep, -delta)
         self.valive[elim] = False
         self.ealive[e] = False
@@ -248,6 +264,8 @@ class _Deleter:
         t.X = self.X[self.valive].copy()
         if self.W is not None:
             t.eattr["wrap"] = self.W[self.ealive].copy()
+        if self.C is not None:
+            t.eattr["wrap_code"] = self.C[self.ealive].copy()
         moved = np.unique(np.array(self.moved, np.int64))
         moved = moved[self.valive[moved]] if len(moved) else moved
         if len(moved):
@@ -273,6 +291,9 @@ def _in_id_order(first, visit):
 
 
 def _edge_vectors(s):
+    group = group_of(s)
+    if group is not None:
+        return GD.edge_vectors(s, group)
     D = s.X[s.E[:, 1]] - s.X[s.E[:, 0]]
     return D if s.periods is None else D + s.eattr["wrap"] @ s.periods
 
@@ -325,6 +346,11 @@ def _facet_area(d, f):
 def _weed(s, facets, area):
     """Visit ``facets`` in id order (with ``area``: also facets that a merge
     made smaller than ``area``, and only while they still are)."""
+    if group_of(s) is not None:
+        raise UnsupportedError(f'weeding or deleting facets in SYMMETRY_GROUP '
+                               f'"{s.symmetry_group}" (REF\'s choice of facets after a '
+                               f'merge is not the one the areas across the wrapped sides '
+                               f'give: xyz.fe, `w 0.03`)')
     d = _Deleter(s)
     weeded = [0]
 

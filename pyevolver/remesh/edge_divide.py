@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.groups import group_of
 from ..model.records import torus_lift_shifts
 from .refine import split_edges
 
@@ -42,11 +43,15 @@ def edge_divide(s, edges, choosers=None):
             now, now_by = todo[:n], by[:n]
             todo, by = todo[n:], by[n:]
             wv = s.wrap_shift()
-            if wv is not None:
+            group = group_of(s)
+            if wv is not None or group is not None:
                 idx_, sgn_, _ = s.topology()
                 back = (sgn_[now_by] * (idx_[now_by] == now[:, None])).sum(axis=1) < 0
                 moved.append(s.nv + np.nonzero(back)[0])
-                shift.append(-wv[now[back]])
+                if group is not None:       # the codes: the head's frame is g⁻¹'s
+                    shift.append(s.eattr["wrap_code"][now[back]])
+                else:
+                    shift.append(-wv[now[back]])
         else:
             sel = np.zeros(s.ne, bool)
             sel[todo] = True
@@ -73,10 +78,19 @@ def edge_divide(s, edges, choosers=None):
         # (which pair a body's facets at an edge by their angles there) are
         # taken before the move, on the untangled surface: the move keeps
         # the topology and the wraps, and REF's volumes are those.
+        # In a symmetry group (pyevolver.model.groups) REF puts it alike in
+        # the head's frame, g⁻¹(midpoint), the new edges' codes as for a
+        # midpoint in the tail's frame (measured on rotate.fe: ``K 0.9``).
+        s.X = s.X.copy()
+        v = np.concatenate(moved)
+        group = group_of(s)
+        if group is not None:
+            A, b = group.affine(np.concatenate(shift))
+            s.X[v] = np.einsum("nji,nj->ni", A, s.X[v] - b)       # (A orthogonal)
+            return s, count
         if s.bodies.n:
             torus_lift_shifts(s)
-        s.X = s.X.copy()
-        s.X[np.concatenate(moved)] += np.concatenate(shift)
+        s.X[v] += np.concatenate(shift)
     return s, count
 
 

@@ -43,7 +43,33 @@ def new_edge_codes(s, t, group, R, I, FW, new_edges) -> None:
     off[:, 3] = group.compose(off[:, 2], oriented[:, 2])
     offm = np.where(FW, off[:, :3], off[:, 1:])
     off = off[:, :3]
+    if group.name == "quarter_turn":
+        _local_codes(group, W, oriented, FW, new_edges)
+        return
     for eidx, f, p, q in new_edges:
         op = (off if p[0] == "c" else offm)[f, p[1]]
         oq = (off if q[0] == "c" else offm)[f, q[1]]
         W[eidx] = group.compose(group.inverse(op), oq)
+
+
+def _local_codes(group, W, oriented, FW, new_edges) -> None:
+    """quarter_turn: a new edge's code composed along the facet's rim from
+    its start to its end the short way (corner i -> midpoint i -> corner
+    i+1: the halves' codes, 0 on the tail's side), not through corner 0:
+    REF's product there is not associative (the second z power taken
+    modulo 4), and REF's codes after `r` are these (quarter_turn.fe:
+    ``r; list edges``)."""
+    zero = np.zeros_like(oriented)
+    a = np.where(FW, zero, oriented)             # corner i -> midpoint i
+    b = np.where(FW, oriented, zero)             # midpoint i -> corner i+1
+    steps = np.stack([a[:, 0], b[:, 0], a[:, 1], b[:, 1], a[:, 2], b[:, 2]], 1)
+    for eidx, f, p, q in new_edges:
+        i = 2 * p[1] + (p[0] != "c")             # places on the rim: c0 m0 c1 m1 c2 m2
+        j = 2 * q[1] + (q[0] != "c")
+        fwd = (j - i) % 6
+        lo, n = (i, fwd) if fwd <= 3 else (j, 6 - fwd)
+        code = np.zeros(len(np.atleast_1d(f)), np.int64)
+        st = steps[f]
+        for k in range(n):
+            code = group.compose(code, st[:, (lo + k) % 6])
+        W[eidx] = code if fwd <= 3 else group.inverse(code)

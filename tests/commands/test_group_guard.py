@@ -27,8 +27,10 @@ def test_group_aware_commands_run():
     assert sess.value("total_energy") < e0
     for word in ("g", "r", "j", "list", "dump", "print"):
         group_guard.check(sess, word)
-    with pytest.raises(PyEvolverError, match="`g` in SYMMETRY_GROUP \"quarter_turn\""):
-        group_guard.check(pyevolver.load(os.path.join(DATA, "quarter_turn.fe")), "g10")
+    qt = pyevolver.load(os.path.join(DATA, "quarter_turn.fe"))
+    group_guard.check(qt, "g10")
+    with pytest.raises(PyEvolverError, match="`r` in SYMMETRY_GROUP \"quarter_turn\""):
+        group_guard.check(qt, "r")
 
 
 def test_torus_group_untouched():

@@ -25,11 +25,25 @@ def _fd(s, f, h=1e-6):
 
 @pytest.mark.parametrize("name", ["rotate", "flip_rotate", "screw_symmetry", "cubelat", "xyz",
                                   "central_symmetry"])
-def test_area_and_edge_tension_gradients(name):
+def test_area_and_edge_length_gradients(name):
+    from pyevolver.methods.basic import edge_length_grad
     s = _surface(name)
-    s.eattr["tension"] = np.linspace(0.1, 0.5, s.ne)       # edge lengths through g too
+    ne, w = np.arange(s.ne), np.linspace(0.1, 0.5, s.ne)     # edge lengths through g too
     t = s.evaluate()
-    assert np.allclose(energy_gradient(t), _fd(s, lambda t: t.energy), atol=1e-7)
+
+    def energy(t):
+        return t.energy + w @ np.linalg.norm(t.edge_vec, axis=1)
+    g = energy_gradient(t) + edge_length_grad(t, ne, w)
+    assert np.allclose(g, _fd(s, energy), atol=1e-7)
+
+
+def test_edge_tension_attribute_refused():
+    """REF leaves the edges' TENSION out of the energy in these groups."""
+    from pyevolver.errors import UnsupportedError
+    s = _surface("flip_rotate")
+    s.eattr["tension"] = np.full(s.ne, 0.3)
+    with pytest.raises(UnsupportedError, match="edge TENSION"):
+        s.evaluate()
 
 
 def test_volume_gradient_and_corners():
@@ -83,3 +97,43 @@ def test_wrapped_boundary_edge_refused():
         GG.check_supported(s)
     s.eattr["boundary"] = np.zeros(s.ne, np.int64)
     GG.check_supported(s)
+
+
+@pytest.mark.parametrize("name", ["flip_rotate", "cubelat", "central_symmetry"])
+def test_hessians_through_the_maps(name):
+    """Area, edge-length and volume Hessians (methods._common.group_blocks:
+    ``A_aᵀ H_ab A_b``) against central differences of the gradients."""
+    from finite_differences import assert_hessian_columns
+    from pyevolver.methods._common import corner_scatter
+    from pyevolver.methods.basic import (edge_length_grad, edge_length_hessian,
+                                         facet_area_hessian, facet_volume_grad,
+                                         facet_volume_hessian)
+    s = _surface(name)
+    ne = np.arange(s.ne)
+    we = np.linspace(0.1, 0.5, s.ne)
+    wf = np.linspace(0.5, 1.5, s.nf)
+
+    def grad(s):
+        t = s.evaluate()
+        return (energy_gradient(t) + edge_length_grad(t, ne, we)
+                + corner_scatter(t, facet_volume_grad(t, False), wf))
+    t = s.evaluate()
+    H = (facet_area_hessian(t, s.facet_tension) + edge_length_hessian(t, ne, we)
+         + facet_volume_hessian(t, wf, False)).toarray()
+    assert np.abs(H).max() > 0.1
+    assert_hessian_columns(s, H, grad, h=1e-5, tol=1e-6)
+
+
+def test_quarter_turn_forces_leave_out_wrapped_corners():
+    """REF's forces in quarter_turn (measured with v_force): a facet's corner
+    whose code is not 0 adds nothing to its vertex; edge tension refused."""
+    from pyevolver.errors import UnsupportedError
+    s = _surface("quarter_turn")
+    t = s.evaluate()
+    codes = GG.corner_codes(s, group_of(s))
+    assert (codes != 0).any()
+    assert not t.corner_maps[codes != 0].any()
+    assert np.allclose(t.corner_maps[codes == 0], np.eye(3))
+    s.eattr["tension"] = np.full(s.ne, 0.5)
+    with pytest.raises(UnsupportedError, match="edge TENSION"):
+        s.evaluate()

@@ -40,3 +40,18 @@ def test_axial_facet_new_edge():
     mid = {e: s.nv + e for e in range(s.ne)}
     k = np.nonzero((E[:, 0] == mid[1]) & (E[:, 1] == mid[0]))[0]
     assert len(k) == 1 and W[k[0]] == -1
+
+
+def test_quarter_turn_codes_along_the_rim(evolver):
+    """quarter_turn (REF's product not associative): the new edges' codes
+    composed along each facet's rim the short way are REF's after `r`
+    (`r` itself stays refused there: commands.group_guard)."""
+    import re
+    from reference import run_reference
+    path = os.path.join(DATA, "quarter_turn.fe")
+    ref = run_reference(evolver, path, "r\nlist edges\n")
+    codes = [int(m.group(1)) for m in (re.search(r"wrap (-?\d+)", ln) for ln in ref) if m]
+    t = refine(pyevolver.load(path).surface)
+    assert len(codes) == t.ne > 100
+    assert list(t.eattr["wrap_code"]) == codes
+    assert len(set(codes)) > 3
