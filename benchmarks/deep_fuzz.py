@@ -27,22 +27,30 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOC = os.path.join(ROOT, "docs", "fuzzing.md")
 
 
-def run(inputs: int, reduced: bool, jobs: int) -> tuple[int, dict, str]:
+def run(inputs: int, reduced: bool, jobs: int, targets=None, log=None) -> tuple[int, dict, str]:
     env = dict(os.environ, PYEVOLVER_NIGHTLY="1", PYTHONPATH=ROOT)
     if reduced:                        # below the deep run's floor: for trying it out
         env["PYEVOLVER_HOSTILE_REDUCED"] = str(inputs)
     else:
         env["PYEVOLVER_HOSTILE_INPUTS"] = str(inputs)
+    k = "hostile_deep" if not targets else \
+        "hostile_deep and (" + " or ".join(targets) + ")"
     cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-           "tests/robustness/test_fuzz.py", "-k", "hostile_deep", "--nightly"]
+           "tests/robustness/test_fuzz.py", "-k", k, "--nightly"]
     if jobs > 1:
         cmd += ["-n", str(jobs)]
     proc = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+    if log:                            # the whole output: a failure's input and traceback
+        with open(log, "w") as fh:
+            fh.write(proc.stdout + proc.stderr)
     counts = {}
     for m in re.finditer(r"^(hostile \w+ \(deep\)): (\d+) in ([\d.]+) s \(([\d.]+) s CPU\)",
                          proc.stdout, re.M):
         counts[m.group(1)] = (int(m.group(2)), float(m.group(3)), float(m.group(4)))
     failures = re.findall(r"^(?:FAILED|ERROR) .*$", proc.stdout, re.M)
+    # what failed on which input (the first lines of each FuzzFailure)
+    failures += [m.group(0)[:600] for m in
+                 re.finditer(r"^E\s+fuzzing\.FuzzFailure: .*(?:\n^E .*){0,6}", proc.stdout, re.M)]
     if proc.returncode and not failures:
         failures = (proc.stdout + proc.stderr).strip().splitlines()[-30:]
     return proc.returncode, counts, "\n".join(failures)
@@ -78,10 +86,13 @@ def main(argv=None) -> int:
                     help="allow fewer than 100,000 inputs (a trial; the doc says so)")
     ap.add_argument("--jobs", type=int, default=1, help="pytest-xdist workers")
     ap.add_argument("--doc", default=DOC, help="where the counts go (docs/fuzzing.md)")
+    ap.add_argument("--targets", nargs="+", choices=["reader", "parser", "interpreter"],
+                    help="only these targets (default: all three)")
+    ap.add_argument("--log", default=None, help="file for pytest's whole output")
     args = ap.parse_args(argv)
     if args.inputs < 100_000 and not args.reduced:
         ap.error("the deep run needs --inputs >= 100000 (or --reduced)")
-    rc, counts, failures = run(args.inputs, args.reduced, args.jobs)
+    rc, counts, failures = run(args.inputs, args.reduced, args.jobs, args.targets, args.log)
     write(rc, counts, failures, args.reduced, args.doc)
     print(f"wrote {args.doc}: " + ", ".join(f"{t}: {n}" for t, (n, _, _) in sorted(counts.items())))
     return rc

@@ -54,10 +54,11 @@ def test_bench_hessian_runs(evolver, tmp_path):
 def test_deep_fuzz_writes_its_counts(tmp_path):
     """benchmarks/deep_fuzz.py: a reduced deep run (50 inputs per target)
     and the table of counts it writes (docs/fuzzing.md is this table)."""
-    doc = tmp_path / "fuzzing.md"
+    doc, log = tmp_path / "fuzzing.md", tmp_path / "fuzz.log"
     out = _run([os.path.join(BENCH, "deep_fuzz.py"), "--inputs", "50", "--reduced",
-                "--doc", str(doc)], tmp_path)
+                "--doc", str(doc), "--log", str(log)], tmp_path)
     text = doc.read_text()
+    assert "3 passed" in log.read_text()
     assert "result: passed" in text and "wrote" in out
     for target in ("reader", "parser", "interpreter"):
         assert f"| hostile {target} (deep) | 50 | 0 | 0 |" in text
