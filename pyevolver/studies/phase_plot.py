@@ -1,0 +1,62 @@
+"""The figure of the discrete phase study (:mod:`pyevolver.studies.phase_study`):
+``W/(4π)`` against the reduced volume per branch, the discrete points
+(filled: stable, open: unstable, ×: not converged) over the axisymmetric
+reference's curves, the transitions marked; below, the relative error of
+each point against its reference."""
+from __future__ import annotations
+
+import numpy as np
+
+COLORS = {"prolate": "tab:blue", "oblate": "tab:orange", "stomatocyte": "tab:green"}
+
+
+def plot(stem: str, rows: list[dict], refs: dict, trans: list[dict]) -> list[str]:
+    """Write ``stem.png`` and ``stem.pdf``; returns their paths."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True,
+                                  gridspec_kw={"height_ratios": [3, 1.3]})
+    for b, color in COLORS.items():
+        pts = sorted(refs.get(b, {}).values(), key=lambda p: p.v)
+        if pts:
+            ax.plot([p.v for p in pts], [p.W / (4 * np.pi) for p in pts], "-", color=color,
+                    lw=1, label=f"{b} (axisymmetric reference)")
+        mine = sorted((r for r in rows if r["branch"] == b), key=lambda r: r["v"])
+        for r in mine:
+            y = r["W"] / (4 * np.pi)
+            if r["converged"] is not True:
+                ax.plot(r["v"], y, "x", color=color)
+            elif r["stable"] is True:
+                ax.plot(r["v"], y, "o", color=color, ms=5)
+            else:
+                ax.plot(r["v"], y, "o", mfc="white", color=color, ms=5)
+        ok = [r for r in mine if r["converged"] is True]
+        if ok:
+            ax2.plot([r["v"] for r in ok], [100 * r["rel_err"] for r in ok], "o-",
+                     color=color, ms=3, lw=0.8)
+    for t in trans:
+        if t["v"] is not None:
+            ax.axvline(t["v"], color="k", ls="--", lw=0.8)
+            ax.text(t["v"], ax.get_ylim()[1], f" {t['from'][:3]}/{t['to'][:3]}\n {t['v']:.3f}",
+                    va="top", fontsize=8)
+        if t["v_published"] is not None:
+            ax.axvline(t["v_published"], color="0.6", ls=":", lw=0.8)
+    ax.plot([], [], "ko", ms=5, label="discrete, stable")
+    ax.plot([], [], "o", mfc="white", color="k", ms=5, label="discrete, unstable")
+    ax.plot([], [], "k--", lw=0.8, label="discrete transition")
+    ax.plot([], [], ":", color="0.6", label="published (SBL 1991)")
+    nv = sorted({int(r["nv"]) for r in rows})
+    ax.set_ylabel("W / 4π")
+    ax.set_title(f"discrete phase study, c0 = 0 (about {nv[len(nv) // 2] if nv else '?'} "
+                 "vertices)")
+    ax.legend(fontsize=7, loc="upper right")
+    ax2.axhline(0, color="0.7", lw=0.5)
+    ax2.set_xlabel("reduced volume v")
+    ax2.set_ylabel("rel. error (%)")
+    fig.tight_layout()
+    paths = [f"{stem}.png", f"{stem}.pdf"]
+    for p in paths:
+        fig.savefig(p, dpi=120)
+    plt.close(fig)
+    return paths
