@@ -60,3 +60,30 @@ def plot(stem: str, rows: list[dict], refs: dict, trans: list[dict]) -> list[str
         fig.savefig(p, dpi=120)
     plt.close(fig)
     return paths
+
+
+def _fmt(x, spec):
+    return "—" if x is None or x == "" or (isinstance(x, float) and x != x) else format(x, spec)
+
+
+def summary_markdown(rows: list[dict], trans: list[dict]) -> str:
+    """The study's tables in Markdown (written as ``summary.md`` next to
+    ``phase.csv``; docs/phase.md quotes it): the transitions, then one row
+    per point."""
+    out = ["| transition | discrete | axisymmetric reference | published (SBL 1991) |",
+           "|---|---|---|---|"]
+    for t in trans:
+        out.append(f"| {t['from']}/{t['to']} | {_fmt(t['v'], '.4f')} | "
+                   f"{_fmt(t['v_ref'], '.4f')} | {t['v_published']} |")
+    out += ["", "| branch | v | vertices | W/4π | W_ref/4π | rel. error | lowest eigenvalue "
+            "| stable | λ | min angle | solver |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in sorted(rows, key=lambda r: (list(COLORS).index(r["branch"]), r["v"])):
+        ok = r["converged"] is True
+        out.append(
+            f"| {r['branch']} | {r['v']:.3f} | {int(r['nv'])} | "
+            f"{r['W'] / (4 * np.pi):.5f} | {r['W_ref'] / (4 * np.pi):.5f} | "
+            + (f"{100 * r['rel_err']:+.3f}%" if ok else "not converged") + " | "
+            f"{_fmt(r['eig1'], '.4g')} | "
+            + ("yes" if r["stable"] is True else ("no" if ok else "—")) + " | "
+            f"{r['lambda']:g} | {r['min_angle_deg']:.1f}° | {r['start']} |")
+    return "\n".join(out) + "\n"

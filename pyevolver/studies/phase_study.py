@@ -33,7 +33,8 @@ above −10⁻³.
 
 writes ``DIR/phase.csv`` (one row per branch and v), ``DIR/transitions.csv``
 (the crossings of the discrete branches, linearly interpolated, with the
-reference's and the published values) and ``DIR/phase.png``/``.pdf``.  It is
+reference's and the published values), ``DIR/summary.md`` (both as
+Markdown tables) and ``DIR/phase.png``/``.pdf``.  It is
 resumable: rows already in ``phase.csv`` (same branch, c0, v, nv) are kept,
 and their meshes (``DIR/meshes/``) are the neighbours' meshes of the fallback.
 """
@@ -284,6 +285,8 @@ def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
     rows = [r for r in rows if int(r.get("nv_target", 0)) == nv]
     trans = transitions(rows, refs)
     write_transitions(os.path.join(out, "transitions.csv"), trans)
+    with open(os.path.join(out, "summary.md"), "w") as fh:
+        fh.write(phase_plot.summary_markdown(rows, trans))
     if plot:
         phase_plot.plot(os.path.join(out, "phase"), rows, refs, trans)
     return rows, trans

@@ -3,7 +3,7 @@ PNG and PDF from rows, references and transitions (synthetic here)."""
 import os
 from types import SimpleNamespace
 
-from pyevolver.studies.phase_plot import plot
+from pyevolver.studies.phase_plot import plot, summary_markdown
 
 
 def test_png_and_pdf_are_written(tmp_path):
@@ -19,3 +19,21 @@ def test_png_and_pdf_are_written(tmp_path):
     paths = plot(str(tmp_path / "phase"), rows, refs, trans)
     assert paths == [str(tmp_path / "phase.png"), str(tmp_path / "phase.pdf")]
     assert all(os.path.getsize(p) > 1000 for p in paths)
+
+
+def test_summary_tables():
+    rows = [{"branch": "oblate", "v": 0.7, "W": 4 * 3.14159265358979, "W_ref": 12.0, "nv": 642,
+             "converged": True, "stable": False, "rel_err": 0.0123, "eig1": -1.5,
+             "lambda": 0.3, "min_angle_deg": 40.0, "start": "revolved/critical"},
+            {"branch": "prolate", "v": 0.6, "W": 30.0, "W_ref": 29.0, "nv": 642,
+             "converged": False, "stable": "", "rel_err": 0.5, "eig1": float("nan"),
+             "lambda": 0.6, "min_angle_deg": 3.0, "start": "continued/min"}]
+    trans = [{"from": "prolate", "to": "oblate", "v": 0.64591, "v_ref": None,
+              "v_published": 0.652}]
+    text = summary_markdown(rows, trans)
+    lines = text.splitlines()
+    assert lines[2] == "| prolate/oblate | 0.6459 | — | 0.652 |"
+    # prolate first (branch order), not converged; then the oblate saddle
+    assert lines[-2].startswith("| prolate | 0.600 | 642 |") and "not converged" in lines[-2]
+    assert "| +1.230% | -1.5 | no | 0.3 | 40.0° | revolved/critical |" in lines[-1]
+    assert "| 1.00000 |" in lines[-1]
