@@ -50,18 +50,20 @@ def newton_critical(session: Session, tol: float = 1e-9, maxit: int = 30
     bordered system of :func:`newton_lm` with μ = 0, solved by the engine's
     indefinite solver), the step halved until max |∇L| drops (at most 8
     times; then the shorter step is kept anyway): it converges to a saddle
-    as well as to a minimum from a close enough start.  Returns
+    as well as to a minimum from a close enough start; abandoned when the
+    energy passes twice its start (a diverging iteration).  Returns
     ``(converged, steps, max |∇L|)``."""
     s = session.surface
     it = session.iterator
     cons = _Constraints(s)
     mobile = ~s.vattr["fixed"]
     gnorm = math.inf
+    E0 = s.evaluate().energy
     for step in range(maxit):
         gL, C, lam, resid, targets = _grad_lagrangian(s, cons)
         gnorm = float(np.abs(gL).max())
-        if not math.isfinite(gnorm):
-            return False, step, gnorm
+        if not math.isfinite(gnorm) or s.evaluate().energy > 2 * abs(E0):
+            return False, step, gnorm          # diverging (mesh folding up)
         if gnorm < tol and np.all(np.abs(resid) < 1e-10 * np.abs(targets)):
             return True, step, gnorm
 

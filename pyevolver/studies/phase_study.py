@@ -17,8 +17,8 @@ Newton iteration does not converge, whose mesh degenerates (smallest angle
 below 10°) or whose shape leaves the branch (on the unstable part of a
 branch every descent does) is solved by plain Newton on the critical-point
 equations (:func:`~pyevolver.studies.phase_newton.newton_critical`, which
-finds saddles), then minimised with 2λ, and last from the neighbouring
-point's discrete minimiser.  (Starting every point from its neighbour's
+finds saddles), then both again with 2λ, and last minimised and solved by
+Newton from the last converged neighbour's mesh.  (Starting every point from its neighbour's
 mesh, the first design, lets the triangulation drift: on the prolate
 branch at 300 vertices the error grew from +0.8% to +3.2% between
 v = 0.8 and 0.6, against +0.8% from the revolved start.)  For each point
@@ -35,7 +35,8 @@ writes ``DIR/phase.csv`` (one row per branch and v), ``DIR/transitions.csv``
 (the crossings of the discrete branches, linearly interpolated, with the
 reference's and the published values), ``DIR/summary.md`` (both as
 Markdown tables) and ``DIR/phase.png``/``.pdf``.  It is
-resumable: rows already in ``phase.csv`` (same branch, c0, v, nv) are kept,
+resumable: converged rows already in ``phase.csv`` (same branch, c0, v, nv)
+are kept (failed ones are solved again),
 and their meshes (``DIR/meshes/``) are the neighbours' meshes of the fallback.
 """
 from __future__ import annotations
@@ -104,16 +105,27 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
     t0 = time.perf_counter()
     rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi)
     attempts = [("revolved", rev, lam, "min"), ("revolved", rev, lam, "critical"),
-                ("revolved", rev, 2 * lam, "min")]
+                ("revolved", rev, 2 * lam, "min"), ("revolved", rev, 2 * lam, "critical")]
     if start is not None:
-        attempts.append(("continued", start, lam, "min"))
+        attempts += [("continued", start, lam, "min"), ("continued", start, lam, "critical")]
     steps = 0
+
+    def on_branch(surf):
+        """Stop a descent that leaves the branch (a saddle's: the oblate to
+        the prolate) or folds the mesh up."""
+        if mesh_quality(surf.X, surf.F)["min_angle_deg"] < MIN_ANGLE / 2:
+            return False
+        return (branch == "stomatocyte"
+                or mesh_descriptors(surf.X, surf.F)["type"] in TYPES[branch])
     with tempfile.TemporaryDirectory() as tmp:
         for kind, (X, F), lam_k, solver in attempts:
             s = _session(X, F, v, lam_k, tmp)
             restore(s)
             if solver == "min":
-                ok, n, _ = newton_lm(s, maxit=maxit)
+                ok, n, _ = newton_lm(s, maxit=maxit, guard=on_branch)
+                if not ok and on_branch(s.surface):     # restart the damping once
+                    ok, n2, _ = newton_lm(s, maxit=maxit // 2, guard=on_branch)
+                    n += n2
             else:
                 ok, n, _ = newton_critical(s)
             steps += n
@@ -181,22 +193,28 @@ def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[d
     """Solve the branch's points of ``volumes`` (those with a reference in
     ``refs``, v -> BranchPoint) by continuation from its seed outwards,
     appending to ``rows`` and rewriting ``out/phase.csv`` after each point;
-    points already in ``rows`` are skipped."""
+    converged points already in ``rows`` are skipped, failed ones solved
+    again.  The fallback start of a point is the last converged point's
+    mesh on its side of the seed."""
     mesh_dir = os.path.join(out, "meshes")
     os.makedirs(mesh_dir, exist_ok=True)
     vs = np.array(sorted(v for v in volumes if float(v) in refs))
     if not len(vs):
         return
     seed = vs[np.argmin(np.abs(vs - PR.SEEDS[branch]))]
-    done = {(r["branch"], round(r["v"], 6)) for r in rows if int(r.get("nv_target", 0)) == nv}
+
+    def mine(r, v):
+        return (r["branch"] == branch and round(r["v"], 6) == round(float(v), 6)
+                and int(r.get("nv_target", 0)) == nv)
     for side in (vs[vs >= seed], vs[vs < seed][::-1]):
         start = None
         for v in side:
             key = os.path.join(mesh_dir, _key(branch, v, nv) + ".npz")
-            if (branch, round(float(v), 6)) in done and os.path.exists(key):
+            if any(mine(r, v) and r["converged"] is True for r in rows) and os.path.exists(key):
                 with np.load(key) as z:
                     start = (z["X"], z["F"])
                 continue
+            rows[:] = [r for r in rows if not mine(r, v)]       # a failed point: again
             if start is None and side[0] != seed and v == side[0]:
                 sk = os.path.join(mesh_dir, _key(branch, seed, nv) + ".npz")
                 if os.path.exists(sk):
@@ -206,12 +224,13 @@ def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[d
                                     eigen=eigen)
             row["nv_target"] = nv
             rows.append(row)
-            np.savez(key, X=X, F=F)
+            if row["converged"]:
+                np.savez(key, X=X, F=F)
+                start = (X, F)          # else the last converged point stays the start
             write_rows(os.path.join(out, "phase.csv"), rows)
             log(f"{branch} v={v:.4f} W={row['W']:.6f} rel_err={row['rel_err']:+.5f} "
                 f"eig1={row['eig1']:.4g} stable={row['stable']} lambda={row['lambda']:g} "
                 f"{row['start']} {row['type']} {row['seconds']:.1f}s")
-            start = (X, F) if row["converged"] else None
 
 
 def crossing_linear(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> float | None:
@@ -251,7 +270,7 @@ def write_transitions(path: str, trans: list[dict]) -> None:
         w = csv.DictWriter(fh, fieldnames=["c0", "from", "to", "v", "v_ref", "v_published"])
         w.writeheader()
         for t in trans:
-            w.writerow({k: ("" if val is None else (f"{val:.6g}" if isinstance(val, float)
+            w.writerow({k: ("" if val is None else (f"{val:.10g}" if isinstance(val, float)
                                                      else val)) for k, val in t.items()})
 
 
@@ -282,7 +301,9 @@ def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
     rows = read_rows(os.path.join(out, "phase.csv"))
     for b in branches:
         run_branch(b, volumes, nv, out, refs[b], rows, log=log, eigen=eigen)
-    rows = [r for r in rows if int(r.get("nv_target", 0)) == nv]
+    # the tables as written (the summary is then exactly the CSV's)
+    rows = [r for r in read_rows(os.path.join(out, "phase.csv"))
+            if int(r.get("nv_target", 0)) == nv and r["branch"] in branches]
     trans = transitions(rows, refs)
     write_transitions(os.path.join(out, "transitions.csv"), trans)
     with open(os.path.join(out, "summary.md"), "w") as fh:

@@ -1,9 +1,14 @@
 """Direct tests of pyevolver.studies.phase_plot: the figure is written as
-PNG and PDF from rows, references and transitions (synthetic here)."""
+PNG and PDF from rows, references and transitions (synthetic here); the
+tables of docs/phase.md are the committed study output's."""
+import csv
 import os
 from types import SimpleNamespace
 
 from pyevolver.studies.phase_plot import plot, summary_markdown
+from pyevolver.studies.phase_study import read_rows
+
+DOCS = os.path.join(os.path.dirname(__file__), "..", "..", "docs")
 
 
 def test_png_and_pdf_are_written(tmp_path):
@@ -37,3 +42,26 @@ def test_summary_tables():
     assert lines[-2].startswith("| prolate | 0.600 | 642 |") and "not converged" in lines[-2]
     assert "| +1.230% | -1.5 | no | 0.3 | 40.0° | revolved/critical |" in lines[-1]
     assert "| 1.00000 |" in lines[-1]
+
+
+def _read_transitions(path):
+    with open(path, newline="") as fh:
+        out = []
+        for r in csv.DictReader(fh):
+            out.append({"from": r["from"], "to": r["to"],
+                        "v": float(r["v"]) if r["v"] else None,
+                        "v_ref": float(r["v_ref"]) if r["v_ref"] else None,
+                        "v_published": float(r["v_published"])})
+        return out
+
+
+def test_committed_study_tables_are_the_committed_csv():
+    """docs/phase/summary.md and the tables quoted in docs/phase.md are what
+    summary_markdown writes from the committed docs/phase/*.csv."""
+    rows = read_rows(os.path.join(DOCS, "phase", "phase.csv"))
+    trans = _read_transitions(os.path.join(DOCS, "phase", "transitions.csv"))
+    text = summary_markdown(rows, trans)
+    with open(os.path.join(DOCS, "phase", "summary.md")) as fh:
+        assert fh.read() == text
+    with open(os.path.join(DOCS, "phase.md")) as fh:
+        assert text in fh.read()
