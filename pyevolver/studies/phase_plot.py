@@ -1,6 +1,7 @@
 """The figure of the discrete phase study (:mod:`pyevolver.studies.phase_study`):
 ``W/(4π)`` against the reduced volume per branch, the discrete points
-(filled: stable, open: unstable, ×: not converged) over the axisymmetric
+(filled: stable, open: unstable, ×: not converged, drawn at the
+reference's energy) over the axisymmetric
 reference's curves, the transitions marked; below, the relative error of
 each point against its reference."""
 from __future__ import annotations
@@ -25,8 +26,8 @@ def plot(stem: str, rows: list[dict], refs: dict, trans: list[dict]) -> list[str
         mine = sorted((r for r in rows if r["branch"] == b), key=lambda r: r["v"])
         for r in mine:
             y = r["W"] / (4 * np.pi)
-            if r["converged"] is not True:
-                ax.plot(r["v"], y, "x", color=color)
+            if r["converged"] is not True:          # marked at the reference's energy
+                ax.plot(r["v"], r["W_ref"] / (4 * np.pi), "x", color=color, ms=8)
             elif r["stable"] is True:
                 ax.plot(r["v"], y, "o", color=color, ms=5)
             else:
@@ -44,6 +45,7 @@ def plot(stem: str, rows: list[dict], refs: dict, trans: list[dict]) -> list[str
             ax.axvline(t["v_published"], color="0.6", ls=":", lw=0.8)
     ax.plot([], [], "ko", ms=5, label="discrete, stable")
     ax.plot([], [], "o", mfc="white", color="k", ms=5, label="discrete, unstable")
+    ax.plot([], [], "kx", ms=8, label="not converged (at W_ref)")
     ax.plot([], [], "k--", lw=0.8, label="discrete transition")
     ax.plot([], [], ":", color="0.6", label="published (SBL 1991)")
     nv = sorted({int(r["nv"]) for r in rows})

@@ -18,7 +18,7 @@ def test_png_and_pdf_are_written(tmp_path):
             {"branch": "oblate", "v": 0.7, "W": 13.2, "nv": 100, "converged": True,
              "stable": False, "rel_err": 0.02},
             {"branch": "oblate", "v": 0.6, "W": 14.5, "nv": 100, "converged": False,
-             "stable": "", "rel_err": 0.5}]
+             "stable": "", "rel_err": 0.5, "W_ref": 14.4}]
     trans = [{"from": "prolate", "to": "oblate", "v": 0.65, "v_published": 0.652},
              {"from": "oblate", "to": "stomatocyte", "v": None, "v_published": 0.592}]
     paths = plot(str(tmp_path / "phase"), rows, refs, trans)
