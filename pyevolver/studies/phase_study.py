@@ -17,7 +17,8 @@ Newton iteration does not converge, whose mesh degenerates (smallest angle
 below 10°) or whose shape leaves the branch (on the unstable part of a
 branch every descent does) is solved by plain Newton on the critical-point
 equations (:func:`~pyevolver.studies.phase_newton.newton_critical`, which
-finds saddles), then both again with 2λ, and last minimised and solved by
+finds saddles), then both again with 2λ, minimised with 4λ (the
+stomatocyte's neck at 2,562 vertices needs it), and last minimised and solved by
 Newton from the last converged neighbour's mesh.  (Starting every point from its neighbour's
 mesh, the first design, lets the triangulation drift: on the prolate
 branch at 300 vertices the error grew from +0.8% to +3.2% between
@@ -105,7 +106,8 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
     t0 = time.perf_counter()
     rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi)
     attempts = [("revolved", rev, lam, "min"), ("revolved", rev, lam, "critical"),
-                ("revolved", rev, 2 * lam, "min"), ("revolved", rev, 2 * lam, "critical")]
+                ("revolved", rev, 2 * lam, "min"), ("revolved", rev, 2 * lam, "critical"),
+                ("revolved", rev, 4 * lam, "min")]
     if start is not None:
         attempts += [("continued", start, lam, "min"), ("continued", start, lam, "critical")]
     steps = 0
