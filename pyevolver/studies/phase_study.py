@@ -315,6 +315,23 @@ def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
     return rows, trans
 
 
+def merge(sources: list[str], out: str) -> tuple[list[dict], list[dict]]:
+    """Combine the ``phase.csv`` of several runs (e.g. one per branch, run
+    at the same time) into ``out``: its ``phase.csv``, ``transitions.csv``
+    (without the reference's crossings) and ``summary.md``."""
+    rows: list[dict] = []
+    for src in sources:
+        rows += read_rows(os.path.join(src, "phase.csv"))
+    os.makedirs(out, exist_ok=True)
+    write_rows(os.path.join(out, "phase.csv"), rows)
+    rows = read_rows(os.path.join(out, "phase.csv"))
+    trans = transitions(rows)
+    write_transitions(os.path.join(out, "transitions.csv"), trans)
+    with open(os.path.join(out, "summary.md"), "w") as fh:
+        fh.write(phase_plot.summary_markdown(rows, trans))
+    return rows, trans
+
+
 def main(argv: list[str] | None = None) -> int:
     """``pyevolver study phase`` (see the module docstring); returns the exit code."""
     p = argparse.ArgumentParser(prog="pyevolver study phase",
@@ -336,21 +353,31 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-plot", dest="plot", action="store_false")
     p.add_argument("--no-eigen", dest="eigen", action="store_false",
                    help="skip the Hessian eigenvalues")
+    p.add_argument("--merge", metavar="DIR1,DIR2,...", default=None,
+                   help="only combine these runs' phase.csv into --out (no solving)")
 
 
 def run_args(args: argparse.Namespace) -> int:
+    if args.merge:
+        rows, trans = merge(args.merge.split(","), args.out)
+        _print_transitions(trans)
+        return 0
     volumes = (grid(args.vmin, args.vmax, args.step) if args.volumes is None
                else [float(x) for x in args.volumes.split(",")])
     rows, trans = run(nv=args.nv, volumes=volumes,
                       branches=tuple(args.branches.split(",")), out=args.out, c0=args.c0,
                       plot=args.plot, eigen=args.eigen,
                       log=lambda t: print(t, flush=True))
+    _print_transitions(trans)
+    return 0 if all(r["converged"] is True for r in rows) else 1
+
+
+def _print_transitions(trans):
     for t in trans:
         v = "none" if t["v"] is None else f"{t['v']:.4f}"
         vr = "none" if t["v_ref"] is None else f"{t['v_ref']:.4f}"
         print(f"transition {t['from']}/{t['to']}: v = {v} (reference {vr}, "
               f"published {t['v_published']})")
-    return 0 if all(r["converged"] is True for r in rows) else 1
 
 
 if __name__ == "__main__":

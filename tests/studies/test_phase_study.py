@@ -71,6 +71,11 @@ def test_run_writes_the_tables_and_resumes(tmp_path):
                       modes=12, log=logged.append, plot=False)
     assert len(logged) == 1
     assert [r["W"] for r in again] == pytest.approx([r["W"] for r in rows], rel=1e-9)
+    # merging runs: the same rows, tables written
+    merged, mtrans = PS.merge([out], str(tmp_path / "merged"))
+    assert [r["W"] for r in merged] == [r["W"] for r in again]
+    assert os.path.exists(tmp_path / "merged" / "summary.md")
+    assert [t["v"] for t in mtrans] == [None, None]
 
 
 def test_nonzero_spontaneous_curvature_is_refused(tmp_path):
