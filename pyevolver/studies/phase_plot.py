@@ -86,6 +86,7 @@ def summary_markdown(rows: list[dict], trans: list[dict]) -> str:
             f"{r['W'] / (4 * np.pi):.5f} | {r['W_ref'] / (4 * np.pi):.5f} | "
             + (f"{100 * r['rel_err']:+.3f}%" if ok else "not converged") + " | "
             f"{_fmt(r['eig1'], '.4g')} | "
-            + ("yes" if r["stable"] is True else ("no" if ok else "—")) + " | "
+            + ("yes" if r["stable"] is True else ("no" if r["stable"] is False else "—"))
+            + " | "
             f"{r['lambda']:g} | {r['min_angle_deg']:.1f}° | {r['start']} |")
     return "\n".join(out) + "\n"
