@@ -3,7 +3,7 @@
 ``pyevolver FILE.fe`` loads the datafile (running its ``read`` section) and
 then reads commands from the terminal (prompt ``Enter command: ``) or from
 standard input when it is not a terminal; ``-f FILE`` runs a command file
-after loading.  ``pyevolver convert|show|sweep ...`` are the subcommands
+after loading.  ``pyevolver convert|show|sweep|study ...`` are the subcommands
 of :mod:`pyevolver.cli.tools`.  Errors become messages and exit codes here only.
 """
 from __future__ import annotations
@@ -31,7 +31,7 @@ def build_parser():
         prog="pyevolver",
         description="Surface Evolver datafiles and command scripts in Python.",
         epilog="Other commands: pyevolver convert IN OUT | pyevolver show FILE.fe -o "
-               "shape.png | pyevolver sweep SPEC.toml  (each with --help)")
+               "shape.png | pyevolver sweep SPEC.toml | pyevolver study phase  (each with --help)")
     p.add_argument("datafile", help="Surface Evolver datafile (.fe)")
     p.add_argument("-f", dest="command_file", help="command file to run after loading")
     p.add_argument("-p", dest="threads", type=int, default=1,

@@ -11,7 +11,7 @@ CUBE = os.path.join(os.path.dirname(__file__), "..", "..", "datafiles", "cube.fe
 
 
 def test_every_subcommand_module_has_add_args_and_run():
-    assert set(tools.SUBCOMMANDS) == {"convert", "show", "sweep"}
+    assert set(tools.SUBCOMMANDS) == {"convert", "show", "sweep", "study"}
     for name, (mod, help_) in tools.SUBCOMMANDS.items():
         m = importlib.import_module(f"pyevolver.cli.tools.{mod}")
         assert callable(m.add_args) and callable(m.run) and help_

@@ -1,6 +1,7 @@
 """The subcommands of ``pyevolver`` besides running a datafile:
 ``pyevolver convert IN OUT``, ``pyevolver show FILE.fe -o shape.png`` and
-``pyevolver sweep SPEC.toml``.  One module each, with ``add_args(parser)``
+``pyevolver sweep SPEC.toml`` and
+``pyevolver study NAME``.  One module each, with ``add_args(parser)``
 and ``run(args)`` returning the exit code."""
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ SUBCOMMANDS = {
     "convert": ("convert", "convert a surface between .fe and meshio formats"),
     "show": ("show", "render a datafile's surface to an image, headless"),
     "sweep": ("sweep", "run a datafile over a grid of parameter values"),
+    "study": ("study", "run a named study (phase: the discrete vesicle phase diagram)"),
 }
 
 

@@ -1,0 +1,384 @@
+"""The discrete vesicle phase study (issue 27): branches, stability, transitions.
+
+For ``c0 = 0`` the reduced volume ``v`` is swept on three branches
+(prolate, oblate/discocyte, stomatocyte).  Each point minimises the discrete
+bending energy ``W = Σ_v h_v² A_v/3`` (``normal_sq_mean_curvature``, a
+sphere: 4π) plus the paper's harmonic regularization ``λ E`` (``E = (1/√3)
+Σ_edges |e|²``) over all vertex coordinates, at fixed area ``4π`` and
+volume ``v·4π/3`` (damped Newton, :func:`~pyevolver.studies.vesicle_newton.newton_lm`).
+λ(h) = ``LAMBDA_642 · 642/nv`` (∝ h²; 0.3 at 642 vertices).
+
+Every point starts from the axisymmetric reference at its ``v`` — itself
+followed along the branch by continuation from the neighbouring point
+(:func:`~pyevolver.studies.phase_reference.follow`) — revolved into a mesh
+of about ``nv`` vertices (:func:`~pyevolver.studies.phase_mesh.revolve`).
+The branch is swept from its seed volume outwards.  A point whose damped
+Newton iteration does not converge, whose mesh degenerates (smallest angle
+below 10°) or whose shape leaves the branch (on the unstable part of a
+branch every descent does) is solved by plain Newton on the critical-point
+equations (:func:`~pyevolver.studies.phase_newton.newton_critical`, which
+finds saddles), then both again with 2λ, minimised with 4λ (the
+stomatocyte's neck at 2,562 vertices needs it), and last minimised and solved by
+Newton from the last converged neighbour's mesh.  (Starting every point from its neighbour's
+mesh, the first design, lets the triangulation drift: on the prolate
+branch at 300 vertices the error grew from +0.8% to +3.2% between
+v = 0.8 and 0.6, against +0.8% from the revolved start.)  For each point
+the row gives W, the reference ``W_ref`` (:mod:`~pyevolver.studies.phase_reference`),
+``rel_err``, the mesh quality, and the lowest eigenvalues of the constrained
+Hessian of W (normal vertex motions, mass-weighted, rigid motions removed;
+:mod:`~pyevolver.studies.phase_stability`) with ``stable`` = the lowest
+above −10⁻³.
+
+    pyevolver study phase [--nv 642] [--vmin 0.5 --vmax 0.95 --step 0.025]
+        [--branches prolate,oblate,stomatocyte] [--out DIR] [--no-plot]
+
+writes ``DIR/phase.csv`` (one row per branch and v), ``DIR/transitions.csv``
+(the crossings of the discrete branches, linearly interpolated, with the
+reference's and the published values), ``DIR/summary.md`` (both as
+Markdown tables) and ``DIR/phase.png``/``.pdf``.  It is
+resumable: converged rows already in ``phase.csv`` (same branch, c0, v, nv)
+are kept (failed ones are solved again),
+and their meshes (``DIR/meshes/``) are the neighbours' meshes of the fallback.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import os
+import tempfile
+import time
+from typing import Any, Callable
+
+import numpy as np
+
+from ..errors import UnsupportedError
+from ..session.core import Session
+from . import phase_plot, phase_reference as PR
+from .axisymmetric import BRANCHES
+from .meshes import write_fe
+from .phase_mesh import mesh_quality, revolve
+from .phase_newton import newton_critical, restore
+from .phase_stability import lowest_eigenvalues, stability
+from .vesicle_newton import newton_lm
+from .vesicle_shapes import mesh_descriptors
+
+#: λ at 642 vertices; λ(h) = LAMBDA_642 · 642 / nv
+LAMBDA_642 = 0.3
+#: published transitions at c0 = 0 (Seifert, Berndl & Lipowsky 1991, Fig. 8)
+PUBLISHED = {("prolate", "oblate"): 0.652, ("oblate", "stomatocyte"): 0.592}
+#: shape types accepted on each branch
+TYPES = {"prolate": {"prolate", "sphere"}, "oblate": {"oblate", "discocyte", "sphere"},
+         "stomatocyte": {"stomatocyte"}}
+COLUMNS = ["branch", "c0", "v", "nv", "W", "W_ref", "rel_err", "stable", "eig1", "eig2",
+           "eig3", "lambda", "min_angle_deg", "aspect", "h", "type", "start", "converged",
+           "newton_steps", "seconds"]
+MIN_ANGLE = 10.0
+
+
+def lam_for(nv: int) -> float:
+    """λ(h) of the study: ``LAMBDA_642 · 642 / nv`` (∝ h²)."""
+    return LAMBDA_642 * 642.0 / nv
+
+
+def _session(X, F, v, lam, directory):
+    path = os.path.join(directory, "point.fe")
+    hdr = "\n".join([
+        "// discrete phase study point (pyevolver.studies.phase_study)",
+        f"parameter v0 = {v!r}",
+        "quantity willmore energy method normal_sq_mean_curvature global",
+        "quantity surf fixed = 4*pi method facet_area global",
+        f"quantity harm energy modulus {lam!r} method harmonic_energy global"])
+    write_fe(path, X, F, header=hdr, face_attrs="tension 0")
+    with open(path, "a") as fh:
+        fh.write("\nbodies\n1 " + " ".join(str(i + 1) for i in range(len(F)))
+                 + " volume v0*4*pi/3\n")
+    return Session.load(path, out=io.StringIO(), err=io.StringIO())
+
+
+def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
+                start: tuple[np.ndarray, np.ndarray] | None = None, maxit: int = 60,
+                eigen: bool = True) -> tuple[dict, np.ndarray, np.ndarray]:
+    """One point of a branch: minimise W + λE from ``start`` (a mesh; default
+    the reference ``ref`` revolved), falling back as the module docstring
+    says.  Returns ``(row, X, F)``."""
+    lam = lam_for(nv) if lam is None else lam
+    t0 = time.perf_counter()
+    rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi)
+    attempts = [("revolved", rev, lam, "min"), ("revolved", rev, lam, "critical"),
+                ("revolved", rev, 2 * lam, "min"), ("revolved", rev, 2 * lam, "critical"),
+                ("revolved", rev, 4 * lam, "min")]
+    if start is not None:
+        attempts += [("continued", start, lam, "min"), ("continued", start, lam, "critical")]
+    steps = 0
+
+    def on_branch(surf):
+        """Stop a descent that leaves the branch (a saddle's: the oblate to
+        the prolate) or folds the mesh up."""
+        if mesh_quality(surf.X, surf.F)["min_angle_deg"] < MIN_ANGLE / 2:
+            return False
+        return (branch == "stomatocyte"
+                or mesh_descriptors(surf.X, surf.F)["type"] in TYPES[branch])
+    with tempfile.TemporaryDirectory() as tmp:
+        for kind, (X, F), lam_k, solver in attempts:
+            s = _session(X, F, v, lam_k, tmp)
+            restore(s)
+            if solver == "min":
+                ok, n, _ = newton_lm(s, maxit=maxit, guard=on_branch)
+                if not ok and on_branch(s.surface):     # restart the damping once
+                    ok, n2, _ = newton_lm(s, maxit=maxit // 2, guard=on_branch)
+                    n += n2
+            else:
+                ok, n, _ = newton_critical(s)
+            steps += n
+            X1, F1 = s.surface.X.copy(), s.surface.F.copy()
+            q = mesh_quality(X1, F1)
+            kind_shape = mesh_descriptors(X1, F1)["type"]
+            good = ok and q["min_angle_deg"] >= MIN_ANGLE and kind_shape in TYPES[branch]
+            if good:
+                break
+        W = float(s.totals.quantity_values["willmore"])
+        eig = lowest_eigenvalues(s, k=3) if (eigen and good) else np.full(3, np.nan)
+    row = {"branch": branch, "c0": 0.0, "v": float(v), "nv": len(X1), "W": W,
+           "W_ref": float(ref.W), "rel_err": W / ref.W - 1.0,
+           "stable": (stability(eig) if good and eigen else ""),
+           "eig1": eig[0], "eig2": eig[1], "eig3": eig[2], "lambda": lam_k,
+           "min_angle_deg": q["min_angle_deg"], "aspect": q["aspect"], "h": q["h"],
+           "type": kind_shape, "start": f"{kind}/{solver}", "converged": bool(good),
+           "newton_steps": steps, "seconds": time.perf_counter() - t0}
+    return row, X1, F1
+
+
+# -- the sweep ----------------------------------------------------------------------------------
+
+def grid(vmin: float = 0.5, vmax: float = 0.95, step: float = 0.025) -> np.ndarray:
+    return np.round(np.arange(vmin, vmax + 0.5 * step, step), 10)
+
+
+def _key(branch, v, nv_target):
+    return f"{branch}_{v:.4f}_{nv_target}"
+
+
+def read_rows(path: str) -> list[dict]:
+    """The rows of a ``phase.csv`` (numbers as floats, booleans as bool)."""
+    if not os.path.exists(path):
+        return []
+    out = []
+    with open(path, newline="") as fh:
+        for r in csv.DictReader(fh):
+            row: dict[str, Any] = {}
+            for k, val in r.items():
+                if val in ("True", "False"):
+                    row[k] = val == "True"
+                elif k in ("branch", "type", "start") or val == "":
+                    row[k] = val
+                else:
+                    row[k] = float(val)
+            out.append(row)
+    return out
+
+
+def write_rows(path: str, rows: list[dict]) -> None:
+    rows = sorted(rows, key=lambda r: (BRANCHES.index(r["branch"]), r["v"]))
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=COLUMNS + ["nv_target"], extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{r[k]:.10g}" if isinstance(r.get(k), float) else r.get(k, ""))
+                        for k in COLUMNS + ["nv_target"]})
+    os.replace(tmp, path)
+
+
+def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[dict],
+               log: Callable[[str], Any] = print, eigen: bool = True) -> None:
+    """Solve the branch's points of ``volumes`` (those with a reference in
+    ``refs``, v -> BranchPoint) by continuation from its seed outwards,
+    appending to ``rows`` and rewriting ``out/phase.csv`` after each point;
+    converged points already in ``rows`` are skipped, failed ones solved
+    again.  The fallback start of a point is the last converged point's
+    mesh on its side of the seed."""
+    mesh_dir = os.path.join(out, "meshes")
+    os.makedirs(mesh_dir, exist_ok=True)
+    vs = np.array(sorted(v for v in volumes if float(v) in refs))
+    if not len(vs):
+        return
+    seed = vs[np.argmin(np.abs(vs - PR.SEEDS[branch]))]
+
+    def mine(r, v):
+        return (r["branch"] == branch and round(r["v"], 6) == round(float(v), 6)
+                and int(r.get("nv_target", 0)) == nv)
+    for side in (vs[vs >= seed], vs[vs < seed][::-1]):
+        start = None
+        for v in side:
+            key = os.path.join(mesh_dir, _key(branch, v, nv) + ".npz")
+            if any(mine(r, v) and r["converged"] is True for r in rows) and os.path.exists(key):
+                with np.load(key) as z:
+                    start = (z["X"], z["F"])
+                continue
+            rows[:] = [r for r in rows if not mine(r, v)]       # a failed point: again
+            if start is None and side[0] != seed and v == side[0]:
+                sk = os.path.join(mesh_dir, _key(branch, seed, nv) + ".npz")
+                if os.path.exists(sk):
+                    with np.load(sk) as z:
+                        start = (z["X"], z["F"])
+            row, X, F = solve_point(branch, float(v), refs[float(v)].result, nv, start=start,
+                                    eigen=eigen)
+            row["nv_target"] = nv
+            rows.append(row)
+            if row["converged"]:
+                np.savez(key, X=X, F=F)
+                start = (X, F)          # else the last converged point stays the start
+            write_rows(os.path.join(out, "phase.csv"), rows)
+            log(f"{branch} v={v:.4f} W={row['W']:.6f} rel_err={row['rel_err']:+.5f} "
+                f"eig1={row['eig1']:.4g} stable={row['stable']} lambda={row['lambda']:g} "
+                f"{row['start']} {row['type']} {row['seconds']:.1f}s")
+
+
+def crossing_linear(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> float | None:
+    """The first v (ascending) where the piecewise linear energies ``a`` and
+    ``b`` (lists of (v, W)) cross on their common volumes; None if they do
+    not."""
+    wa, wb = dict(a), dict(b)
+    common = sorted(set(wa) & set(wb))
+    d = [wa[v] - wb[v] for v in common]
+    for k in range(len(common) - 1):
+        if d[k] == 0:
+            return common[k]
+        if d[k] * d[k + 1] < 0:
+            return common[k] + (common[k + 1] - common[k]) * d[k] / (d[k] - d[k + 1])
+    return None
+
+
+def transitions(rows: list[dict], refs: dict | None = None) -> list[dict]:
+    """Crossings prolate/oblate and oblate/stomatocyte of the discrete
+    branches (converged points only), of the reference (exact, by
+    :func:`phase_reference.crossing`, when ``refs`` is given) and the
+    published values."""
+    out = []
+    for (fa, fb), pub in PUBLISHED.items():
+        pa = [(r["v"], r["W"]) for r in rows if r["branch"] == fa and r["converged"] is True]
+        pb = [(r["v"], r["W"]) for r in rows if r["branch"] == fb and r["converged"] is True]
+        v = crossing_linear(pa, pb)
+        vref = None
+        if refs is not None and refs.get(fa) and refs.get(fb):
+            vref = PR.crossing(list(refs[fa].values()), list(refs[fb].values()))
+        out.append({"c0": 0.0, "from": fa, "to": fb, "v": v, "v_ref": vref, "v_published": pub})
+    return out
+
+
+def write_transitions(path: str, trans: list[dict]) -> None:
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=["c0", "from", "to", "v", "v_ref", "v_published"])
+        w.writeheader()
+        for t in trans:
+            w.writerow({k: ("" if val is None else (f"{val:.10g}" if isinstance(val, float)
+                                                     else val)) for k, val in t.items()})
+
+
+def references(volumes, branches=BRANCHES, modes: int | None = None) -> dict:
+    """branch -> {v: BranchPoint} of the axisymmetric reference on ``volumes``
+    (``modes`` sine modes; default :data:`phase_reference.MODES`)."""
+    return {b: {p.v: p for p in PR.follow(b, volumes, n=modes)} for b in branches}
+
+
+def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
+        c0: float = 0.0, plot: bool = True, eigen: bool = True,
+        log: Callable[[str], Any] = print, modes: int | None = None
+        ) -> tuple[list[dict], list[dict]]:
+    """The study (see the module docstring); returns ``(rows, transitions)``.
+    ``modes``: sine modes of the references (default per branch, see
+    :data:`phase_reference.MODES`; fewer for quick runs)."""
+    if c0 != 0.0:
+        raise UnsupportedError("the discrete phase study at c0 != 0",
+                               "normal_sq_mean_curvature has no spontaneous curvature "
+                               "term; only c0 = 0 is swept (the axisymmetric reference, "
+                               "phase_reference, takes any c0)")
+    for b in branches:
+        if b not in BRANCHES:
+            raise ValueError(f"unknown branch {b!r}; expected one of {BRANCHES}")
+    volumes = grid() if volumes is None else np.asarray(volumes, dtype=float)
+    os.makedirs(out, exist_ok=True)
+    refs = references(volumes, branches, modes)
+    rows = read_rows(os.path.join(out, "phase.csv"))
+    for b in branches:
+        run_branch(b, volumes, nv, out, refs[b], rows, log=log, eigen=eigen)
+    # the tables as written (the summary is then exactly the CSV's)
+    rows = [r for r in read_rows(os.path.join(out, "phase.csv"))
+            if int(r.get("nv_target", 0)) == nv and r["branch"] in branches]
+    trans = transitions(rows, refs)
+    write_transitions(os.path.join(out, "transitions.csv"), trans)
+    with open(os.path.join(out, "summary.md"), "w") as fh:
+        fh.write(phase_plot.summary_markdown(rows, trans))
+    if plot:
+        phase_plot.plot(os.path.join(out, "phase"), rows, refs, trans)
+    return rows, trans
+
+
+def merge(sources: list[str], out: str) -> tuple[list[dict], list[dict]]:
+    """Combine the ``phase.csv`` of several runs (e.g. one per branch, run
+    at the same time) into ``out``: its ``phase.csv``, ``transitions.csv``
+    (without the reference's crossings) and ``summary.md``."""
+    rows: list[dict] = []
+    for src in sources:
+        rows += read_rows(os.path.join(src, "phase.csv"))
+    os.makedirs(out, exist_ok=True)
+    write_rows(os.path.join(out, "phase.csv"), rows)
+    rows = read_rows(os.path.join(out, "phase.csv"))
+    trans = transitions(rows)
+    write_transitions(os.path.join(out, "transitions.csv"), trans)
+    with open(os.path.join(out, "summary.md"), "w") as fh:
+        fh.write(phase_plot.summary_markdown(rows, trans))
+    return rows, trans
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``pyevolver study phase`` (see the module docstring); returns the exit code."""
+    p = argparse.ArgumentParser(prog="pyevolver study phase",
+                                description=__doc__.split("\n")[0])
+    add_args(p)
+    return run_args(p.parse_args(argv))
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--nv", type=int, default=642, help="vertices per mesh (about)")
+    p.add_argument("--vmin", type=float, default=0.5)
+    p.add_argument("--vmax", type=float, default=0.95)
+    p.add_argument("--step", type=float, default=0.025)
+    p.add_argument("--volumes", default=None,
+                   help="comma-separated reduced volumes (instead of the grid)")
+    p.add_argument("--c0", type=float, default=0.0, help="only 0 is supported")
+    p.add_argument("--branches", default=",".join(BRANCHES))
+    p.add_argument("--out", default="phase_out", help="output folder")
+    p.add_argument("--no-plot", dest="plot", action="store_false")
+    p.add_argument("--no-eigen", dest="eigen", action="store_false",
+                   help="skip the Hessian eigenvalues")
+    p.add_argument("--merge", metavar="DIR1,DIR2,...", default=None,
+                   help="only combine these runs' phase.csv into --out (no solving)")
+
+
+def run_args(args: argparse.Namespace) -> int:
+    if args.merge:
+        rows, trans = merge(args.merge.split(","), args.out)
+        _print_transitions(trans)
+        return 0
+    volumes = (grid(args.vmin, args.vmax, args.step) if args.volumes is None
+               else [float(x) for x in args.volumes.split(",")])
+    rows, trans = run(nv=args.nv, volumes=volumes,
+                      branches=tuple(args.branches.split(",")), out=args.out, c0=args.c0,
+                      plot=args.plot, eigen=args.eigen,
+                      log=lambda t: print(t, flush=True))
+    _print_transitions(trans)
+    return 0 if all(r["converged"] is True for r in rows) else 1
+
+
+def _print_transitions(trans):
+    for t in trans:
+        v = "none" if t["v"] is None else f"{t['v']:.4f}"
+        vr = "none" if t["v_ref"] is None else f"{t['v_ref']:.4f}"
+        print(f"transition {t['from']}/{t['to']}: v = {v} (reference {vr}, "
+              f"published {t['v_published']})")
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
