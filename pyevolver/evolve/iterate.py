@@ -29,10 +29,11 @@ def _solve(A, d):
     multipliers)."""
     A = np.asarray(A, dtype=float)
     if A.size and np.all(np.isfinite(A)) and np.all(np.isfinite(d)) \
-            and np.linalg.cond(A) >= 1e10:
+            and (A[0, 0] == 0 if A.shape == (1, 1) else np.linalg.cond(A) >= 1e10):
         # dependent constraint gradients (an icosahedron's area and volume
         # gradients are both radial): the minimum-norm least-squares step
         # instead of coefficients of 1e13 whose cancellation is round-off
+        # (1 x 1: the condition number is 1, or infinite for 0)
         return np.linalg.lstsq(A, d, rcond=1e-10)[0]
     try:
         return np.linalg.solve(A, d)        # non-finite values: the caller restores

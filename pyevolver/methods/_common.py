@@ -7,6 +7,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..geometry.kernels import cross
+
 
 def scatter(nv: int, idx: np.ndarray, vecs: np.ndarray) -> np.ndarray:
     """Sum per-corner vectors ``vecs (m, 3)`` into vertices ``idx (m,)``."""
@@ -26,8 +28,8 @@ def facet_points(t) -> np.ndarray:
 def n2_grad_dot(P: np.ndarray, D: np.ndarray) -> np.ndarray:
     """Per-corner gradients of D . N2, N2 = (x1-x0) x (x2-x0), D per facet."""
     g = np.empty_like(P)
-    g[:, 1] = np.cross(P[:, 2] - P[:, 0], D)
-    g[:, 2] = np.cross(D, P[:, 1] - P[:, 0])
+    g[:, 1] = cross(P[:, 2] - P[:, 0], D)
+    g[:, 2] = cross(D, P[:, 1] - P[:, 0])
     g[:, 0] = -g[:, 1] - g[:, 2]
     return g
 
