@@ -10,6 +10,15 @@ import scipy.sparse as sp
 from ..geometry.kernels import cross
 
 
+def finite(x: np.ndarray) -> np.ndarray:
+    """``np.nan_to_num(x)`` for an array ``x`` the caller has just made (it is
+    changed in place, and returned as it is when all finite, the usual
+    case: a tenth of nan_to_num's time, which counts on small surfaces)."""
+    if np.isfinite(x).all():
+        return x
+    return np.nan_to_num(x, copy=False)
+
+
 def scatter(nv: int, idx: np.ndarray, vecs: np.ndarray) -> np.ndarray:
     """Sum per-corner vectors ``vecs (m, 3)`` into vertices ``idx (m,)``."""
     out = np.empty((nv, 3))

@@ -24,7 +24,7 @@ from . import metric as MT
 from .jets import skew
 from ..model.formulas import located
 from ._common import (assemble, assemble_projected, corner_scatter, edge_pullback, facet_points,
-                      n2_grad_dot, scatter)
+                      finite, n2_grad_dot, scatter)
 from .registry import register_method
 
 # ---------------------------------------------------------------------------
@@ -114,7 +114,7 @@ def facet_area_grad(t, euclidean=False):
     N2 = t.facet_N2
     with np.errstate(all="ignore"):
         n = N2 / np.linalg.norm(N2, axis=1)[:, None]
-    n = np.nan_to_num(n)
+    n = finite(n)
     g = np.empty_like(P)
     g[:, 0] = 0.5 * G.cross(n, P[:, 2] - P[:, 1])      # (np.cross's products, less overhead)
     g[:, 1] = 0.5 * G.cross(n, P[:, 0] - P[:, 2])

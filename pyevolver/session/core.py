@@ -507,10 +507,11 @@ class Session(SessionAPI):
         return results.finish(self)
 
     def _steps(self, n, callback, echo, results, bar):
+        start = None
         for k in range(n, 0, -1):
             self.interp.tick()
             it = self.iterator
-            r = it.step()
+            r = it.step(start=start)
             # what the step did, kept by the session: the motion (the v_force,
             # v_oldx, v_velocity attributes), the optimized scale, the totals,
             # the iteration count and the time
@@ -546,6 +547,11 @@ class Session(SessionAPI):
                 break
             if callback is not None and callback(r):
                 break
+            # the next step starts from this evaluation when nothing changed it
+            # (no autopop or autochop; a callback of the API may change anything)
+            chain = (self.totals is r.totals and getattr(callback, "pure", callback is None)
+                     and not self.toggles.get("autopop") and not self.toggles.get("autochop"))
+            start = r.totals if chain else None
 
     def go(self, n: int) -> None:
         """``g n`` at the prompt: steps with progress lines.
@@ -554,7 +560,10 @@ class Session(SessionAPI):
         step: the step completes, the run stops and the surface is the one
         after that step."""
         with _deferred_sigint() as flag:
-            self.g(n, echo=True, callback=lambda r: flag["hit"])
+            def stop(r):
+                return flag["hit"]
+            setattr(stop, "pure", True)     # (changes nothing: steps may chain their evaluations)
+            self.g(n, echo=True, callback=stop)
         if flag["hit"]:
             # the rest of the command (an enclosing loop too) is abandoned; the
             # surface is the one after the last complete iteration
