@@ -28,6 +28,11 @@ def _solve(A, d):
     """``A⁻¹ d``, least squares when A is singular (restoring coefficients,
     multipliers)."""
     A = np.asarray(A, dtype=float)
+    if A.shape == (1, 1) and A[0, 0] != 0 and math.isfinite(A[0, 0]) and \
+            np.all(np.isfinite(d)):
+        # one fixed value (a body): LAPACK's solve of a 1 x 1 system is this
+        # division, bit for bit, at a tenth of the cost
+        return np.asarray(d, dtype=float) / A[0, 0]
     if A.size and np.all(np.isfinite(A)) and np.all(np.isfinite(d)) \
             and (A[0, 0] == 0 if A.shape == (1, 1) else np.linalg.cond(A) >= 1e10):
         # dependent constraint gradients (an icosahedron's area and volume
@@ -109,7 +114,9 @@ class StepResult:
     the evaluation of the surface after the step.  ``motion``: the force
     (nv, 3), the moving vertices' starting coordinates (nv, 3) and the
     motion direction (nv, 3) of a ``g`` step, with its surface first (read
-    by the ``v_force``, ``v_oldx`` and ``v_velocity`` attributes).
+    by the ``v_force``, ``v_oldx`` and ``v_velocity`` attributes).  In the
+    list that ``g n`` returns, only the last step keeps its ``totals``
+    and ``motion`` (a few megabytes each on large surfaces).
     """
 
     energy: float

@@ -19,6 +19,18 @@ def finite(x: np.ndarray) -> np.ndarray:
     return np.nan_to_num(x, copy=False)
 
 
+def csr_matvec(M, x: np.ndarray) -> np.ndarray:
+    """``M @ x`` for a sparse matrix ``M`` and a vector ``x``: for CSR the
+    same products summed in the same order as scipy's (each row from 0, in
+    stored order), so the same numbers, without scipy's call overhead (a
+    fifth of a small surface's evaluation: the bodies' volumes)."""
+    if getattr(M, "format", None) != "csr" or x.ndim != 1 or x.dtype != np.float64 \
+            or M.dtype != np.float64:
+        return M @ x
+    rows = np.repeat(np.arange(M.shape[0]), np.diff(M.indptr))
+    return np.bincount(rows, weights=M.data * x[M.indices], minlength=M.shape[0])
+
+
 def scatter(nv: int, idx: np.ndarray, vecs: np.ndarray) -> np.ndarray:
     """Sum per-corner vectors ``vecs (m, 3)`` into vertices ``idx (m,)``."""
     out = np.empty((nv, 3))

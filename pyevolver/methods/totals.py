@@ -14,6 +14,7 @@ from ..errors import PyEvolverError, UnsupportedError
 from ..geometry import kernels as G
 from ..model.records import convex_edges, torus_lift_shifts
 from ..model.groups import group_of
+from ._common import csr_matvec
 from .group_geometry import totals_geometry
 from ..model.surface import HOOKS, Quantity, Surface
 from . import metric as MT
@@ -244,7 +245,7 @@ class Totals:
         b = s.bodies
         if not b.n:
             return np.zeros(0)
-        vols = b.facet_matrix @ self.facet_volume
+        vols = csr_matvec(b.facet_matrix, self.facet_volume)
         if self.con_content is not None:
             # edge content counts toward the bodies of the facets the edge is on
             vols = vols + b.facet_matrix @ self.facet_edge_sum(self.con_content)

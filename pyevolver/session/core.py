@@ -523,6 +523,8 @@ class Session(SessionAPI):
                 self.iteration_counter += 1
                 self.total_time += r.scale
                 r.energy, r.area = self.totals.energy, self.totals.total_area
+            if results:                 # only the last step keeps its arrays (memory)
+                results[-1].totals = results[-1].motion = None
             results.append(r)
             self.history.append((self.iteration_counter, r.energy, r.area))
             if bar is not None:
