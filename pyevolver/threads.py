@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import functools
 import os
-from contextlib import nullcontext
+from contextlib import contextmanager, nullcontext
 from typing import Any, Callable, TypeVar
 
 ENV = "PYEVOLVER_BLAS_THREADS"
@@ -56,13 +56,30 @@ def _control():
     return _controller or None
 
 
+_depth = 0
+
+
+@contextmanager
 def limited():
-    """Context manager: BLAS limited to :func:`setting` threads inside."""
+    """Context manager: BLAS limited to :func:`setting` threads inside
+    (nested uses inside the first one change nothing: the steps of one
+    ``g n`` run under one limit, set once)."""
+    global _depth
+    if _depth:
+        _depth += 1
+        try:
+            yield
+        finally:
+            _depth -= 1
+        return
     n = setting()
     ctl = _control() if n is not None else None
-    if ctl is None:
-        return nullcontext()
-    return ctl.limit(limits=n, user_api="blas")
+    with (nullcontext() if ctl is None else ctl.limit(limits=n, user_api="blas")):
+        _depth = 1
+        try:
+            yield
+        finally:
+            _depth = 0
 
 
 def blas_limited(fn: F) -> F:

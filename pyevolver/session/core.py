@@ -35,6 +35,7 @@ from ..evolve.iterate import IterateSettings, Iterator, _Constraints, progress_l
 from ..evolve.newton import damped_newton, hessian_step
 from ..expr import nodes as N
 from ..limits import MAX_EXPANDED_LINE
+from ..threads import limited
 from ..model.build import build_surface
 from ..remesh.quadratic import from_listed
 from ..remesh.string import split_edges
@@ -500,7 +501,8 @@ class Session(SessionAPI):
             return results.finish(self)
         bar = None if echo else progress_bar(n, progress, "g")
         try:
-            self._steps(n, callback, echo, results, bar)
+            with limited():                     # (once for all the steps: pyevolver.threads)
+                self._steps(n, callback, echo, results, bar)
         finally:
             if bar is not None:
                 bar.close()
