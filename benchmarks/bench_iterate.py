@@ -12,8 +12,8 @@ Surfaces (``make_icosphere.py``, made if missing; default levels 2, 3, 5, 6
 * ``vesicle`` (issue 5; not in the default run): ``star_perp_sq_mean_curvature``,
   tension 0, the area fixed by a quantity and the body volume fixed.
 
-For each surface and program, fresh children run ``PREFIX; q`` and
-``PREFIX; g K; q``, alternating programs and runs; the cost of one ``g`` is
+For each surface and program, fresh children run ``PREFIX; printf; q`` and
+``PREFIX; g K; printf; q``, alternating programs and runs; the cost of one ``g`` is
 the difference of the children's CPU times (user + system, ``os.wait4``)
 divided by K, the median of ``--repeat`` pairs.  K (``--steps``) is by default
 about 400,000 / facets, between 5 and 1,000, so that the small surfaces'
@@ -62,7 +62,7 @@ def measure(programs, f, k, repeat):
         cpu_run(cmd + [f], "q\nq\n", env)
     for _ in range(repeat):
         for name, (cmd, env) in programs.items():
-            base = cpu_run(cmd + [f], PROLATE + "q\nq\n", env)
+            base = cpu_run(cmd + [f], PROLATE + PRINT + "q\nq\n", env)
             full = cpu_run(cmd + [f], PROLATE + f"g {k}\n" + PRINT + "q\nq\n", env)
             cpu[name].append((full[0] - base[0]) / k)
             res[name] = energy(full[2])

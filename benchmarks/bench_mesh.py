@@ -7,8 +7,8 @@ Surfaces (made by ``make_icosphere.py`` if missing): the level-6 icosphere
 tangentially by 0.3 of the mean edge length (seed 0), on which ``u`` has
 thousands of edges to flip (7,720) and ``V`` moves every vertex.
 
-For each command and program, fresh children run ``load; q`` and
-``load; CMD; printf ...; q``, alternating programs and runs; the command's
+For each command and program, fresh children run ``load; printf ...; q``
+and ``load; CMD; printf ...; q``, alternating programs and runs; the command's
 cost is the difference of the children's CPU times (user + system, from
 ``os.wait4``), the median of ``--repeat`` pairs.  Both programs' report
 lines (counts after ``r``, flips of ``u``) and total areas after the command
@@ -66,7 +66,7 @@ def main():
             cpu_run(prog + [f], "q\nq\n", env)
         for _ in range(a.repeat):
             for name, (prog, env) in programs.items():
-                base = cpu_run(prog + [f], "q\nq\n", env)
+                base = cpu_run(prog + [f], PRINT + "q\nq\n", env)
                 full = cpu_run(prog + [f], f"{cmd}\n{PRINT}q\nq\n", env)
                 cpu[name].append(full[0] - base[0])
                 res[name] = report(full[2])
