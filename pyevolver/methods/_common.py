@@ -27,7 +27,12 @@ def csr_matvec(M, x: np.ndarray) -> np.ndarray:
     if getattr(M, "format", None) != "csr" or x.ndim != 1 or x.dtype != np.float64 \
             or M.dtype != np.float64:
         return M @ x
-    rows = np.repeat(np.arange(M.shape[0]), np.diff(M.indptr))
+    cached = M.__dict__.get("_rows_of_entries")
+    if cached is not None and cached[0] is M.indptr and len(cached[1]) == len(M.data):
+        rows = cached[1]
+    else:                       # (kept on the matrix while its structure is the same)
+        rows = np.repeat(np.arange(M.shape[0]), np.diff(M.indptr))
+        M.__dict__["_rows_of_entries"] = (M.indptr, rows)
     return np.bincount(rows, weights=M.data * x[M.indices], minlength=M.shape[0])
 
 
