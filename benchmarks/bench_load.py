@@ -153,6 +153,8 @@ def child_env(root=None):
     env = dict(os.environ)
     if env.pop("PYTHONDONTWRITEBYTECODE", None) is not None:
         env.setdefault("PYTHONPYCACHEPREFIX", os.path.join("/tmp", "pyevolver_bench_pycache"))
+    if root is None and os.path.isdir(os.path.join(REPO, "pyevolver")):
+        root = REPO                 # this checkout (as the other scripts), not an installed one
     if root is not None:
         env["PYTHONPATH"] = os.path.abspath(root)
     elif importlib.util.find_spec("pyevolver") is None and \

@@ -21,6 +21,8 @@ import importlib.util
 import os
 import sys
 
+import numpy
+
 #: numpy's submodules that numpy itself imports on first attribute access
 #: and that pyevolver needs at most in a few commands (``jiggle``'s random).
 LAZY_SUBMODULES = ("f2py", "testing", "random", "fft", "ma", "ctypeslib", "polynomial")
@@ -42,7 +44,6 @@ def lazy_numpy_submodules() -> list[str]:
     if _done or os.environ.get("PYEVOLVER_LAZY_NUMPY", "1") == "0":
         return []
     _done = True
-    import numpy
     done = []
     for short in LAZY_SUBMODULES:
         name = "numpy." + short

@@ -446,10 +446,8 @@ class Iterator:
         settings : IterateSettings, optional
             Replaces :attr:`settings` (kept for later steps and moves).
         start : Totals, optional
-            The previous step's ``totals``, when the caller changed nothing
-            since (the steps of one ``g n``): taken as the evaluation the
-            step starts from if the coordinates are still those it was made
-            at, instead of evaluating them again.
+            The previous step's ``totals`` when nothing changed since (one
+            ``g n``): the start's evaluation if the coordinates are the same.
 
         Returns
         -------
@@ -666,10 +664,8 @@ class Iterator:
             qp[q.name] = q.pressure
             k += 1
         self.pressures_valid = True
-        if settings.jiggle:
+        if settings.jiggle:     # (else t is the final move's evaluation, where it ended)
             t = s.evaluate()
-        # (else t is the evaluation of these coordinates already: the moves
-        # return the evaluation where they end)
         self._end = (t, s.X.copy())
         return StepResult(t.energy, t.total_area, scale,
                           b.lagrange.copy() if b.n else np.zeros(0), qp, True,
