@@ -62,6 +62,7 @@ def pyevolver_env(root):
     them, as an installed package has them)."""
     env = dict(os.environ)
     env["PYTHONPATH"] = os.path.abspath(root)
+    env["PYTHONSAFEPATH"] = "1"     # (else -m and -c put the working directory's package first)
     if env.pop("PYTHONDONTWRITEBYTECODE", None) is not None:
         env.setdefault("PYTHONPYCACHEPREFIX", os.path.join("/tmp", "pyevolver_bench_pycache"))
     return env

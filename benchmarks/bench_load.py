@@ -157,6 +157,7 @@ def child_env(root=None):
         root = REPO                 # this checkout (as the other scripts), not an installed one
     if root is not None:
         env["PYTHONPATH"] = os.path.abspath(root)
+        env["PYTHONSAFEPATH"] = "1"     # (else -c puts the working directory's package first)
     elif importlib.util.find_spec("pyevolver") is None and \
             os.path.isdir(os.path.join(REPO, "pyevolver")):
         env["PYTHONPATH"] = os.pathsep.join(
