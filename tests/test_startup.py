@@ -6,6 +6,10 @@ import os
 import subprocess
 import sys
 
+import numpy
+
+from pyevolver.startup import LAZY_SUBMODULES, lazy_numpy_submodules
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 HEAVY = ["meshio", "scipy.sparse.linalg", "scipy.linalg", "numpy.f2py.crackfortran", "unittest",
@@ -48,3 +52,11 @@ def test_load_and_quit_imports_no_heavy_optional_modules_that_work_when_used():
     assert ref[0] == "True []"
     assert out[2:] == ref[1:]
     assert out[3:] == ["[2.0, 0.0]", "['evolver'] 24"]
+
+
+def test_registered_once_and_only_numpys_optional_submodules():
+    # (this process imported pyevolver: the call at import was the first)
+    assert lazy_numpy_submodules() == []
+    for short in LAZY_SUBMODULES:
+        assert f"numpy.{short}" in sys.modules and getattr(numpy, short) is \
+            sys.modules[f"numpy.{short}"]
