@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import functools
 import os
+import sys
 from contextlib import contextmanager, nullcontext
 from typing import Any, Callable, TypeVar
 
@@ -42,17 +43,23 @@ def setting() -> int | None:
     return n if n > 0 else None
 
 
+_modules_seen = -1
+
+
 def _control():
-    """A threadpoolctl controller of the BLAS libraries loaded now (made once;
-    None without threadpoolctl)."""
-    global _controller
-    if _controller is None:
+    """A threadpoolctl controller of the BLAS libraries loaded now (made
+    again when modules were imported since: scipy's linear algebra, which
+    brings its own BLAS, is imported when first used; None without
+    threadpoolctl)."""
+    global _controller, _modules_seen
+    if _controller is None or (_controller and len(sys.modules) != _modules_seen):
         try:
             from threadpoolctl import ThreadpoolController
         except ImportError:
             _controller = False
         else:
             _controller = ThreadpoolController()
+            _modules_seen = len(sys.modules)
     return _controller or None
 
 
