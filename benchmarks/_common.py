@@ -49,3 +49,50 @@ def wall(cmd, stdin, repeat):
         best = dt if best is None else min(best, dt)
         out = p.stdout
     return best, out
+
+
+#: The prolate start of bench_hessian.py and bench_iterate.py: the sphere
+#: stretched along z, its body's target set to the new volume, two steps.
+PROLATE = "set vertex z z*1.5\nset body target body[1].volume\ng 2\n"
+
+
+def pyevolver_env(root):
+    """Environment whose ``python -m pyevolver`` is the checkout at ``root``
+    (compiled modules cached in /tmp when the environment forbids writing
+    them, as an installed package has them)."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.path.abspath(root)
+    env["PYTHONSAFEPATH"] = "1"     # (else -m and -c put the working directory's package first)
+    if env.pop("PYTHONDONTWRITEBYTECODE", None) is not None:
+        env.setdefault("PYTHONPYCACHEPREFIX", os.path.join("/tmp", "pyevolver_bench_pycache"))
+    return env
+
+
+def cpu_run(cmd, stdin, env=None):
+    """Run ``cmd`` with ``stdin``: (CPU seconds user + system of the child
+    from ``os.wait4``, its peak RSS in MB, its output); exits on a failure."""
+    p = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True, env=env)
+    p.stdin.write(stdin)
+    p.stdin.close()
+    out = p.stdout.read()
+    p.stdout.close()
+    _, status, ru = os.wait4(p.pid, 0)
+    p.returncode = os.waitstatus_to_exitcode(status)    # tell Popen it is reaped
+    if p.returncode != 0:
+        raise SystemExit(f"{cmd[0]} failed: {out[-800:]}")
+    return ru.ru_utime + ru.ru_stime, ru.ru_maxrss / 1024.0, out
+
+
+def write_doc(path, tag, text):
+    """Put ``text`` into the Markdown file ``path`` between the markers
+    ``<!-- TAG -->`` and ``<!-- /TAG -->`` (appended when missing)."""
+    begin, end = f"<!-- {tag} -->", f"<!-- /{tag} -->"
+    old = open(path).read() if os.path.exists(path) else ""
+    block = f"{begin}\n{text}\n{end}"
+    if begin in old and end in old:
+        new = old[:old.index(begin)] + block + old[old.index(end) + len(end):]
+    else:
+        new = old.rstrip("\n") + "\n\n" + block + "\n"
+    with open(path, "w") as fh:
+        fh.write(new)

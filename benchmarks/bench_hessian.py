@@ -206,6 +206,7 @@ def main():
     a = ap.parse_args()
     env = dict(os.environ)
     env["PYTHONPATH"] = os.path.abspath(a.pyevolver)
+    env["PYTHONSAFEPATH"] = "1"     # (else -m puts the working directory's package first)
     programs = {"py": ([sys.executable, "-m", "pyevolver"], env),
                 # REF single-threaded: with worker threads (-p1) its Hessian
                 # of a method quantity loses terms (docs/differences.md)

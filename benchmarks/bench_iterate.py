@@ -1,97 +1,121 @@
 #!/usr/bin/env python3
-"""Per-iteration benchmark: seconds per ``g`` step and per ``hessian`` step,
-pyevolver vs. evolver-nox-d, on icospheres with a fixed body volume.
+"""Per-iteration benchmark (issues 3, 5, 24): CPU time of one ``g`` step,
+pyevolver vs. evolver-nox-d, on prolate icospheres with a fixed body volume.
 
-For each level (default 4, 5, 6 = 5,120, 20,480, 81,920 facets; data made by
-``make_icosphere.py`` if missing) and each program, in fresh processes:
+Surfaces (``make_icosphere.py``, made if missing; default levels 2, 3, 5, 6
+= 320, 1,280, 20,480, 81,920 facets), stretched as in ``bench_hessian.py``
+(``set vertex z z*1.5``, the body's target set to the new volume, ``g 2``):
 
-* evolver-nox-d: wall time of ``load; g K; q`` minus that of ``load; q``
-  (best of ``--repeat``), divided by K; the same with ``hessian``;
-* pyevolver: in one child process, load, one warm-up ``g 1``, then the wall
-  time of ``g K`` / K, then one ``hessian`` (modules imported beforehand, as
-  start-up is subtracted from the Evolver's times too).
+* ``area``: facet tension 1 and the fixed body volume;
+* ``bending``: ``star_perp_sq_mean_curvature`` plus facet tension 1 and the
+  fixed body volume;
+* ``vesicle`` (issue 5; not in the default run): ``star_perp_sq_mean_curvature``,
+  tension 0, the area fixed by a quantity and the body volume fixed.
 
-Both programs' final energies after ``g K`` are printed; they agree to the
-first lines' 1e-9 on these files.  Prints a table with ratios
-(pyevolver / evolver); a ratio below 1 means pyevolver is faster.
+For each surface and program, fresh children run ``PREFIX; printf; q`` and
+``PREFIX; g K; printf; q``, alternating programs and runs; the cost of one ``g`` is
+the difference of the children's CPU times (user + system, ``os.wait4``)
+divided by K, the median of ``--repeat`` pairs.  K (``--steps``) is by default
+about 400,000 / facets, between 5 and 1,000, so that the small surfaces'
+steps are measured over a few tenths of a second.  The Evolver runs without
+worker threads, pyevolver in the default environment.  Both programs'
+energies after the steps are printed (they agree step for step).
 
-    PYTHONPATH=/work/main python benchmarks/bench_iterate.py [--levels 4 5 6] [--steps 5]
+    PYTHONPATH=. python benchmarks/bench_iterate.py [--levels 2 3 5 6] [--cases area bending]
+        [--repeat 3] [--steps K] [--pyevolver ROOT] [--label after] [--doc docs/performance.md]
 
-Goals (issue 3): not slower than the Evolver at 5,120 facets, at least 3x
-faster at 81,920; cost per iteration linear in the facet count.
+``--doc`` writes the table into that Markdown file between the markers
+``<!-- bench_iterate LABEL -->`` and ``<!-- /bench_iterate LABEL -->``.
+Issue 24's goals: ratio (pyevolver / Evolver) at most 1.0 up to 20,480
+facets and at most 0.33 at 81,920 (the "goal" column).
 """
 import argparse
 import os
-import subprocess
+import re
+import statistics
 import sys
 
-from _common import REPO, bending_file, icosphere_file, wall
+from _common import (PROLATE, REPO, bending_file, cpu_run, icosphere_file, pyevolver_env,
+                     write_doc)
 
-CHILD = r"""
-import io, sys, time
-from pyevolver import Session
-import pyevolver.evolve.hessian   # module import (scipy.sparse.linalg, ~0.1 s) is start-up
-s = Session.load(sys.argv[1], out=io.StringIO())
-k = int(sys.argv[2])
-s.g(1)
-t0 = time.perf_counter(); s.g(k); t1 = time.perf_counter()
-e = s.total_energy
-t2 = time.perf_counter()
-if sys.argv[3] == "1":
-    s.hessian(echo=False)
-t3 = time.perf_counter()
-print((t1 - t0) / k, t3 - t2, repr(e))
-"""
+PRINT = 'printf "RESULT %.17g\\n", total_energy\n'
+FILES = {"area": lambda lev: icosphere_file(lev), "bending": bending_file,
+         "vesicle": lambda lev: icosphere_file(lev, vesicle=True)}
+
+
+def goal(nf):
+    return 0.33 if nf >= 81920 else 1.0
+
+
+def energy(out):
+    m = re.findall(r"RESULT (\S+)", out)
+    if not m:
+        raise SystemExit("no RESULT line in:\n" + out[-800:])
+    return float(m[-1])
+
+
+def measure(programs, f, k, repeat):
+    """{program: (median CPU seconds per g, energy after the steps)}."""
+    cpu = {name: [] for name in programs}
+    res = {}
+    for cmd, env in programs.values():          # warm-up (file caches, compiled modules)
+        cpu_run(cmd + [f], "q\nq\n", env)
+    for _ in range(repeat):
+        for name, (cmd, env) in programs.items():
+            base = cpu_run(cmd + [f], PROLATE + PRINT + "q\nq\n", env)
+            full = cpu_run(cmd + [f], PROLATE + f"g {k}\n" + PRINT + "q\nq\n", env)
+            cpu[name].append((full[0] - base[0]) / k)
+            res[name] = energy(full[2])
+    return {name: (statistics.median(cpu[name]), res[name]) for name in programs}
+
+
+def table(rows, label):
+    head = (f"| case ({label}) | facets | steps | pyevolver CPU per `g` [ms] | Evolver CPU per "
+            "`g` [ms] | ratio | goal | pyevolver energy | Evolver energy |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for case, nf, k, py, ref in rows:
+        r = py[0] / ref[0] if ref[0] > 0 else float("inf")
+        lines.append(f"| {case} | {nf:,} | {k} | {1e3 * py[0]:.3f} | {1e3 * ref[0]:.3f} | "
+                     f"{r:.2f} | ≤ {goal(nf):g} {'met' if r <= goal(nf) else 'missed'} | "
+                     f"{py[1]:.12g} | {ref[1]:.12g} |")
+    return "\n".join(lines)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--levels", type=int, nargs="+", default=[4, 5, 6])
-    ap.add_argument("--steps", type=int, default=5)
-    ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--levels", type=int, nargs="+", default=[2, 3, 5, 6])
+    ap.add_argument("--cases", nargs="+", default=["area", "bending"], choices=sorted(FILES))
+    ap.add_argument("--steps", type=int, default=None,
+                    help="g steps per run (default about 400,000 / facets, 5 to 1,000)")
+    ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--evolver", default="evolver-nox-d")
-    ap.add_argument("--vesicle", action="store_true",
-                    help="issue 5: star_perp_sq_mean_curvature energy, area fixed by a "
-                         "quantity and the body volume fixed (no hessian column)")
-    ap.add_argument("--bending", action="store_true",
-                    help="star_perp_sq_mean_curvature energy plus unit surface tension, "
-                         "body volume fixed (no fixed quantity, so REF's hessian runs too)")
+    ap.add_argument("--pyevolver", default=REPO, help="checkout whose pyevolver runs")
+    ap.add_argument("--vesicle", action="store_true", help="the same as --cases vesicle")
+    ap.add_argument("--bending", action="store_true", help="the same as --cases bending")
+    ap.add_argument("--label", default="after")
+    ap.add_argument("--doc", default=None, help="Markdown file to write the table into")
     a = ap.parse_args()
-    env = dict(os.environ)
-    env["PYTHONPATH"] = REPO + os.pathsep + env.get("PYTHONPATH", "")
+    cases = ["vesicle"] * a.vesicle + ["bending"] * a.bending or a.cases
+    programs = {"py": ([sys.executable, "-m", "pyevolver"], pyevolver_env(a.pyevolver)),
+                "ref": ([a.evolver], None)}
     rows = []
     for lev in a.levels:
-        f = bending_file(lev) if a.bending else icosphere_file(lev, vesicle=a.vesicle)
         nf = 20 * 4 ** lev
-        base, _ = wall([a.evolver, "-p1", f], "q\nq\n", a.repeat)
-        gk, out = wall([a.evolver, "-p1", f], f"g 1\ng {a.steps}\nq\nq\n", a.repeat)
-        g1, _ = wall([a.evolver, "-p1", f], "g 1\nq\nq\n", a.repeat)
-        # the Hessian single-threaded (REF's -p1 Hessian loses terms)
-        g1s = g1 if a.vesicle else wall([a.evolver, f], "g 1\nq\nq\n", a.repeat)[0]
-        hs = g1s if a.vesicle else wall([a.evolver, f], "g 1\nhessian\nq\nq\n",
-                                        a.repeat)[0]
-        ref_g = (gk - g1) / a.steps
-        ref_h = hs - g1s
-        ref_e = [l for l in out.splitlines() if "energy:" in l][-1].split("energy:")[1].split()[0]
-        p = subprocess.run([sys.executable, "-c", CHILD, f, str(a.steps),
-                            "0" if a.vesicle else "1"], capture_output=True,
-                           text=True, env=env, timeout=3600)
-        if p.returncode != 0:
-            raise SystemExit("pyevolver failed: " + p.stderr[-800:])
-        py_g, py_h, py_e = p.stdout.split()
-        rows.append((nf, float(py_g), ref_g, float(py_h), ref_h, float(py_e), float(ref_e)))
-        print(f"level {lev}: {nf} facets done", file=sys.stderr)
-    print(f"{'facets':>8} {'py g [s]':>10} {'evolver g':>10} {'ratio':>7} "
-          f"{'py hess':>9} {'ev hess':>9} {'ratio':>7}  energy rel diff")
-    for nf, pg, rg, ph, rh, pe, re_ in rows:
-        hess = (f"{ph:9.3f} {rh:9.3f} {ph / rh:7.2f}" if rh > 0 else f"{'-':>9} {'-':>9} {'-':>7}")
-        print(f"{nf:8d} {pg:10.4f} {rg:10.4f} {pg / rg:7.2f} {hess}  "
-              f"{abs(pe - re_) / abs(re_):.1e}")
-    if len(rows) > 1:
-        a0, a1 = rows[0], rows[-1]
-        print(f"per-facet cost growth (g), {a0[0]} -> {a1[0]} facets: "
-              f"pyevolver x{(a1[1] / a1[0]) / (a0[1] / a0[0]):.2f}, "
-              f"evolver x{(a1[2] / a1[0]) / (a0[2] / a0[0]):.2f}")
+        k = a.steps or max(5, min(1000, round(400000 / nf)))
+        for case in cases:
+            m = measure(programs, FILES[case](lev), k, a.repeat)
+            rows.append((case, nf, k, m["py"], m["ref"]))
+            print(f"{case} {nf} facets: ratio {m['py'][0] / max(m['ref'][0], 1e-12):.2f}, "
+                  f"energies {m['py'][1]!r} {m['ref'][1]!r}", file=sys.stderr)
+    text = table(rows, a.label)
+    print(text)
+    bad = [r for r in rows if abs(r[3][1] - r[4][1]) > 1e-5 * max(1.0, abs(r[4][1]))]
+    for case, nf, *_ in bad:
+        print(f"energies differ: {case} {nf}", file=sys.stderr)
+    if a.doc:
+        write_doc(a.doc, f"bench_iterate {a.label}", text)
+    if bad:
+        sys.exit(2)
 
 
 if __name__ == "__main__":

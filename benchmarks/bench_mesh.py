@@ -1,51 +1,46 @@
 #!/usr/bin/env python3
-"""Mesh-upkeep benchmark (issue 4): one ``r`` and one ``u`` sweep on a surface
-of 81,920 facets, pyevolver vs. evolver-nox-d.
+"""Mesh-upkeep benchmark (issues 4, 24): one ``r``, one ``u`` sweep and one
+``V`` on a surface of 81,920 facets, pyevolver vs. evolver-nox-d, in CPU time.
 
 Surfaces (made by ``make_icosphere.py`` if missing): the level-6 icosphere
 (``r``: 81,920 -> 327,680 facets) and the same sphere with its vertices moved
 tangentially by 0.3 of the mean edge length (seed 0), on which ``u`` has
-thousands of edges to flip (7,720).
+thousands of edges to flip (7,720) and ``V`` moves every vertex.
 
-* evolver-nox-d: wall time of ``load; CMD; q`` minus that of ``load; q``
-  (best of ``--repeat`` fresh processes);
-* pyevolver: in one child process, load, then the wall time of the
-  command (``Session.refine`` / ``Session.equiangulate``; best of
-  ``--repeat`` on fresh loads).
+For each command and program, fresh children run ``load; printf ...; q``
+and ``load; CMD; printf ...; q``, alternating programs and runs; the command's
+cost is the difference of the children's CPU times (user + system, from
+``os.wait4``), the median of ``--repeat`` pairs.  Both programs' report
+lines (counts after ``r``, flips of ``u``) and total areas after the command
+are printed and must agree (the script exits 2 when they do not).  Ratios
+are pyevolver / evolver: below 1 means pyevolver is faster.  Issue 24's
+goals: ``u`` at most 1.0, ``r`` and ``V`` at most 0.5.
 
-Both programs' report lines (counts after ``r``, flips of ``u``) and total
-areas after the command are printed and must agree (the script exits 2 when
-they do not).  Ratios are pyevolver / evolver: below 1 means pyevolver is
-faster.  Goal (issue 4): no slower than the Evolver.
+    PYTHONPATH=. python benchmarks/bench_mesh.py [--level 6] [--repeat 3]
+        [--pyevolver ROOT] [--label after] [--doc docs/performance.md]
 
-    PYTHONPATH=/work/main python benchmarks/bench_mesh.py [--level 6] [--repeat 3]
+``--doc`` writes the table into that Markdown file between the markers
+``<!-- bench_mesh LABEL -->`` and ``<!-- /bench_mesh LABEL -->``.
 """
 import argparse
-import os
-import subprocess
+import re
+import statistics
 import sys
 
-from _common import REPO, icosphere_file, wall
+from _common import REPO, cpu_run, icosphere_file, pyevolver_env, write_doc
 
-CHILD = r"""
-import io, sys, time
-from pyevolver import Session
-import pyevolver.remesh.refine, pyevolver.remesh.equiangulate   # imports are start-up
-path, cmd, repeat = sys.argv[1], sys.argv[2], int(sys.argv[3])
-best = None
-for _ in range(repeat):
-    out = io.StringIO()
-    s = Session.load(path, out=out)
-    t0 = time.perf_counter()
-    if cmd == "r":
-        s.refine()
-    else:
-        s.equiangulate()
-    dt = time.perf_counter() - t0
-    best = dt if best is None else min(best, dt)
-print(best, repr(s.total_area))
-print(out.getvalue().strip().splitlines()[-1])
-"""
+PRINT = 'printf "AREA %.17g\\n", total_area\n'
+COMMANDS = (("r", 0.0, 0.5), ("u", 0.3, 1.0), ("V", 0.3, 0.5))
+
+
+def report(out):
+    """(the command's report line or '', the area after it)."""
+    lines = [ln.replace("Enter command:", "").strip() for ln in out.splitlines()]
+    rep = [ln for ln in lines if ln.startswith(("Vertices:", "Edges switched"))]
+    area = re.findall(r"AREA (\S+)", out)
+    if not area:
+        raise SystemExit("no AREA line in:\n" + out[-800:])
+    return (rep[-1] if rep else ""), float(area[-1])
 
 
 def main():
@@ -53,32 +48,45 @@ def main():
     ap.add_argument("--level", type=int, default=6)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--evolver", default="evolver-nox-d")
+    ap.add_argument("--pyevolver", default=REPO, help="checkout whose pyevolver runs")
+    ap.add_argument("--commands", nargs="+", default=[c for c, _, _ in COMMANDS])
+    ap.add_argument("--label", default="after")
+    ap.add_argument("--doc", default=None, help="Markdown file to write the table into")
     a = ap.parse_args()
-    env = dict(os.environ)
-    env["PYTHONPATH"] = REPO + os.pathsep + env.get("PYTHONPATH", "")
+    programs = {"py": ([sys.executable, "-m", "pyevolver"], pyevolver_env(a.pyevolver)),
+                "ref": ([a.evolver], None)}
     rows, bad = [], False
-    for cmd, jitter in (("r", 0.0), ("u", 0.3)):
+    for cmd, jitter, goal in COMMANDS:
+        if cmd not in a.commands:
+            continue
         f = icosphere_file(a.level, jitter)
-        base, _ = wall([a.evolver, "-p1", f], "q\nq\n", a.repeat)
-        tot, out = wall([a.evolver, "-p1", f],
-                        f'{cmd}\nprintf "AREA %.17g\\n", total_area\nq\nq\n', a.repeat)
-        ref_t = tot - base
-        lines = out.splitlines()
-        ref_report = [l for l in lines if l.startswith(("Vertices:", "Edges switched"))][-1].strip()
-        ref_area = float([l for l in lines if l.startswith("AREA")][-1].split()[1])
-        p = subprocess.run([sys.executable, "-c", CHILD, f, cmd, str(a.repeat)],
-                           capture_output=True, text=True, env=env, timeout=3600)
-        if p.returncode != 0:
-            raise SystemExit("pyevolver failed: " + p.stderr[-800:])
-        first, report = p.stdout.strip().splitlines()
-        py_t, py_area = (float(x) for x in first.split())
-        same = report.strip() == ref_report and abs(py_area - ref_area) <= 1e-12 * ref_area
+        cpu = {k: [] for k in programs}
+        res = {}
+        for prog, env in programs.values():          # warm-up (caches, compiled modules)
+            cpu_run(prog + [f], "q\nq\n", env)
+        for _ in range(a.repeat):
+            for name, (prog, env) in programs.items():
+                base = cpu_run(prog + [f], PRINT + "q\nq\n", env)
+                full = cpu_run(prog + [f], f"{cmd}\n{PRINT}q\nq\n", env)
+                cpu[name].append(full[0] - base[0])
+                res[name] = report(full[2])
+        (prep, parea), (rrep, rarea) = res["py"], res["ref"]
+        same = prep == rrep and abs(parea - rarea) <= 1e-12 * abs(rarea)
         bad |= not same
-        rows.append((cmd, os.path.basename(f), py_t, ref_t, report.strip(), same))
-    print(f"{'cmd':>3} {'surface':>32} {'pyevolver [s]':>14} {'evolver [s]':>12} {'ratio':>6}  "
-          "report (same as REF?)")
-    for cmd, name, pt, rt, rep, same in rows:
-        print(f"{cmd:>3} {name:>32} {pt:14.3f} {rt:12.3f} {pt / rt:6.2f}  {rep} ({same})")
+        py, ref = statistics.median(cpu["py"]), statistics.median(cpu["ref"])
+        rows.append((cmd, 20 * 4 ** a.level, py, ref, goal, prep or "-", same))
+        print(f"{cmd}: ratio {py / ref:.2f}, same as REF: {same}", file=sys.stderr)
+    head = (f"| command ({a.label}) | facets | pyevolver CPU [s] | Evolver CPU [s] | ratio | "
+            "goal | report (same as REF) |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for cmd, nf, py, ref, goal, rep, same in rows:
+        r = py / ref if ref > 0 else float("inf")
+        lines.append(f"| `{cmd}` | {nf:,} | {py:.3f} | {ref:.3f} | {r:.2f} | "
+                     f"≤ {goal:g} {'met' if r <= goal else 'missed'} | {rep} ({same}) |")
+    text = "\n".join(lines)
+    print(text)
+    if a.doc:
+        write_doc(a.doc, f"bench_mesh {a.label}", text)
     if bad:
         sys.exit(2)
 

@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import functools
 import os
-from contextlib import nullcontext
+import sys
+from contextlib import contextmanager, nullcontext
 from typing import Any, Callable, TypeVar
 
 ENV = "PYEVOLVER_BLAS_THREADS"
@@ -42,27 +43,50 @@ def setting() -> int | None:
     return n if n > 0 else None
 
 
+_modules_seen = -1
+
+
 def _control():
-    """A threadpoolctl controller of the BLAS libraries loaded now (made once;
-    None without threadpoolctl)."""
-    global _controller
-    if _controller is None:
+    """A threadpoolctl controller of the BLAS libraries loaded now (made
+    again when modules were imported since: scipy's linear algebra, which
+    brings its own BLAS, is imported when first used; None without
+    threadpoolctl)."""
+    global _controller, _modules_seen
+    if _controller is None or (_controller and len(sys.modules) != _modules_seen):
         try:
             from threadpoolctl import ThreadpoolController
         except ImportError:
             _controller = False
         else:
             _controller = ThreadpoolController()
+            _modules_seen = len(sys.modules)
     return _controller or None
 
 
+_depth = 0
+
+
+@contextmanager
 def limited():
-    """Context manager: BLAS limited to :func:`setting` threads inside."""
+    """Context manager: BLAS limited to :func:`setting` threads inside
+    (nested uses inside the first one change nothing: the steps of one
+    ``g n`` run under one limit, set once)."""
+    global _depth
+    if _depth:
+        _depth += 1
+        try:
+            yield
+        finally:
+            _depth -= 1
+        return
     n = setting()
     ctl = _control() if n is not None else None
-    if ctl is None:
-        return nullcontext()
-    return ctl.limit(limits=n, user_api="blas")
+    with (nullcontext() if ctl is None else ctl.limit(limits=n, user_api="blas")):
+        _depth = 1
+        try:
+            yield
+        finally:
+            _depth = 0
 
 
 def blas_limited(fn: F) -> F:

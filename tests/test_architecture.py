@@ -29,7 +29,8 @@ PKG = ROOT / "pyevolver"
 OPTIONAL = {"matplotlib", "tqdm", "prompt_toolkit", "sksparse", "dask", "distributed",
             "h5py", "PIL", "threadpoolctl", "tomli", "tomllib", "readline", "pexpect",
             "pyvista", "vtk", "imageio_ffmpeg"}
-HEAVY = {"scipy.special", "scipy.sparse.linalg"}
+HEAVY = {"scipy.special", "scipy.sparse.linalg", "scipy.sparse.csgraph",
+         "meshio"}             # (imported where used: start-up time, issue 24)
 MAX_LINES = 800
 
 

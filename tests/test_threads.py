@@ -2,6 +2,7 @@
 PYEVOLVER_BLAS_THREADS, the limit inside the steps and the user's
 setting restored after them."""
 import io
+import sys
 
 import pytest
 from threadpoolctl import threadpool_info
@@ -58,3 +59,15 @@ def test_g_and_hessian_run_limited(monkeypatch):
     s.hessian(echo=False)
     assert len(seen) == 3
     assert set(probe()) <= {1}
+
+
+def test_controller_made_again_after_new_imports(monkeypatch):
+    """scipy's linear algebra (its own BLAS) is imported when first used,
+    after the controller may have been made: a new import makes a new one."""
+    import types
+    first = TH._control()
+    if first is None:
+        pytest.skip("threadpoolctl is not installed")
+    assert TH._control() is first
+    monkeypatch.setitem(sys.modules, "pyevolver_test_new_module", types.ModuleType("x"))
+    assert TH._control() is not first

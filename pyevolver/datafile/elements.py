@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import re
+from array import array
 
 import numpy as np
 from lark.exceptions import UnexpectedInput, VisitError
@@ -19,6 +20,7 @@ from ..expr import nodes as N
 from ..limits import MAX_FACE_EDGES, MAX_ID, MAX_NESTING, nesting_depth
 from .grammar import _LINE, line_parser
 from .located import _LocatedName, _keywords
+from .table import numeric_table
 from .scan import (_BAD_NUMBER, _KW_INTEGER, _KW_NEEDS_VALUE, _LONG, _NUMERIC_HEAD,
                    _NUMERIC_LINE, _binary_minus_in_parens, _long_numeric, _plain_tail)
 
@@ -35,6 +37,13 @@ class ElementSections:
         """
         kind = sec.kind
         block = getattr(self.scene, kind)
+        if not len(block.ids):
+            table = numeric_table(sec.text, sec.line, sec.lines, _LONG)
+            if table is not None:               # a plain table: read at once (datafile.table)
+                vals, lens, src = table
+                block.lines = array("l", src.astype("l").tobytes())
+                self._bulk_values(kind, block, range(len(lens)), vals, lens, whole=True)
+                return
         start = {"vertices": "vertex_line", "edges": "edge_line", "faces": "face_line",
                  "bodies": "body_line"}[kind]
         lines = sec.text.split("\n")
@@ -75,6 +84,7 @@ class ElementSections:
                                  line.index(";") + 1)
             head = long_head if long_kind == "head" else (
                 head_re(line) if len(line) <= _LONG else None)
+            head_vals = None
             try:
                 if head is not None and kind != "edges" or (head is not None and not torus):
                     nums_ = np.fromstring(line[:head.end()], dtype=float, sep=" ")
@@ -85,7 +95,7 @@ class ElementSections:
                                                    start=start)
                         _, items = _LINE.transform(tree)
                     eid = int(line[:head.end()].split()[0])
-                    items = nums_[1:].tolist() + items
+                    head_vals = nums_[1:]        # (kept as an array: a body's 81,920 facets)
                 else:
                     tree = line_parser().parse(line, start=start)
                     eid, items = _LINE.transform(tree)
@@ -110,7 +120,7 @@ class ElementSections:
                 raise self.error(f"expression nested more than {MAX_NESTING} levels deep",
                                  srcline)
             self._cur_line = line
-            self._element(kind, block, eid, items, srcline)
+            self._element(kind, block, eid, items, srcline, head_vals)
             entries += 1
         if numeric_txt:
             self._bulk(kind, block, numeric_pos, numeric_txt)
@@ -121,6 +131,12 @@ class ElementSections:
         vals = np.fromstring(" ".join(texts), dtype=float, sep=" ")
         if vals.size != int(lens.sum()):       # cannot happen for lines that matched
             raise self.error("could not read the numbers of this section", block.lines[positions[0]])
+        self._bulk_values(kind, block, positions, vals, lens,
+                          whole=len(positions) == len(block.ids))
+
+    def _bulk_values(self, kind, block, positions, vals, lens, whole):
+        """Store the numbers ``vals`` of the lines at ``positions`` (``lens``
+        numbers each; ``whole``: they are all of the section's lines)."""
         starts = np.concatenate([[0], np.cumsum(lens)[:-1]])
         what = {"vertices": "vertex", "edges": "edge", "faces": "face", "bodies": "body"}[kind]
 
@@ -152,10 +168,10 @@ class ElementSections:
             vals = vals.astype(np.int64)
         ids = vals[starts].astype(np.int64)
         uniform = bool(np.all(lens == lens[0]))
-        if uniform and len(positions) == len(block.ids):
+        if uniform and whole:
             # the whole section is one table: keep it as arrays
             block.ids = ids
-            block.data = vals.reshape(len(texts), int(lens[0]))[:, 1:]
+            block.data = vals.reshape(len(lens), int(lens[0]))[:, 1:]
             if kind == "vertices" and 1 <= block.data.shape[1] < self.scene.space_dimension:
                 block.data = self._pad_coordinates(block.data, ids, block.lines)
             return
@@ -215,7 +231,10 @@ class ElementSections:
             keep.append(it)
         return keep
 
-    def _element(self, kind, block, eid, items, srcline):
+    def _element(self, kind, block, eid, items, srcline, head=None):
+        """Store one element: its id, the values ``head`` (an array of the
+        plain numbers after the id, or None) followed by ``items``, and its
+        attributes."""
         sc = self.scene
         etype = {"vertices": "vertex", "edges": "edge", "faces": "facet", "bodies": "body"}[kind]
         qnames = set(sc.quantities) | set(sc.method_instances)
@@ -269,6 +288,16 @@ class ElementSections:
             values = [self._value(e, srcline, f"{etype} {eid}") for e in data]
         except _LocatedName as exc:
             raise self._undefined(exc, srcline) from None
+        if head is not None and len(head):
+            values = head.tolist() + values
+            # the head's numbers checked at once when they are all good (else
+            # one by one below, for the message about the first bad one)
+            ok = np.isfinite(head).all()
+            if ok and kind != "vertices":
+                ok = bool((head == np.trunc(head)).all() and (np.abs(head) <= MAX_ID).all())
+            checked = len(head) if ok else 0
+        else:
+            checked = 0
         if not 1 <= eid <= MAX_ID:
             raise self.error(f"{etype} id {eid} is out of range (ids are 1 to {MAX_ID})",
                              srcline, 1)
@@ -279,12 +308,12 @@ class ElementSections:
                       f"{len(values)} instead of {sc.space_dimension} (the rest are 0)", srcline)
             values = values + [0.0] * (sc.space_dimension - len(values))
         if kind == "vertices":
-            for v in values:
+            for v in values[checked:]:
                 if not math.isfinite(v):
                     raise self.error(f"vertex {eid}: coordinate {v:g} is not a finite number",
                                      srcline)
         else:
-            for v in values:
+            for v in values[checked:]:
                 if not (math.isfinite(v) and v == int(v)):
                     raise self.error(f"expected an integer id in {etype} {eid}, got {v:g}", srcline)
                 if abs(v) > MAX_ID:
@@ -293,7 +322,8 @@ class ElementSections:
             if kind == "faces" and len(values) > MAX_FACE_EDGES:
                 raise self.error(f"face {eid} has {len(values)} edges; at most "
                                  f"{MAX_FACE_EDGES} are allowed", srcline)
-            values = [int(v) for v in values]
+            values = ([int(v) for v in values] if not checked else
+                      head.astype(np.int64).tolist() + [int(v) for v in values[checked:]])
         cooked = []
         for kw, args, col in attrs:
             if kw == "quantity":

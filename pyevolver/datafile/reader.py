@@ -19,6 +19,7 @@ from .elements import ElementSections
 from .grammar import line_parser, top_parser
 from .located import _LocatedName, _walk, describe
 from .preprocess import preprocess, read_source
+from .source_lines import SourceLines
 from .top import TopSection
 
 __all__ = ["Reader", "read_datafile", "top_parser", "line_parser"]
@@ -45,7 +46,7 @@ class Reader(TopSection, ElementSections):
     @property
     def src_lines(self):
         if self._src_lines is None:
-            self._src_lines = self.text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+            self._src_lines = SourceLines(self.text)
         return self._src_lines
 
     # -- errors -----------------------------------------------------------

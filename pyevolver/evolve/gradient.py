@@ -141,7 +141,9 @@ def body_volume_gradients(t):
         P = _facet_points(t)
     content = content_edge_terms(t)
     for i in range(b.n):
-        w = np.asarray(Bm.getrow(i).todense()).ravel()
+        w = np.zeros(Bm.shape[1])    # row i dense (as todense() sums: in stored order)
+        lo, hi = Bm.indptr[i], Bm.indptr[i + 1]
+        np.add.at(w, Bm.indices[lo:hi], Bm.data[lo:hi])
         out[i] = corner_scatter(t, vg, w)
         if lift:
             if s.symmetric_content:

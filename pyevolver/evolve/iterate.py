@@ -28,11 +28,17 @@ def _solve(A, d):
     """``A⁻¹ d``, least squares when A is singular (restoring coefficients,
     multipliers)."""
     A = np.asarray(A, dtype=float)
+    if A.shape == (1, 1) and A[0, 0] != 0 and math.isfinite(A[0, 0]) and \
+            np.all(np.isfinite(d)):
+        # one fixed value (a body): LAPACK's solve of a 1 x 1 system is this
+        # division, bit for bit, at a tenth of the cost
+        return np.asarray(d, dtype=float) / A[0, 0]
     if A.size and np.all(np.isfinite(A)) and np.all(np.isfinite(d)) \
-            and np.linalg.cond(A) >= 1e10:
+            and (A[0, 0] == 0 if A.shape == (1, 1) else np.linalg.cond(A) >= 1e10):
         # dependent constraint gradients (an icosahedron's area and volume
         # gradients are both radial): the minimum-norm least-squares step
         # instead of coefficients of 1e13 whose cancellation is round-off
+        # (1 x 1: the condition number is 1, or infinite for 0)
         return np.linalg.lstsq(A, d, rcond=1e-10)[0]
     try:
         return np.linalg.solve(A, d)        # non-finite values: the caller restores
@@ -108,7 +114,9 @@ class StepResult:
     the evaluation of the surface after the step.  ``motion``: the force
     (nv, 3), the moving vertices' starting coordinates (nv, 3) and the
     motion direction (nv, 3) of a ``g`` step, with its surface first (read
-    by the ``v_force``, ``v_oldx`` and ``v_velocity`` attributes).
+    by the ``v_force``, ``v_oldx`` and ``v_velocity`` attributes).  In the
+    list that ``g n`` returns, only the last step keeps its ``totals``
+    and ``motion`` (a few megabytes each on large surfaces).
     """
 
     energy: float
@@ -432,7 +440,7 @@ class Iterator:
 
     # -- the step --------------------------------------------------------------------
     @blas_limited
-    def step(self, settings: IterateSettings | None = None) -> StepResult:
+    def step(self, settings: IterateSettings | None = None, start: Any = None) -> StepResult:
         """One ``g`` step: the motion, the line search (or the fixed
         scale) and the restoring of the fixed values.
 
@@ -440,6 +448,9 @@ class Iterator:
         ----------
         settings : IterateSettings, optional
             Replaces :attr:`settings` (kept for later steps and moves).
+        start : Totals, optional
+            The previous step's ``totals`` when nothing changed since (one
+            ``g n``): the start's evaluation if the coordinates are the same.
 
         Returns
         -------
@@ -454,7 +465,12 @@ class Iterator:
         mobile = self._mobile()
         cons = _Constraints(s)
         _check_freedom(s, mobile, len(cons))
-        t0 = s.evaluate()
+        end = self.__dict__.pop("_end", None)
+        if (start is not None and end is not None and end[0] is start and start.surface is s
+                and end[1].shape == s.X.shape and np.array_equal(end[1], s.X)):
+            t0 = start
+        else:
+            t0 = s.evaluate()
         if settings.diffusion and s.bodies.n:
             self._diffuse(t0, settings)
         f = -GR.energy_gradient(t0)
@@ -651,7 +667,9 @@ class Iterator:
             qp[q.name] = q.pressure
             k += 1
         self.pressures_valid = True
-        t = s.evaluate()
+        if settings.jiggle:     # (else t is the final move's evaluation, where it ended)
+            t = s.evaluate()
+        self._end = (t, s.X.copy())
         return StepResult(t.energy, t.total_area, scale,
                           b.lagrange.copy() if b.n else np.zeros(0), qp, True,
                           warnings=report + warnings, totals=t, motion=motion)

@@ -24,7 +24,6 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 
 def star_measure(t: Any) -> np.ndarray:
@@ -90,6 +89,7 @@ class Mobility:
                 keep = keep & (bnd == 0)
             self.keep = np.nonzero(keep)[0]
             if len(self.keep):
+                import scipy.sparse.linalg as spla   # 0.08 s at start-up: when first used
                 self.lu = spla.splu(S[self.keep][:, self.keep].tocsc())
             return
         if area_normalization:

@@ -113,7 +113,7 @@ def facet_sides(edge_vec, FE, index=None):
     return S
 
 
-def corner_geometry(XT, Fc, symmetric=False):
+def corner_geometry(XT, Fc, symmetric=False, sides=False):
     """Facet areas and volume contributions from coordinates gathered per axis.
 
     Parameters
@@ -122,27 +122,39 @@ def corner_geometry(XT, Fc, symmetric=False):
     Fc : (3, nf) contiguous facet corners (``F.T``)
     symmetric : bool
         Symmetric content ``x0 . N / 6`` instead of the z-flux (spec §4.2).
+    sides : bool
+        Also return the sides ``a = x1 - x0`` and ``b = x2 - x0``, (3, nf) each.
 
     Returns
     -------
-    P : list of three (3, nf) arrays, ``P[axis][corner]``
+    P : (3, 3, nf) array, ``P[axis][corner]``
     N2T : (3, nf) doubled area vectors ``(x1-x0) x (x2-x0)``
     area : (nf,)
     volume : (nf,)
+
+    Each array operation covers the three axes at once (a few dozen numpy
+    calls fewer per evaluation, which matter on small surfaces); every
+    number is the same sum of the same products as component by component.
     """
-    P = [XT[k][Fc] for k in range(3)]
-    a = [P[k][1] - P[k][0] for k in range(3)]
-    b = [P[k][2] - P[k][0] for k in range(3)]
-    N2T = np.empty((3, Fc.shape[1]))
-    N2T[0] = a[1] * b[2] - a[2] * b[1]
-    N2T[1] = a[2] * b[0] - a[0] * b[2]
-    N2T[2] = a[0] * b[1] - a[1] * b[0]
-    area = 0.5 * np.sqrt(N2T[0] * N2T[0] + N2T[1] * N2T[1] + N2T[2] * N2T[2])
+    P = XT.take(Fc, axis=1)             # (take: several times faster than XT[:, Fc])
+    a = P[:, 1] - P[:, 0]
+    b = P[:, 2] - P[:, 0]
+    # N2T[i] = a[i+1] b[i+2] - a[i+2] b[i+1]
+    N2T = a.take(_NEXT, axis=0) * b.take(_NEXT2, axis=0)
+    N2T -= a.take(_NEXT2, axis=0) * b.take(_NEXT, axis=0)
+    sq = N2T * N2T
+    area = 0.5 * np.sqrt(sq[0] + sq[1] + sq[2])
     if symmetric:
         vol = (P[0][0] * N2T[0] + P[1][0] * N2T[1] + P[2][0] * N2T[2]) / 6.0
     else:
         vol = (P[2][0] + P[2][1] + P[2][2]) / 6.0 * N2T[2]
+    if sides:
+        return P, N2T, area, vol, a, b
     return P, N2T, area, vol
+
+
+_NEXT = np.array([1, 2, 0])
+_NEXT2 = np.array([2, 0, 1])
 
 
 def vertex_normals(F, N2, nv, rank=None):

@@ -29,9 +29,12 @@ Files are written atomically (:mod:`pyevolver.atomic`).
 """
 from __future__ import annotations
 
+import importlib.abc
+import importlib.util
 import os
+import sys
+from typing import TYPE_CHECKING
 
-import meshio
 import numpy as np
 
 from ..atomic import atomic_path
@@ -43,6 +46,9 @@ from ..model.arrays import surface_from_arrays
 from ..model.build import build_surface
 from ..model.surface import Surface
 from .fields import surface_fields
+
+if TYPE_CHECKING:
+    import meshio
 
 FORMAT = "evolver"
 
@@ -68,6 +74,7 @@ def surface_mesh(surface, data: bool = True):
     block ``F`` (nf, 3) and, with ``data``, the point and cell data of
     :func:`pyevolver.io.fields.surface_fields`.  Refused in SPACE_DIMENSION
     > 3 (``dump`` writes such a surface)."""
+    import meshio
     s = _surface(surface)
     if s is None:
         raise CommandError("export: no surface is loaded")
@@ -201,6 +208,7 @@ def write_fe(filename: str, mesh, **kwargs) -> None:
 
 def file_format(path) -> str:
     """The meshio format of ``path``, from its extension."""
+    import meshio
     name = os.path.basename(os.fspath(path)).lower()
     parts = name.split(".")
     for k in range(1, len(parts)):
@@ -234,6 +242,7 @@ def export(surface, path: str, fmt: str | None = None, data: bool = True,
 def write_mesh(path, mesh, fmt: str | None = None) -> str:
     """Write a meshio mesh atomically in ``fmt`` (default: by the extension;
     ``evolver`` for ``.fe``) with :data:`WRITE_OPTIONS`."""
+    import meshio
     fmt = fmt or file_format(path)
     if fmt == "xdmf":
         try:
@@ -256,6 +265,55 @@ def write_mesh(path, mesh, fmt: str | None = None) -> str:
 
 
 def register() -> None:
-    """Register the ``.fe`` reader and writer with meshio (idempotent)."""
+    """Register the ``.fe`` reader and writer with meshio (idempotent).
+
+    ``import pyevolver`` calls :func:`register_when_imported` instead:
+    importing meshio takes about 0.1 s, which the start-up of the
+    ``pyevolver`` command does not pay."""
+    import meshio
     if FORMAT not in meshio.extension_to_filetypes.get(".fe", []):
         meshio.register_format(FORMAT, [".fe"], read_fe, {FORMAT: write_fe})
+
+
+class _RegisteringLoader(importlib.abc.Loader):
+    """meshio's own loader, then :func:`register` once meshio is imported."""
+
+    def __init__(self, loader):
+        self.loader = loader
+
+    def create_module(self, spec):
+        return self.loader.create_module(spec)
+
+    def exec_module(self, module):
+        self.loader.exec_module(module)
+        register()
+
+    def __getattr__(self, name):            # get_resource_reader, is_package, ...
+        return getattr(self.loader, name)
+
+
+class _MeshioHook(importlib.abc.MetaPathFinder):
+    """Finds nothing itself: wraps meshio's loader when meshio is imported."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname != "meshio":
+            return None
+        _remove_hook()
+        spec = importlib.util.find_spec(fullname)
+        if spec is not None and spec.loader is not None:
+            spec.loader = _RegisteringLoader(spec.loader)
+        return spec
+
+
+def _remove_hook() -> None:
+    sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, _MeshioHook)]
+
+
+def register_when_imported() -> None:
+    """Register the ``.fe`` format now when meshio is imported, else as soon
+    as it is (``import meshio, pyevolver`` and ``import pyevolver, meshio``
+    both give ``meshio.read("cube.fe")``)."""
+    if "meshio" in sys.modules:
+        register()
+    elif not any(isinstance(f, _MeshioHook) for f in sys.meta_path):
+        sys.meta_path.insert(0, _MeshioHook())

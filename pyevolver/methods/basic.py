@@ -24,7 +24,7 @@ from . import metric as MT
 from .jets import skew
 from ..model.formulas import located
 from ._common import (assemble, assemble_projected, corner_scatter, edge_pullback, facet_points,
-                      group_blocks, has_group_maps, n2_grad_dot, scatter)
+                      finite, group_blocks, has_group_maps, n2_grad_dot, scatter)
 from .registry import register_method
 
 # ---------------------------------------------------------------------------
@@ -114,11 +114,11 @@ def facet_area_grad(t, euclidean=False):
     N2 = t.facet_N2
     with np.errstate(all="ignore"):
         n = N2 / np.linalg.norm(N2, axis=1)[:, None]
-    n = np.nan_to_num(n)
+    n = finite(n)
     g = np.empty_like(P)
-    g[:, 0] = 0.5 * np.cross(n, P[:, 2] - P[:, 1])
-    g[:, 1] = 0.5 * np.cross(n, P[:, 0] - P[:, 2])
-    g[:, 2] = 0.5 * np.cross(n, P[:, 1] - P[:, 0])
+    g[:, 0] = 0.5 * G.cross(n, P[:, 2] - P[:, 1])      # (np.cross's products, less overhead)
+    g[:, 1] = 0.5 * G.cross(n, P[:, 0] - P[:, 2])
+    g[:, 2] = 0.5 * G.cross(n, P[:, 1] - P[:, 0])
     return g
 
 
@@ -140,9 +140,9 @@ def facet_volume_grad(t, symmetric):
     P = facet_points(t)
     if symmetric:
         g = np.empty_like(P)
-        g[:, 0] = np.cross(P[:, 1], P[:, 2]) / 6.0
-        g[:, 1] = np.cross(P[:, 2], P[:, 0]) / 6.0
-        g[:, 2] = np.cross(P[:, 0], P[:, 1]) / 6.0
+        g[:, 0] = G.cross(P[:, 1], P[:, 2]) / 6.0
+        g[:, 1] = G.cross(P[:, 2], P[:, 0]) / 6.0
+        g[:, 2] = G.cross(P[:, 0], P[:, 1]) / 6.0
         return g
     cz = t.facet_N2[:, 2]
     Z = P[:, :, 2].sum(axis=1)

@@ -34,7 +34,8 @@ import numpy as np
 from ..constraints.levelset import curved_constraints, tangent_projectors
 from ..errors import UnsupportedError
 from ..model.records import edge_facets
-from ._common import corner_scatter, facet_points, n2_grad_dot, scatter
+from ._common import corner_scatter, facet_points, finite, n2_grad_dot, scatter
+from ..geometry.kernels import cross
 from .basic import facet_area_grad
 
 # method -> (estimate, honours h_zero, old-style (zero at FIXED / boundary vertices))
@@ -63,6 +64,10 @@ def vertex_weights(nv, idx, w):
     return wv
 
 
+_C1 = np.array([1, 2, 0])         # (c + 1) % 3
+_C2 = np.array([2, 0, 1])         # (c + 2) % 3
+
+
 def star_sums(t):
     """Per-vertex star area ``A`` (nv,), area gradient ``F`` (nv, 3) and sum
     of area vectors ``N`` (nv, 3), from the corners the :class:`Totals`
@@ -88,19 +93,26 @@ def star_sums(t):
                        a[0] * b[1] - a[1] * b[0]])           # (3, nf)
     L = 2.0 * t.facet_area
     with np.errstate(all="ignore"):
-        n = np.nan_to_num(N2 / L)
+        n = finite(N2 / L)
     flat = Fc.ravel()
-    A = 0.5 * np.bincount(flat, weights=np.tile(L, 3), minlength=nv)
+    A = 0.5 * np.bincount(flat, weights=np.concatenate((L, L, L)), minlength=nv)
     N = np.empty((nv, 3))
-    F = np.zeros((nv, 3))
+    F = np.empty((nv, 3))
     for k in range(3):
-        N[:, k] = 0.5 * np.bincount(flat, weights=np.tile(N2[k], 3), minlength=nv)
-    for c in range(3):
-        e = [P[k][(c + 2) % 3] - P[k][(c + 1) % 3] for k in range(3)]   # side opposite c
-        idx = Fc[c]
-        F[:, 0] += np.bincount(idx, weights=0.5 * (n[1] * e[2] - n[2] * e[1]), minlength=nv)
-        F[:, 1] += np.bincount(idx, weights=0.5 * (n[2] * e[0] - n[0] * e[2]), minlength=nv)
-        F[:, 2] += np.bincount(idx, weights=0.5 * (n[0] * e[1] - n[1] * e[0]), minlength=nv)
+        N[:, k] = 0.5 * np.bincount(flat, weights=np.concatenate((N2[k], N2[k], N2[k])),
+                                    minlength=nv)
+    # the side opposite each corner c, e[axis][c] = P[axis][c+2] - P[axis][c+1],
+    # and 0.5 n x e for the three corners at once (W[axis][c]); each axis of F
+    # sums the corners' scatters in the corner order
+    P = np.asarray(P)
+    e = P.take(_C2, axis=1) - P.take(_C1, axis=1)
+    W = n.take(_C1, axis=0)[:, None, :] * e.take(_C2, axis=0)
+    W -= n.take(_C2, axis=0)[:, None, :] * e.take(_C1, axis=0)
+    W *= 0.5
+    for k in range(3):
+        F[:, k] = np.bincount(Fc[0], weights=W[k, 0], minlength=nv)
+        F[:, k] += np.bincount(Fc[1], weights=W[k, 1], minlength=nv)
+        F[:, k] += np.bincount(Fc[2], weights=W[k, 2], minlength=nv)
     return A, F, N
 
 
@@ -251,13 +263,39 @@ def _skipped(s, m=None):
     return skip
 
 
-def _vertex_energy(s, A, F, N, name, m=None):
-    """``E`` (nv,) and its partial derivatives ``dF``, ``dN`` (nv, 3), ``dA``."""
+def _energy_only(s, A, FF, FN, NN, kind, h0, old, m):
+    """The ``E`` of :func:`_vertex_energy`, by the same operations, without
+    the derivatives (the trial moves of ``g`` evaluate energies only)."""
+    with np.errstate(all="ignore"):
+        if kind == "plain":
+            E = 0.75 * FF / A
+        elif kind == "eff":
+            E = 0.75 * A * FF / NN
+        else:
+            if kind == "norm":
+                ok = FN != 0
+                h = np.where(ok, 1.5 * FF / FN, 0.0)
+            else:                               # perp
+                ok = NN > 0
+                h = np.where(ok, 1.5 * FN / NN, 0.0)
+            d = h - (h0 if h0 is not None else 0.0)
+            E = d * d * A / 3.0
+    E = finite(np.asarray(E, float))
+    if old:
+        E[_skipped(s, m)] = 0.0
+    return E
+
+
+def _vertex_energy(s, A, F, N, name, m=None, derivatives=True):
+    """``E`` (nv,) and its partial derivatives ``dF``, ``dN`` (nv, 3), ``dA``
+    (without ``derivatives``: ``E`` and three Nones)."""
     kind, h0, old = _kind(s, name)
     nv = s.nv
     FF = np.einsum("ij,ij->i", F, F)
     FN = np.einsum("ij,ij->i", F, N)
     NN = np.einsum("ij,ij->i", N, N)
+    if not derivatives:
+        return _energy_only(s, A, FF, FN, NN, kind, h0, old, m), None, None, None
     dF = np.zeros((nv, 3))
     dN = np.zeros((nv, 3))
     with np.errstate(all="ignore"):
@@ -288,8 +326,8 @@ def _vertex_energy(s, A, F, N, name, m=None):
             dF = (2 * d * A / 3.0)[:, None] * dhF
             dN = (2 * d * A / 3.0)[:, None] * dhN
             dA = d * d / 3.0
-    E, dA = np.nan_to_num(E), np.nan_to_num(dA)
-    dF, dN = np.nan_to_num(dF), np.nan_to_num(dN)
+    E, dA = finite(np.asarray(E, float)), finite(np.asarray(dA, float))
+    dF, dN = finite(dF), finite(dN)
     if old:
         skip = _skipped(s, m)
         E[skip] = 0.0
@@ -306,7 +344,7 @@ def vertex_values(ctx, m, idx):
     A, F, N = star_sums(ctx)
     rows, P = mirror_projector(s, m)
     F, N = _project(rows, P, F), _project(rows, P, N)
-    E, _, _, _ = _vertex_energy(s, A, F, N, m.method, m)
+    E, _, _, _ = _vertex_energy(s, A, F, N, m.method, m, derivatives=False)
     return E[idx]
 
 
@@ -315,11 +353,11 @@ def _area_hvp(P, n, L, U):
     by facet: the directional derivative of ``∂A/∂x_a = ½ n × e_a``."""
     e = np.stack([P[:, 2] - P[:, 1], P[:, 0] - P[:, 2], P[:, 1] - P[:, 0]], 1)
     de = np.stack([U[:, 2] - U[:, 1], U[:, 0] - U[:, 2], U[:, 1] - U[:, 0]], 1)
-    dN2 = (np.cross(U[:, 1] - U[:, 0], P[:, 2] - P[:, 0])
-           + np.cross(P[:, 1] - P[:, 0], U[:, 2] - U[:, 0]))
+    dN2 = (cross(U[:, 1] - U[:, 0], P[:, 2] - P[:, 0])
+           + cross(P[:, 1] - P[:, 0], U[:, 2] - U[:, 0]))
     with np.errstate(all="ignore"):
-        dn = np.nan_to_num((dN2 - n * np.einsum("ij,ij->i", n, dN2)[:, None]) / L[:, None])
-    return 0.5 * (np.cross(dn[:, None, :], e) + np.cross(n[:, None, :], de))
+        dn = finite((dN2 - n * np.einsum("ij,ij->i", n, dN2)[:, None]) / L[:, None])
+    return 0.5 * (cross(dn[:, None, :], e) + cross(n[:, None, :], de))
 
 
 def vertex_gradient(t, m, idx, w):
@@ -335,7 +373,7 @@ def vertex_gradient(t, m, idx, w):
     P = facet_points(t)
     L = 2.0 * t.facet_area
     with np.errstate(all="ignore"):
-        n = np.nan_to_num(t.facet_N2 / L[:, None])
+        n = finite(t.facet_N2 / L[:, None])
     Ag = facet_area_grad(t)
     wv = vertex_weights(s.nv, idx, w)
     dF, dN, dA = dF * wv[:, None], dN * wv[:, None], dA * wv

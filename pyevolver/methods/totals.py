@@ -14,6 +14,7 @@ from ..errors import PyEvolverError, UnsupportedError
 from ..geometry import kernels as G
 from ..model.records import convex_edges, torus_lift_shifts
 from ..model.groups import group_of
+from ._common import csr_matvec
 from .group_geometry import totals_geometry
 from ..model.surface import HOOKS, Quantity, Surface
 from . import metric as MT
@@ -57,9 +58,10 @@ class Totals:
         elif wrap is None and X.shape[1] == 3:
             # corners gathered one coordinate at a time (several times faster
             # than gathering edge vectors); the torus needs the edge wraps
-            P, N2T, self.facet_area, self.facet_volume = G.corner_geometry(
-                np.ascontiguousarray(X.T), s.facet_corners(), s.symmetric_content)
+            P, N2T, self.facet_area, self.facet_volume, a, b = G.corner_geometry(
+                np.ascontiguousarray(X.T), s.facet_corners(), s.symmetric_content, sides=True)
             self._corner_xyz = P
+            self._corner_sides = (a, b)
             self.facet_N2 = N2T.T
         else:
             self.edge_vec = G.edge_vectors(X, s.E, wrap)
@@ -139,11 +141,15 @@ class Totals:
         return np.stack([P[0][0], P[1][0], P[2][0]], axis=1)
 
     def _make_facet_S(self):
-        P = self._corner_xyz
+        ab = self.__dict__.get("_corner_sides")
+        if ab is None:                  # (a model that gathers the corners itself)
+            P = self._corner_xyz
+            ab = (np.array([P[k][1] - P[k][0] for k in range(3)]),
+                  np.array([P[k][2] - P[k][0] for k in range(3)]))
+        a, b = ab
         S = np.empty((self.surface.nf, 2, 3))
-        for k in range(3):
-            S[:, 0, k] = P[k][1] - P[k][0]
-            S[:, 1, k] = P[k][2] - P[k][0]
+        S[:, 0] = a.T
+        S[:, 1] = b.T
         return S
 
     _LAZY = {"edge_vec": _make_edge_vec, "edge_length": _make_edge_length,
@@ -239,7 +245,7 @@ class Totals:
         b = s.bodies
         if not b.n:
             return np.zeros(0)
-        vols = b.facet_matrix @ self.facet_volume
+        vols = csr_matvec(b.facet_matrix, self.facet_volume)
         if self.con_content is not None:
             # edge content counts toward the bodies of the facets the edge is on
             vols = vols + b.facet_matrix @ self.facet_edge_sum(self.con_content)

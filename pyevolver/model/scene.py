@@ -7,6 +7,7 @@ evolve / remesh -> outputs.
 from __future__ import annotations
 
 from array import array
+from typing import Any
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -101,7 +102,7 @@ class Scene:
     read_line: int = 0
     wraps: dict = field(default_factory=dict)          # edge position -> wrap list
     arrays: dict = field(default_factory=dict)         # global arrays: name -> (type, ndarray)
-    source_lines: list | None = None                   # the text's lines (error excerpts)
+    source_lines: Any = None          # the text's lines (error excerpts; datafile.source_lines)
     constraint_names: dict = field(default_factory=dict)  # id -> name (named constraints)
     boundary_names: dict = field(default_factory=dict)    # id -> name (named boundaries)
     on_assign: dict = field(default_factory=dict)         # parameter -> procedure

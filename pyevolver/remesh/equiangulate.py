@@ -350,8 +350,9 @@ def equiangulate(s, threshold=-0.001, only=None):
     if flips + flips_at_once:
         # an edge's facet loop keeps its start through the flips (REF, ee.facet)
         record_along_first(t, first)
-        for ed, p, q in seq_moves:
-            moves.append((np.array([ed]), np.array([p]), np.array([q])))
+        if seq_moves:               # (one block, in the order flipped)
+            sm = np.array(seq_moves, dtype=np.int64).reshape(-1, 3)
+            moves.append((sm[:, 0], sm[:, 1], sm[:, 2]))
         _flip_rings(s, t, moves)
     t.topology_version = getattr(s, "topology_version", 0) + 1
     return t, flips + flips_at_once

@@ -202,7 +202,9 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
             hi = np.searchsorted(fs, of, "right")
             cnt = hi - lo
             rep = np.repeat(np.arange(len(of)), cnt)
-            kid = order[np.concatenate([np.arange(l, h) for l, h in zip(lo, hi)])] \
+            # the ranges lo[i]:hi[i] one after the other (without a loop)
+            kid = order[np.repeat(lo, cnt) + np.arange(len(rep))
+                        - np.repeat(np.cumsum(cnt) - cnt, cnt)] \
                 if len(rep) else np.zeros(0, np.int64)
             b.occurrences = (np.concatenate([ob, ob[rep]]),
                              np.concatenate([of, s.nf + kid]),

@@ -35,6 +35,7 @@ from ..evolve.iterate import IterateSettings, Iterator, _Constraints, progress_l
 from ..evolve.newton import damped_newton, hessian_step
 from ..expr import nodes as N
 from ..limits import MAX_EXPANDED_LINE
+from ..threads import limited
 from ..model.build import build_surface
 from ..remesh.quadratic import from_listed
 from ..remesh.string import split_edges
@@ -500,17 +501,19 @@ class Session(SessionAPI):
             return results.finish(self)
         bar = None if echo else progress_bar(n, progress, "g")
         try:
-            self._steps(n, callback, echo, results, bar)
+            with limited():                     # (once for all the steps: pyevolver.threads)
+                self._steps(n, callback, echo, results, bar)
         finally:
             if bar is not None:
                 bar.close()
         return results.finish(self)
 
     def _steps(self, n, callback, echo, results, bar):
+        start = None
         for k in range(n, 0, -1):
             self.interp.tick()
             it = self.iterator
-            r = it.step()
+            r = it.step(start=start)
             # what the step did, kept by the session: the motion (the v_force,
             # v_oldx, v_velocity attributes), the optimized scale, the totals,
             # the iteration count and the time
@@ -522,6 +525,8 @@ class Session(SessionAPI):
                 self.iteration_counter += 1
                 self.total_time += r.scale
                 r.energy, r.area = self.totals.energy, self.totals.total_area
+            if results:                 # only the last step keeps its arrays (memory)
+                results[-1].totals = results[-1].motion = None
             results.append(r)
             self.history.append((self.iteration_counter, r.energy, r.area))
             if bar is not None:
@@ -546,6 +551,11 @@ class Session(SessionAPI):
                 break
             if callback is not None and callback(r):
                 break
+            # the next step starts from this evaluation when nothing changed it
+            # (no autopop or autochop; a callback of the API may change anything)
+            chain = (self.totals is r.totals and getattr(callback, "pure", callback is None)
+                     and not self.toggles.get("autopop") and not self.toggles.get("autochop"))
+            start = r.totals if chain else None
 
     def go(self, n: int) -> None:
         """``g n`` at the prompt: steps with progress lines.
@@ -554,7 +564,10 @@ class Session(SessionAPI):
         step: the step completes, the run stops and the surface is the one
         after that step."""
         with _deferred_sigint() as flag:
-            self.g(n, echo=True, callback=lambda r: flag["hit"])
+            def stop(r):
+                return flag["hit"]
+            setattr(stop, "pure", True)     # (changes nothing: steps may chain their evaluations)
+            self.g(n, echo=True, callback=stop)
         if flag["hit"]:
             # the rest of the command (an enclosing loop too) is abandoned; the
             # surface is the one after the last complete iteration

@@ -154,3 +154,22 @@ def test_gram_area_gradient_matches_central_differences():
 def test_scatter_nd_sums_rows_into_vertices():
     out = G.scatter_nd(3, np.array([0, 2, 0]), np.arange(12.0).reshape(3, 4))
     assert out.tolist() == [[8, 10, 12, 14], [0, 0, 0, 0], [4, 5, 6, 7]]
+
+
+def test_corner_geometry_is_the_componentwise_formula_bit_for_bit():
+    """corner_geometry gathers the three axes at once (issue 24): the same
+    products and sums as written out per component, and the sides."""
+    rng = np.random.default_rng(5)
+    X = rng.standard_normal((30, 3)) * 10.0 ** rng.uniform(-3, 3, (30, 1))
+    F = rng.integers(0, 30, size=(50, 3))
+    XT, Fc = np.ascontiguousarray(X.T), np.ascontiguousarray(F.T)
+    P, N2T, area, vol, a, b = G.corner_geometry(XT, Fc, False, sides=True)
+    p = [X[F[:, k]] for k in range(3)]
+    s, t = p[1] - p[0], p[2] - p[0]
+    n = np.stack([s[:, 1] * t[:, 2] - s[:, 2] * t[:, 1], s[:, 2] * t[:, 0] - s[:, 0] * t[:, 2],
+                  s[:, 0] * t[:, 1] - s[:, 1] * t[:, 0]])
+    assert np.array_equal(N2T, n) and np.array_equal(a, s.T) and np.array_equal(b, t.T)
+    assert np.array_equal(area, 0.5 * np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]))
+    assert np.array_equal(vol, (p[0][:, 2] + p[1][:, 2] + p[2][:, 2]) / 6.0 * n[2])
+    _, _, _, vsym = G.corner_geometry(XT, Fc, True)
+    assert np.array_equal(vsym, (p[0][:, 0] * n[0] + p[0][:, 1] * n[1] + p[0][:, 2] * n[2]) / 6.0)

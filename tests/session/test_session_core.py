@@ -105,3 +105,29 @@ def test_quiet_suppresses_notes_only():
     s.write("shown\n")
     s.write_err("err\n")
     assert s.out.getvalue() == "shown\n" and s.err.getvalue() == "err\n"
+
+
+def test_steps_of_one_g_chain_their_evaluations_with_the_same_numbers():
+    """``g 4`` starts each step from the previous step's evaluation (issue 24);
+    four separate ``g 1`` evaluate afresh: the same coordinates bit for bit.
+    Only the last step of the returned list keeps its arrays."""
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "datafiles", "cube.fe")
+    a = Session.load(path, out=io.StringIO())
+    b = Session.load(path, out=io.StringIO())
+    counts = {}
+    for name, sess in (("a", a), ("b", b)):
+        surf = sess.surface
+        evaluate = surf.evaluate
+
+        def counting(*args, _name=name, _evaluate=evaluate, **kw):
+            counts[_name] = counts.get(_name, 0) + 1
+            return _evaluate(*args, **kw)
+        surf.evaluate = counting
+    res = a.g(4)
+    for _ in range(4):
+        b.g(1)
+    assert counts["b"] - counts["a"] == 3          # steps 2 to 4 start from the last
+    assert np.array_equal(a.surface.X, b.surface.X)
+    assert a.totals.energy == b.totals.energy
+    assert res[0].totals is None and res[0].motion is None
+    assert res[-1].totals is a.totals and res[-1].motion is not None
