@@ -84,7 +84,8 @@ def _long_numeric(line):
         vals = np.fromstring(head, dtype=float, sep=" ")
     except ValueError:                  # '1-2', '--3': not plain numbers
         return None, None
-    if vals.size != len(head.split()) or not vals.size or vals[0] != int(vals[0]):
+    if (vals.size != len(head.split()) or not vals.size or not np.isfinite(vals[0])
+            or vals[0] != int(vals[0])):        # (an id of 309 digits and more is inf)
         return None, None
     return ("all", None) if m is None else ("head", _Head(len(head.rstrip())))
 

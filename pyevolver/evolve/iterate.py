@@ -172,8 +172,7 @@ class _Constraints:
             self.redundant = self.bodies[0]
             self.bodies = self.bodies[1:]
         self.quantities = [q for q in s.quantities.values() if q.kind == "fixed"]
-        # REF converts bodies to named quantities when a boundary carries
-        # integrals, and in every symmetry group but the torus
+        # REF makes bodies named quantities (boundary integrals; groups but torus)
         self.named_bodies = any(bd.content is not None or bd.energy is not None
                                 for bd in s.boundaries.values()) \
             or s.symmetry_group not in (None, "torus")

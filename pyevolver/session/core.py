@@ -795,7 +795,6 @@ class Session(SessionAPI):
         if s is None:
             return "<Session: no surface>"
         energy = f"{self.totals.energy:.10g}" if self.totals is not None else "?"
-        nb = s.bodies.n
         return (f"<Session {self.filename or '(no file)'}: {s.nv} vertices, {s.ne} edges, "
-                f"{s.n_facets} facets, {nb} {'body' if nb == 1 else 'bodies'}; "
+                f"{s.n_facets} facets, {s.bodies.n} {'body' if s.bodies.n == 1 else 'bodies'}; "
                 f"energy {energy}>")
