@@ -66,7 +66,9 @@ class ElementSections:
                 block.data.append(None)
                 block.lines.append(srcline)
                 numeric_pos.append(entries)
-                numeric_txt.append(raw)
+                # (a long line was judged with ',' and ':' as separators, as the parser reads them)
+                numeric_txt.append(raw if long_kind is None else
+                                   raw.replace(",", " ").replace(":", " "))
                 entries += 1
                 continue
             if "(" in raw and "-" in raw:
@@ -128,8 +130,11 @@ class ElementSections:
     def _bulk(self, kind, block, positions, texts):
         """Convert pure-numeric lines with one numpy call (no token list)."""
         lens = np.fromiter((len(t.split()) for t in texts), np.int64, len(texts))
-        vals = np.fromstring(" ".join(texts), dtype=float, sep=" ")
-        if vals.size != int(lens.sum()):       # cannot happen for lines that matched
+        try:
+            vals = np.fromstring(" ".join(texts), dtype=float, sep=" ")
+        except ValueError:                     # cannot happen for lines that matched
+            vals = np.empty(0)
+        if vals.size != int(lens.sum()):
             raise self.error("could not read the numbers of this section", block.lines[positions[0]])
         self._bulk_values(kind, block, positions, vals, lens,
                           whole=len(positions) == len(block.ids))

@@ -142,3 +142,16 @@ def test_element_id_beyond_the_float_range_is_located(section):
         Session.load("big.fe", out=io.StringIO(), err=io.StringIO(), text=text)
     msg = str(e.value)
     assert msg.startswith("big.fe:") and ("out of range" in msg or "too large" in msg)
+
+
+@pytest.mark.parametrize("sep", [":", ","])
+def test_long_vertex_line_with_separators_reads_as_a_short_one(sep):
+    # found by the deep hostile fuzz: a long line of numbers and ':' went to
+    # the one-call numeric reader with its colons (ValueError escaped)
+    text = ("STRING\nSPACE_DIMENSION 2\nvertices\n1 0 0\n2 2 0\n3 2.5 {tail}\n"
+            "edges\n1 1 2\n2 2 3\n")
+    short = Session.load("s.fe", out=io.StringIO(), err=io.StringIO(),
+                         text=text.format(tail=sep * 3 + " 7"))
+    long_ = Session.load("l.fe", out=io.StringIO(), err=io.StringIO(),
+                         text=text.format(tail=sep * 3000 + " 7"))
+    assert short.surface.X[2, :2].tolist() == long_.surface.X[2, :2].tolist() == [2.5, 7.0]
