@@ -39,25 +39,10 @@ import statistics
 import subprocess
 import sys
 
-from _common import REPO, bending_file, icosphere_file
+from _common import REPO, bending_file, cpu_run, icosphere_file
 
 PREFIX = "set vertex z z*1.5\nset body target body[1].volume\ng 2\n"
 PRINT = 'printf "RESULT %.17g %.17g %.17g\\n", total_energy, body[1].volume, body[1].target\n'
-
-
-def _popen_wait4(cmd, stdin, env):
-    """Popen without Python's own reaping, so that os.wait4 gets the rusage."""
-    p = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                         stderr=subprocess.STDOUT, text=True, env=env)
-    p.stdin.write(stdin)
-    p.stdin.close()
-    out = p.stdout.read()
-    p.stdout.close()
-    _, status, ru = os.wait4(p.pid, 0)
-    p.returncode = os.waitstatus_to_exitcode(status)    # tell Popen it is reaped
-    if p.returncode != 0:
-        raise SystemExit(f"{cmd[0]} failed: {out[-800:]}")
-    return ru.ru_utime + ru.ru_stime, ru.ru_maxrss / 1024.0, out
 
 
 SOLVERS = r"""
@@ -159,8 +144,8 @@ def measure(programs, f, command, repeat):
     res = {}
     for _ in range(repeat):
         for name, (cmd, env) in programs.items():
-            base = _popen_wait4(cmd + [f], PREFIX + "q\nq\n", env)
-            full = _popen_wait4(cmd + [f], PREFIX + command + "\n" + PRINT + "q\nq\n", env)
+            base = cpu_run(cmd + [f], PREFIX + "q\nq\n", env)
+            full = cpu_run(cmd + [f], PREFIX + command + "\n" + PRINT + "q\nq\n", env)
             cpu[name].append(full[0] - base[0])
             peak[name] = max(peak[name], full[1])
             res[name] = result(full[2])
@@ -223,7 +208,7 @@ def main():
     for lev in a.levels:
         for case in a.cases:
             f = icosphere_file(lev) if case == "area" else bending_file(lev)
-            e0 = result(_popen_wait4([a.evolver, f], PREFIX + PRINT + "q\nq\n",
+            e0 = result(cpu_run([a.evolver, f], PREFIX + PRINT + "q\nq\n",
                                      None)[2])[0]
             for command in a.commands:
                 m = measure(programs, f, command, a.repeat)

@@ -262,6 +262,17 @@ def _quantity_hessian(t, q, weight):
     return out
 
 
+def lagrangian_gradient(cons, lam):
+    """``grad_L(t) -> (nv, 3)``: the gradient of E − Σ λ_i g_i at an
+    evaluation ``t`` (the ``grad_fn`` of :func:`lagrangian_hessian`)."""
+    def grad_L(tt):
+        g = GR.energy_gradient(tt)
+        for lv, gg in zip(lam, cons.gradients(tt) if len(cons) else []):
+            g = g - lv * gg
+        return g
+    return grad_L
+
+
 def lagrangian_hessian(s, cons, lam, grad_fn, basis=None, t=None):
     """Sparse Hessian of E − Σ λ_i g_i (level-set terms excluded): (3nv, 3nv),
     or ``Tᵀ H T`` on a :class:`Basis`; ``t`` the surface's current
@@ -552,12 +563,7 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
                        [q.pressure for q in cons.quantities], dtype=float)
         lam = np.nan_to_num(lam)
 
-    def grad_L(tt):
-        g = GR.energy_gradient(tt)
-        if len(cons):
-            for l, gg in zip(lam, cons.gradients(tt)):
-                g = g - l * gg
-        return g
+    grad_L = lagrangian_gradient(cons, lam)
     if model is not None:           # the string model's motions and energies
         basis, grads = model.basis(s, mobile, normal=normal)
         T = basis.matrix()

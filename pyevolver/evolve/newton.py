@@ -41,8 +41,8 @@ from ..errors import UnsupportedError, dimension_error
 from . import gradient as GR
 from . import hessian_nd
 from .eigen import ShiftedFactor
-from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_hessian,
-                      solve_bordered, tangent_basis)
+from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_gradient,
+                      lagrangian_hessian, solve_bordered, tangent_basis)
 from .iterate import Iterator, StepResult, _Constraints
 from . import symfactor as SF
 from .symfactor import newton_solve
@@ -150,12 +150,7 @@ def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
             lam = np.linalg.lstsq(B, gy, rcond=None)[0]
             d = cons.targets(s) - cons.values(t)
 
-        def grad_L(tt, lam=lam, cons=cons):
-            g = GR.energy_gradient(tt)
-            for l, gg in zip(lam, cons.gradients(tt) if len(cons) else []):
-                g = g - l * gg
-            return g
-        K = lagrangian_hessian(s, cons, lam, grad_L, basis)
+        K = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam), basis)
         gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))
         Hc = constraint_curvature(s, grads, gL)
         if Hc is not None:

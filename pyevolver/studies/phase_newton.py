@@ -11,7 +11,7 @@ import numpy as np
 
 from ..constraints import state
 from ..evolve import gradient as GR
-from ..evolve.hessian import lagrangian_hessian, solve_bordered
+from ..evolve.hessian import lagrangian_gradient, lagrangian_hessian, solve_bordered
 from ..evolve.iterate import _Constraints
 from ..session.core import Session
 from .vesicle_newton import _rigid_motions
@@ -67,12 +67,7 @@ def newton_critical(session: Session, tol: float = 1e-9, maxit: int = 30
         if gnorm < tol and np.all(np.abs(resid) < 1e-10 * np.abs(targets)):
             return True, step, gnorm
 
-        def grad_L(tt, lam=lam):
-            g = GR.energy_gradient(tt)
-            for lv, gg in zip(lam, cons.gradients(tt)):
-                g = g - lv * gg
-            return g
-        H = lagrangian_hessian(s, cons, lam, grad_L).tocsc()
+        H = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam)).tocsc()
         B = np.column_stack([C, _rigid_motions(s.X)])
         d = np.concatenate([resid, np.zeros(B.shape[1] - len(resid))])
         dx = solve_bordered(H, B, -gL, d)[:H.shape[0]].reshape(-1, 3)

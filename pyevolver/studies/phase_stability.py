@@ -25,7 +25,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ..evolve import gradient as GR
-from ..evolve.hessian import lagrangian_hessian, vertex_normals
+from ..evolve.hessian import lagrangian_gradient, lagrangian_hessian, vertex_normals
 from ..evolve.iterate import _Constraints
 from ..session.core import Session
 from .vesicle_newton import _rigid_motions
@@ -62,12 +62,7 @@ def constrained_hessian(session: Session, normal: bool = True, without: tuple = 
         C = np.stack([g.ravel() for g in cons.gradients(t)], 1)
         lam = np.linalg.lstsq(T.T @ C, T.T @ gE.ravel(), rcond=None)[0]
 
-        def grad_L(tt, lam=lam):
-            g = GR.energy_gradient(tt)
-            for lv, gg in zip(lam, cons.gradients(tt)):
-                g = g - lv * gg
-            return g
-        H = lagrangian_hessian(s, cons, lam, grad_L).tocsc()
+        H = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam)).tocsc()
         H = T.T @ (0.5 * (H + H.T)) @ T
         m = np.bincount(s.F.ravel(), weights=np.repeat(t.facet_area, 3), minlength=nv) / 3.0
         if not normal:

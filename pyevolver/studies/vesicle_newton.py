@@ -10,7 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..evolve import gradient as GR
-from ..evolve.hessian import _cholmod, lagrangian_hessian, solve_bordered
+from ..evolve.hessian import _cholmod, lagrangian_gradient, lagrangian_hessian, solve_bordered
 from ..evolve.iterate import _Constraints
 from ..constraints import restore_state, state
 from ..model.surface import Surface
@@ -99,12 +99,7 @@ def newton_lm(session: Session, tol: float = 1e-9, maxit: int = 80, mu: float = 
         if gnorm < tol and np.all(np.abs(resid) < 1e-10 * np.abs(targets)):
             return True, step, gnorm
 
-        def grad_L(tt, lam=lam):
-            g = GR.energy_gradient(tt)
-            for lv, gg in zip(lam, cons.gradients(tt)):
-                g = g - lv * gg
-            return g
-        H = lagrangian_hessian(s, cons, lam, grad_L).tocsc()
+        H = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam)).tocsc()
         mass = sp.diags(np.repeat(np.bincount(s.F.ravel(), weights=np.repeat(t.facet_area, 3),
                                               minlength=s.nv) / 3.0, 3)).tocsc()
         B = np.column_stack([C, _rigid_motions(s.X)])
