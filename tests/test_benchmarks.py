@@ -63,6 +63,12 @@ def test_deep_fuzz_writes_its_counts(tmp_path):
     assert "result: passed" in text and "wrote" in out
     for target in ("reader", "parser", "interpreter"):
         assert f"| hostile {target} (deep) | 50 | 0 | 0 |" in text
+    # the doc written again from the log: the same rows, the run's commit
+    rows = [ln for ln in text.splitlines() if ln.startswith("| hostile")]
+    doc.unlink()
+    _run([os.path.join(BENCH, "deep_fuzz.py"), "--from-log", str(log), "--doc", str(doc)],
+         tmp_path)
+    assert [ln for ln in doc.read_text().splitlines() if ln.startswith("| hostile")] == rows
 
 
 def test_bench_hostile_writes_its_table(tmp_path):
