@@ -294,6 +294,9 @@ class TopSection:
                                  f"{sc.values[name]:g}", self._src(sec, line))
             if fixed:
                 sc.values[name + "_fixed"] = 1.0
+            if name.startswith("integral_order") and not abs(sc.values[name]) <= 1e6:
+                raise self.error(f"{name.upper()} {sc.values[name]:g} is out of range "
+                                 f"(a quadrature order)", self._src(sec, line))
             # the quadrature orders: pyevolver has REF's default rules only
             default = {"integral_order_1d": 3.0, "integral_order_2d": 6.0}.get(name)
             if "quadratic" in sc.flags:     # REF's dump of the quadratic model writes 5 and 3

@@ -155,3 +155,14 @@ def test_long_vertex_line_with_separators_reads_as_a_short_one(sep):
     long_ = Session.load("l.fe", out=io.StringIO(), err=io.StringIO(),
                          text=text.format(tail=sep * 3000 + " 7"))
     assert short.surface.X[2, :2].tolist() == long_.surface.X[2, :2].tolist() == [2.5, 7.0]
+
+
+@pytest.mark.parametrize("order", ["71e308", "-1e400", "(1e400-1e400)"])
+def test_integral_order_beyond_the_float_range_is_located(order):
+    # found by the deep hostile fuzz: INTEGRAL_ORDER 71e308 with a METRIC,
+    # int(inf) escaped as OverflowError
+    text = (f"INTEGRAL_ORDER {order}\nMETRIC\n1 0 0\n0 1 0\n0 0 1\n"
+            "vertices\n1 0 0 0\n2 1 0 0\n3 0 1 0\nedges\n1 1 2\n2 2 3\n3 3 1\nfaces\n1 1 2 3\n")
+    with pytest.raises(DatafileError) as e:
+        Session.load("order.fe", out=io.StringIO(), err=io.StringIO(), text=text)
+    assert str(e.value).startswith("order.fe:1:")
