@@ -116,8 +116,7 @@ class Session(SessionAPI):
 
     def load_file(self, filename: str, run_read: bool = True,
                   text: str | None = None) -> "Session":
-        """Load a datafile into this session (see :meth:`load`); the time
-        limit covers all of it (:mod:`pyevolver.session.deadline`)."""
+        """Load a datafile into this session (:meth:`load`; the time limit covers it all)."""
         try:
             with deadline.limit(self):
                 scene = read_datafile(filename, text)
@@ -128,6 +127,8 @@ class Session(SessionAPI):
         except (deadline.Alarm, I.TimeLimitExceeded):
             raise I.TimeLimitExceeded(f"{filename}: " + deadline.message(
                 self, "loading the datafile")) from None
+        except health.NUMERICAL as exc:          # (a method's matrix of huge input)
+            raise DatafileError(health.explain(exc, load=True), filename) from None
 
     def _install(self, filename, scene, surface, run_read):
         self.filename = filename
@@ -329,7 +330,7 @@ class Session(SessionAPI):
             self._restore(snap)
             raise CommandError(f"{where}:{line}: out of memory; the command was "
                                f"abandoned") from None
-        except (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError) as exc:
+        except health.NUMERICAL as exc:
             self._restore(snap)             # numerical failures in plain words
             raise CommandError(f"{where}:{line}: {health.explain(exc)}") from None
         except Exception as exc:
@@ -392,9 +393,8 @@ class Session(SessionAPI):
 
     def _iterator_state(self):
         it = self._iterator
-        if it is None:
-            return None
-        return (it.cg_history, it.cg_S_old, it.cg_f_old, it.pressures_valid)
+        return None if it is None else (it.cg_history, it.cg_S_old, it.cg_f_old,
+                                        it.pressures_valid)
 
     def _restore(self, snap):
         """Return to a :meth:`_snapshot` (:func:`pyevolver.session.undo.restore`)."""

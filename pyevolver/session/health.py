@@ -65,8 +65,13 @@ def warn_unconverged(session: Any) -> None:
                       f"{tol:g}\n\n")
 
 
-def explain(exc: BaseException) -> str:
-    """A numerical failure inside a command in plain words."""
+#: the numerical failures a command or a load turns into a plain message
+NUMERICAL = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError)
+
+
+def explain(exc: BaseException, load: bool = False) -> str:
+    """A numerical failure inside a command (``load``: in the first
+    evaluation of a loaded datafile) in plain words."""
     text = str(exc).lower()
     if isinstance(exc, np.linalg.LinAlgError) and "singular" in text:
         what = ("a singular linear system (e.g. a constraint whose gradient vanishes at a "
@@ -77,6 +82,9 @@ def explain(exc: BaseException) -> str:
         what = "a division by zero"
     else:
         what = f"a floating-point error ({exc})"
+    if load:
+        return (f"evaluating the loaded surface met {what}: coordinates, attributes or "
+                f"parameters out of range?")
     return f"the command met {what} and was stopped; the surface is as it was before it"
 
 

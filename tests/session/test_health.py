@@ -135,3 +135,19 @@ def test_overflowing_energy_at_load_is_named():
 def test_explain():
     assert "division by zero" in health.explain(ZeroDivisionError())
     assert "could not be solved" in health.explain(np.linalg.LinAlgError("SVD did not converge"))
+
+
+def test_numerical_failure_while_loading_is_a_datafile_error(tmp_path):
+    """Found by the deep hostile fuzz: a reference coordinate of 1e308 made
+    relaxed_elastic's metric not positive definite in the first evaluation
+    of the load (numpy's LinAlgError escaped).  Now a plain message."""
+    text = ("space_dimension 5\nquantity rel info_only method relaxed_elastic global\n"
+            "define vertex attribute ref_coord real[2]\ndefine facet attribute poisson_ratio real\n"
+            "constraint 1 formula: x4 = ref_coord[1]\nconstraint 2 formula: x5 = ref_coord[2]\n"
+            "vertices\n1 0 0 0 0 0 fixed ref_coord 0 0\n"
+            "2 1.2 0 0.1 1 0.1 constraint 1,2 ref_coord 1e308 0\n"
+            "3 0 0.9 0.2 0 1 constraint 1,2 ref_coord 0 1\n"
+            "edges\n1 1 2\n2 2 3\n3 3 1\nfaces\n1 1 2 3\n")
+    with pytest.raises(DatafileError) as e:
+        Session.load("el.fe", out=io.StringIO(), err=io.StringIO(), text=text, run_read=False)
+    assert str(e.value).startswith("el.fe: evaluating the loaded surface met")
