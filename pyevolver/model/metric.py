@@ -85,6 +85,10 @@ def metric_of(sc, error=None) -> Metric | None:
     m = sc.values.get("_metric")
     if m is None:
         return None
+    if m.kind == "matrix" and len(m.comps) != sc.space_dimension ** 2:
+        msg = (f"METRIC has {len(m.comps)} components where SPACE_DIMENSION "
+               f"{sc.space_dimension} needs {sc.space_dimension ** 2}")
+        raise error(msg, m.line) if error is not None else ValueError(msg)
     why = None
     bad = sorted({md.method.lower() for q in sc.quantities.values() for md in q.methods}
                  .union(md.method.lower() for md in sc.method_instances.values())

@@ -166,3 +166,16 @@ def test_integral_order_beyond_the_float_range_is_located(order):
     with pytest.raises(DatafileError) as e:
         Session.load("order.fe", out=io.StringIO(), err=io.StringIO(), text=text)
     assert str(e.value).startswith("order.fe:1:")
+
+
+def test_metric_of_the_wrong_size_is_located():
+    # found by the deep hostile fuzz: metric.fe's STRING line made
+    # "----------1", which continues SPACE_DIMENSION 2's expression (3): a
+    # 2x2 METRIC met three coordinates (IndexError)
+    with open(os.path.join(EX, "metric.fe")) as fh:
+        text = fh.read()
+    assert "STRING" in text
+    with pytest.raises(DatafileError) as e:
+        Session.load("m.fe", out=io.StringIO(), err=io.StringIO(),
+                     text=text.replace("STRING", "----------1"), run_read=False)
+    assert str(e.value).startswith("m.fe:14:") and "METRIC has 4 components" in str(e.value)
