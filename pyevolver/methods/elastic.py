@@ -232,10 +232,13 @@ def _relaxed(t, idx, name):
     P = _strain(t, idx, name)
     n = len(P["A0"])
     ok = P["A0"] > 0
-    Q = np.where(ok[:, None, None], P["Q"], np.eye(2))
+    # a reference metric that overflowed (huge reference coordinates): NaN values
+    bad = ~np.all(np.isfinite(P["Q"]) & np.isfinite(P["F"]), axis=(1, 2))
+    Q = np.where((ok & ~bad)[:, None, None], P["Q"], np.eye(2))
     L = np.linalg.cholesky(Q)                                  # Q = L Lᵀ
-    R = np.swapaxes(L, 1, 2) @ P["F"] @ L                      # symmetric, eigenvalues of FQ
-    mu, r = np.linalg.eigh(R)                                  # ascending
+    R = np.swapaxes(L, 1, 2) @ np.where(bad[:, None, None], 0.0, P["F"]) @ L
+    mu, r = np.linalg.eigh(R)                                  # ascending, of FQ
+    mu[bad] = np.nan
     lam = 0.5 * (mu - 1.0)                                     # eigenvalues of C
     l1, l2 = lam[:, 1], lam[:, 0]
     nu = P["nu"]

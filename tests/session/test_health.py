@@ -137,10 +137,11 @@ def test_explain():
     assert "could not be solved" in health.explain(np.linalg.LinAlgError("SVD did not converge"))
 
 
-def test_numerical_failure_while_loading_is_a_datafile_error(tmp_path):
+def test_relaxed_elastic_reference_that_overflows_loads_with_the_warning(tmp_path):
     """Found by the deep hostile fuzz: a reference coordinate of 1e308 made
     relaxed_elastic's metric not positive definite in the first evaluation
-    of the load (numpy's LinAlgError escaped).  Now a plain message."""
+    of the load (numpy's LinAlgError escaped).  Now its facets' values are
+    NaN and the load warns, as for any overflow."""
     text = ("space_dimension 5\nquantity rel info_only method relaxed_elastic global\n"
             "define vertex attribute ref_coord real[2]\ndefine facet attribute poisson_ratio real\n"
             "constraint 1 formula: x4 = ref_coord[1]\nconstraint 2 formula: x5 = ref_coord[2]\n"
@@ -148,6 +149,22 @@ def test_numerical_failure_while_loading_is_a_datafile_error(tmp_path):
             "2 1.2 0 0.1 1 0.1 constraint 1,2 ref_coord 1e308 0\n"
             "3 0 0.9 0.2 0 1 constraint 1,2 ref_coord 0 1\n"
             "edges\n1 1 2\n2 2 3\n3 3 1\nfaces\n1 1 2 3\n")
+    err = io.StringIO()
+    with np.errstate(all="ignore"):
+        Session.load("el.fe", out=io.StringIO(), err=err, text=text, run_read=False)
+    assert "el.fe: warning: the total energy is " in err.getvalue()      # (NaN or infinite)
+
+
+def test_numerical_failure_while_loading_is_a_datafile_error(monkeypatch):
+    """What is left of a numerical failure in a load's first evaluation is
+    a DatafileError in plain words, not a traceback."""
+    from pyevolver.model import surface as S
+
+    def singular(self):
+        raise np.linalg.LinAlgError("Singular matrix")
+    monkeypatch.setattr(S.Surface, "evaluate", singular)
     with pytest.raises(DatafileError) as e:
-        Session.load("el.fe", out=io.StringIO(), err=io.StringIO(), text=text, run_read=False)
-    assert str(e.value).startswith("el.fe: evaluating the loaded surface met")
+        Session.load("c.fe", out=io.StringIO(), err=io.StringIO(), run_read=False,
+                     text="vertices\n1 0 0 0\n2 1 0 0\n3 0 1 0\nedges\n1 1 2\n2 2 3\n3 3 1\n"
+                          "faces\n1 1 2 3\n")
+    assert str(e.value).startswith("c.fe: evaluating the loaded surface met a singular")
