@@ -48,7 +48,8 @@ def check_scene(builder) -> None:
                      sc.decl_lines.get("surface_dimension"))
     if sc.space_dimension < k:
         raise builder.error(f"SURFACE_DIMENSION {k} is above SPACE_DIMENSION "
-                            f"{sc.space_dimension}", sc.decl_lines.get("surface_dimension"))
+                            f"{sc.space_dimension}", sc.decl_lines.get("surface_dimension")
+                            or sc.decl_lines.get("space_dimension") or line)
     if sc.space_dimension > 6:
         raise refuse(f"SPACE_DIMENSION {sc.space_dimension} (REF's refinement order is "
                      f"known up to 6 dimensions)", sc.decl_lines.get("space_dimension"))

@@ -179,3 +179,13 @@ def test_metric_of_the_wrong_size_is_located():
         Session.load("m.fe", out=io.StringIO(), err=io.StringIO(),
                      text=text.replace("STRING", "----------1"), run_read=False)
     assert str(e.value).startswith("m.fe:14:") and "METRIC has 4 components" in str(e.value)
+
+
+def test_simplex_surface_above_its_space_is_located():
+    # found by the deep hostile fuzz: SPACE_DIMENSION 1 with the default
+    # SURFACE_DIMENSION 2 in the simplex model: the message had no line
+    text = ("SPACE_DIMENSION 1\nSIMPLEX_REPRESENTATION\nvertices\n1 0\n2 1\n3 2\n"
+            "faces\n1 1 2 3\n")
+    with pytest.raises(DatafileError) as e:
+        Session.load("sx.fe", out=io.StringIO(), err=io.StringIO(), text=text)
+    assert str(e.value).startswith("sx.fe:1:") and "above SPACE_DIMENSION 1" in str(e.value)
