@@ -39,7 +39,7 @@ import statistics
 import subprocess
 import sys
 
-from _common import REPO, bending_file, cpu_run, icosphere_file
+from _common import REPO, bending_file, cpu_run, icosphere_file, write_doc
 
 PREFIX = "set vertex z z*1.5\nset body target body[1].volume\ng 2\n"
 PRINT = 'printf "RESULT %.17g %.17g %.17g\\n", total_energy, body[1].volume, body[1].target\n'
@@ -164,18 +164,6 @@ def table(rows, label):
     return "\n".join(lines)
 
 
-def write_doc(path, label, text):
-    begin, end = f"<!-- bench_hessian {label} -->", f"<!-- /bench_hessian {label} -->"
-    old = open(path).read() if os.path.exists(path) else ""
-    block = f"{begin}\n{text}\n{end}"
-    if begin in old and end in old:
-        new = old[:old.index(begin)] + block + old[old.index(end) + len(end):]
-    else:
-        new = old.rstrip("\n") + "\n\n" + block + "\n"
-    with open(path, "w") as fh:
-        fh.write(new)
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--levels", type=int, nargs="+", default=[4, 6])
@@ -202,7 +190,7 @@ def main():
                         (f"bending, {20 * 4 ** lev:,} facets", bending_file(lev))], env)
         print(text)
         if a.doc:
-            write_doc(a.doc, "solvers", text)
+            write_doc(a.doc, "bench_hessian solvers", text)
         return
     rows = []
     for lev in a.levels:
@@ -219,7 +207,7 @@ def main():
     text = table(rows, a.label)
     print(text)
     if a.doc:
-        write_doc(a.doc, a.label, text)
+        write_doc(a.doc, f"bench_hessian {a.label}", text)
 
 
 if __name__ == "__main__":

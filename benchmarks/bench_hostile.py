@@ -37,7 +37,7 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _common import REPO, bending_file, icosphere_file  # noqa: E402
+from _common import REPO, bending_file, icosphere_file, write_doc  # noqa: E402
 
 CUBE = os.path.join(REPO, "datafiles", "cube.fe")
 TRIANGLE = ("vertices\n1 0 0 0\n2 1 0 0\n3 0 1 0\nedges\n1 1 2\n2 2 3\n3 3 1\n"
@@ -153,15 +153,6 @@ def table(rows):
     return "\n".join(out)
 
 
-def write_doc(path, text):
-    start, end = "<!-- bench_hostile -->", "<!-- /bench_hostile -->"
-    with open(path, encoding="utf-8") as fh:
-        doc = fh.read()
-    i, j = doc.index(start), doc.index(end)
-    with open(path, "w", encoding="utf-8") as fh:
-        fh.write(doc[:i + len(start)] + "\n" + text + "\n" + doc[j:])
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeat", type=int, default=3)
@@ -181,7 +172,7 @@ def main(argv=None):
     text = table(rows)
     print(text)
     if a.doc:
-        write_doc(a.doc, text)
+        write_doc(a.doc, "bench_hostile", text)
 
 
 if __name__ == "__main__":
