@@ -27,13 +27,32 @@ def test_bench_load_runs(evolver, tmp_path):
 
 
 @pytest.mark.parametrize("script,args", [
-    ("bench_iterate.py", ["--levels", "2", "--steps", "1", "--repeat", "1"]),
     ("bench_mesh.py", ["--level", "2", "--repeat", "1"]),
     ("bench_startup.py", ["--repeat", "1"]),
 ])
 def test_bench_scripts_run(evolver, tmp_path, script, args):
     out = _run([os.path.join(BENCH, script)] + args, tmp_path)
     assert "ratio" in out.lower() or "| goal" in out
+
+
+def test_bench_all_summarizes_and_plots(evolver, tmp_path):
+    """benchmarks/bench_all.py runs bench_iterate (here level 1, one step)
+    and bench_hessian (level 1), reads their tables back from the document and
+    writes the goals' summary between its markers, and the log-log plot."""
+    doc, png = tmp_path / "perf.md", tmp_path / "perf.png"
+    doc.write_text("intro\n")
+    out = _run([os.path.join(BENCH, "bench_all.py"), "--only", "iterate", "hessian",
+                "--iterate-levels", "1", "--hessian-levels", "1", "--steps", "1",
+                "--repeat", "1", "--label", "t", "--doc", str(doc), "--plot", str(png)], tmp_path)
+    text = doc.read_text()
+    for tag in ("bench_iterate t", "bench_hessian t", "bench_all t"):
+        assert f"<!-- {tag} -->" in text and f"<!-- /{tag} -->" in text
+    summary = text[text.index("<!-- bench_all t -->"):]
+    assert "| `g`, area, 80 facets |" in summary and "| `g`, bending, 80 facets |" in summary
+    assert "| `hessian`, bending, 80 facets | peak [MB] |" in summary
+    assert summary.count("| `") == 2 + 2 * 2 * 4      # g: 2 cases; hessian: 2 × 2 commands × 4 rows
+    assert out.rstrip().endswith(summary[summary.index("| goal"):summary.index("<!-- /")].rstrip())
+    assert png.stat().st_size > 10000
 
 
 def test_bench_hessian_runs(evolver, tmp_path):
