@@ -215,7 +215,12 @@ def _hostile_bodies():
 
     def interp(rng):
         if "s" not in state or rng.random() < 0.05 or state["s"].surface.nf > 1000:
-            s = Session.load(CUBE, out=io.StringIO(), err=io.StringIO())
+            # a copy in the working directory (a temporary one): `dump` with no
+            # file name writes next to the datafile
+            if "cube" not in state:
+                state["cube"] = os.path.abspath("cube.fe")
+                shutil.copyfile(CUBE, state["cube"])
+            s = Session.load(state["cube"], out=io.StringIO(), err=io.StringIO())
             s.run(F.PRELUDE)
             s.time_limit = 0.05
             state["s"] = s
