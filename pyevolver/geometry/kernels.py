@@ -137,6 +137,14 @@ def corner_geometry(XT, Fc, symmetric=False, sides=False):
     number is the same sum of the same products as component by component.
     """
     P = XT.take(Fc, axis=1)             # (take: several times faster than XT[:, Fc])
+    out = geometry_of_corners(P, symmetric)
+    return out if sides else out[:4]
+
+
+def geometry_of_corners(P, symmetric=False):
+    """:func:`corner_geometry` from the gathered corners ``P`` (3, 3, nf):
+    ``(P, N2T, area, volume, a, b)`` (the ``g`` fast path moves the
+    gathered corners themselves, pyevolver.evolve.fastpath)."""
     a = P[:, 1] - P[:, 0]
     b = P[:, 2] - P[:, 0]
     # N2T[i] = a[i+1] b[i+2] - a[i+2] b[i+1]
@@ -148,9 +156,7 @@ def corner_geometry(XT, Fc, symmetric=False, sides=False):
         vol = (P[0][0] * N2T[0] + P[1][0] * N2T[1] + P[2][0] * N2T[2]) / 6.0
     else:
         vol = (P[2][0] + P[2][1] + P[2][2]) / 6.0 * N2T[2]
-    if sides:
-        return P, N2T, area, vol, a, b
-    return P, N2T, area, vol
+    return P, N2T, area, vol, a, b
 
 
 _NEXT = np.array([1, 2, 0])
