@@ -107,6 +107,15 @@ class _Plan:
         b = s.bodies
         self.bodies = [i for i in range(b.n) if not math.isnan(b.target[i])]
         self.body_w = []
+        # one body of all the facets in order, each +1 (csr_matvec's bincount
+        # with the products by 1 left out: the same sum)
+        self.one = None
+        M = b.facet_matrix
+        if b.n == 1 and getattr(M, "format", None) == "csr" and M.nnz == s.nf \
+                and np.array_equal(M.indices, np.arange(s.nf)) and np.all(M.data == 1.0) \
+                and b.volconst is not None and len(b.volconst) == 1:
+            self.one = np.zeros(s.nf, np.int64)
+            self.vc0 = float(b.volconst[0])
         if self.bodies:
             Bm = b.facet_matrix.tocsr()
             for i in self.bodies:
@@ -131,69 +140,87 @@ class _Plan:
         return np.ascontiguousarray(V.T).take(self.Fc, axis=1)
 
     def volumes(self, P, symmetric):
-        """The body volumes at the corners ``P`` (the facet contents only)."""
+        """The constrained bodies' volumes at the corners ``P`` (the facet
+        contents only), a list of floats."""
         if symmetric:
             vol = geometry_of_corners(P, True)[3]
         else:
-            a0 = P[0, 1] - P[0, 0]
-            a1 = P[1, 1] - P[1, 0]
-            b0 = P[0, 2] - P[0, 0]
-            b1 = P[1, 2] - P[1, 0]
-            cz = a0 * b1
-            cz -= a1 * b0
-            vol = (P[2][0] + P[2][1] + P[2][2]) / 6.0 * cz
-        return self.body_volumes(vol)
+            Pxy = P[:2]
+            a = Pxy[:, 1] - Pxy[:, 0]
+            b = Pxy[:, 2] - Pxy[:, 0]
+            cz = a[0] * b[1]
+            cz -= a[1] * b[0]
+            vol = np.add.reduce(P[2], axis=0)       # (z0 + z1) + z2
+            vol /= 6.0
+            vol *= cz
+        return self.constrained(vol)
+
+    def constrained(self, vol):
+        """The constrained bodies' volumes from the facet contents ``vol``:
+        :meth:`body_volumes`' numbers, a list of floats."""
+        if self.one is not None:
+            return [float(np.bincount(self.one, weights=vol, minlength=1)[0]) + self.vc0]
+        vols = self.body_volumes(vol)
+        return [float(vols[i]) for i in self.bodies]
 
     def body_volumes(self, vol):
+        """The body volumes (Totals._volumes without edge contents)."""
         b = self.surface.bodies
         return csr_matvec(b.facet_matrix, vol) + b.volconst
 
-    def volume_grads(self, P, a, b, N2T, symmetric, mobile_off):
+    def volume_grads(self, P, a, b, N2T, symmetric, mobile_off, QE=None):
         """The constrained bodies' volume gradients (nv, 3), zero at the
-        FIXED vertices (as ``body_volume_gradients`` and ``_constrained_dirs``)."""
-        Q0 = P[:, 0]
-        Q1 = Q0 + a                      # (facet_points: x0 + the sides)
-        Q2 = Q0 + b
+        FIXED vertices (as ``body_volume_gradients`` and ``_constrained_dirs``;
+        ``QE``: :func:`_sides` of the corners when known)."""
+        Q, E = _sides(P, a, b) if QE is None else QE
         g = np.empty_like(P)
-        if symmetric:
-            g[:, 0] = _cross(Q1, Q2) / 6.0
-            g[:, 1] = _cross(Q2, Q0) / 6.0
-            g[:, 2] = _cross(Q0, Q1) / 6.0
+        if symmetric:                   # corner c: Q[c+1] x Q[c+2] / 6
+            g[:] = _cross(Q.take(_NEXT, axis=1), Q.take(_NEXT2, axis=1))
+            g /= 6.0
         else:
-            x, y = (Q0[0], Q1[0], Q2[0]), (Q0[1], Q1[1], Q2[1])
-            Z = (Q0[2] + Q1[2] + Q2[2]) / 6.0
-            g[0, 0] = (y[1] - y[2]) * Z
-            g[0, 1] = (y[2] - y[0]) * Z
-            g[0, 2] = (y[0] - y[1]) * Z
-            g[1, 0] = (x[2] - x[1]) * Z
-            g[1, 1] = (x[0] - x[2]) * Z
-            g[1, 2] = (x[1] - x[0]) * Z
-            g[2] = 0.0 * Z                  # (_cz_grad's zeros times Z)
-            g[2] += N2T[2] / 6.0
+            # _cz_grad times Z: corner c's x part y[c+1] - y[c+2] = -E[y][c],
+            # its y part x[c+2] - x[c+1] = E[x][c]; z: cz / 6 (+ 0 Z)
+            Z = np.add.reduce(Q[2], axis=0)
+            Z /= 6.0
+            np.multiply(E[1], -Z, out=g[0])
+            np.multiply(E[0], Z, out=g[1])
+            g[2] = N2T[2] / 6.0
         out = []
+        any_fixed = mobile_off.any()
         for w in self.body_w:
             v = self.scatter(g * w)
-            v[mobile_off] = 0.0
+            if any_fixed:
+                v[mobile_off] = 0.0
             out.append(v)
         return out
 
-    def area_grad(self, P, a, b, N2T, area, tension):
+    def area_grad(self, P, a, b, N2T, area, tension, QE=None):
         """The facet-tension energy gradient (nv, 3) (``facet_area_grad``
         scattered with the tensions)."""
-        Q0 = P[:, 0]
-        Q1 = Q0 + a
-        Q2 = Q0 + b
+        _, E = _sides(P, a, b) if QE is None else QE
         with np.errstate(all="ignore"):
             n = finite(N2T / (2.0 * area))     # (|N2| = 2 area exactly)
-        g = np.empty_like(P)
-        g[:, 0] = 0.5 * _cross(n, Q2 - Q1)
-        g[:, 1] = 0.5 * _cross(n, Q0 - Q2)
-        g[:, 2] = 0.5 * _cross(n, Q1 - Q0)
-        return self.scatter(g * tension)
+        g = _cross(n[:, None, :], E)            # corner c: n x E[c]
+        g *= 0.5
+        g *= tension
+        return self.scatter(g)
+
+
+def _sides(P, a, b):
+    """``facet_points``' corners Q (3 axes, 3 corners, nf) — x0, x0 + a,
+    x0 + b — and the sides opposite each corner, E[c] = Q[c+2] - Q[c+1]."""
+    Q = np.empty_like(P)
+    Q[:, 0] = P[:, 0]
+    np.add(P[:, 0], a, out=Q[:, 1])
+    np.add(P[:, 0], b, out=Q[:, 2])
+    E = Q.take(_NEXT2, axis=1)
+    E -= Q.take(_NEXT, axis=1)
+    return Q, E
 
 
 def _cross(u, v):
-    """Cross products of (3, nf) arrays, component i = u[i+1] v[i+2] - u[i+2] v[i+1]."""
+    """Cross products along the first axis (3, ...): component i is
+    u[i+1] v[i+2] - u[i+2] v[i+1] (G.cross's products)."""
     out = u.take(_NEXT, axis=0) * v.take(_NEXT2, axis=0)
     out -= u.take(_NEXT2, axis=0) * v.take(_NEXT, axis=0)
     return out
@@ -287,22 +314,27 @@ def _step(it, plan, s, settings, t0):
         raise _Fallback
     a0, b0 = t0._corner_sides
     N2T0 = t0.facet_N2.T
+    QE = _sides(P0, a0, b0)
     if area_mode:
-        f = -plan.area_grad(P0, a0, b0, N2T0, t0.facet_area, tension)
+        f = -plan.area_grad(P0, a0, b0, N2T0, t0.facet_area, tension, QE)
     else:
         f = -GR.energy_gradient(t0)
-    motion: tuple = (s, f + 0.0, np.where(~mobile_off[:, None], X0, 0.0))
-    f[mobile_off] = 0.0
+    any_fixed = bool(mobile_off.any())
+    motion: tuple = (s, f + 0.0, np.where(~mobile_off[:, None], X0, 0.0) if any_fixed
+                     else X0.copy())
+    if any_fixed:
+        f[mobile_off] = 0.0
     s._one_sided_released = None
     nb = len(plan.bodies)
     tol = settings.target_tolerance
     if nb:
         targets = [float(s.bodies.target[i]) for i in plan.bodies]
-        gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off)
+        start_vols = [float(t0.volumes[i]) for i in plan.bodies]
+        gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE)
         A = _matrix(gs)
         bvec = np.array([float(np.sum(f * g)) for g in gs])
         lam = _solve(A, bvec)
-        vel = f - sum(lv * u for lv, u in zip(lam, gs))
+        vel = f - _combo(lam, gs)
         Pus = [plan.gather(u) for u in gs]
     else:
         lam = np.zeros(0)
@@ -317,32 +349,37 @@ def _step(it, plan, s, settings, t0):
         if area_mode:
             geom = geometry_of_corners(P, symmetric)
             return geom, float(geom[2] @ tension), \
-                plan.body_volumes(geom[3]) if nb else None
+                plan.constrained(geom[3]) if nb else None
         s.X = X
         t = s.evaluate()
-        return t, t.energy, t.volumes
+        return t, t.energy, [float(t.volumes[i]) for i in plan.bodies]
 
     def diffs(vols):
-        d = [tg - float(vols[i]) for tg, i in zip(targets, plan.bodies)]
+        if nb == 1:
+            d0 = targets[0] - vols[0]
+            return [d0], abs(d0) / tol
+        d = [tg - v for tg, v in zip(targets, vols)]
         return d, sum(abs(x) / tol for x in d)
 
     def move(scale):
         """The move by ``scale``: (geometry or Totals, energy, the
         corrections [(coefficients, directions)])."""
-        P = P0 + scale * Pv
+        # (at scale 0 the corners are P0's, to the sign of a zero: the
+        # volumes are t0's)
+        P = P0 + scale * Pv if scale != 0 else P0
         X = None if area_mode else X0 + scale * vel
         shifts = []
         if not nb:
             g, e, _ = evaluate(P, X)
             return g, e, shifts
-        vols = plan.volumes(P, symmetric)
+        vols = start_vols if scale == 0 else plan.volumes(P, symmetric)
         d, err = diffs(vols)
         cur_us, cur_Pu, cur_A = gs, Pus, A
         for k in range(10):
             delta = _coefficients(cur_A, d)
-            P = P + sum(dl * pu for dl, pu in zip(delta, cur_Pu))
+            P = P + _combo(delta, cur_Pu)
             if X is not None:
-                X = X + sum(dl * u for dl, u in zip(delta, cur_us))
+                X = X + _combo(delta, cur_us)
             shifts.append((delta, cur_us))
             g, e, vols_new = evaluate(P, X)
             d_new, err_new = diffs(vols_new)
@@ -383,7 +420,7 @@ def _step(it, plan, s, settings, t0):
         raise _Fallback
     X = X0 + actual * vel
     for delta, us in shifts:
-        X = X + sum(dl * u for dl, u in zip(delta, us))
+        X = X + _combo(delta, us)
     if not np.all(np.isfinite(X)):
         raise _Fallback
     s.X = X
@@ -404,6 +441,14 @@ def _step(it, plan, s, settings, t0):
     it._end = (t, X.copy())
     return StepResult(t.energy, t.total_area, scale, b.lagrange.copy() if b.n else np.zeros(0),
                       {}, True, warnings=[], totals=t, motion=motion)
+
+
+def _combo(coef, vecs):
+    """``Σ c_i v_i`` (the general step's ``sum(c * v for ...)``; its
+    leading ``0 +`` changes only the sign of a zero)."""
+    if len(vecs) == 1:
+        return coef[0] * vecs[0]
+    return sum(c * v for c, v in zip(coef, vecs))
 
 
 def _matrix(gs):
