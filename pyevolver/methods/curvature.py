@@ -37,6 +37,7 @@ from ..model.records import edge_facets
 from ._common import corner_scatter, facet_points, finite, n2_grad_dot, scatter
 from ..geometry.kernels import cross
 from .basic import facet_area_grad
+from . import axis_major as AM
 
 # method -> (estimate, honours h_zero, old-style (zero at FIXED / boundary vertices))
 VERTEX_METHODS = {
@@ -370,6 +371,9 @@ def vertex_gradient(t, m, idx, w):
     F, N = _project(rows, Pm, F), _project(rows, Pm, N)
     _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method, m)
     dF, dN = _project(rows, Pm, dF), _project(rows, Pm, dN)   # projectors held constant
+    if AM.available(t):                 # (the same numbers, fewer numpy calls)
+        wv = vertex_weights(s.nv, idx, w)
+        return AM.scatter(s, AM.star_perp_chain(t, dF * wv[:, None], dN * wv[:, None], dA * wv))
     P = facet_points(t)
     L = 2.0 * t.facet_area
     with np.errstate(all="ignore"):
