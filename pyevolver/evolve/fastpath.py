@@ -135,6 +135,20 @@ class _Plan:
         out = np.bincount(self.idx3, weights=W.transpose(0, 2, 1).ravel(), minlength=3 * nv)
         return np.ascontiguousarray(out.reshape(3, nv).T)
 
+    def scatter_many(self, Ws):
+        """:meth:`scatter` of several per-corner arrays in one bincount."""
+        k = len(Ws)
+        if k == 1:
+            return [self.scatter(Ws[0])]
+        nv = self.surface.nv
+        idx = self.__dict__.get(("idx", k))
+        if idx is None:
+            idx = self.__dict__[("idx", k)] = np.concatenate(
+                [self.idx3 + j * 3 * nv for j in range(k)])
+        W = np.stack(Ws).transpose(0, 1, 3, 2).ravel()
+        out = np.bincount(idx, weights=W, minlength=3 * k * nv).reshape(k, 3, nv)
+        return [np.ascontiguousarray(o.T) for o in out]
+
     def gather(self, V):
         """(3, 3, nf) corners of the (nv, 3) vectors ``V``."""
         return np.ascontiguousarray(V.T).take(self.Fc, axis=1)
@@ -145,11 +159,9 @@ class _Plan:
         if symmetric:
             vol = geometry_of_corners(P, True)[3]
         else:
-            Pxy = P[:2]
-            a = Pxy[:, 1] - Pxy[:, 0]
-            b = Pxy[:, 2] - Pxy[:, 0]
-            cz = a[0] * b[1]
-            cz -= a[1] * b[0]
+            D = P[:2, 1:] - P[:2, :1]               # the sides' x and y
+            cz = D[0, 0] * D[1, 1]
+            cz -= D[1, 0] * D[0, 1]
             vol = np.add.reduce(P[2], axis=0)       # (z0 + z1) + z2
             vol /= 6.0
             vol *= cz
@@ -168,10 +180,11 @@ class _Plan:
         b = self.surface.bodies
         return csr_matvec(b.facet_matrix, vol) + b.volconst
 
-    def volume_grads(self, P, a, b, N2T, symmetric, mobile_off, QE=None):
+    def volume_grads(self, P, a, b, N2T, symmetric, mobile_off, QE=None, also=None):
         """The constrained bodies' volume gradients (nv, 3), zero at the
         FIXED vertices (as ``body_volume_gradients`` and ``_constrained_dirs``;
-        ``QE``: :func:`_sides` of the corners when known)."""
+        ``QE``: :func:`_sides` of the corners when known).  ``also``: one
+        more per-corner array to scatter with them, returned first."""
         Q, E = _sides(P, a, b) if QE is None else QE
         g = np.empty_like(P)
         if symmetric:                   # corner c: Q[c+1] x Q[c+2] / 6
@@ -185,25 +198,23 @@ class _Plan:
             np.multiply(E[1], -Z, out=g[0])
             np.multiply(E[0], Z, out=g[1])
             g[2] = N2T[2] / 6.0
-        out = []
         any_fixed = mobile_off.any()
-        for w in self.body_w:
-            v = self.scatter(g * w)
+        out = self.scatter_many(([] if also is None else [also]) + [g * w for w in self.body_w])
+        for v in out[0 if also is None else 1:]:
             if any_fixed:
                 v[mobile_off] = 0.0
-            out.append(v)
         return out
 
-    def area_grad(self, P, a, b, N2T, area, tension, QE=None):
+    def area_grad(self, P, a, b, N2T, area, tension, QE=None, scattered=True):
         """The facet-tension energy gradient (nv, 3) (``facet_area_grad``
-        scattered with the tensions)."""
+        scattered with the tensions; per corner unless ``scattered``)."""
         _, E = _sides(P, a, b) if QE is None else QE
         with np.errstate(all="ignore"):
             n = finite(N2T / (2.0 * area))     # (|N2| = 2 area exactly)
         g = _cross(n[:, None, :], E)            # corner c: n x E[c]
         g *= 0.5
         g *= tension
-        return self.scatter(g)
+        return self.scatter(g) if scattered else g
 
 
 def _sides(P, a, b):
@@ -302,7 +313,7 @@ def step(it, settings, start) -> Any:
 
 
 def _step(it, plan, s, settings, t0):
-    from .iterate import StepResult, _solve
+    from .iterate import StepResult
     X0 = s.X
     it._fast_X0 = X0
     mobile_off = s.vattr["fixed"]
@@ -315,8 +326,15 @@ def _step(it, plan, s, settings, t0):
     a0, b0 = t0._corner_sides
     N2T0 = t0.facet_N2.T
     QE = _sides(P0, a0, b0)
+    nb = len(plan.bodies)
+    gs = None
     if area_mode:
-        f = -plan.area_grad(P0, a0, b0, N2T0, t0.facet_area, tension, QE)
+        Ga = plan.area_grad(P0, a0, b0, N2T0, t0.facet_area, tension, QE, scattered=False)
+        if nb:          # (the area and volume gradients in one scatter)
+            f, *gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE, also=Ga)
+            f = -f
+        else:
+            f = -plan.scatter(Ga)
     else:
         f = -GR.energy_gradient(t0)
     any_fixed = bool(mobile_off.any())
@@ -325,15 +343,15 @@ def _step(it, plan, s, settings, t0):
     if any_fixed:
         f[mobile_off] = 0.0
     s._one_sided_released = None
-    nb = len(plan.bodies)
     tol = settings.target_tolerance
     if nb:
         targets = [float(s.bodies.target[i]) for i in plan.bodies]
         start_vols = [float(t0.volumes[i]) for i in plan.bodies]
-        gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE)
+        if gs is None:
+            gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE)
         A = _matrix(gs)
-        bvec = np.array([float(np.sum(f * g)) for g in gs])
-        lam = _solve(A, bvec)
+        bvec = [float(np.sum(f * g)) for g in gs]
+        lam = np.array(_coefficients(A, bvec))
         vel = f - _combo(lam, gs)
         Pus = [plan.gather(u) for u in gs]
     else:

@@ -509,10 +509,13 @@ class Session(SessionAPI):
         return results.finish(self)
 
     def _steps(self, n, callback, echo, results, bar):
-        start = None
+        start = it = None
         for k in range(n, 0, -1):
             self.interp.tick()
-            it = self.iterator
+            if start is None or it is None:
+                it = self.iterator
+            else:               # (the run goes on unchanged: only the scale is new)
+                it.settings.scale = self.settings["scale"]
             r = it.step(start=start)
             # what the step did, kept by the session: the motion (the v_force,
             # v_oldx, v_velocity attributes), the optimized scale, the totals,
