@@ -262,31 +262,46 @@ def _plan(it, s, settings, chained):
     """The iterator's plan for ``s`` (made or checked again unless the step
     continues a ``g n`` on the same surface), or None."""
     plan = it.__dict__.get("_fast_plan")
-    if chained and plan is not None and plan.valid_for(s):
-        return plan if _settings_ok(settings) else None
+    if chained and plan is not None and plan.valid_for(s) and _settings_ok(settings):
+        return plan             # (the last step was the fast path's, on this surface)
+    it._fast_plan = None        # (any step of the general path drops the plan)
     if not enabled() or not _settings_ok(settings):
         return None
     mode = _surface_ok(s)
     if mode is None:
         return None
-    if plan is None or not plan.valid_for(s) or plan.mode != mode:
-        plan = _Plan(s, mode)
-    it._fast_plan = plan
-    return plan
+    return _Plan(s, mode)
 
 
-def _check_area(plan, s, t0):
-    """The area mode's evaluation must be the general one's, bit for bit
+def _light_totals(s, plan, P, symmetric):
+    """The :class:`Totals` at the corners ``P`` (the vertices already
+    moved there) without ``Totals.__init__``'s tests of every energy term:
+    the facet tension, the bodies' volumes and the quantities, summed in
+    ``Totals``' order."""
+    geom = geometry_of_corners(P, symmetric)
+    e = float(geom[2] @ s.facet_tension)
+    t = _totals(s, geom, e, plan.body_volumes(geom[3]) if s.bodies.n else np.zeros(0))
+    if s.quantities:
+        e = t.energy
+        for q in s.quantities.values():
+            v = t.quantity_value(q)
+            t.quantity_values[q.name] = v
+            if q.kind == "energy":
+                e += v
+        t.energy = e
+    return t
+
+
+def _check(plan, s, t0):
+    """The fast path's evaluation must be the general one's, bit for bit
     (a guard against energy terms this module does not know)."""
     from ..methods.totals import Totals
     if getattr(t0, "_corner_xyz", None) is None or type(t0) is not Totals:
         return False
-    geom = geometry_of_corners(t0._corner_xyz, s.symmetric_content)
-    e = float(geom[2] @ s.facet_tension)
-    mine = _totals(s, geom, e, plan.body_volumes(geom[3]) if s.bodies.n else np.zeros(0))
-    extra = set(vars(t0)) - set(vars(mine))
+    mine = _light_totals(s, plan, t0._corner_xyz, s.symmetric_content)
     return (mine.energy == t0.energy and set(vars(mine)) <= set(vars(t0))
-            and extra <= set(Totals._LAZY) and np.array_equal(mine.volumes, t0.volumes))
+            and mine.terms == t0.terms and mine.quantity_values == t0.quantity_values
+            and np.array_equal(mine.volumes, t0.volumes))
 
 
 def step(it, settings, start) -> Any:
@@ -300,9 +315,9 @@ def step(it, settings, start) -> Any:
     if plan is None:
         return None
     t0 = start if chained else s.evaluate()
-    if plan.mode == "area" and not chained and not _check_area(plan, s, t0):
-        it._fast_plan = None
+    if plan is not it.__dict__.get("_fast_plan") and not _check(plan, s, t0):   # (a new plan)
         return None
+    it._fast_plan = plan
     it.__dict__.pop("_end", None)
     try:
         return _step(it, plan, s, settings, t0)
@@ -369,7 +384,7 @@ def _step(it, plan, s, settings, t0):
             return geom, float(geom[2] @ tension), \
                 plan.constrained(geom[3]) if nb else None
         s.X = X
-        t = s.evaluate()
+        t = _light_totals(s, plan, P, symmetric)
         return t, t.energy, [float(t.volumes[i]) for i in plan.bodies]
 
     def diffs(vols):
