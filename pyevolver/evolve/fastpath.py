@@ -145,8 +145,10 @@ class _Plan:
         if idx is None:
             idx = self.__dict__[("idx", k)] = np.concatenate(
                 [self.idx3 + j * 3 * nv for j in range(k)])
-        W = np.stack(Ws).transpose(0, 1, 3, 2).ravel()
-        out = np.bincount(idx, weights=W, minlength=3 * k * nv).reshape(k, 3, nv)
+        W = np.empty((k, 3, Ws[0].shape[2], 3))
+        for j, Wj in enumerate(Ws):
+            W[j] = Wj.transpose(0, 2, 1)
+        out = np.bincount(idx, weights=W.ravel(), minlength=3 * k * nv).reshape(k, 3, nv)
         return [np.ascontiguousarray(o.T) for o in out]
 
     def gather(self, V):
@@ -199,7 +201,8 @@ class _Plan:
             np.multiply(E[0], Z, out=g[1])
             g[2] = N2T[2] / 6.0
         any_fixed = mobile_off.any()
-        out = self.scatter_many(([] if also is None else [also]) + [g * w for w in self.body_w])
+        gw = [g] if self.one is not None else [g * w for w in self.body_w]   # (w = 1)
+        out = self.scatter_many(([] if also is None else [also]) + gw)
         for v in out[0 if also is None else 1:]:
             if any_fixed:
                 v[mobile_off] = 0.0
@@ -209,8 +212,12 @@ class _Plan:
         """The facet-tension energy gradient (nv, 3) (``facet_area_grad``
         scattered with the tensions; per corner unless ``scattered``)."""
         _, E = _sides(P, a, b) if QE is None else QE
-        with np.errstate(all="ignore"):
-            n = finite(N2T / (2.0 * area))     # (|N2| = 2 area exactly)
+        L = 2.0 * area                          # (|N2| = 2 area exactly)
+        if L.all():
+            n = finite(N2T / L)
+        else:
+            with np.errstate(all="ignore"):
+                n = finite(N2T / L)
         g = _cross(n[:, None, :], E)            # corner c: n x E[c]
         g *= 0.5
         g *= tension
@@ -365,7 +372,7 @@ def _step(it, plan, s, settings, t0):
         if gs is None:
             gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE)
         A = _matrix(gs)
-        bvec = [float(np.sum(f * g)) for g in gs]
+        bvec = [float((f * g).sum()) for g in gs]
         lam = np.array(_coefficients(A, bvec))
         vel = f - _combo(lam, gs)
         Pus = [plan.gather(u) for u in gs]
@@ -404,7 +411,7 @@ def _step(it, plan, s, settings, t0):
         shifts = []
         if not nb:
             g, e, _ = evaluate(P, X)
-            return g, e, shifts
+            return g, e, shifts, None
         vols = start_vols if scale == 0 else plan.volumes(P, symmetric)
         d, err = diffs(vols)
         cur_us, cur_Pu, cur_A = gs, Pus, A
@@ -419,7 +426,7 @@ def _step(it, plan, s, settings, t0):
             if err_new <= 1.0:
                 if k == 9:
                     raise _Fallback
-                return g, e, shifts
+                return g, e, shifts, vols_new
             if err_new > 1.01 * err:
                 raise _Fallback
             improved = err_new < 0.5 * err
@@ -447,7 +454,7 @@ def _step(it, plan, s, settings, t0):
     else:
         scale, E0, _ = it._line_search(E, settings.scale, settings.scale_limit)
     actual = settings.scale_scale * scale
-    g, e, shifts = move(actual)
+    g, e, shifts, last_vols = move(actual)
     if not math.isfinite(e) or (settings.check_increase and e > E0) \
             or (not settings.fixed_scale and e > E0 and scale > 0):
         raise _Fallback
@@ -459,7 +466,10 @@ def _step(it, plan, s, settings, t0):
     s.X = X
     it.__dict__.pop("_fast_X0", None)
     if area_mode:
-        vols = plan.body_volumes(g[3]) if s.bodies.n else np.zeros(0)
+        if plan.one is not None and nb:     # (the volume the move ended with)
+            vols = np.array(last_vols)
+        else:
+            vols = plan.body_volumes(g[3]) if s.bodies.n else np.zeros(0)
         t = _totals(s, g, e, vols)
     else:
         t = g
@@ -491,7 +501,7 @@ def _matrix(gs):
     A = np.empty((k, k))
     for i in range(k):
         for j in range(k):
-            A[i, j] = float(np.sum(gs[i] * gs[j]))
+            A[i, j] = float((gs[i] * gs[j]).sum())
     for i in range(k):
         if A[i, i] == 0:
             A[i, i] = 1.0
