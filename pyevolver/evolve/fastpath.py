@@ -42,6 +42,7 @@ import numpy as np
 
 from ..geometry.kernels import geometry_of_corners
 from ..methods._common import csr_matvec, finite
+from ..methods.totals import Totals
 from . import gradient as GR
 
 _NEXT = np.array([1, 2, 0])
@@ -247,7 +248,6 @@ def _cross(u, v):
 def _totals(s, geom, energy, vols):
     """The :class:`Totals` of a facet-tension surface from its corner
     geometry (what ``Totals.__init__`` sets on such a surface)."""
-    from ..methods.totals import Totals
     P, N2T, area, vol, a, b = geom
     t = object.__new__(Totals)
     t.surface = s
@@ -302,7 +302,6 @@ def _light_totals(s, plan, P, symmetric):
 def _check(plan, s, t0):
     """The fast path's evaluation must be the general one's, bit for bit
     (a guard against energy terms this module does not know)."""
-    from ..methods.totals import Totals
     if getattr(t0, "_corner_xyz", None) is None or type(t0) is not Totals:
         return False
     mine = _light_totals(s, plan, t0._corner_xyz, s.symmetric_content)
@@ -311,9 +310,10 @@ def _check(plan, s, t0):
             and np.array_equal(mine.volumes, t0.volumes))
 
 
-def step(it, settings, start) -> Any:
+def step(it, settings, start, result_type, solve) -> Any:
     """One ``g`` step of the iterator ``it`` by the fast path, or None when
-    the general step must take it (nothing changed then)."""
+    the general step must take it (nothing changed then).  ``result_type``
+    and ``solve``: iterate's StepResult and its solve of the small systems."""
     s = it.surface
     end = it.__dict__.get("_end")
     chained = (start is not None and end is not None and end[0] is start and start.surface is s
@@ -327,15 +327,14 @@ def step(it, settings, start) -> Any:
     it._fast_plan = plan
     it.__dict__.pop("_end", None)
     try:
-        return _step(it, plan, s, settings, t0)
+        return _step(it, plan, s, settings, t0, result_type, solve)
     except _Fallback:
         s.X = t0_X = it.__dict__.pop("_fast_X0")
         it._end = (t0, t0_X.copy())
         return None
 
 
-def _step(it, plan, s, settings, t0):
-    from .iterate import StepResult
+def _step(it, plan, s, settings, t0, result_type, solve):
     X0 = s.X
     it._fast_X0 = X0
     mobile_off = s.vattr["fixed"]
@@ -373,7 +372,7 @@ def _step(it, plan, s, settings, t0):
             gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE)
         A = _matrix(gs)
         bvec = [float((f * g).sum()) for g in gs]
-        lam = np.array(_coefficients(A, bvec))
+        lam = np.array(_coefficients(A, bvec, solve))
         vel = f - _combo(lam, gs)
         Pus = [plan.gather(u) for u in gs]
     else:
@@ -416,7 +415,7 @@ def _step(it, plan, s, settings, t0):
         d, err = diffs(vols)
         cur_us, cur_Pu, cur_A = gs, Pus, A
         for k in range(10):
-            delta = _coefficients(cur_A, d)
+            delta = _coefficients(cur_A, d, solve)
             P = P + _combo(delta, cur_Pu)
             if X is not None:
                 X = X + _combo(delta, cur_us)
@@ -482,7 +481,7 @@ def _step(it, plan, s, settings, t0):
     it._carry = (gs, A)
     it.pressures_valid = True
     it._end = (t, X.copy())
-    return StepResult(t.energy, t.total_area, scale, b.lagrange.copy() if b.n else np.zeros(0),
+    return result_type(t.energy, t.total_area, scale, b.lagrange.copy() if b.n else np.zeros(0),
                       {}, True, warnings=[], totals=t, motion=motion)
 
 
@@ -508,12 +507,11 @@ def _matrix(gs):
     return A
 
 
-def _coefficients(A, d):
+def _coefficients(A, d, solve):
     """The restoring coefficients ``A⁻¹ d`` (iterate._solve; one body in
     Python floats, the same division)."""
     if len(d) == 1:
         a = float(A[0, 0])
         if a != 0 and math.isfinite(a) and math.isfinite(d[0]):
             return (np.float64(d[0]) / a,)
-    from .iterate import _solve
-    return tuple(_solve(A, np.array(d)))
+    return tuple(solve(A, np.array(d)))

@@ -458,7 +458,7 @@ class Iterator:
         if settings is not None:
             self.settings = settings
         settings = self.settings
-        fast = FP.step(self, settings, start)   # (plain surfaces: pyevolver.evolve.fastpath)
+        fast = FP.step(self, settings, start, StepResult, _solve)   # (plain surfaces: fastpath)
         if fast is not None:
             return fast
         s = self.surface
