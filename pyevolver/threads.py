@@ -93,6 +93,8 @@ def blas_limited(fn: F) -> F:
     """Decorator: run ``fn`` under :func:`limited`."""
     @functools.wraps(fn)
     def run(*args, **kwargs):
+        if _depth:                      # (inside a limit already: each step of `g n`)
+            return fn(*args, **kwargs)
         with limited():
             return fn(*args, **kwargs)
     return run  # type: ignore[return-value]

@@ -41,6 +41,14 @@ def test_limit_inside_and_restored_after(monkeypatch):
 
 
 def test_g_and_hessian_run_limited(monkeypatch):
+    from pyevolver.evolve.iterate import Iterator
+    inside = []
+    real_search = Iterator._line_search
+
+    def search(self, *args):
+        inside.append((TH._depth, set(_blas_threads())))
+        return real_search(self, *args)
+    monkeypatch.setattr(Iterator, "_line_search", search)
     seen = []
 
     @TH.blas_limited
@@ -55,9 +63,10 @@ def test_g_and_hessian_run_limited(monkeypatch):
     monkeypatch.setattr(TH, "limited", spy)
     s = Session.load(example("cube.fe"), out=io.StringIO())
     s.g(2)
-    assert len(seen) == 2                       # each g step
+    assert len(inside) == 2                     # each g step runs inside the limit
+    assert all(depth >= 1 and threads <= {1} for depth, threads in inside)
     s.hessian(echo=False)
-    assert len(seen) == 3
+    assert len(seen) == 1
     assert set(probe()) <= {1}
 
 

@@ -18,8 +18,7 @@ from ..constraints import (displace, project_tangent, project_to_constraints, re
                        restore_state, state)
 from ..errors import UnsupportedError
 from ..threads import blas_limited
-from . import gradient as GR
-from . import optparams as OP
+from . import fastpath as FP, gradient as GR, optparams as OP
 from ..errors import ConstraintError
 from .mobility import Mobility, diffuse, jiggle_vertices, normal_project
 
@@ -422,9 +421,8 @@ class Iterator:
             if not improved:
                 _, cur_us, cur_A = self._constrained_dirs(t, cons, mobile)
             self._carry = (cur_us, cur_A)
-        # REF's loop ends with one more correction that it does not check
-        # (itdebug: a last volume_restore() and no "Next diff" after the
-        # tenth check), then warns with the last difference it checked
+        # REF's loop ends with one more, unchecked, correction (itdebug: a last volume_restore(),
+        # no "Next diff" after the tenth check), then warns with the last difference it checked
         delta = factor * _solve(cur_A, d)
         displace(s, state(s), sum(dl * u for dl, u in zip(delta, cur_us)))
         self._project(moved)
@@ -460,6 +458,9 @@ class Iterator:
         if settings is not None:
             self.settings = settings
         settings = self.settings
+        fast = FP.step(self, settings, start, StepResult, _solve)   # (plain surfaces: fastpath)
+        if fast is not None:
+            return fast
         s = self.surface
         mobile = self._mobile()
         cons = _Constraints(s)
@@ -586,7 +587,6 @@ class Iterator:
         # directions the rejected move last recomputed (REF keeps those),
         # checked restoring step by restoring step on check 14.
         self._carry = (us, A)
-
         first = [True]          # the first trial motion of the step
 
         def E(scale):

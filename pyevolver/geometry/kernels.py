@@ -137,20 +137,33 @@ def corner_geometry(XT, Fc, symmetric=False, sides=False):
     number is the same sum of the same products as component by component.
     """
     P = XT.take(Fc, axis=1)             # (take: several times faster than XT[:, Fc])
-    a = P[:, 1] - P[:, 0]
-    b = P[:, 2] - P[:, 0]
-    # N2T[i] = a[i+1] b[i+2] - a[i+2] b[i+1]
-    N2T = a.take(_NEXT, axis=0) * b.take(_NEXT2, axis=0)
-    N2T -= a.take(_NEXT2, axis=0) * b.take(_NEXT, axis=0)
+    out = geometry_of_corners(P, symmetric)
+    return out if sides else out[:4]
+
+
+def geometry_of_corners(P, symmetric=False):
+    """:func:`corner_geometry` from the gathered corners ``P`` (3, 3, nf):
+    ``(P, N2T, area, volume, a, b)`` (the ``g`` fast path moves the
+    gathered corners themselves, pyevolver.evolve.fastpath)."""
+    D = P[:, 1:] - P[:, :1]             # (3, 2, nf): the sides a and b
+    a = D[:, 0]
+    b = D[:, 1]
+    # N2T[i] = a[i+1] b[i+2] - a[i+2] b[i+1] (one take for both sides; the
+    # row sums below are sequential, (r0 + r1) + r2, as written out)
+    D1 = D.take(_NEXT, axis=0)
+    D2 = D.take(_NEXT2, axis=0)
+    N2T = D1[:, 0] * D2[:, 1]
+    N2T -= D2[:, 0] * D1[:, 1]
     sq = N2T * N2T
-    area = 0.5 * np.sqrt(sq[0] + sq[1] + sq[2])
+    area = np.sqrt(np.add.reduce(sq, axis=0))
+    area *= 0.5
     if symmetric:
         vol = (P[0][0] * N2T[0] + P[1][0] * N2T[1] + P[2][0] * N2T[2]) / 6.0
     else:
-        vol = (P[2][0] + P[2][1] + P[2][2]) / 6.0 * N2T[2]
-    if sides:
-        return P, N2T, area, vol, a, b
-    return P, N2T, area, vol
+        vol = np.add.reduce(P[2], axis=0)
+        vol /= 6.0
+        vol *= N2T[2]
+    return P, N2T, area, vol, a, b
 
 
 _NEXT = np.array([1, 2, 0])

@@ -37,6 +37,7 @@ from ..model.records import edge_facets
 from ._common import corner_scatter, facet_points, finite, n2_grad_dot, scatter
 from ..geometry.kernels import cross
 from .basic import facet_area_grad
+from . import axis_major as AM
 
 # method -> (estimate, honours h_zero, old-style (zero at FIXED / boundary vertices))
 VERTEX_METHODS = {
@@ -94,26 +95,44 @@ def star_sums(t):
     L = 2.0 * t.facet_area
     with np.errstate(all="ignore"):
         n = finite(N2 / L)
-    flat = Fc.ravel()
-    A = 0.5 * np.bincount(flat, weights=np.concatenate((L, L, L)), minlength=nv)
-    N = np.empty((nv, 3))
-    F = np.empty((nv, 3))
-    for k in range(3):
-        N[:, k] = 0.5 * np.bincount(flat, weights=np.concatenate((N2[k], N2[k], N2[k])),
-                                    minlength=nv)
+    idx4, idxc = _star_index(s, Fc)
+    # A and the three axes of N in one bincount (each its own bins, summed in
+    # the corners' order as one bincount per axis would)
+    W4 = np.empty((4, 3, len(L)))
+    W4[0] = L
+    W4[1:] = np.asarray(N2)[:, None, :]
+    AN = np.bincount(idx4, weights=W4.ravel(), minlength=4 * nv).reshape(4, nv)
+    AN *= 0.5
+    A = AN[0]
+    N = np.ascontiguousarray(AN[1:].T)
     # the side opposite each corner c, e[axis][c] = P[axis][c+2] - P[axis][c+1],
-    # and 0.5 n x e for the three corners at once (W[axis][c]); each axis of F
-    # sums the corners' scatters in the corner order
+    # and 0.5 n x e for the three corners at once (W[axis][c]); F sums the
+    # corners' scatters in the corner order, (c0 + c1) + c2, the axes together
     P = np.asarray(P)
     e = P.take(_C2, axis=1) - P.take(_C1, axis=1)
     W = n.take(_C1, axis=0)[:, None, :] * e.take(_C2, axis=0)
     W -= n.take(_C2, axis=0)[:, None, :] * e.take(_C1, axis=0)
     W *= 0.5
-    for k in range(3):
-        F[:, k] = np.bincount(Fc[0], weights=W[k, 0], minlength=nv)
-        F[:, k] += np.bincount(Fc[1], weights=W[k, 1], minlength=nv)
-        F[:, k] += np.bincount(Fc[2], weights=W[k, 2], minlength=nv)
+    F3 = np.bincount(idxc[0], weights=W[:, 0].ravel(), minlength=3 * nv)
+    F3 += np.bincount(idxc[1], weights=W[:, 1].ravel(), minlength=3 * nv)
+    F3 += np.bincount(idxc[2], weights=W[:, 2].ravel(), minlength=3 * nv)
+    F = np.ascontiguousarray(F3.reshape(3, nv).T)
     return A, F, N
+
+
+def _star_index(s, Fc):
+    """Bincount indices of :func:`star_sums` (kept with the corners ``Fc``):
+    the corners, corner-major, for four quantities, and each corner's for
+    three axes."""
+    c = s.__dict__.get("_star_index")
+    if c is not None and c[0] is Fc:
+        return c[1], c[2]
+    nv = s.nv
+    flat = Fc.ravel()
+    idx4 = np.concatenate([flat + j * nv for j in range(4)])
+    idxc = [np.concatenate([Fc[k] + j * nv for j in range(3)]) for k in range(3)]
+    s._star_index = (Fc, idx4, idxc)
+    return idx4, idxc
 
 
 def _h_zero(s, method):
@@ -370,6 +389,9 @@ def vertex_gradient(t, m, idx, w):
     F, N = _project(rows, Pm, F), _project(rows, Pm, N)
     _, dF, dN, dA = _vertex_energy(s, A, F, N, m.method, m)
     dF, dN = _project(rows, Pm, dF), _project(rows, Pm, dN)   # projectors held constant
+    if AM.available(t):                 # (the same numbers, fewer numpy calls)
+        wv = vertex_weights(s.nv, idx, w)
+        return AM.scatter(s, AM.star_perp_chain(t, dF * wv[:, None], dN * wv[:, None], dA * wv))
     P = facet_points(t)
     L = 2.0 * t.facet_area
     with np.errstate(all="ignore"):

@@ -509,14 +509,14 @@ class Session(SessionAPI):
         return results.finish(self)
 
     def _steps(self, n, callback, echo, results, bar):
-        start = None
+        start = it = None
         for k in range(n, 0, -1):
             self.interp.tick()
-            it = self.iterator
+            it = self.iterator if start is None or it is None else it   # (else: the scale alone
+            it.settings.scale = self.settings["scale"]                   # is new in a g n run)
             r = it.step(start=start)
-            # what the step did, kept by the session: the motion (the v_force,
-            # v_oldx, v_velocity attributes), the optimized scale, the totals,
-            # the iteration count and the time
+            # what the step did, kept by the session: the motion (v_force, v_oldx, v_velocity),
+            # the optimized scale, the totals, the iteration count and the time
             self._last_motion = r.motion
             if r.printed and not it.settings.fixed_scale:
                 self.settings["scale"] = r.scale
