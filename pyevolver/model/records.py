@@ -91,8 +91,11 @@ def along_first(s: Surface) -> np.ndarray:
 def record_vertex_rings(s: Surface, rank: np.ndarray) -> None:
     """Attach REF's edge rings to ``s``: ``rank`` (ne, 2) is the position of
     each edge in the ring of its tail (column 0) and head (column 1) vertex
-    (:func:`vertex_edge_rank`), valid while the edges stay what they are."""
-    s._rings = (s.E.copy(), np.asarray(rank, np.int64))
+    (:func:`vertex_edge_rank`), valid while the edges stay what they are.
+    ``rank`` may be a function of no arguments that computes it, called
+    the first time the rings are read (``r`` leaves them to the first
+    ``u``, ``V`` or ``vv.edge`` that needs them)."""
+    s._rings = (s.E.copy(), rank if callable(rank) else np.asarray(rank, np.int64))
 
 
 def vertex_edge_rank(s: Surface) -> np.ndarray:
@@ -110,6 +113,8 @@ def vertex_edge_rank(s: Surface) -> np.ndarray:
     ne, nv = s.ne, s.nv
     c = s.__dict__.get("_rings")
     if c is not None and c[0].shape == s.E.shape and np.array_equal(c[0], s.E):
+        if callable(c[1]):
+            c = s._rings = (c[0], np.asarray(c[1](), np.int64))
         return c[1]
     t = np.empty(ne, np.int64)
     t[np.argsort(s.ids("edge"), kind="stable")] = np.arange(ne)

@@ -41,14 +41,21 @@ def _flip_rings(s, t, moves):
     The pass flips in edge id order; each flip takes the edge out of the
     rings of its old ends and puts it in those of its new ends (measured
     with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
-    Runs of flips with no vertex in common are replayed at once."""
-    g = Rings(s, t.ne, t.nv)
+    Runs of flips with no vertex in common are replayed at once.  The rings
+    are computed when first read (:func:`record_vertex_rings`)."""
+    E, nv = t.E.copy(), t.nv
+    record_vertex_rings(t, lambda: _rings_after_flips(s, E, nv, moves))
+
+
+def _rings_after_flips(s, E, nv, moves):
+    """The rank of :func:`_flip_rings` (``E``, ``nv``: the new surface's)."""
+    g = Rings(s, len(E), nv)
     I = np.concatenate([m[0] for m in moves])
     o = np.argsort(I, kind="stable")
     I = I[o]
     p = np.concatenate([m[1] for m in moves])[o]
     q = np.concatenate([m[2] for m in moves])[o]
-    x, y = t.E[I, 0], t.E[I, 1]
+    x, y = E[I, 0], E[I, 1]
     quads = np.stack([p, q, x, y], 1).tolist()
     start, used = 0, set()
     for k in range(len(I) + 1):
@@ -62,7 +69,15 @@ def _flip_rings(s, t, moves):
         g.insert(y[b], 2 * I[b] + 1)
         if k < len(I):
             start, used = k, set(quads[k])
-    record_vertex_rings(t, g.rank())
+    return g.rank()
+
+
+def _flat(a):
+    """A one-dimensional memoryview of C-contiguous array ``a`` (writes go
+    into ``a``)."""
+    if not a.flags.c_contiguous:
+        raise ValueError("_flat: the array must be C-contiguous")
+    return memoryview(a.reshape(-1))
 
 
 def _quads(E, FE, ef, edges):
@@ -238,15 +253,17 @@ def equiangulate(s, threshold=-0.001, only=None):
     heapq.heapify(heap)
     flips = 0
     finite = bool(np.isfinite(threshold))
-    okl = ok.tolist()
-    vall = val.tolist()
-    lengths = lengths.tolist()
     Xl = t.X                     # read with .item(): scalar access without array temporaries
-    # flat Python lists for the sequential part (list indexing is several
-    # times faster than numpy scalar access); written back at the end
-    El = E.ravel().tolist()
-    FEl = FE.ravel().tolist()
-    efl = ef.ravel().tolist()
+    # memoryviews of the arrays for the sequential part: indexing them gives
+    # and takes Python numbers as fast as a list's, without converting the
+    # whole arrays to lists and back (E, FE, ef and lengths change in place)
+    okl = _flat(ok)
+    vall = _flat(val)
+    lengths = _flat(lengths)
+    El = _flat(E)
+    FEl = _flat(FE)
+    efl = _flat(ef)
+    firstl = _flat(np.ascontiguousarray(first))
 
     def dec(x):
         return x if x >= 0 else ~x
@@ -261,8 +278,8 @@ def equiangulate(s, threshold=-0.001, only=None):
         if not okl[ed]:
             continue
         fa, fb = efl[2 * ed], efl[2 * ed + 1]
-        row_a = FEl[3 * fa:3 * fa + 3]
-        row_b = FEl[3 * fb:3 * fb + 3]
+        row_a = FEl[3 * fa], FEl[3 * fa + 1], FEl[3 * fa + 2]
+        row_b = FEl[3 * fb], FEl[3 * fb + 1], FEl[3 * fb + 2]
         ned = ~ed
         x = row_a[0]
         ka = 0 if (x == ed or x == ned) else (1 if (row_a[1] == ed or row_a[1] == ned) else 2)
@@ -297,7 +314,7 @@ def equiangulate(s, threshold=-0.001, only=None):
         seq_moves.append((ed, p, q))
         pairs.discard(min(p, q) * nv + max(p, q))
         pairs.add(key)
-        al = bool(first[ed])
+        al = firstl[ed]
         if group is not None:
             def o(x):
                 return wrap[x] if x >= 0 else int(group.inverse(wrap[~x]))
@@ -310,13 +327,13 @@ def equiangulate(s, threshold=-0.001, only=None):
             wrap[ed] = (-1 if al else 1) * (w(c1) + w(b2))       # through p
         if al:
             El[2 * ed], El[2 * ed + 1] = sv, r
-            FEl[3 * fa:3 * fa + 3] = (ed, c1, b2)
-            FEl[3 * fb:3 * fb + 3] = (~ed, c2, b1)
+            FEl[3 * fa], FEl[3 * fa + 1], FEl[3 * fa + 2] = ed, c1, b2
+            FEl[3 * fb], FEl[3 * fb + 1], FEl[3 * fb + 2] = ~ed, c2, b1
             moved = ((b1, fa, fb), (b2, fb, fa))
         else:
             El[2 * ed], El[2 * ed + 1] = r, sv
-            FEl[3 * fa:3 * fa + 3] = (ed, c2, b1)
-            FEl[3 * fb:3 * fb + 3] = (~ed, c1, b2)
+            FEl[3 * fa], FEl[3 * fa + 1], FEl[3 * fa + 2] = ed, c2, b1
+            FEl[3 * fb], FEl[3 * fb + 1], FEl[3 * fb + 2] = ~ed, c1, b2
             moved = ((c1, fa, fb), (c2, fb, fa))
         for side, old, new in moved:
             i = dec(side)
@@ -343,9 +360,6 @@ def equiangulate(s, threshold=-0.001, only=None):
             i = x if x >= 0 else ~x
             if i > ed:                # not yet visited (visits go in id order)
                 heapq.heappush(heap, i)
-    if flips:
-        t.E = np.array(El, dtype=np.int64).reshape(-1, 2)
-        t.FE = np.array(FEl, dtype=np.int64).reshape(-1, 3)
     t.__dict__.pop("_topo", None)          # E and FE were changed
     if flips + flips_at_once:
         # an edge's facet loop keeps its start through the flips (REF, ee.facet)

@@ -314,18 +314,27 @@ def _split_rings(s, t, R, half, inner=None):
     its head vertex and the new half joining it; a midpoint's ring is the
     new half (first), then the old edge; then the edges cutting the facets
     join the rings at both their ends, in id order.
+
+    The rings are computed when first read (:func:`record_vertex_rings`),
+    from ``s`` (kept until then) and copies of the arrays used here.
     """
+    E, R, half, nv = t.E.copy(), R.copy(), half.copy(), t.nv
+    record_vertex_rings(t, lambda: _rings_after_split(s, E, nv, R, half, inner))
+
+
+def _rings_after_split(s, E, nv, R, half, inner):
+    """The rank of :func:`_split_rings` (``E``, ``nv``: the new surface's)."""
     ne, k = s.ne, len(R)
-    g = Rings(s, t.ne, t.nv)
+    g = Rings(s, len(E), nv)
     h_all = s.E[R, 1]
     for sel in rounds(h_all, R):
         g.remove(h_all[sel], 2 * R[sel] + 1)
         g.insert(h_all[sel], 2 * half[R[sel]] + 1)
-    g.set_pair(t.E[R, 1], 2 * half[R], 2 * R + 1)
+    g.set_pair(E[R, 1], 2 * half[R], 2 * R + 1)
     if inner is None:
-        inner = np.arange(ne + k, t.ne)
-    iv = t.E[inner].ravel()
+        inner = np.arange(ne + k, len(E))
+    iv = E[inner].ravel()
     islot = 2 * np.repeat(inner, 2) + np.tile([0, 1], len(inner))
     for sel in rounds(iv, islot):
         g.insert(iv[sel], islot[sel])
-    record_vertex_rings(t, g.rank())
+    return g.rank()

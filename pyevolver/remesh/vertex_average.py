@@ -39,7 +39,7 @@ from ..constraints import project_tangent, project_to_constraints
 from ..model.records import vertex_facet_rank
 
 
-def vertex_average(s, mode="V"):
+def vertex_average(s, mode="V", totals=None):
     """Return a copy of surface ``s`` with vertices averaged.
 
     Parameters
@@ -48,13 +48,16 @@ def vertex_average(s, mode="V"):
     mode : {"V", "raw", "rawest"}
         ``V`` (volume-preserving: normal component removed), ``rawv`` or
         ``rawestv``.
+    totals : Totals, optional
+        An evaluation of ``s`` as it is (the session's, when nothing
+        changed since it was made); evaluated here otherwise.
 
     Returns
     -------
     Surface
         A new surface sharing the topology of ``s``, new coordinates.
     """
-    t = s.evaluate()
+    t = totals if totals is not None and totals.surface is s else s.evaluate()
     nv, ne = s.nv, s.ne
     idx = s.topology()[0]                                        # (nf, 3) edge ids
     valence = np.bincount(idx.ravel(), minlength=ne)
