@@ -12,7 +12,8 @@ their methods, a few levels deep) and the session's variables, toggles,
 settings and arrays.  Arrays enter by shape, type and a CRC-32 of their
 bytes, so a change made in place (``set vertex x ...``, an attribute
 assignment, a user of the API writing into ``surface.X``) changes the
-fingerprint as a new array does.  :func:`is_fresh` says whether the totals
+fingerprint as a new array does; only the connectivity arrays ``E`` and
+``FE``, which nothing changes in place, enter by identity.  :func:`is_fresh` says whether the totals
 are still the marked ones and the fingerprint is unchanged; only then is the
 evaluation skipped.  Anything not understood enters by identity, so an
 unknown change leads to an evaluation, never to stale totals.
@@ -31,6 +32,10 @@ DEPTH = 4
 CACHES = frozenset({"_topo", "_corners", "_corner_sides", "_lift_cache", "_rings",
                     "_attr_cache", "_free_boundary", "_loop_eval", "_edge_first",
                     "_along_first", "_fresh"})
+#: arrays that enter by identity: the connectivity, never changed in place on
+#: a surface in use (``Surface.topology`` caches on the same rule; operations
+#: that change it build new arrays)
+BY_IDENTITY = frozenset({"E", "FE"})
 _SCALARS = (int, float, complex, str, bytes, bool, type(None))
 
 
@@ -62,8 +67,13 @@ def _fp(x: Any, depth: int, seen: dict) -> Any:
     d = getattr(x, "__dict__", None)
     if d is None or callable(x):
         return ("id", key)
-    return ("o", key, tuple((k, _fp(v, depth - 1, seen)) for k, v in d.items()
-                            if k not in CACHES))
+    return ("o", key, tuple((k, _fp(v, depth - 1, seen) if k not in BY_IDENTITY
+                             else _same(v, seen)) for k, v in d.items() if k not in CACHES))
+
+
+def _same(x: Any, seen: dict) -> tuple:
+    seen[id(x)] = x
+    return ("id", id(x), getattr(x, "shape", None))
 
 
 def fingerprint(session: Any) -> tuple:

@@ -188,17 +188,21 @@ def vertex_normals(F, N2, nv, rank=None):
                 N[:, i] += np.bincount(F[:, k], weights=N2[:, i], minlength=nv)
     else:
         v = F.ravel()
-        f = np.repeat(np.arange(len(F)), 3)
-        order = np.lexsort((f, np.asarray(rank).ravel(), v))
-        v, f = v[order], f[order]
-        start = np.searchsorted(v, np.arange(nv))
-        slot = np.arange(len(v)) - start[v]
+        nf = len(F)
+        rk = np.asarray(rank, np.int64).ravel()
+        # order by (vertex, rank, facet): one sort of a combined key
+        R = int(rk.max()) + 1 if len(rk) else 1
+        f = np.argsort((v * R + rk) * nf + np.repeat(np.arange(nf), 3), kind="stable") // 3
+        cnt = np.bincount(v, minlength=nv)
+        start = np.cumsum(cnt) - cnt
         N = np.zeros((nv, 3))
-        for j in range(int(slot.max()) + 1 if len(slot) else 0):
-            sel = slot == j
-            vs, n = v[sel], N2[f[sel]]
-            d = np.einsum("ij,ij->i", n, N[vs])
-            N[vs] += np.where(d >= 0, 1.0, -1.0)[:, None] * n
+        vs = np.arange(nv)
+        for j in range(int(cnt.max()) if len(cnt) else 0):
+            vs = vs[cnt[vs] > j]                # the vertices with a j-th facet
+            n = N2[f[start[vs] + j]]
+            Nv = N[vs]
+            d = np.einsum("ij,ij->i", n, Nv)
+            N[vs] = Nv + np.where(d >= 0, 1.0, -1.0)[:, None] * n
     L = np.linalg.norm(N, axis=1)
     return np.where(L[:, None] > 0, N / np.where(L > 0, L, 1.0)[:, None], 0.0)
 

@@ -128,7 +128,10 @@ def vertex_edge_rank(s: Surface) -> np.ndarray:
     start = np.searchsorted(vs, np.arange(nv))
     pos = np.empty(2 * ne, np.int64)
     pos[order] = np.arange(2 * ne) - start[vs]
-    return pos.reshape(ne, 2)
+    pos = pos.reshape(ne, 2)
+    pos.flags.writeable = False          # (kept: the next call while E is unchanged)
+    record_vertex_rings(s, pos)
+    return pos
 
 
 def vertex_facet_rank(s: Surface) -> np.ndarray:
