@@ -172,7 +172,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     t.__dict__.pop("_lift_cache", None)
     E, FE = t.E, t.FE
     wrap = t.eattr.get("wrap")
-    ef, ekk, val = edge_facets(t)
+    ef, ekk, val = edge_facets(s)          # (s: its topology is cached; the same as t's)
     first = along_first(s)
     wv = t.wrap_shift()
     group = group_of(t)
@@ -194,7 +194,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     ok[ok] &= (fsig[f0[ok]] == esig[ok]) & (fsig[f1[ok]] == esig[ok])
     cand = np.nonzero(ok)[0]
     if len(cand):
-        cand = cand[_passes(t.topology()[0], ef, cand, lengths, threshold, ekk)]
+        cand = cand[_passes(s.topology()[0], ef, cand, lengths, threshold, ekk)]
     if not len(cand):
         return s, 0
 
@@ -206,6 +206,8 @@ def equiangulate(s, threshold=-0.001, only=None):
     heap = cand
     flips_at_once = 0
     moves = []              # (edges, old tails, old heads) in the order flipped
+    # adjacency for the "already joined" test
+    pairs = set((np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])).tolist())
     if wrap is None:
         quad = _quads(E, FE, ef, cand)
         if quad is not None:
@@ -213,14 +215,15 @@ def equiangulate(s, threshold=-0.001, only=None):
             use = np.bincount(np.concatenate([E[cand, 0], E[cand, 1], r, sv]), minlength=nv)
             iso = ((use[E[cand, 0]] == 1) & (use[E[cand, 1]] == 1) & (use[r] == 1)
                    & (use[sv] == 1) & (r != sv))
-            keys = np.sort(np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1]))
             k = np.minimum(r, sv) * nv + np.maximum(r, sv)
-            pos = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
-            iso &= keys[pos] != k                     # r and sv not joined yet
+            iso &= np.array([x not in pairs for x in k.tolist()], bool)   # r, sv not joined
             if iso.any():
                 I = cand[iso]
                 fa, fb, b1, c1, b2, c2, r, sv = (x[iso] for x in quad)
                 moves.append((I, E[I, 0].copy(), E[I, 1].copy()))
+                pairs.difference_update((np.minimum(E[I, 0], E[I, 1]) * nv
+                                         + np.maximum(E[I, 0], E[I, 1])).tolist())
+                pairs.update(k[iso].tolist())
                 al = first[I][:, None]
                 E[I, 0], E[I, 1] = np.where(al[:, 0], sv, r), np.where(al[:, 0], r, sv)
                 FE[fa] = np.where(al, np.stack([I, c1, b2], 1), np.stack([I, c2, b1], 1))
@@ -240,15 +243,13 @@ def equiangulate(s, threshold=-0.001, only=None):
                 outer = np.stack([c1, b2, c2, b1], 1)
                 outer = np.where(outer >= 0, outer, ~outer)
                 later = outer > I[:, None]
-                again = np.unique(outer[later])
+                again = np.sort(outer[later])         # (repeats: skipped when popped)
                 okd = np.zeros(len(again), bool)
                 sel = ok[again]
                 okd[sel] = _passes(np.where(FE >= 0, FE, ~FE), ef, again[sel], lengths,
                                     threshold)
-                heap = np.union1d(cand[~iso], again[okd])
+                heap = np.concatenate([cand[~iso], again[okd]])
 
-    # adjacency for the "already joined" test
-    pairs = set((np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])).tolist())
     heap = np.asarray(heap).tolist()
     heapq.heapify(heap)
     flips = 0
@@ -270,8 +271,9 @@ def equiangulate(s, threshold=-0.001, only=None):
 
     last = -1
     seq_moves = []
+    pop, push = heapq.heappop, heapq.heappush
     while heap:
-        ed = heapq.heappop(heap)
+        ed = pop(heap)
         if ed == last:              # pops come in increasing order: a repeat is adjacent
             continue
         last = ed
@@ -291,20 +293,26 @@ def equiangulate(s, threshold=-0.001, only=None):
             continue            # the two facets do not have opposite orientations
         b1, c1 = row_a[(ka + 1) % 3], row_a[(ka + 2) % 3]
         b2, c2 = row_b[(kb + 1) % 3], row_b[(kb + 2) % 3]
+        # (the tests have no side effects: the criterion, the most selective, first)
+        if finite:
+            A = lengths[ed]
+            lb = lengths[b1 if b1 >= 0 else ~b1]
+            lc = lengths[c1 if c1 >= 0 else ~c1]
+            ld = lengths[b2 if b2 >= 0 else ~b2]
+            le = lengths[c2 if c2 >= 0 else ~c2]
+            d1, d2 = lb * lc, ld * le
+            if d1 and d2:
+                crit = (lb * lb + lc * lc - A * A) / d1 + (ld * ld + le * le - A * A) / d2
+            else:
+                crit = _div(lb * lb + lc * lc - A * A, d1) + _div(ld * ld + le * le - A * A, d2)
+            if not crit < threshold:
+                continue
         r = El[2 * b1 + 1] if b1 >= 0 else El[2 * ~b1]          # head of b1
         sv = El[2 * b2 + 1] if b2 >= 0 else El[2 * ~b2]         # head of b2
         if r == sv:
             continue
         key = r * nv + sv if r < sv else sv * nv + r
         if key in pairs:
-            continue
-        A = lengths[ed]
-        lb = lengths[b1 if b1 >= 0 else ~b1]
-        lc = lengths[c1 if c1 >= 0 else ~c1]
-        ld = lengths[b2 if b2 >= 0 else ~b2]
-        le = lengths[c2 if c2 >= 0 else ~c2]
-        crit = _div(lb * lb + lc * lc - A * A, lb * lc) + _div(ld * ld + le * le - A * A, ld * le)
-        if finite and not crit < threshold:
             continue
         # flip: a was p->q in fa = (a, b1: q->r, c1: r->p), fb = (~a, b2: p->s, c2: s->q).
         # As REF (list edges / list facets after u): when fa comes first in the
@@ -359,7 +367,7 @@ def equiangulate(s, threshold=-0.001, only=None):
         for x in (c1, b2, c2, b1):
             i = x if x >= 0 else ~x
             if i > ed:                # not yet visited (visits go in id order)
-                heapq.heappush(heap, i)
+                push(heap, i)
     t.__dict__.pop("_topo", None)          # E and FE were changed
     if flips + flips_at_once:
         # an edge's facet loop keeps its start through the flips (REF, ee.facet)

@@ -48,3 +48,25 @@ def test_located_names_the_declaration():
         LocatedFormula(F(), "boundary 1", 4).values()
     except PyEvolverError as exc:
         assert exc.line == 4
+
+
+
+def test_rings_recorded_as_a_function_are_computed_once_when_read():
+    from pyevolver.model.records import record_vertex_rings
+    s = cube()
+    rank = vertex_edge_rank(s)
+    assert not rank.flags.writeable                       # the loaded order, kept
+    assert vertex_edge_rank(s) is rank
+    calls = []
+
+    def later():
+        calls.append(1)
+        return rank + 0
+    record_vertex_rings(s, later)
+    assert not calls                                      # not computed yet
+    assert np.array_equal(vertex_edge_rank(s), rank)
+    assert np.array_equal(vertex_edge_rank(s), rank)
+    assert calls == [1]                                   # once
+    s.E = s.E[:, ::-1].copy()                             # the edges changed: not used
+    vertex_edge_rank(s)
+    assert calls == [1] and s._rings[1] is not rank
