@@ -4,6 +4,7 @@ torus lift of each body's facets."""
 from __future__ import annotations
 
 from collections import deque
+from typing import Any
 
 import numpy as np
 
@@ -58,11 +59,13 @@ def edge_first_facet(s: Surface) -> np.ndarray:
     return first
 
 
-def record_along_first(s: Surface, along: np.ndarray) -> None:
+def record_along_first(s: Surface, along: np.ndarray, copies: tuple | None = None) -> None:
     """Attach to ``s`` which edges have the facet running along them first
     in their facet loop (``along`` (ne,) bool), valid while its connectivity
-    stays what it is now."""
-    s._along_first = (s.FE.copy(), s.E.copy(), np.asarray(along, bool))
+    stays what it is now.  ``copies``: copies of ``(s.FE, s.E)`` already made
+    (shared with other records; nothing may write into them)."""
+    FE, E = copies if copies is not None else (s.FE.copy(), s.E.copy())
+    s._along_first = (FE, E, np.asarray(along, bool))
 
 
 def along_first(s: Surface) -> np.ndarray:
@@ -88,14 +91,25 @@ def along_first(s: Surface) -> np.ndarray:
     return out
 
 
-def record_vertex_rings(s: Surface, rank: np.ndarray) -> None:
+def record_vertex_rings(s: Surface, rank: Any, E: np.ndarray | None = None) -> None:
     """Attach REF's edge rings to ``s``: ``rank`` (ne, 2) is the position of
     each edge in the ring of its tail (column 0) and head (column 1) vertex
     (:func:`vertex_edge_rank`), valid while the edges stay what they are.
     ``rank`` may be a function of no arguments that computes it, called
     the first time the rings are read (``r`` leaves them to the first
-    ``u``, ``V`` or ``vv.edge`` that needs them)."""
-    s._rings = (s.E.copy(), rank if callable(rank) else np.asarray(rank, np.int64))
+    ``u``, ``V`` or ``vv.edge`` that needs them).  ``E``: a copy of
+    ``s.E`` already made (shared with other records)."""
+    E = s.E.copy() if E is None else E
+    s._rings = (E, rank if callable(rank) else np.asarray(rank, np.int64))
+
+
+def settle_rings(s: Surface) -> None:
+    """Compute now the rings of ``s`` recorded as a function, so that a new
+    surface's function can depend on ``s``'s rings without keeping a chain
+    of older surfaces alive (``K`` bisects in rounds, each a new surface)."""
+    c = s.__dict__.get("_rings")
+    if c is not None and callable(c[1]):
+        vertex_edge_rank(s)
 
 
 def vertex_edge_rank(s: Surface) -> np.ndarray:

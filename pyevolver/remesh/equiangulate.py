@@ -21,7 +21,8 @@ import numpy as np
 
 from ..geometry import kernels as G
 from ..model.groups import group_of
-from ..model.records import along_first, edge_facets, record_along_first, record_vertex_rings
+from ..model.records import (along_first, edge_facets, record_along_first,
+                             record_vertex_rings, settle_rings)
 from .rings import Rings
 
 
@@ -35,7 +36,7 @@ def _div(a, b):
     return a / b
 
 
-def _flip_rings(s, t, moves):
+def _flip_rings(s, t, moves, E=None):
     """Record REF's edge rings (:mod:`pyevolver.remesh.rings`) of ``t``, ``s``
     with edges flipped: ``moves`` lists (edges, old tails, old heads).
     The pass flips in edge id order; each flip takes the edge out of the
@@ -43,8 +44,9 @@ def _flip_rings(s, t, moves):
     with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
     Runs of flips with no vertex in common are replayed at once.  The rings
     are computed when first read (:func:`record_vertex_rings`)."""
-    E, nv = t.E.copy(), t.nv
-    record_vertex_rings(t, lambda: _rings_after_flips(s, E, nv, moves))
+    settle_rings(s)                     # (no chain of surfaces kept for later)
+    E, nv = t.E.copy() if E is None else E, t.nv
+    record_vertex_rings(t, lambda: _rings_after_flips(s, E, nv, moves), E)
 
 
 def _rings_after_flips(s, E, nv, moves):
@@ -371,10 +373,11 @@ def equiangulate(s, threshold=-0.001, only=None):
     t.__dict__.pop("_topo", None)          # E and FE were changed
     if flips + flips_at_once:
         # an edge's facet loop keeps its start through the flips (REF, ee.facet)
-        record_along_first(t, first)
+        copies = (t.FE.copy(), t.E.copy())    # (one copy for both records)
+        record_along_first(t, first, copies)
         if seq_moves:               # (one block, in the order flipped)
             sm = np.array(seq_moves, dtype=np.int64).reshape(-1, 3)
             moves.append((sm[:, 0], sm[:, 1], sm[:, 2]))
-        _flip_rings(s, t, moves)
+        _flip_rings(s, t, moves, copies[1])
     t.topology_version = getattr(s, "topology_version", 0) + 1
     return t, flips + flips_at_once

@@ -13,7 +13,7 @@ import numpy as np
 from ..methods import metric as MT
 from ..geometry import kernels as G
 from ..constraints import constrained_vertices, project_to_constraints
-from ..model.records import along_first, record_along_first, record_vertex_rings
+from ..model.records import along_first, record_along_first, record_vertex_rings, settle_rings
 from ..model.groups import group_of
 from . import group_refine as GR
 from .grow import grow, reorder_new_edges
@@ -281,8 +281,9 @@ def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
 
     if group is not None:                   # a symmetry group's codes (remesh.group_refine)
         GR.new_edge_codes(s, t, group, R, I, FW, new_edges)
-    _split_rings(s, t, R, half, None if perm is None else np.sort(base1))
-    _split_loops(s, t, R, half)
+    copies = (t.FE.copy(), t.E.copy())        # (one copy for both records)
+    _split_rings(s, t, R, half, None if perm is None else np.sort(base1), copies[1])
+    _split_loops(s, t, R, half, copies)
     new_v = np.arange(nv, nv + k)
     boundary_midpoints(t, s.E[R, 0], s.E[R, 1], new_v)
     sel = new_v[constrained_vertices(t)[new_v]]
@@ -291,7 +292,7 @@ def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
     return t
 
 
-def _split_loops(s, t, R, half):
+def _split_loops(s, t, R, half, copies=None):
     """Record which edges of ``t`` have the facet along them first in their
     facet loop (:func:`pyevolver.model.records.along_first`): the tail half of a split edge
     keeps its edge's order, the head half has the other one, the edges
@@ -301,10 +302,10 @@ def _split_loops(s, t, R, half):
     old = along_first(s)
     out[:s.ne] = old
     out[half[R]] = ~old[R]
-    record_along_first(t, out)
+    record_along_first(t, out, copies)
 
 
-def _split_rings(s, t, R, half, inner=None):
+def _split_rings(s, t, R, half, inner=None, E=None):
     """Record REF's edge rings (:mod:`pyevolver.remesh.rings`) at the vertices
     of ``t``: ``s`` with the edges ``R`` split (new head halves ``half[R]``)
     and its facets cut.
@@ -318,8 +319,10 @@ def _split_rings(s, t, R, half, inner=None):
     The rings are computed when first read (:func:`record_vertex_rings`),
     from ``s`` (kept until then) and copies of the arrays used here.
     """
-    E, R, half, nv = t.E.copy(), R.copy(), half.copy(), t.nv
-    record_vertex_rings(t, lambda: _rings_after_split(s, E, nv, R, half, inner))
+    settle_rings(s)                     # (no chain of surfaces kept for later)
+    E = t.E.copy() if E is None else E
+    R, half, nv = R.copy(), half.copy(), t.nv
+    record_vertex_rings(t, lambda: _rings_after_split(s, E, nv, R, half, inner), E)
 
 
 def _rings_after_split(s, E, nv, R, half, inner):

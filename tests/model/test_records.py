@@ -70,3 +70,14 @@ def test_rings_recorded_as_a_function_are_computed_once_when_read():
     s.E = s.E[:, ::-1].copy()                             # the edges changed: not used
     vertex_edge_rank(s)
     assert calls == [1] and s._rings[1] is not rank
+
+
+def test_lazy_rings_do_not_chain_surfaces():
+    # K bisects in rounds, each a new surface: a round's lazy rings are
+    # settled when the next round records its own (no chain kept alive)
+    from pyevolver.remesh.refine import refine
+    s1 = refine(cube())
+    assert callable(s1._rings[1])
+    s2 = refine(s1)
+    assert not callable(s1._rings[1]) and callable(s2._rings[1])
+    assert vertex_edge_rank(s2).shape == (s2.ne, 2)
