@@ -3,20 +3,22 @@ evaluation after a command can be skipped.
 
 After every command the session evaluates the surface again (energies,
 areas, volumes: :meth:`Session.refresh`).  Many commands have just done so
-(``r``, ``u``, ``V`` replace the surface and evaluate the new one) or change
-nothing the evaluation reads (``print``, ``printf``, ``list``...).  When an
-evaluation is made, :func:`mark` records a fingerprint of everything the
-evaluation can read: the surface's public attributes (coordinates,
-topology, element attributes, constraint memberships, bodies, quantities and
-their methods, a few levels deep) and the session's variables, toggles,
-settings and arrays.  Arrays enter by shape, type and a CRC-32 of their
-bytes, so a change made in place (``set vertex x ...``, an attribute
+(``r``, ``u``, ``V`` replace the surface and evaluate the new one; ``g``
+ends with the evaluation of its last move) or change nothing the
+evaluation reads (``print``, ``printf``, ``list``...).  When an evaluation
+is made, :func:`mark` records a fingerprint of everything the evaluation
+can read: the surface's attributes (coordinates, element attributes,
+constraint memberships, bodies, quantities and their methods, a few levels
+deep; not its caches of derived data) and the session's variables,
+toggles, settings and arrays.  Arrays enter by shape, type and a CRC-32 of
+their bytes, so a change made in place (``set vertex x ...``, an attribute
 assignment, a user of the API writing into ``surface.X``) changes the
 fingerprint as a new array does; only the connectivity arrays ``E`` and
-``FE``, which nothing changes in place, enter by identity.  :func:`is_fresh` says whether the totals
-are still the marked ones and the fingerprint is unchanged; only then is the
-evaluation skipped.  Anything not understood enters by identity, so an
-unknown change leads to an evaluation, never to stale totals.
+``FE``, which nothing changes in place, enter by identity.
+:func:`is_fresh` says whether the totals are still the marked ones and the
+fingerprint is unchanged; only then is the evaluation skipped.  Objects
+beyond the depth followed enter by identity (kept alive with the record):
+only a change made in place that deep (none is known) would go unseen.
 """
 from __future__ import annotations
 

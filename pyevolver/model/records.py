@@ -63,9 +63,10 @@ def record_along_first(s: Surface, along: np.ndarray, copies: tuple | None = Non
     """Attach to ``s`` which edges have the facet running along them first
     in their facet loop (``along`` (ne,) bool), valid while its connectivity
     stays what it is now.  ``copies``: copies of ``(s.FE, s.E)`` already made
-    (shared with other records; nothing may write into them)."""
+    (shared with other records; nothing may write into them).  ``along``
+    may be a function of no arguments, called when first read (``r``)."""
     FE, E = copies if copies is not None else (s.FE.copy(), s.E.copy())
-    s._along_first = (FE, E, np.asarray(along, bool))
+    s._along_first = (FE, E, along if callable(along) else np.asarray(along, bool))
 
 
 def along_first(s: Surface) -> np.ndarray:
@@ -78,6 +79,8 @@ def along_first(s: Surface) -> np.ndarray:
     c = s.__dict__.get("_along_first")
     if c is not None and c[0].shape == s.FE.shape and c[1].shape == s.E.shape and \
             np.array_equal(c[0], s.FE) and np.array_equal(c[1], s.E):
+        if callable(c[2]):
+            c = s._along_first = (c[0], c[1], np.asarray(c[2](), bool))
         return c[2].copy()
     out = np.ones(s.ne, bool)
     first = edge_first_facet(s)
@@ -103,13 +106,17 @@ def record_vertex_rings(s: Surface, rank: Any, E: np.ndarray | None = None) -> N
     s._rings = (E, rank if callable(rank) else np.asarray(rank, np.int64))
 
 
-def settle_rings(s: Surface) -> None:
-    """Compute now the rings of ``s`` recorded as a function, so that a new
-    surface's function can depend on ``s``'s rings without keeping a chain
-    of older surfaces alive (``K`` bisects in rounds, each a new surface)."""
+def settle_records(s: Surface) -> None:
+    """Compute now the rings and loop starts of ``s`` recorded as functions,
+    so that a new surface's functions can depend on them without keeping a
+    chain of older surfaces alive (``K`` bisects in rounds, each a new
+    surface)."""
     c = s.__dict__.get("_rings")
     if c is not None and callable(c[1]):
         vertex_edge_rank(s)
+    c = s.__dict__.get("_along_first")
+    if c is not None and callable(c[2]):
+        along_first(s)
 
 
 def vertex_edge_rank(s: Surface) -> np.ndarray:

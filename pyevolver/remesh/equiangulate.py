@@ -22,7 +22,7 @@ import numpy as np
 from ..geometry import kernels as G
 from ..model.groups import group_of
 from ..model.records import (along_first, edge_facets, record_along_first,
-                             record_vertex_rings, settle_rings)
+                             record_vertex_rings, settle_records)
 from .rings import Rings
 
 
@@ -44,7 +44,7 @@ def _flip_rings(s, t, moves, E=None):
     with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
     Runs of flips with no vertex in common are replayed at once.  The rings
     are computed when first read (:func:`record_vertex_rings`)."""
-    settle_rings(s)                     # (no chain of surfaces kept for later)
+    settle_records(s)                     # (no chain of surfaces kept for later)
     E, nv = t.E.copy() if E is None else E, t.nv
     record_vertex_rings(t, lambda: _rings_after_flips(s, E, nv, moves), E)
 

@@ -13,7 +13,8 @@ import numpy as np
 from ..methods import metric as MT
 from ..geometry import kernels as G
 from ..constraints import constrained_vertices, project_to_constraints
-from ..model.records import along_first, record_along_first, record_vertex_rings, settle_rings
+from ..model.records import (along_first, record_along_first, record_vertex_rings,
+                             settle_records)
 from ..model.groups import group_of
 from . import group_refine as GR
 from .grow import grow, reorder_new_edges
@@ -298,11 +299,16 @@ def _split_loops(s, t, R, half, copies=None):
     keeps its edge's order, the head half has the other one, the edges
     cutting the facets have the facet along them first (measured with
     ``ee.facet`` after ``r`` on catbody.fe; it decides how ``u`` renumbers)."""
-    out = np.ones(t.ne, bool)
-    old = along_first(s)
-    out[:s.ne] = old
-    out[half[R]] = ~old[R]
-    record_along_first(t, out, copies)
+    ne, R, half = t.ne, R.copy(), half.copy()
+
+    def later():                        # (when first read: along_first)
+        out = np.ones(ne, bool)
+        old = along_first(s)
+        out[:s.ne] = old
+        out[half[R]] = ~old[R]
+        return out
+    settle_records(s)
+    record_along_first(t, later, copies)
 
 
 def _split_rings(s, t, R, half, inner=None, E=None):
@@ -319,7 +325,7 @@ def _split_rings(s, t, R, half, inner=None, E=None):
     The rings are computed when first read (:func:`record_vertex_rings`),
     from ``s`` (kept until then) and copies of the arrays used here.
     """
-    settle_rings(s)                     # (no chain of surfaces kept for later)
+    settle_records(s)                     # (no chain of surfaces kept for later)
     E = t.E.copy() if E is None else E
     R, half, nv = R.copy(), half.copy(), t.nv
     record_vertex_rings(t, lambda: _rings_after_split(s, E, nv, R, half, inner), E)

@@ -87,6 +87,24 @@ def test_remesh_commands_evaluate_once(session, count):
         _exact(session)
 
 
+def test_g_ends_with_the_evaluation_of_its_last_move(session, count):
+    session.run("g 2")
+    session.run("print 1")
+    del count[:]
+    session.run("g 3")
+    steps = len(count)                   # (the steps' own evaluations)
+    del count[:]
+    session.run("print 1")
+    assert not count
+    _exact(session)
+    session.run("g 1")
+    assert len(count) <= steps           # no evaluation after the steps
+    _exact(session)
+    del count[:]
+    session.run("g 0")                   # no step: nothing new to trust
+    _exact(session)
+
+
 def test_changes_in_place_are_seen(session, count):
     session.run("print 1")
     for cmd in ("set vertex[1] x 0.1", "set facet[2] tension 3", "kk := 2",

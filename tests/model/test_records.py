@@ -4,7 +4,8 @@ import numpy as np
 from pyevolver.datafile.reader import read_datafile
 from pyevolver.model.build import build_surface
 from pyevolver.model.formulas import LocatedFormula, located
-from pyevolver.model.records import convex_edges, edge_facets, edge_first_facet, vertex_edge_rank
+from pyevolver.model.records import (along_first, convex_edges, edge_facets, edge_first_facet,
+                                     vertex_edge_rank)
 from pyevolver.errors import PyEvolverError
 
 
@@ -80,4 +81,6 @@ def test_lazy_rings_do_not_chain_surfaces():
     assert callable(s1._rings[1])
     s2 = refine(s1)
     assert not callable(s1._rings[1]) and callable(s2._rings[1])
+    assert not callable(s1._along_first[2]) and callable(s2._along_first[2])
+    assert along_first(s2).shape == (s2.ne,) and not callable(s2._along_first[2])
     assert vertex_edge_rank(s2).shape == (s2.ne, 2)
