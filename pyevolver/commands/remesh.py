@@ -66,7 +66,10 @@ def _replaced(session: SessionLike, result, count=None, note=None, echo=True):
     after ``t``, ... are the last such command's) and print ``note``
     (``{n}`` filled in)."""
     new, n = result
-    session._replace_surface(new)
+    if new is session.surface and fresh.is_fresh(session):
+        session.reset_cg()              # (nothing changed: as the recalc would, no evaluation)
+    else:
+        session._replace_surface(new)
     if count is not None:
         set_count(session, count, n)
     if echo and note is not None:
