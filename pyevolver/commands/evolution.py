@@ -9,6 +9,7 @@ from __future__ import annotations
 from ..errors import CommandError
 from ..evolve import optparams as OP
 from ..model.groups import group_of
+from . import fresh
 from .registry import register
 from .values import as_float
 
@@ -18,7 +19,14 @@ FAMILY = "evolution"
 @register("g", usage="g [n] | gN", help="n iteration steps (default 1)", family=FAMILY)
 def _g(interp, raw, arg):
     n = int(raw[1:]) if len(raw) > 1 else (1 if arg is None else interp.count(arg))
-    interp.session.go(n)
+    s = interp.session
+    before = s.totals
+    s.go(n)
+    if s.totals is not before and not (s.toggles.get("autopop") or s.toggles.get("autochop")):
+        # the last step's evaluation of its final move is the surface's (the
+        # same numbers as a new one): the check after the command need not
+        # evaluate again, unless autopop or autochop changed the surface
+        fresh.mark(s)
 
 
 @register("m", usage="m scale", help="fix the scale factor of g", family=FAMILY)

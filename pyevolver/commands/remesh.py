@@ -20,6 +20,7 @@ from ..remesh import notch as NO, pop as POP, vertex_average as VA
 from ..remesh.quadratic import refine_quadratic
 from ..remesh.refine import refine as _refine_all
 from ..remesh.simplex import refine as refine_simplex
+from . import fresh
 from . import element_attrs, elements, variables
 from .registry import register
 from .values import ElemRef, SessionLike, as_float, is_true
@@ -65,7 +66,10 @@ def _replaced(session: SessionLike, result, count=None, note=None, echo=True):
     after ``t``, ... are the last such command's) and print ``note``
     (``{n}`` filled in)."""
     new, n = result
-    session._replace_surface(new)
+    if new is session.surface and fresh.is_fresh(session):
+        session.reset_cg()              # (nothing changed: as the recalc would, no evaluation)
+    else:
+        session._replace_surface(new)
     if count is not None:
         set_count(session, count, n)
     if echo and note is not None:
@@ -284,7 +288,8 @@ def vertex_average(session: SessionLike, mode="V", echo=True):
     if session.surface.string:
         session._replace_surface(SM.vertex_average(session.surface, mode))
     else:
-        session._replace_surface(VA.vertex_average(session.surface, mode))
+        now = session.totals if fresh.is_fresh(session) else None    # (no new evaluation)
+        session._replace_surface(VA.vertex_average(session.surface, mode, now))
     if echo:
         session.note("Vertex averaging done.\n")
 

@@ -201,17 +201,29 @@ def vertex_normals(F, N2, nv, rank=None):
                 N[:, i] += np.bincount(F[:, k], weights=N2[:, i], minlength=nv)
     else:
         v = F.ravel()
-        f = np.repeat(np.arange(len(F)), 3)
-        order = np.lexsort((f, np.asarray(rank).ravel(), v))
-        v, f = v[order], f[order]
-        start = np.searchsorted(v, np.arange(nv))
-        slot = np.arange(len(v)) - start[v]
+        nf = len(F)
+        rk = np.asarray(rank, np.int64).ravel()
+        cnt = np.bincount(v, minlength=nv)
+        start = np.cumsum(cnt) - cnt
+        # the facets in (vertex, rank, facet) order; where the ranks at each
+        # vertex are 0 .. count - 1 (a closed surface), they are the places
+        pos = start[v] + rk
+        if len(pos) and rk.min() >= 0 and pos.max() < len(pos) and \
+                np.all(np.bincount(pos, minlength=len(pos)) == 1):
+            f = np.empty(len(pos), np.int64)
+            f[pos] = np.arange(len(pos)) // 3
+        else:                               # one sort of a combined key
+            R = int(rk.max()) + 1 if len(rk) else 1
+            f = np.argsort((v * R + rk) * nf + np.repeat(np.arange(nf), 3), kind="stable") // 3
+        N2 = np.ascontiguousarray(N2)          # (rows gathered below: fast when contiguous)
         N = np.zeros((nv, 3))
-        for j in range(int(slot.max()) + 1 if len(slot) else 0):
-            sel = slot == j
-            vs, n = v[sel], N2[f[sel]]
-            d = np.einsum("ij,ij->i", n, N[vs])
-            N[vs] += np.where(d >= 0, 1.0, -1.0)[:, None] * n
+        vs = np.arange(nv)
+        for j in range(int(cnt.max()) if len(cnt) else 0):
+            vs = vs[cnt[vs] > j]                # the vertices with a j-th facet
+            n = N2.take(f[start[vs] + j], axis=0)   # (take: faster than [] on rows)
+            Nv = N.take(vs, axis=0)
+            d = np.einsum("ij,ij->i", n, Nv)
+            N[vs] = Nv + np.where(d >= 0, 1.0, -1.0)[:, None] * n
     L = np.linalg.norm(N, axis=1)
     return np.where(L[:, None] > 0, N / np.where(L > 0, L, 1.0)[:, None], 0.0)
 

@@ -4,6 +4,7 @@ torus lift of each body's facets."""
 from __future__ import annotations
 
 from collections import deque
+from typing import Any
 
 import numpy as np
 
@@ -58,11 +59,14 @@ def edge_first_facet(s: Surface) -> np.ndarray:
     return first
 
 
-def record_along_first(s: Surface, along: np.ndarray) -> None:
+def record_along_first(s: Surface, along: np.ndarray, copies: tuple | None = None) -> None:
     """Attach to ``s`` which edges have the facet running along them first
     in their facet loop (``along`` (ne,) bool), valid while its connectivity
-    stays what it is now."""
-    s._along_first = (s.FE.copy(), s.E.copy(), np.asarray(along, bool))
+    stays what it is now.  ``copies``: copies of ``(s.FE, s.E)`` already made
+    (shared with other records; nothing may write into them).  ``along``
+    may be a function of no arguments, called when first read (``r``)."""
+    FE, E = copies if copies is not None else (s.FE.copy(), s.E.copy())
+    s._along_first = (FE, E, along if callable(along) else np.asarray(along, bool))
 
 
 def along_first(s: Surface) -> np.ndarray:
@@ -75,6 +79,8 @@ def along_first(s: Surface) -> np.ndarray:
     c = s.__dict__.get("_along_first")
     if c is not None and c[0].shape == s.FE.shape and c[1].shape == s.E.shape and \
             np.array_equal(c[0], s.FE) and np.array_equal(c[1], s.E):
+        if callable(c[2]):
+            c = s._along_first = (c[0], c[1], np.asarray(c[2](), bool))
         return c[2].copy()
     out = np.ones(s.ne, bool)
     first = edge_first_facet(s)
@@ -88,11 +94,29 @@ def along_first(s: Surface) -> np.ndarray:
     return out
 
 
-def record_vertex_rings(s: Surface, rank: np.ndarray) -> None:
+def record_vertex_rings(s: Surface, rank: Any, E: np.ndarray | None = None) -> None:
     """Attach REF's edge rings to ``s``: ``rank`` (ne, 2) is the position of
     each edge in the ring of its tail (column 0) and head (column 1) vertex
-    (:func:`vertex_edge_rank`), valid while the edges stay what they are."""
-    s._rings = (s.E.copy(), np.asarray(rank, np.int64))
+    (:func:`vertex_edge_rank`), valid while the edges stay what they are.
+    ``rank`` may be a function of no arguments that computes it, called
+    the first time the rings are read (``r`` leaves them to the first
+    ``u``, ``V`` or ``vv.edge`` that needs them).  ``E``: a copy of
+    ``s.E`` already made (shared with other records)."""
+    E = s.E.copy() if E is None else E
+    s._rings = (E, rank if callable(rank) else np.asarray(rank, np.int64))
+
+
+def settle_records(s: Surface) -> None:
+    """Compute now the rings and loop starts of ``s`` recorded as functions,
+    so that a new surface's functions can depend on them without keeping a
+    chain of older surfaces alive (``K`` bisects in rounds, each a new
+    surface)."""
+    c = s.__dict__.get("_rings")
+    if c is not None and callable(c[1]):
+        vertex_edge_rank(s)
+    c = s.__dict__.get("_along_first")
+    if c is not None and callable(c[2]):
+        along_first(s)
 
 
 def vertex_edge_rank(s: Surface) -> np.ndarray:
@@ -110,6 +134,8 @@ def vertex_edge_rank(s: Surface) -> np.ndarray:
     ne, nv = s.ne, s.nv
     c = s.__dict__.get("_rings")
     if c is not None and c[0].shape == s.E.shape and np.array_equal(c[0], s.E):
+        if callable(c[1]):
+            c = s._rings = (c[0], np.asarray(c[1](), np.int64))
         return c[1]
     t = np.empty(ne, np.int64)
     t[np.argsort(s.ids("edge"), kind="stable")] = np.arange(ne)
@@ -123,7 +149,10 @@ def vertex_edge_rank(s: Surface) -> np.ndarray:
     start = np.searchsorted(vs, np.arange(nv))
     pos = np.empty(2 * ne, np.int64)
     pos[order] = np.arange(2 * ne) - start[vs]
-    return pos.reshape(ne, 2)
+    pos = pos.reshape(ne, 2)
+    pos.flags.writeable = False          # (kept: the next call while E is unchanged)
+    record_vertex_rings(s, pos)
+    return pos
 
 
 def vertex_facet_rank(s: Surface) -> np.ndarray:

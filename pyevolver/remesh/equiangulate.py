@@ -21,7 +21,8 @@ import numpy as np
 
 from ..geometry import kernels as G
 from ..model.groups import group_of
-from ..model.records import along_first, edge_facets, record_along_first, record_vertex_rings
+from ..model.records import (along_first, edge_facets, record_along_first,
+                             record_vertex_rings, settle_records)
 from .rings import Rings
 
 
@@ -35,20 +36,28 @@ def _div(a, b):
     return a / b
 
 
-def _flip_rings(s, t, moves):
+def _flip_rings(s, t, moves, E=None):
     """Record REF's edge rings (:mod:`pyevolver.remesh.rings`) of ``t``, ``s``
     with edges flipped: ``moves`` lists (edges, old tails, old heads).
     The pass flips in edge id order; each flip takes the edge out of the
     rings of its old ends and puts it in those of its new ends (measured
     with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
-    Runs of flips with no vertex in common are replayed at once."""
-    g = Rings(s, t.ne, t.nv)
+    Runs of flips with no vertex in common are replayed at once.  The rings
+    are computed when first read (:func:`record_vertex_rings`)."""
+    settle_records(s)                     # (no chain of surfaces kept for later)
+    E, nv = t.E.copy() if E is None else E, t.nv
+    record_vertex_rings(t, lambda: _rings_after_flips(s, E, nv, moves), E)
+
+
+def _rings_after_flips(s, E, nv, moves):
+    """The rank of :func:`_flip_rings` (``E``, ``nv``: the new surface's)."""
+    g = Rings(s, len(E), nv)
     I = np.concatenate([m[0] for m in moves])
     o = np.argsort(I, kind="stable")
     I = I[o]
     p = np.concatenate([m[1] for m in moves])[o]
     q = np.concatenate([m[2] for m in moves])[o]
-    x, y = t.E[I, 0], t.E[I, 1]
+    x, y = E[I, 0], E[I, 1]
     quads = np.stack([p, q, x, y], 1).tolist()
     start, used = 0, set()
     for k in range(len(I) + 1):
@@ -62,7 +71,15 @@ def _flip_rings(s, t, moves):
         g.insert(y[b], 2 * I[b] + 1)
         if k < len(I):
             start, used = k, set(quads[k])
-    record_vertex_rings(t, g.rank())
+    return g.rank()
+
+
+def _flat(a):
+    """A one-dimensional memoryview of C-contiguous array ``a`` (writes go
+    into ``a``)."""
+    if not a.flags.c_contiguous:
+        raise ValueError("_flat: the array must be C-contiguous")
+    return memoryview(a.reshape(-1))
 
 
 def _quads(E, FE, ef, edges):
@@ -157,7 +174,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     t.__dict__.pop("_lift_cache", None)
     E, FE = t.E, t.FE
     wrap = t.eattr.get("wrap")
-    ef, ekk, val = edge_facets(t)
+    ef, ekk, val = edge_facets(s)          # (s: its topology is cached; the same as t's)
     first = along_first(s)
     wv = t.wrap_shift()
     group = group_of(t)
@@ -179,7 +196,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     ok[ok] &= (fsig[f0[ok]] == esig[ok]) & (fsig[f1[ok]] == esig[ok])
     cand = np.nonzero(ok)[0]
     if len(cand):
-        cand = cand[_passes(t.topology()[0], ef, cand, lengths, threshold, ekk)]
+        cand = cand[_passes(s.topology()[0], ef, cand, lengths, threshold, ekk)]
     if not len(cand):
         return s, 0
 
@@ -191,6 +208,8 @@ def equiangulate(s, threshold=-0.001, only=None):
     heap = cand
     flips_at_once = 0
     moves = []              # (edges, old tails, old heads) in the order flipped
+    # adjacency for the "already joined" test
+    pairs = set((np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])).tolist())
     if wrap is None:
         quad = _quads(E, FE, ef, cand)
         if quad is not None:
@@ -198,14 +217,15 @@ def equiangulate(s, threshold=-0.001, only=None):
             use = np.bincount(np.concatenate([E[cand, 0], E[cand, 1], r, sv]), minlength=nv)
             iso = ((use[E[cand, 0]] == 1) & (use[E[cand, 1]] == 1) & (use[r] == 1)
                    & (use[sv] == 1) & (r != sv))
-            keys = np.sort(np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1]))
             k = np.minimum(r, sv) * nv + np.maximum(r, sv)
-            pos = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
-            iso &= keys[pos] != k                     # r and sv not joined yet
+            iso &= np.array([x not in pairs for x in k.tolist()], bool)   # r, sv not joined
             if iso.any():
                 I = cand[iso]
                 fa, fb, b1, c1, b2, c2, r, sv = (x[iso] for x in quad)
                 moves.append((I, E[I, 0].copy(), E[I, 1].copy()))
+                pairs.difference_update((np.minimum(E[I, 0], E[I, 1]) * nv
+                                         + np.maximum(E[I, 0], E[I, 1])).tolist())
+                pairs.update(k[iso].tolist())
                 al = first[I][:, None]
                 E[I, 0], E[I, 1] = np.where(al[:, 0], sv, r), np.where(al[:, 0], r, sv)
                 FE[fa] = np.where(al, np.stack([I, c1, b2], 1), np.stack([I, c2, b1], 1))
@@ -225,44 +245,45 @@ def equiangulate(s, threshold=-0.001, only=None):
                 outer = np.stack([c1, b2, c2, b1], 1)
                 outer = np.where(outer >= 0, outer, ~outer)
                 later = outer > I[:, None]
-                again = np.unique(outer[later])
+                again = np.sort(outer[later])         # (repeats: skipped when popped)
                 okd = np.zeros(len(again), bool)
                 sel = ok[again]
                 okd[sel] = _passes(np.where(FE >= 0, FE, ~FE), ef, again[sel], lengths,
                                     threshold)
-                heap = np.union1d(cand[~iso], again[okd])
+                heap = np.concatenate([cand[~iso], again[okd]])
 
-    # adjacency for the "already joined" test
-    pairs = set((np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])).tolist())
     heap = np.asarray(heap).tolist()
     heapq.heapify(heap)
     flips = 0
     finite = bool(np.isfinite(threshold))
-    okl = ok.tolist()
-    vall = val.tolist()
-    lengths = lengths.tolist()
     Xl = t.X                     # read with .item(): scalar access without array temporaries
-    # flat Python lists for the sequential part (list indexing is several
-    # times faster than numpy scalar access); written back at the end
-    El = E.ravel().tolist()
-    FEl = FE.ravel().tolist()
-    efl = ef.ravel().tolist()
+    # memoryviews of the arrays for the sequential part: indexing them gives
+    # and takes Python numbers as fast as a list's, without converting the
+    # whole arrays to lists and back (E, FE, ef and lengths change in place)
+    okl = _flat(ok)
+    vall = _flat(val)
+    lengths = _flat(lengths)
+    El = _flat(E)
+    FEl = _flat(FE)
+    efl = _flat(ef)
+    firstl = _flat(np.ascontiguousarray(first))
 
     def dec(x):
         return x if x >= 0 else ~x
 
     last = -1
     seq_moves = []
+    pop, push = heapq.heappop, heapq.heappush
     while heap:
-        ed = heapq.heappop(heap)
+        ed = pop(heap)
         if ed == last:              # pops come in increasing order: a repeat is adjacent
             continue
         last = ed
         if not okl[ed]:
             continue
         fa, fb = efl[2 * ed], efl[2 * ed + 1]
-        row_a = FEl[3 * fa:3 * fa + 3]
-        row_b = FEl[3 * fb:3 * fb + 3]
+        row_a = FEl[3 * fa], FEl[3 * fa + 1], FEl[3 * fa + 2]
+        row_b = FEl[3 * fb], FEl[3 * fb + 1], FEl[3 * fb + 2]
         ned = ~ed
         x = row_a[0]
         ka = 0 if (x == ed or x == ned) else (1 if (row_a[1] == ed or row_a[1] == ned) else 2)
@@ -274,20 +295,26 @@ def equiangulate(s, threshold=-0.001, only=None):
             continue            # the two facets do not have opposite orientations
         b1, c1 = row_a[(ka + 1) % 3], row_a[(ka + 2) % 3]
         b2, c2 = row_b[(kb + 1) % 3], row_b[(kb + 2) % 3]
+        # (the tests have no side effects: the criterion, the most selective, first)
+        if finite:
+            A = lengths[ed]
+            lb = lengths[b1 if b1 >= 0 else ~b1]
+            lc = lengths[c1 if c1 >= 0 else ~c1]
+            ld = lengths[b2 if b2 >= 0 else ~b2]
+            le = lengths[c2 if c2 >= 0 else ~c2]
+            d1, d2 = lb * lc, ld * le
+            if d1 and d2:
+                crit = (lb * lb + lc * lc - A * A) / d1 + (ld * ld + le * le - A * A) / d2
+            else:
+                crit = _div(lb * lb + lc * lc - A * A, d1) + _div(ld * ld + le * le - A * A, d2)
+            if not crit < threshold:
+                continue
         r = El[2 * b1 + 1] if b1 >= 0 else El[2 * ~b1]          # head of b1
         sv = El[2 * b2 + 1] if b2 >= 0 else El[2 * ~b2]         # head of b2
         if r == sv:
             continue
         key = r * nv + sv if r < sv else sv * nv + r
         if key in pairs:
-            continue
-        A = lengths[ed]
-        lb = lengths[b1 if b1 >= 0 else ~b1]
-        lc = lengths[c1 if c1 >= 0 else ~c1]
-        ld = lengths[b2 if b2 >= 0 else ~b2]
-        le = lengths[c2 if c2 >= 0 else ~c2]
-        crit = _div(lb * lb + lc * lc - A * A, lb * lc) + _div(ld * ld + le * le - A * A, ld * le)
-        if finite and not crit < threshold:
             continue
         # flip: a was p->q in fa = (a, b1: q->r, c1: r->p), fb = (~a, b2: p->s, c2: s->q).
         # As REF (list edges / list facets after u): when fa comes first in the
@@ -297,7 +324,7 @@ def equiangulate(s, threshold=-0.001, only=None):
         seq_moves.append((ed, p, q))
         pairs.discard(min(p, q) * nv + max(p, q))
         pairs.add(key)
-        al = bool(first[ed])
+        al = firstl[ed]
         if group is not None:
             def o(x):
                 return wrap[x] if x >= 0 else int(group.inverse(wrap[~x]))
@@ -310,13 +337,13 @@ def equiangulate(s, threshold=-0.001, only=None):
             wrap[ed] = (-1 if al else 1) * (w(c1) + w(b2))       # through p
         if al:
             El[2 * ed], El[2 * ed + 1] = sv, r
-            FEl[3 * fa:3 * fa + 3] = (ed, c1, b2)
-            FEl[3 * fb:3 * fb + 3] = (~ed, c2, b1)
+            FEl[3 * fa], FEl[3 * fa + 1], FEl[3 * fa + 2] = ed, c1, b2
+            FEl[3 * fb], FEl[3 * fb + 1], FEl[3 * fb + 2] = ~ed, c2, b1
             moved = ((b1, fa, fb), (b2, fb, fa))
         else:
             El[2 * ed], El[2 * ed + 1] = r, sv
-            FEl[3 * fa:3 * fa + 3] = (ed, c2, b1)
-            FEl[3 * fb:3 * fb + 3] = (~ed, c1, b2)
+            FEl[3 * fa], FEl[3 * fa + 1], FEl[3 * fa + 2] = ed, c2, b1
+            FEl[3 * fb], FEl[3 * fb + 1], FEl[3 * fb + 2] = ~ed, c1, b2
             moved = ((c1, fa, fb), (c2, fb, fa))
         for side, old, new in moved:
             i = dec(side)
@@ -342,17 +369,15 @@ def equiangulate(s, threshold=-0.001, only=None):
         for x in (c1, b2, c2, b1):
             i = x if x >= 0 else ~x
             if i > ed:                # not yet visited (visits go in id order)
-                heapq.heappush(heap, i)
-    if flips:
-        t.E = np.array(El, dtype=np.int64).reshape(-1, 2)
-        t.FE = np.array(FEl, dtype=np.int64).reshape(-1, 3)
+                push(heap, i)
     t.__dict__.pop("_topo", None)          # E and FE were changed
     if flips + flips_at_once:
         # an edge's facet loop keeps its start through the flips (REF, ee.facet)
-        record_along_first(t, first)
+        copies = (t.FE.copy(), t.E.copy())    # (one copy for both records)
+        record_along_first(t, first, copies)
         if seq_moves:               # (one block, in the order flipped)
             sm = np.array(seq_moves, dtype=np.int64).reshape(-1, 3)
             moves.append((sm[:, 0], sm[:, 1], sm[:, 2]))
-        _flip_rings(s, t, moves)
+        _flip_rings(s, t, moves, copies[1])
     t.topology_version = getattr(s, "topology_version", 0) + 1
     return t, flips + flips_at_once

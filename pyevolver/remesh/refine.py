@@ -13,7 +13,8 @@ import numpy as np
 from ..methods import metric as MT
 from ..geometry import kernels as G
 from ..constraints import constrained_vertices, project_to_constraints
-from ..model.records import along_first, record_along_first, record_vertex_rings
+from ..model.records import (along_first, record_along_first, record_vertex_rings,
+                             settle_records)
 from ..model.groups import group_of
 from . import group_refine as GR
 from .grow import grow, reorder_new_edges
@@ -281,8 +282,9 @@ def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
 
     if group is not None:                   # a symmetry group's codes (remesh.group_refine)
         GR.new_edge_codes(s, t, group, R, I, FW, new_edges)
-    _split_rings(s, t, R, half, None if perm is None else np.sort(base1))
-    _split_loops(s, t, R, half)
+    copies = (t.FE.copy(), t.E.copy())        # (one copy for both records)
+    _split_rings(s, t, R, half, None if perm is None else np.sort(base1), copies[1])
+    _split_loops(s, t, R, half, copies)
     new_v = np.arange(nv, nv + k)
     boundary_midpoints(t, s.E[R, 0], s.E[R, 1], new_v)
     sel = new_v[constrained_vertices(t)[new_v]]
@@ -291,20 +293,25 @@ def split_edges(s, ref, one_by_one=False, order=None, choosers=None):
     return t
 
 
-def _split_loops(s, t, R, half):
+def _split_loops(s, t, R, half, copies=None):
     """Record which edges of ``t`` have the facet along them first in their
     facet loop (:func:`pyevolver.model.records.along_first`): the tail half of a split edge
     keeps its edge's order, the head half has the other one, the edges
     cutting the facets have the facet along them first (measured with
     ``ee.facet`` after ``r`` on catbody.fe; it decides how ``u`` renumbers)."""
-    out = np.ones(t.ne, bool)
-    old = along_first(s)
-    out[:s.ne] = old
-    out[half[R]] = ~old[R]
-    record_along_first(t, out)
+    ne, R, half = t.ne, R.copy(), half.copy()
+
+    def later():                        # (when first read: along_first)
+        out = np.ones(ne, bool)
+        old = along_first(s)
+        out[:s.ne] = old
+        out[half[R]] = ~old[R]
+        return out
+    settle_records(s)
+    record_along_first(t, later, copies)
 
 
-def _split_rings(s, t, R, half, inner=None):
+def _split_rings(s, t, R, half, inner=None, E=None):
     """Record REF's edge rings (:mod:`pyevolver.remesh.rings`) at the vertices
     of ``t``: ``s`` with the edges ``R`` split (new head halves ``half[R]``)
     and its facets cut.
@@ -314,18 +321,29 @@ def _split_rings(s, t, R, half, inner=None):
     its head vertex and the new half joining it; a midpoint's ring is the
     new half (first), then the old edge; then the edges cutting the facets
     join the rings at both their ends, in id order.
+
+    The rings are computed when first read (:func:`record_vertex_rings`),
+    from ``s`` (kept until then) and copies of the arrays used here.
     """
+    settle_records(s)                     # (no chain of surfaces kept for later)
+    E = t.E.copy() if E is None else E
+    R, half, nv = R.copy(), half.copy(), t.nv
+    record_vertex_rings(t, lambda: _rings_after_split(s, E, nv, R, half, inner), E)
+
+
+def _rings_after_split(s, E, nv, R, half, inner):
+    """The rank of :func:`_split_rings` (``E``, ``nv``: the new surface's)."""
     ne, k = s.ne, len(R)
-    g = Rings(s, t.ne, t.nv)
+    g = Rings(s, len(E), nv)
     h_all = s.E[R, 1]
     for sel in rounds(h_all, R):
         g.remove(h_all[sel], 2 * R[sel] + 1)
         g.insert(h_all[sel], 2 * half[R[sel]] + 1)
-    g.set_pair(t.E[R, 1], 2 * half[R], 2 * R + 1)
+    g.set_pair(E[R, 1], 2 * half[R], 2 * R + 1)
     if inner is None:
-        inner = np.arange(ne + k, t.ne)
-    iv = t.E[inner].ravel()
+        inner = np.arange(ne + k, len(E))
+    iv = E[inner].ravel()
     islot = 2 * np.repeat(inner, 2) + np.tile([0, 1], len(inner))
     for sel in rounds(iv, islot):
         g.insert(iv[sel], islot[sel])
-    record_vertex_rings(t, g.rank())
+    return g.rank()

@@ -39,7 +39,7 @@ from ..constraints import project_tangent, project_to_constraints
 from ..model.records import vertex_facet_rank
 
 
-def vertex_average(s, mode="V"):
+def vertex_average(s, mode="V", totals=None):
     """Return a copy of surface ``s`` with vertices averaged.
 
     Parameters
@@ -48,13 +48,16 @@ def vertex_average(s, mode="V"):
     mode : {"V", "raw", "rawest"}
         ``V`` (volume-preserving: normal component removed), ``rawv`` or
         ``rawestv``.
+    totals : Totals, optional
+        An evaluation of ``s`` as it is (the session's, when nothing
+        changed since it was made); evaluated here otherwise.
 
     Returns
     -------
     Surface
         A new surface sharing the topology of ``s``, new coordinates.
     """
-    t = s.evaluate()
+    t = totals if totals is not None and totals.surface is s else s.evaluate()
     nv, ne = s.nv, s.ne
     idx = s.topology()[0]                                        # (nf, 3) edge ids
     valence = np.bincount(idx.ravel(), minlength=ne)
@@ -78,13 +81,16 @@ def vertex_average(s, mode="V"):
                 on_e = s.econ.get(c)
                 on_e = np.zeros(ne, bool) if on_e is None else (on_e != 0)
                 use &= ~on_v[v] | on_e[e]
-        trip = valence[e] >= 3
-        ntrip = np.bincount(v, weights=trip.astype(float), minlength=nv)
-        use &= (ntrip[v] == 0) | trip
-        free = valence[e] == 1
-        nfree = np.bincount(v, weights=free.astype(float), minlength=nv)
-        use &= (nfree[v] == 0) | free
-        frozen = ntrip >= 3
+        if len(valence) and valence.min() == 2 and valence.max() == 2:
+            frozen = np.zeros(nv, bool)         # (no triple or free edges: the rules below are void)
+        else:
+            trip = valence[e] >= 3
+            ntrip = np.bincount(v, weights=trip.astype(float), minlength=nv)
+            use &= (ntrip[v] == 0) | trip
+            free = valence[e] == 1
+            nfree = np.bincount(v, weights=free.astype(float), minlength=nv)
+            use &= (nfree[v] == 0) | free
+            frozen = ntrip >= 3
     w2 = np.where(use, w * w, 0.0)
     cnt = np.bincount(v, weights=use.astype(float), minlength=nv)
     W = np.bincount(v, weights=w2, minlength=nv)

@@ -19,7 +19,7 @@ from . import deadline, health, popping, undo
 from .deadline import deferred_sigint as _deferred_sigint
 from .api import SessionAPI, progress_bar
 from .result import GResult
-from ..commands import constraints, element_attrs, elements, files, remesh, variables
+from ..commands import constraints, element_attrs, elements, files, fresh, remesh, variables
 from ..commands import interpreter as I
 from ..commands.variables import DEFAULTS, READ_ONLY  # noqa: F401 (READ_ONLY: re-exported)
 from ..constraints import (boundary_eval, boundary_groups, constrained_vertices,
@@ -393,12 +393,10 @@ class Session(SessionAPI):
 
     def _iterator_state(self):
         it = self._iterator
-        return None if it is None else (it.cg_history, it.cg_S_old, it.cg_f_old,
-                                        it.pressures_valid)
+        return it and (it.cg_history, it.cg_S_old, it.cg_f_old, it.pressures_valid)
 
     def _restore(self, snap):
-        """Return to a :meth:`_snapshot` (:func:`pyevolver.session.undo.restore`)."""
-        undo.restore(self, snap)
+        undo.restore(self, snap)        # (back to a _snapshot)
 
     # -- evaluation ------------------------------------------------------------------
     def recalc(self, keep_cg: bool = False, reposition: bool = False,
@@ -694,6 +692,7 @@ class Session(SessionAPI):
     def _replace_surface(self, new):
         self.surface = new
         self.recalc()
+        fresh.mark(self)
 
     def no_string(self, what: str, surface: Any = None) -> None:
         """Refuse ``what`` by name on a string-model surface."""
@@ -711,6 +710,7 @@ class Session(SessionAPI):
             stale = self.__dict__.get("_stale_totals")
             self.recalc(keep_cg=True)
             popping.keep_stale(self, stale)
+            fresh.mark(self)
 
     # -- the public API: values ----------------------------------------------------
     @property

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import CommandError
+from ..commands import fresh
 
 #: most zero-area facets named one by one (then a count)
 MAX_NAMED = 10
@@ -34,7 +35,8 @@ def check(session: Any, before: Any = None, motion: Any = None) -> None:
     if not np.all(np.isfinite(s.X)):
         # e.g. a huge jiggle or a boundary formula out of its domain
         raise CommandError("the command would make vertex coordinates infinite or NaN")
-    session.refresh()
+    if not fresh.is_fresh(session):     # (nothing changed since the last evaluation)
+        session.refresh()
     t = session.totals
     e = getattr(t, "energy", 0.0)
     if t is not None and not np.isfinite(e):

@@ -173,3 +173,42 @@ def test_corner_geometry_is_the_componentwise_formula_bit_for_bit():
     assert np.array_equal(vol, (p[0][:, 2] + p[1][:, 2] + p[2][:, 2]) / 6.0 * n[2])
     _, _, _, vsym = G.corner_geometry(XT, Fc, True)
     assert np.array_equal(vsym, (p[0][:, 0] * n[0] + p[0][:, 1] * n[1] + p[0][:, 2] * n[2]) / 6.0)
+
+
+def _ordered_normals_by_loops(F, N2, nv, rank):
+    """REF's ordered vertex normal written out vertex by vertex."""
+    N = np.zeros((nv, 3))
+    for v in range(nv):
+        fs, ks = np.nonzero(F == v)
+        for f in fs[np.lexsort((fs, rank[fs, ks]))]:
+            n = N2[f]
+            N[v] += n if n @ N[v] >= 0 else -n
+    L = np.linalg.norm(N, axis=1)
+    return np.where(L[:, None] > 0, N / np.where(L > 0, L, 1.0)[:, None], 0.0)
+
+
+@pytest.mark.parametrize("closed", [True, False])
+def test_ordered_vertex_normals_follow_the_rank_bit_for_bit(closed):
+    # a fan of 6 triangles round vertex 0 (open), or an octahedron (closed);
+    # the ranks a permutation at each vertex (the placing path) or not (the sort)
+    rng = np.random.default_rng(3)
+    if closed:
+        F = np.array([[0, 2, 4], [0, 4, 3], [0, 3, 5], [0, 5, 2],
+                      [1, 4, 2], [1, 3, 4], [1, 5, 3], [1, 2, 5]])
+        X = np.array([[0, 0, 1], [0, 0, -1], [1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0]],
+                     float) + 0.2 * rng.standard_normal((6, 3))
+    else:
+        t = np.linspace(0, 2 * np.pi, 7)[:-1]
+        X = np.c_[np.cos(t), np.sin(t), 0.3 * rng.standard_normal(6)]
+        X = np.vstack([[0, 0, 0.5], X])
+        F = np.array([[0, 1 + k, 1 + (k + 1) % 6] for k in range(6)])
+    nv = len(X)
+    N2 = G.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+    N2[1] *= -1                              # one folded facet: the sign rule acts
+    rank = np.zeros(F.shape, np.int64)
+    for v in range(nv):
+        fs, ks = np.nonzero(F == v)
+        rank[fs, ks] = rng.permutation(len(fs)) * (1 if closed else 2)
+    got = G.vertex_normals(F, N2, nv, rank)
+    assert np.array_equal(got, _ordered_normals_by_loops(F, N2, nv, rank))
+    assert np.array_equal(G.vertex_normals(F, N2.T.copy().T, nv, rank), got)   # strided N2

@@ -4,7 +4,8 @@ import numpy as np
 from pyevolver.datafile.reader import read_datafile
 from pyevolver.model.build import build_surface
 from pyevolver.model.formulas import LocatedFormula, located
-from pyevolver.model.records import convex_edges, edge_facets, edge_first_facet, vertex_edge_rank
+from pyevolver.model.records import (along_first, convex_edges, edge_facets, edge_first_facet,
+                                     vertex_edge_rank)
 from pyevolver.errors import PyEvolverError
 
 
@@ -48,3 +49,38 @@ def test_located_names_the_declaration():
         LocatedFormula(F(), "boundary 1", 4).values()
     except PyEvolverError as exc:
         assert exc.line == 4
+
+
+
+def test_rings_recorded_as_a_function_are_computed_once_when_read():
+    from pyevolver.model.records import record_vertex_rings
+    s = cube()
+    rank = vertex_edge_rank(s)
+    assert not rank.flags.writeable                       # the loaded order, kept
+    assert vertex_edge_rank(s) is rank
+    calls = []
+
+    def later():
+        calls.append(1)
+        return rank + 0
+    record_vertex_rings(s, later)
+    assert not calls                                      # not computed yet
+    assert np.array_equal(vertex_edge_rank(s), rank)
+    assert np.array_equal(vertex_edge_rank(s), rank)
+    assert calls == [1]                                   # once
+    s.E = s.E[:, ::-1].copy()                             # the edges changed: not used
+    vertex_edge_rank(s)
+    assert calls == [1] and s._rings[1] is not rank
+
+
+def test_lazy_rings_do_not_chain_surfaces():
+    # K bisects in rounds, each a new surface: a round's lazy rings are
+    # settled when the next round records its own (no chain kept alive)
+    from pyevolver.remesh.refine import refine
+    s1 = refine(cube())
+    assert callable(s1._rings[1])
+    s2 = refine(s1)
+    assert not callable(s1._rings[1]) and callable(s2._rings[1])
+    assert not callable(s1._along_first[2]) and callable(s2._along_first[2])
+    assert along_first(s2).shape == (s2.ne,) and not callable(s2._along_first[2])
+    assert vertex_edge_rank(s2).shape == (s2.ne, 2)
