@@ -4,7 +4,7 @@ triangulated, bodies and quantities set up, vertices projected)."""
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
+from .facet_csr import canonical_csr
 
 from ..errors import DatafileError, PyEvolverError, UnsupportedError
 from ..expr.nodes import Formula
@@ -654,7 +654,7 @@ class _Builder:
             if "volume" in kws and "pressure" in kws:
                 raise self.error(f"body {blk.ids[pos]}: VOLUME and PRESSURE exclude each other",
                                  blk.lines[pos])
-        b.facet_matrix = sp.csr_matrix((vals, (rows, cols)), shape=(nb, s.n_facets))
+        b.facet_matrix = canonical_csr(vals, rows, cols, (nb, s.n_facets))  # (scipy's CSR)
         b.occurrences = (np.asarray(rows, np.int64), np.asarray(cols, np.int64),
                          np.asarray(vals, float))
         b.volume = None
