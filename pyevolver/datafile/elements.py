@@ -41,7 +41,7 @@ class ElementSections:
             table = numeric_table(sec.text, sec.line, sec.lines, _LONG)
             if table is not None:               # a plain table: read at once (datafile.table)
                 vals, lens, src = table
-                block.lines = array("l", src.astype("l").tobytes())
+                block.lines = array("i", src.astype("i").tobytes())    # (4 bytes: memory)
                 self._bulk_values(kind, block, range(len(lens)), vals, lens, whole=True)
                 return
         start = {"vertices": "vertex_line", "edges": "edge_line", "faces": "face_line",
@@ -177,6 +177,8 @@ class ElementSections:
             # the whole section is one table: keep it as arrays
             block.ids = ids
             block.data = vals.reshape(len(lens), int(lens[0]))[:, 1:]
+            if kind != "vertices":      # ids within +-MAX_ID: int32, a copy without the ids
+                block.data = block.data.astype(np.int32)    # (the load's peak memory)
             if kind == "vertices" and 1 <= block.data.shape[1] < self.scene.space_dimension:
                 block.data = self._pad_coordinates(block.data, ids, block.lines)
             return
@@ -327,8 +329,11 @@ class ElementSections:
             if kind == "faces" and len(values) > MAX_FACE_EDGES:
                 raise self.error(f"face {eid} has {len(values)} edges; at most "
                                  f"{MAX_FACE_EDGES} are allowed", srcline)
-            values = ([int(v) for v in values] if not checked else
-                      head.astype(np.int64).tolist() + [int(v) for v in values[checked:]])
+            if kind == "bodies" and checked == len(values) > 64:
+                values = head.astype(np.int64)      # a long facet list: an array (load memory)
+            else:
+                values = ([int(v) for v in values] if not checked else
+                          head.astype(np.int64).tolist() + [int(v) for v in values[checked:]])
         cooked = []
         for kw, args, col in attrs:
             if kw == "quantity":

@@ -60,6 +60,9 @@ def test_same_scene_as_the_line_reader(extra, monkeypatch, tmp_path):
     ("7 0.5 0.5", False),                  # a shorter line (padded, warned by the reader)
     ("7.0 0.5 0.5 0.5", False),            # the id must be digits
     ("-7 0.5 0.5 0.5", False),
+    ("  7e0 0.5 0.5 0.5", False),
+    ("\t 7 0.5 0.5 0.5", True),           # blanks before the id
+    ("7 0.5 0.5 0.5 " + " 1" * 3, False),  # another count of numbers
     ("7 0.5 0.5 1e", False),               # not one number
     ("7 0.5.5 0.5 0.5", False),            # malformed number: the reader's message
     ("7 0.5 0.5 0.5\r", False),            # (carriage returns are normalised before)
