@@ -20,7 +20,7 @@ from ..expr import nodes as N
 from ..limits import MAX_FACE_EDGES, MAX_ID, MAX_NESTING, nesting_depth
 from .grammar import _LINE, line_parser
 from .located import _LocatedName, _keywords
-from .table import numeric_table
+from .table import floats_of, numeric_table
 from .scan import (_BAD_NUMBER, _KW_INTEGER, _KW_NEEDS_VALUE, _LONG, _NUMERIC_HEAD,
                    _NUMERIC_LINE, _binary_minus_in_parens, _long_numeric, _plain_tail)
 
@@ -89,7 +89,7 @@ class ElementSections:
             head_vals = None
             try:
                 if head is not None and kind != "edges" or (head is not None and not torus):
-                    nums_ = np.fromstring(line[:head.end()], dtype=float, sep=" ")
+                    nums_ = floats_of(line[:head.end()])
                     tail = line[head.end():]
                     items = _plain_tail(tail, head.end())
                     if items is None:
@@ -131,7 +131,7 @@ class ElementSections:
         """Convert pure-numeric lines with one numpy call (no token list)."""
         lens = np.fromiter((len(t.split()) for t in texts), np.int64, len(texts))
         try:
-            vals = np.fromstring(" ".join(texts), dtype=float, sep=" ")
+            vals = floats_of(" ".join(texts))
         except ValueError:                     # cannot happen for lines that matched
             vals = np.empty(0)
         if vals.size != int(lens.sum()):

@@ -33,7 +33,9 @@ _CLASS[ord("\n")] = 7
 
 # a line whose first token has a byte other than a digit (the section's
 # bytes being of the classes above)
-_ID_NOT_DIGITS = re.compile(r"^[ \t]*[0-9]*[^0-9 \t\n]", re.M)
+# (a line after a newline: a literal first character, which re searches fast)
+_ID_NOT_DIGITS = re.compile(r"\n[ \t]*[0-9]*[^0-9 \t\n]")
+_FIRST_ID_NOT_DIGITS = re.compile(r"[ \t]*[0-9]*[^0-9 \t\n]")
 
 
 def numeric_table(text: str, first_line: int, line_map, long_line: int):
@@ -88,12 +90,10 @@ def numeric_table(text: str, first_line: int, line_map, long_line: int):
         return None
     # the first token of each line (an id): digits only, so no '.', 'e', '+'
     # or '-' in it
-    if _ID_NOT_DIGITS.search(text):
+    if _FIRST_ID_NOT_DIGITS.match(text) or _ID_NOT_DIGITS.search(text):
         return None
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")             # (older numpy: a warning, not an error)
-            values = np.fromstring(text, dtype=float, sep=" ")
+        values = floats_of(text)
     except ValueError:                                 # a token that is not a number
         return None
     if values.size != int(counts.sum()):               # a token that is not one number
@@ -104,3 +104,21 @@ def numeric_table(text: str, first_line: int, line_map, long_line: int):
     else:
         src = first_line + used.astype(np.int64)
     return values, lens, src
+
+
+
+def floats_of(text: str) -> np.ndarray:
+    """``np.fromstring(text, dtype=float, sep=" ")``, the same numbers
+    (ValueError for a token that is not one), faster for a text of integers:
+    without '.', 'e', 'E' or "-0" it is read as integers (ten times faster)
+    and converted, exact below 2^53 (else read again as floats)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                 # (older numpy: a warning, not an error)
+        if "." not in text and "e" not in text and "E" not in text and "-0" not in text:
+            try:
+                ints = np.fromstring(text, dtype=np.int64, sep=" ")
+            except ValueError:
+                ints = None
+            if ints is not None and (not ints.size or np.abs(ints).max() < 2 ** 53):
+                return ints.astype(float)
+        return np.fromstring(text, dtype=float, sep=" ")

@@ -90,3 +90,15 @@ def test_errors_are_the_line_readers(old, new, words, monkeypatch, tmp_path):
             _scene(text, fast, monkeypatch, tmp_path)
         msgs.append(str(exc.value))
     assert msgs[0] == msgs[1] and words in msgs[0]
+
+
+@pytest.mark.parametrize("text", ["1 2 3", "1 -0 2", " +5 -7\n8 ", "99999999999999999999 1",
+                                  "9007199254740993 1", "1 2.5", "1 nan", "", "1 2e3"])
+def test_floats_of_reads_as_fromstring(text):
+    want = np.fromstring(text, dtype=float, sep=" ")
+    got = T.floats_of(text)
+    assert got.dtype == want.dtype and np.array_equal(np.signbit(got), np.signbit(want))
+    np.testing.assert_array_equal(got, want)
+    for bad in ("1 x", "1 5-", "0x10"):
+        with pytest.raises(ValueError):
+            T.floats_of(bad)
