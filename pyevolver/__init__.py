@@ -14,9 +14,11 @@ _gc_enabled = _gc.isenabled()
 _gc.disable()               # importing creates ~10^5 objects: no collections meanwhile (start-up)
 try:
     from .startup import lazy_numpy_submodules as _lazy_numpy, lazy_scipy_sparse  # noqa: E402
+    from .startup import lark_without_regex  # noqa: E402
 
     _lazy_numpy()               # numpy.f2py, numpy.testing... when first used (pyevolver.startup)
     lazy_scipy_sparse()         # scipy.sparse likewise
+    lark_without_regex()        # and the regex module that lark imports
 
     from .errors import (PyEvolverError, DatafileError, CommandError, UnsupportedError,  # noqa: E402
                          ExpressionError, ConstraintError, ConvergenceWarning)

@@ -22,10 +22,17 @@ pyevolver.model.facet_csr): the first read of one of its attributes (or
 the import of one of its submodules) imports it, and the placeholder then
 holds the same attributes as the module.  ``PYEVOLVER_LAZY_SCIPY=0`` turns
 this off.
+
+:func:`lark_without_regex`: lark imports the third-party ``regex`` module
+when it is installed (7 ms), for grammars that ask for it; pyevolver's use
+``re``.  lark is imported with ``regex`` hidden, and then given ``regex``
+as a lazily loaded module, so that ``Lark(..., regex=True)`` works as
+before and imports it when used.
 """
 from __future__ import annotations
 
 import importlib
+import importlib.machinery
 import importlib.util
 import os
 import sys
@@ -74,11 +81,12 @@ def lazy_numpy_submodules() -> list[str]:
     return done
 
 
-class _LazySparse(types.ModuleType):
-    """``scipy.sparse`` until one of its attributes is read."""
+class _Placeholder(types.ModuleType):
+    """A module (``scipy``, ``scipy.sparse``) until one of its attributes
+    is read, then a copy of the real module's attributes."""
 
     def __getattr__(self, name: str):
-        real = _import_sparse(self)
+        real = _import_real(self)
         return getattr(real, name)
 
     def __setattr__(self, name: str, value) -> None:
@@ -88,7 +96,7 @@ class _LazySparse(types.ModuleType):
             setattr(real, name, value)      # (a submodule imported through the placeholder)
 
 
-def _import_sparse(placeholder: types.ModuleType) -> types.ModuleType:
+def _import_real(placeholder: types.ModuleType) -> types.ModuleType:
     name = placeholder.__name__
     if sys.modules.get(name) is placeholder:
         del sys.modules[name]
@@ -98,19 +106,29 @@ def _import_sparse(placeholder: types.ModuleType) -> types.ModuleType:
         sys.modules.setdefault(name, placeholder)
         raise
     parent, _, short = name.rpartition(".")
-    setattr(sys.modules[parent], short, real)
-    for key, value in real.__dict__.items():
+    if parent:
+        setattr(sys.modules[parent], short, real)
+    for key, value in list(real.__dict__.items()):
         if key not in ("__getattr__", "__dir__"):
             types.ModuleType.__setattr__(placeholder, key, value)
     return real
+
+
+def _placeholder(name: str, spec) -> types.ModuleType:
+    p = _Placeholder(name)
+    types.ModuleType.__setattr__(p, "__spec__", spec)
+    types.ModuleType.__setattr__(p, "__package__", name)
+    sys.modules[name] = p
+    return p
 
 
 _sparse_done = False
 
 
 def lazy_scipy_sparse() -> bool:
-    """Stand a placeholder for ``scipy.sparse`` in ``sys.modules`` until it
-    is used (see the module docstring).
+    """Stand placeholders for ``scipy.sparse`` (and for ``scipy`` when it is
+    not imported yet) in ``sys.modules`` until they are used (see the
+    module docstring).
 
     Returns
     -------
@@ -124,15 +142,53 @@ def lazy_scipy_sparse() -> bool:
         return False
     _sparse_done = True
     try:
-        import scipy
-        spec = importlib.util.find_spec("scipy.sparse")
+        if "scipy" in sys.modules:
+            scipy = sys.modules["scipy"]
+            spec = importlib.util.find_spec("scipy.sparse")
+        else:   # (found without importing scipy: its __init__ costs 10 ms)
+            top = importlib.util.find_spec("scipy")
+            if top is None or not top.submodule_search_locations:
+                return False
+            spec = importlib.machinery.PathFinder.find_spec(
+                "scipy.sparse", list(top.submodule_search_locations))
+            if spec is None:
+                return False
+            scipy = _placeholder("scipy", top)
     except ImportError:
         return False
     if spec is None:
         return False
-    placeholder = _LazySparse("scipy.sparse")
-    types.ModuleType.__setattr__(placeholder, "__spec__", spec)
-    types.ModuleType.__setattr__(placeholder, "__package__", "scipy.sparse")
-    sys.modules["scipy.sparse"] = placeholder
-    types.ModuleType.__setattr__(scipy, "sparse", placeholder)
+    types.ModuleType.__setattr__(scipy, "sparse", _placeholder("scipy.sparse", spec))
+    return True
+
+
+def lark_without_regex() -> bool:
+    """Import lark without importing ``regex`` (see the module docstring).
+
+    Returns
+    -------
+    bool
+        True when lark was imported so now (not when lark or regex is
+        imported already, or regex is not installed).
+    """
+    if "lark" in sys.modules or "regex" in sys.modules:
+        return False
+    spec = importlib.util.find_spec("regex")
+    if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
+        return False
+    sys.modules["regex"] = None         # type: ignore[assignment]  (lark: "not installed")
+    try:
+        import lark.lark
+        import lark.utils
+    finally:
+        del sys.modules["regex"]
+    loader = importlib.util.LazyLoader(spec.loader)
+    spec.loader = loader
+    regex = importlib.util.module_from_spec(spec)
+    sys.modules["regex"] = regex
+    loader.exec_module(regex)
+    for mod in (lark.utils, lark.lark):
+        if hasattr(mod, "_has_regex"):
+            mod.regex = regex           # type: ignore[attr-defined]
+            mod._has_regex = True       # type: ignore[attr-defined]
     return True
