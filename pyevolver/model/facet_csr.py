@@ -17,6 +17,7 @@ into the scipy matrix on first use (pyevolver.model.surface).
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp       # (a placeholder until used: pyevolver.startup)
 
 _INT32_MAX = np.iinfo(np.int32).max
 
@@ -39,7 +40,6 @@ class PendingCSR:
 
     def to_scipy(self):
         """The scipy CSR matrix of these arrays (sharing them)."""
-        import scipy.sparse as sp
         M = sp.csr_matrix((self.data, self.indices, self.indptr), shape=self.shape, copy=False)
         M.has_canonical_format = True
         return M
