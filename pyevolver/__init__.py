@@ -33,6 +33,9 @@ try:
     _register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)
     _tune_allocator()           # large numpy temporaries stay in the heap (pyevolver.memory)
 finally:
+    if hasattr(_gc, "freeze"):
+        _gc.freeze()            # the modules' objects go to the oldest generation at once,
+        _gc.unfreeze()          # (not scanned as young objects at the next allocation)
     if _gc_enabled:
         _gc.enable()
 
