@@ -8,22 +8,36 @@ __version__ = "0.1.0"
 
 from typing import Any  # noqa: E402
 
-from .startup import lazy_numpy_submodules as _lazy_numpy  # noqa: E402
+import gc as _gc  # noqa: E402
 
-_lazy_numpy()               # numpy.f2py, numpy.testing... when first used (pyevolver.startup)
+_gc_enabled = _gc.isenabled()
+_gc.disable()               # importing creates ~10^5 objects: no collections meanwhile (start-up)
+try:
+    from .startup import lazy_numpy_submodules as _lazy_numpy, lazy_scipy_sparse  # noqa: E402
+    from .startup import lark_without_regex  # noqa: E402
 
-from .errors import (PyEvolverError, DatafileError, CommandError, UnsupportedError,  # noqa: E402
-                     ExpressionError, ConstraintError, ConvergenceWarning)
-from .datafile.reader import read_datafile  # noqa: E402
-from .model.surface import Surface  # noqa: E402
-from .model.build import build_surface  # noqa: E402
-from . import methods as _methods  # noqa: E402,F401  (installs the model's evaluate/method hooks)
-from .session.core import Session  # noqa: E402
-from .io.meshio_plugin import register_when_imported as _register_meshio  # noqa: E402
-from .memory import tune_allocator as _tune_allocator  # noqa: E402
+    _lazy_numpy()               # numpy.f2py, numpy.testing... when first used (pyevolver.startup)
+    lazy_scipy_sparse()         # scipy.sparse likewise
+    lark_without_regex()        # and the regex module that lark imports
 
-_register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)
-_tune_allocator()           # large numpy temporaries stay in the heap (pyevolver.memory)
+    from .errors import (PyEvolverError, DatafileError, CommandError, UnsupportedError,  # noqa: E402
+                         ExpressionError, ConstraintError, ConvergenceWarning)
+    from .datafile.reader import read_datafile  # noqa: E402
+    from .model.surface import Surface  # noqa: E402
+    from .model.build import build_surface  # noqa: E402
+    from . import methods as _methods  # noqa: E402,F401  (installs the model's evaluate/method hooks)
+    from .session.core import Session  # noqa: E402
+    from .io.meshio_plugin import register_when_imported as _register_meshio  # noqa: E402
+    from .memory import tune_allocator as _tune_allocator  # noqa: E402
+
+    _register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)
+    _tune_allocator()           # large numpy temporaries stay in the heap (pyevolver.memory)
+finally:
+    if hasattr(_gc, "freeze"):
+        _gc.freeze()            # the modules' objects go to the oldest generation at once,
+        _gc.unfreeze()          # (not scanned as young objects at the next allocation)
+    if _gc_enabled:
+        _gc.enable()
 
 
 def load(filename: str, **kwargs: Any) -> Session:

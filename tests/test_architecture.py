@@ -30,7 +30,8 @@ OPTIONAL = {"matplotlib", "tqdm", "prompt_toolkit", "sksparse", "dask", "distrib
             "h5py", "PIL", "threadpoolctl", "tomli", "tomllib", "readline", "pexpect",
             "pyvista", "vtk", "imageio_ffmpeg"}
 HEAVY = {"scipy.special", "scipy.sparse.linalg", "scipy.sparse.csgraph",
-         "meshio"}             # (imported where used: start-up time, issue 24)
+         "meshio",             # (imported where used: start-up time, issue 24)
+         "lark.lark", "lark.utils"}    # (pyevolver.startup: lark imported without regex)
 MAX_LINES = 800
 
 

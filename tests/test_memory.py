@@ -30,3 +30,26 @@ def test_thresholds_are_set_at_import_on_glibc():
 def test_the_user_can_keep_the_defaults():
     assert _child({"PYEVOLVER_MALLOC": "0"}) == "False"
     assert _child({"MALLOC_TRIM_THRESHOLD_": "131072"}) == "False"
+
+
+def test_loading_runs_the_step_and_restores():
+    calls = []
+
+    @memory.loading
+    def step(x, fail=False):
+        calls.append(memory._depth)
+        if fail:
+            raise ValueError("bad")
+        return step2(x) + 1
+
+    @memory.loading
+    def step2(x):
+        calls.append(memory._depth)
+        return x * 2
+
+    assert step(3) == 7 and memory._depth == 0
+    with pytest.raises(ValueError):
+        step(1, fail=True)
+    assert memory._depth == 0
+    on = memory._mallopt is not None        # (glibc: the thresholds lowered once, nested too)
+    assert calls == ([1, 1, 1] if on else [0, 0, 0])

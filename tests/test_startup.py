@@ -13,7 +13,7 @@ from pyevolver.startup import LAZY_SUBMODULES, lazy_numpy_submodules
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 HEAVY = ["meshio", "scipy.sparse.linalg", "scipy.linalg", "numpy.f2py.crackfortran", "unittest",
-         "scipy.sparse.csgraph"]
+         "scipy.sparse.csgraph", "scipy.sparse._csr", "scipy._lib", "regex._regex_core"]
 
 USE = ("import numpy as np\n"
        "print(np.random.default_rng(0).integers(10, size=3).tolist())\n"
@@ -21,7 +21,17 @@ USE = ("import numpy as np\n"
        "from numpy.fft import rfft\n"
        "print(rfft([1.0, 1.0]).real.tolist())\n"
        "m = meshio.read('datafiles/cube.fe')\n"
-       "print(meshio.extension_to_filetypes['.fe'], len(m.cells_dict['triangle']))\n")
+       "print(meshio.extension_to_filetypes['.fe'], len(m.cells_dict['triangle']))\n"
+       "import scipy.sparse as sp\n"
+       "import scipy.sparse.linalg\n"
+       "import scipy\n"
+       "from scipy import linalg\n"
+       "print(linalg.det(np.eye(2)), scipy.__version__ == sys.modules['scipy'].__version__)\n"
+       "import importlib.util, lark\n"
+       "print(lark.Lark(r'start: /\\p{L}+/', parser='lalr', regex=True).parse('ab').children\n"
+       "      if importlib.util.find_spec('regex') else \"[Token('__ANON_0', 'ab')]\")\n"
+       "print(sp.csr_matrix(np.eye(3)).nnz, sp.linalg.norm(sp.eye(4)) ** 2, sys.modules['scipy.sparse'] is"
+       " sys.modules['scipy'].sparse, isinstance(sp.eye(2), sys.modules['scipy.sparse'].spmatrix))\n")
 
 
 def _run(code, **env_extra):
@@ -48,10 +58,11 @@ def test_load_and_quit_imports_no_heavy_optional_modules_that_work_when_used():
     # the lazy numpy modules (numpy's own import on scipy's first use)
     ref = _run("import sys, meshio, pyevolver, scipy.sparse\nfrom pyevolver import startup\n"
                "print('numpy.f2py' in sys.modules, startup.lazy_numpy_submodules())\n" + USE,
-               PYEVOLVER_LAZY_NUMPY="0")
+               PYEVOLVER_LAZY_NUMPY="0", PYEVOLVER_LAZY_SCIPY="0")
     assert ref[0] == "True []"
     assert out[2:] == ref[1:]
-    assert out[3:] == ["[2.0, 0.0]", "['evolver'] 24"]
+    assert out[3:] == ["[2.0, 0.0]", "['evolver'] 24", "1.0 True", "[Token('__ANON_0', 'ab')]",
+                       "3 4.0 True True"]
 
 
 def test_registered_once_and_only_numpys_optional_submodules():

@@ -8,11 +8,12 @@ import functools
 import os
 import re
 
-from lark import Lark, v_args
+from lark import v_args
 from lark.exceptions import UnexpectedInput, VisitError
 
 from ..errors import CommandError, PyEvolverError
 from ..expr import nodes as N
+from ..expr.lark_cache import cached_lark
 from ..expr.transform import ExprTransformer, expr_grammar
 from ..limits import MAX_NESTING, clip, nesting_depth
 from .nodes import (Aggregate, ArrayLit, ArrayRef, Attr, ElemIndex, OnTest, Sprintf,
@@ -27,8 +28,8 @@ _HERE = os.path.dirname(__file__)
 def command_parser():
     with open(os.path.join(_HERE, "commands.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
-    return Lark(grammar, parser="lalr", lexer="contextual", start="start",
-                maybe_placeholders=False, cache=True)
+    return cached_lark(grammar, parser="lalr", lexer="contextual", start="start",
+                       maybe_placeholders=False)
 
 
 SETTABLE_ATTRS = {"x", "y", "z", "x1", "x2", "x3", "color", "colour", "frontcolor", "backcolor",

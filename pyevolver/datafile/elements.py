@@ -20,7 +20,7 @@ from ..expr import nodes as N
 from ..limits import MAX_FACE_EDGES, MAX_ID, MAX_NESTING, nesting_depth
 from .grammar import _LINE, line_parser
 from .located import _LocatedName, _keywords
-from .table import numeric_table
+from .table import floats_of, numeric_table
 from .scan import (_BAD_NUMBER, _KW_INTEGER, _KW_NEEDS_VALUE, _LONG, _NUMERIC_HEAD,
                    _NUMERIC_LINE, _binary_minus_in_parens, _long_numeric, _plain_tail)
 
@@ -41,7 +41,7 @@ class ElementSections:
             table = numeric_table(sec.text, sec.line, sec.lines, _LONG)
             if table is not None:               # a plain table: read at once (datafile.table)
                 vals, lens, src = table
-                block.lines = array("l", src.astype("l").tobytes())
+                block.lines = array("i", src.astype("i").tobytes())    # (4 bytes: memory)
                 self._bulk_values(kind, block, range(len(lens)), vals, lens, whole=True)
                 return
         start = {"vertices": "vertex_line", "edges": "edge_line", "faces": "face_line",
@@ -89,7 +89,7 @@ class ElementSections:
             head_vals = None
             try:
                 if head is not None and kind != "edges" or (head is not None and not torus):
-                    nums_ = np.fromstring(line[:head.end()], dtype=float, sep=" ")
+                    nums_ = floats_of(line[:head.end()])
                     tail = line[head.end():]
                     items = _plain_tail(tail, head.end())
                     if items is None:
@@ -131,7 +131,7 @@ class ElementSections:
         """Convert pure-numeric lines with one numpy call (no token list)."""
         lens = np.fromiter((len(t.split()) for t in texts), np.int64, len(texts))
         try:
-            vals = np.fromstring(" ".join(texts), dtype=float, sep=" ")
+            vals = floats_of(" ".join(texts))
         except ValueError:                     # cannot happen for lines that matched
             vals = np.empty(0)
         if vals.size != int(lens.sum()):
@@ -177,6 +177,8 @@ class ElementSections:
             # the whole section is one table: keep it as arrays
             block.ids = ids
             block.data = vals.reshape(len(lens), int(lens[0]))[:, 1:]
+            if kind != "vertices":      # ids within +-MAX_ID: int32, a copy without the ids
+                block.data = block.data.astype(np.int32)    # (the load's peak memory)
             if kind == "vertices" and 1 <= block.data.shape[1] < self.scene.space_dimension:
                 block.data = self._pad_coordinates(block.data, ids, block.lines)
             return
@@ -327,8 +329,11 @@ class ElementSections:
             if kind == "faces" and len(values) > MAX_FACE_EDGES:
                 raise self.error(f"face {eid} has {len(values)} edges; at most "
                                  f"{MAX_FACE_EDGES} are allowed", srcline)
-            values = ([int(v) for v in values] if not checked else
-                      head.astype(np.int64).tolist() + [int(v) for v in values[checked:]])
+            if kind == "bodies" and checked == len(values) > 64:
+                values = head.astype(np.int64)      # a long facet list: an array (load memory)
+            else:
+                values = ([int(v) for v in values] if not checked else
+                          head.astype(np.int64).tolist() + [int(v) for v in values[checked:]])
         cooked = []
         for kw, args, col in attrs:
             if kw == "quantity":

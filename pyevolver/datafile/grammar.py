@@ -13,6 +13,7 @@ from lark import Lark, Token, v_args
 
 from ..expr import nodes as N
 from ..errors import ExpressionError
+from ..expr.lark_cache import cached_lark
 from ..expr.transform import ExprTransformer, _at, expr_grammar
 from ..limits import clip
 from .located import _Unsupported
@@ -29,10 +30,9 @@ def top_parser() -> Lark:
     """LALR parser of the top section (``fe_top.lark`` + ``expr.lark``)."""
     with open(os.path.join(_HERE, "fe_top.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
-    return Lark(grammar, parser="lalr", lexer="contextual", start="start",
-                maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse,
-                                                    "UNSUPPORTED2_KW": _refuse},
-                cache=True)
+    return cached_lark(grammar, parser="lalr", lexer="contextual", start="start",
+                       maybe_placeholders=False, lexer_callbacks={"UNSUPPORTED_KW": _refuse,
+                                                           "UNSUPPORTED2_KW": _refuse})
 
 
 @functools.lru_cache(maxsize=1)
@@ -40,9 +40,9 @@ def line_parser() -> Lark:
     """LALR parser of one element line (``fe_elements.lark`` + ``expr.lark``)."""
     with open(os.path.join(_HERE, "fe_elements.lark")) as fh:
         grammar = expr_grammar() + "\n" + fh.read()
-    return Lark(grammar, parser="lalr", lexer="contextual",
-                start=["vertex_line", "edge_line", "face_line", "body_line"],
-                maybe_placeholders=False, cache=True)
+    return cached_lark(grammar, parser="lalr", lexer="contextual",
+                       start=["vertex_line", "edge_line", "face_line", "body_line"],
+                       maybe_placeholders=False)
 
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import DatafileError, ExpressionError
+from ..memory import loading
 from ..expr import nodes as N
 from ..model.scene import Scene
 from .elements import ElementSections
@@ -205,6 +206,7 @@ class Reader(TopSection, ElementSections):
         return self._const(expr, line, what)
 
 
+@loading
 def read_datafile(filename: str, text: str | None = None) -> Scene:
     """Read a datafile into a :class:`~pyevolver.model.scene.Scene`.
 

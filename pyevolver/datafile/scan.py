@@ -11,6 +11,8 @@ import re
 
 import numpy as np
 
+from .table import floats_of
+
 # numbers with two decimal points or an exponent without digits.  Every
 # digit run is taken whole (``(?=(\d+))\1`` is an atomic group, which Python
 # before 3.11 lacks), so a long digit run that fails cannot backtrack: the
@@ -67,11 +69,40 @@ class _Head:
     def end(self):
         return self._end
 
+    def start(self):
+        return self._end
+
+
+_LETTER = np.zeros(256, bool)
+_LETTER[np.frombuffer(b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz_", np.uint8)] = True
+_EXP = np.zeros(256, bool)
+_EXP[np.frombuffer(b"DdEe", np.uint8)] = True
+_DIGIT_DOT = np.zeros(256, bool)
+_DIGIT_DOT[np.frombuffer(b"0123456789.", np.uint8)] = True
+
+
+def _first_word(line):
+    """``_FIRST_WORD.search(line)`` (its ``start()``), with array operations
+    on a long ASCII line (a body's list of 81,920 facets: 1 ms, not 30)."""
+    if not line.isascii():
+        return _FIRST_WORD.search(line)
+    b = np.frombuffer(line.encode("ascii"), np.uint8)
+    idx = np.flatnonzero(_LETTER[b])
+    if len(idx):
+        after_number = np.zeros(len(idx), bool)
+        inner = idx > 0
+        after_number[inner] = _DIGIT_DOT[b[idx[inner] - 1]]
+        word = ~_EXP[b[idx]] | ~after_number
+        hit = np.flatnonzero(word)
+        if len(hit):
+            return _Head(int(idx[hit[0]]))      # (its start() and end(): the position)
+    return None
+
 
 def _long_numeric(line):
     """For a long line: ``("all", None)`` if it is plain numbers, ``("head",
     m)`` if plain numbers are followed by a word, else ``(None, None)``."""
-    m = _FIRST_WORD.search(line)
+    m = _first_word(line)
     end = m.start() if m else len(line)
     head = line[:end]
     if not _NUM_CHARS.fullmatch(head) or (m and end and not line[end - 1].isspace()):
@@ -81,7 +112,7 @@ def _long_numeric(line):
     if not head.split() or not head.split(None, 1)[0].isdigit():
         return None, None               # the element id: digits ('1e308' is not one)
     try:
-        vals = np.fromstring(head, dtype=float, sep=" ")
+        vals = floats_of(head)
     except ValueError:                  # '1-2', '--3': not plain numbers
         return None, None
     if (vals.size != len(head.split()) or not vals.size or not np.isfinite(vals[0])

@@ -213,8 +213,10 @@ class TopSection:
         try:
             if _MATRIX_RE.search(text):
                 text = self._extract_matrices(text)
-            tree = top_parser().parse(text, start="start")
-            decls = _TOP.transform(tree)
+            if text.strip(" \t\f\r\n"):     # (the grammar's blanks; else no declaration)
+                decls = _TOP.transform(top_parser().parse(text, start="start"))
+            else:
+                decls = []      # (start-up: a top section of comments needs no parser)
         except _MatrixError as exc:
             raise self.error(exc.args[1], self._src(sec, exc.args[0]), 1) from None
         except _Unsupported as exc:

@@ -245,7 +245,7 @@ class Totals:
         b = s.bodies
         if not b.n:
             return np.zeros(0)
-        vols = csr_matvec(b.facet_matrix, self.facet_volume)
+        vols = csr_matvec(b.facet_csr, self.facet_volume)
         if self.con_content is not None:
             # edge content counts toward the bodies of the facets the edge is on
             vols = vols + b.facet_matrix @ self.facet_edge_sum(self.con_content)

@@ -4,11 +4,12 @@ triangulated, bodies and quantities set up, vertices projected)."""
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
+from .facet_csr import canonical_csr
 
 from ..errors import DatafileError, PyEvolverError, UnsupportedError
 from ..expr.nodes import Formula
 from ..limits import MAX_ARRAY_ENTRIES
+from ..memory import loading
 from .formulas import located
 from .ids import IdMap, Lazy, split_midpoints
 from .metric import metric_of
@@ -330,6 +331,7 @@ class _Builder:
                     f"vertex {s.vattr['original'][heads[j]]} but the next edge "
                     f"{flat[nxt[j]]} starts at vertex {s.vattr['original'][tails[nxt[j]]]}",
                     blk.lines[k])
+            del flat, owner, heads, nxt, ends       # (the load's peak memory)
             enc = np.where(rev, ~eidx, eidx)
         else:
             enc = np.zeros(0, np.int64)
@@ -344,9 +346,7 @@ class _Builder:
         big = np.nonzero(~tri3)[0]
         if len(big) and "wrap_code" in s.eattr:         # (model.groups: wrapped rims refused)
             symmetry.group_face_check(s, big, starts, lengths, eidx, blk, self.error)
-        new_X = []
-        new_E = []
-        new_F = []            # (FE row, parent face position)
+        new_X, new_E, new_F = [], [], []      # new_F: (FE row, parent face position)
         self.split_children = {}     # face position -> its triangles (faces split on load)
         nv = s.nv
         ne = ne0
@@ -654,7 +654,7 @@ class _Builder:
             if "volume" in kws and "pressure" in kws:
                 raise self.error(f"body {blk.ids[pos]}: VOLUME and PRESSURE exclude each other",
                                  blk.lines[pos])
-        b.facet_matrix = sp.csr_matrix((vals, (rows, cols)), shape=(nb, s.n_facets))
+        b.facet_matrix = canonical_csr(vals, rows, cols, (nb, s.n_facets))  # (scipy's CSR)
         b.occurrences = (np.asarray(rows, np.int64), np.asarray(cols, np.int64),
                          np.asarray(vals, float))
         b.volume = None
@@ -765,6 +765,7 @@ class _Builder:
         HOOKS.require("project")(self.s, np.arange(self.s.nv))
 
 
+@loading
 def build_surface(scene: Scene) -> Surface:
     """Build a :class:`Surface` from a :class:`~pyevolver.model.scene.Scene`.
 

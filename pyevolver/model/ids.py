@@ -24,6 +24,11 @@ class IdMap:
         self.ids = np.asarray(ids, dtype=np.int64)
         self.what = what
         self.filename = filename
+        n = len(self.ids)
+        if n and self.ids[0] == 1 and self.ids[-1] == n and \
+                np.array_equal(self.ids, np.arange(1, n + 1)):
+            self.sorted = self.order = None     # ids 1..n in order: position = id - 1
+            return
         order = np.argsort(self.ids, kind="stable")
         self.sorted = self.ids[order]
         self.order = order
@@ -34,15 +39,18 @@ class IdMap:
 
     def lookup(self, raw, lines, user, user_ids):
         raw = np.asarray(raw, dtype=np.int64)
-        if not len(self.sorted):
+        if not len(self.ids):
             if raw.size:
                 raise DatafileError(f"{user} {user_ids[0]} refers to {self.what} "
                                     f"{int(raw.flat[0])}, but there are no {self.what}s",
                                     self.filename, lines[0])
             return raw
-        pos = np.searchsorted(self.sorted, raw)
-        pos_c = np.minimum(pos, len(self.sorted) - 1)
-        ok = self.sorted[pos_c] == raw
+        if self.order is None:
+            ok = (raw >= 1) & (raw <= len(self.ids))
+        else:
+            pos_c = np.searchsorted(self.sorted, raw)
+            np.minimum(pos_c, len(self.sorted) - 1, out=pos_c)  # (in place: load memory)
+            ok = self.sorted[pos_c] == raw
         if not ok.all():
             flat = np.nonzero(~ok.reshape(len(ok), -1).all(axis=-1) if ok.ndim > 1 else ~ok)[0][0]
             bad = raw[flat]
@@ -50,7 +58,7 @@ class IdMap:
                 if np.ndim(bad) else int(bad)
             raise DatafileError(f"{user} {user_ids[flat]} refers to {self.what} {bad}, "
                                 f"which is not defined", self.filename, lines[flat])
-        return self.order[pos_c]
+        return raw - 1 if self.order is None else self.order[pos_c]
 
 
 def split_midpoints(data, vid: IdMap, lines, ids) -> tuple[list, np.ndarray]:

@@ -27,7 +27,11 @@ def first_facets_on_load(FE: np.ndarray, parent: np.ndarray, ne: int) -> np.ndar
     f = np.repeat(np.arange(nf), 3)
     p = np.asarray(parent)[f]
     order = np.lexsort((f, p, e))
-    e, f, p = e[order], f[order], p[order]
+    del f                       # (one array at a time: the load's peak memory)
+    e = e[order]
+    p = p[order]
+    f = order // 3              # (= the repeated facet numbers, reordered)
+    del order
     head = np.ones(len(e), bool)
     head[1:] = e[1:] != e[:-1]
     first = np.full(ne, -1, np.int64)

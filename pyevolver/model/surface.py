@@ -14,6 +14,7 @@ import numpy as np
 
 from ..geometry import kernels as G
 from ..expr import nodes as N
+from .facet_csr import PendingCSR
 
 
 class Hooks:
@@ -68,7 +69,6 @@ class Quantity:
 @dataclass
 class Bodies:
     n: int = 0
-    facet_matrix: object = None      # sparse (nb, nf) with +-1 entries
     target: Optional[np.ndarray] = None        # nan where no volume constraint
     volconst: Optional[np.ndarray] = None
     pressure: Optional[np.ndarray] = None      # prescribed pressure (nan = none)
@@ -77,6 +77,27 @@ class Bodies:
     lagrange: Optional[np.ndarray] = None      # reported pressures (multipliers)
     original: Optional[np.ndarray] = None
     occurrences: Optional[tuple] = None        # (body, facet, sign) as listed (duplicates kept)
+
+    # the sparse (nb, nf) matrix of +-1 occurrences; a load leaves its CSR
+    # arrays (pyevolver.model.facet_csr), made a scipy matrix when first read
+    _facet_matrix = None
+
+    @property
+    def facet_matrix(self):
+        M = self._facet_matrix
+        if isinstance(M, PendingCSR):
+            M = self._facet_matrix = M.to_scipy()
+        return M
+
+    @facet_matrix.setter
+    def facet_matrix(self, M):
+        self._facet_matrix = M
+
+    @property
+    def facet_csr(self):
+        """The facet matrix, or its CSR arrays while it is not made yet
+        (enough for :func:`pyevolver.methods._common.csr_matvec`)."""
+        return self._facet_matrix
 
 
 class Surface:

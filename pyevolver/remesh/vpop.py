@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sps
-from scipy.sparse import coo_matrix
 
 from ..errors import UnsupportedError
 from .grow import grow
@@ -67,7 +66,7 @@ def link_summary(s):
     rows = np.concatenate(rows) if rows else np.zeros(0, np.int64)
     cols = np.concatenate(cols) if cols else np.zeros(0, np.int64)
     nn = 2 * ne
-    g = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(nn, nn))
+    g = sps.coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(nn, nn))
     from scipy.sparse.csgraph import connected_components   # (start-up time)
     _, comp = connected_components(g, directed=False)
     owner = E.ravel()                                   # vertex of each end

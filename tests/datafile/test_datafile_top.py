@@ -137,3 +137,15 @@ def test_refusals_are_located(top, line, col, words):
     assert words in e.message
     where = f"top.fe:{line}" + (f":{col}" if col else "")
     assert str(e).startswith(where + ": ")
+
+
+def test_a_top_section_of_comments_needs_no_parser(monkeypatch):
+    import pyevolver.datafile.top as top_module
+
+    def refuse():
+        raise AssertionError("the top parser was asked for")
+    monkeypatch.setattr(top_module, "top_parser", refuse)
+    sc = read_datafile("c.fe", "// a comment\n/* another */\n\t\nvertices\n1 0 0 0\n")
+    assert len(sc.vertices.ids) == 1 and not sc.parameters
+    with pytest.raises(AssertionError):         # anything else is parsed
+        read_datafile("c.fe", "\xa0\nvertices\n1 0 0 0\n")

@@ -56,3 +56,17 @@ def test_read_source_takes_any_byte(tmp_path):
     p = tmp_path / "latin.fe"
     p.write_bytes(b"// caf\xe9\nvertices\n")
     assert read_source(str(p)) == "// caf\u00e9\nvertices\n"
+
+
+def test_comments_and_sections_far_into_a_large_text():
+    # the comment scan runs from the first '/' or '"' to the line of the last
+    # '/'; the section search looks at lines starting with a letter
+    rows = "\n".join(f"{k} {k} 0 0" for k in range(1, 3000))
+    text = ("// head\nparameter p = 1 /* c */\nvertices\n" + rows + "\nedges\n1 1 2 // e\n"
+            + rows.replace(" 0 0", "") + '\nfaces /* x\n y */\n  BODIES\n1 1 "s//t"\n')
+    sections, _ = preprocess(text, "f.fe")
+    assert [s.kind for s in sections] == ["top", "vertices", "edges", "faces", "bodies"]
+    assert sections[2].text.startswith("\n1 1 2     \n")
+    assert not sections[3].text.strip() and sections[4].line == text.count("\n") - 1
+    clean = blank_comments(text, "f.fe")
+    assert len(clean) == len(text) and "/*" not in clean and '"s//t"' in clean

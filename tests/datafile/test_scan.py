@@ -53,3 +53,12 @@ def test_lowest_free_number():
 def test_expected_terminals_are_worded():
     assert _expected({"NUMBER", "LPAR", "__ANON_1"}) == "'(', a number"
     assert _expected(set()) == "something else"
+
+
+def test_first_word_as_the_regex():
+    # the array search of a long line's first word finds what _FIRST_WORD finds
+    from pyevolver.datafile.scan import _FIRST_WORD, _first_word
+    for line in ["1 2 3", "1 2e5 3 volume 2", "e5 1", "1 .e2", "1 2 _x", "1 2d3 D3",
+                 "7 1.5E3 fixed", "1 2 3 é", "", "1 2 x3"]:
+        a, b = _FIRST_WORD.search(line), _first_word(line)
+        assert (a and a.start()) == (b and b.start()), line

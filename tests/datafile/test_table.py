@@ -60,6 +60,9 @@ def test_same_scene_as_the_line_reader(extra, monkeypatch, tmp_path):
     ("7 0.5 0.5", False),                  # a shorter line (padded, warned by the reader)
     ("7.0 0.5 0.5 0.5", False),            # the id must be digits
     ("-7 0.5 0.5 0.5", False),
+    ("  7e0 0.5 0.5 0.5", False),
+    ("\t 7 0.5 0.5 0.5", True),           # blanks before the id
+    ("7 0.5 0.5 0.5 " + " 1" * 3, False),  # another count of numbers
     ("7 0.5 0.5 1e", False),               # not one number
     ("7 0.5.5 0.5 0.5", False),            # malformed number: the reader's message
     ("7 0.5 0.5 0.5\r", False),            # (carriage returns are normalised before)
@@ -87,3 +90,15 @@ def test_errors_are_the_line_readers(old, new, words, monkeypatch, tmp_path):
             _scene(text, fast, monkeypatch, tmp_path)
         msgs.append(str(exc.value))
     assert msgs[0] == msgs[1] and words in msgs[0]
+
+
+@pytest.mark.parametrize("text", ["1 2 3", "1 -0 2", " +5 -7\n8 ", "99999999999999999999 1",
+                                  "9007199254740993 1", "1 2.5", "1 nan", "", "1 2e3"])
+def test_floats_of_reads_as_fromstring(text):
+    want = np.fromstring(text, dtype=float, sep=" ")
+    got = T.floats_of(text)
+    assert got.dtype == want.dtype and np.array_equal(np.signbit(got), np.signbit(want))
+    np.testing.assert_array_equal(got, want)
+    for bad in ("1 x", "1 5-", "0x10"):
+        with pytest.raises(ValueError):
+            T.floats_of(bad)

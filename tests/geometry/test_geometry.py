@@ -87,6 +87,13 @@ def test_triangle_rule_is_degree_6():
             assert np.sum(W * B[:, 0] ** i * B[:, 1] ** j) == pytest.approx(exact, rel=1e-13, abs=1e-16)
 
 
+def test_stored_triangle_rule_is_the_polished_one():
+    # TRI6_PARAMS is what polishing the published constants gives (stored for start-up)
+    B, W = G._dunavant6()
+    np.testing.assert_allclose(G.TRI6_B, B, rtol=0, atol=4e-16)
+    np.testing.assert_allclose(G.TRI6_W, W, rtol=0, atol=4e-16)
+
+
 def test_gauss_legendre_exact_to_cubic():
     for k in range(4):
         assert np.sum(G.GL2_W * G.GL2_T ** k) == pytest.approx(1 / (k + 1), rel=1e-15)

@@ -42,6 +42,25 @@ def test_idmap_lookup_and_duplicates():
         IdMap([1, 1], "vertex", "f.fe", [1, 2])
 
 
+@pytest.mark.parametrize("raw", [[[3, 1], [2, 4]], [3, 1, 2], [[1, 5]], [0, 1], [-2], [[2, 2], [4, 6]]])
+def test_ids_one_to_n_map_as_any_ids(raw):
+    # ids 1..n in order take a shortcut (no sorted copy): the same positions and messages
+    fast = IdMap([1, 2, 3, 4], "vertex", "f.fe", [1, 2, 3, 4])
+    slow = IdMap([4, 1, 2, 3], "vertex", "f.fe", [1, 2, 3, 4])     # positions: id 4 -> 0
+    assert fast.order is None and slow.order is not None
+    lines, users = [7, 8], [11, 12]
+    try:
+        got = fast.lookup(raw, lines, "edge", users)
+    except DatafileError as exc:
+        with pytest.raises(DatafileError) as ref:
+            slow.lookup(raw, lines, "edge", users)
+        assert (str(exc), exc.line) == (str(ref.value), ref.value.line)
+        return
+    want = slow.lookup(raw, lines, "edge", users)
+    assert got.dtype == want.dtype == np.int64
+    assert np.array_equal(np.where(want == 0, 3, want - 1), got)   # the two numberings
+
+
 def test_string_model_repr():
     text = "string\nspace_dimension 2\nvertices\n1 0 0\n2 1 0\nedges\n1 1 2\n"
     s = build_surface(read_datafile("s.fe", text))
