@@ -13,7 +13,8 @@ from pyevolver.startup import LAZY_SUBMODULES, lazy_numpy_submodules
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 HEAVY = ["meshio", "scipy.sparse.linalg", "scipy.linalg", "numpy.f2py.crackfortran", "unittest",
-         "scipy.sparse.csgraph", "scipy.sparse._csr", "scipy._lib", "regex._regex_core"]
+         "scipy.sparse.csgraph", "scipy.sparse._csr", "scipy._lib", "regex._regex_core",
+         "numpy.random._generator"]
 
 USE = ("import numpy as np\n"
        "print(np.random.default_rng(0).integers(10, size=3).tolist())\n"

@@ -65,6 +65,20 @@ class SessionAPI:
     attr_types: dict[tuple, str]
     arrays: dict[str, Any]
     history: list[tuple]
+    _rng: Any = None
+
+    @property
+    def rng(self) -> np.random.Generator:
+        """The random generator of ``random`` and ``j`` (seed 1; ``random_seed :=``
+        reseeds it), made when first used: numpy.random's import is not part
+        of a start-up that never draws a number."""
+        if self._rng is None:
+            self._rng = np.random.default_rng(1)
+        return self._rng
+
+    @rng.setter
+    def rng(self, value: np.random.Generator) -> None:
+        self._rng = value
 
     def export(self, path: str, fmt: str | None = None, data: bool = True) -> str:
         """Write the surface to ``path`` in a meshio format chosen by the

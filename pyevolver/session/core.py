@@ -76,7 +76,7 @@ class Session(SessionAPI):
         self.interp = I.Interpreter(self)
         self._iterator = None
         self.counts: dict[str, int] = {}       # equi_count, refine_count, ... (spec §9.7)
-        self.rng = np.random.default_rng(1)    # `random`, `j`; reseeded by random_seed :=
+        self._rng = None       # `random`, `j` (SessionAPI.rng, made when first used)
         self.iteration_counter = 0
         self.total_time = 0.0
         # seconds one top-level command may run (None: no limit); a command

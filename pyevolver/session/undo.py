@@ -38,7 +38,8 @@ def _counters(session) -> tuple:
     steps, the counts (``equi_count``, ...), the iteration counter and
     total time, the random generator's state, the CG iterator object."""
     return (list(session.history), dict(session.counts), session.iteration_counter,
-            session.total_time, session.rng.bit_generator.state, session._iterator,
+            session.total_time,
+            None if session._rng is None else session._rng.bit_generator.state, session._iterator,
             session.__dict__.get("_last_motion"))
 
 
@@ -56,7 +57,10 @@ def restore(session, snap: tuple) -> None:
     session.history[:] = history
     session.counts.clear()
     session.counts.update(counts)
-    session.rng.bit_generator.state = rng_state
+    if rng_state is None:
+        session._rng = None
+    else:
+        session.rng.bit_generator.state = rng_state
     session.filename = filename
     session._attr_store = attr_store          # graphics-only attributes (commands.attributes)
     session.surface = surface

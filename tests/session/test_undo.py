@@ -91,3 +91,18 @@ def test_failing_command_rolls_back_history_counters_and_random_state():
         raise AssertionError("the command should fail")
     assert s.history == hist and s.iteration_counter == it
     assert s.rng.bit_generator.state == r0
+
+
+def test_random_generator_made_when_first_used_and_rolled_back_to_unmade():
+    """The generator of ``random`` (seed 1) is made at its first draw, not at
+    the load; a failing command that made it leaves it unmade, so the next
+    draw is still the seed's first number."""
+    s = session()
+    assert s._rng is None
+    first = np.random.default_rng(1).random()
+    with pytest.raises(CommandError):
+        s.run('{ printf "%.17g\\n", random; set vertex[99] x 1 }')
+    assert s._rng is None
+    s.out = io.StringIO()
+    s.run('printf "%.17g\\n", random')
+    assert float(s.out.getvalue()) == first and s._rng is not None
