@@ -75,7 +75,8 @@ def main():
         bad |= not same
         py, ref = statistics.median(cpu["py"]), statistics.median(cpu["ref"])
         rows.append((cmd, 20 * 4 ** a.level, py, ref, goal, prep or "-", same))
-        print(f"{cmd}: ratio {py / ref:.2f}, same as REF: {same}", file=sys.stderr)
+        print(f"{cmd}: ratio {py / ref if ref > 0 else float('inf'):.2f}, same as REF: {same}",
+              file=sys.stderr)
     head = (f"| command ({a.label}) | facets | pyevolver CPU [s] | Evolver CPU [s] | ratio | "
             "goal | report (same as REF) |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]

@@ -102,6 +102,7 @@ def star_sums(t):
     W4[0] = L
     W4[1:] = np.asarray(N2)[:, None, :]
     AN = np.bincount(idx4, weights=W4.ravel(), minlength=4 * nv).reshape(4, nv)
+    AN = AN.astype(np.float64, copy=False)      # (numpy's bincount of no weights is int64)
     AN *= 0.5
     A = AN[0]
     N = np.ascontiguousarray(AN[1:].T)
@@ -114,6 +115,7 @@ def star_sums(t):
     W -= n.take(_C2, axis=0)[:, None, :] * e.take(_C1, axis=0)
     W *= 0.5
     F3 = np.bincount(idxc[0], weights=W[:, 0].ravel(), minlength=3 * nv)
+    F3 = F3.astype(np.float64, copy=False)
     F3 += np.bincount(idxc[1], weights=W[:, 1].ravel(), minlength=3 * nv)
     F3 += np.bincount(idxc[2], weights=W[:, 2].ravel(), minlength=3 * nv)
     F = np.ascontiguousarray(F3.reshape(3, nv).T)

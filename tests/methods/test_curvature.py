@@ -435,3 +435,14 @@ def test_gradient_matches_finite_differences_on_perturbed_icosphere(rough_icosph
     def value():
         return float(fn(S.evaluate(), _M(name), np.arange(n)) @ w)
     assert _fd_check(S, value, grad, np.random.default_rng(21), n=20) <= FD
+
+
+def test_star_curvature_energies_of_a_surface_without_facets_are_zero():
+    """A datafile cut off in its edges section (deep fuzz of the reader): the
+    star sums scatter no weights, which numpy's bincount returns as integers;
+    the energies are 0, not a casting error."""
+    text = ("quantity sq energy modulus 1 method sq_mean_curvature global\n"
+            "quantity st energy modulus 1 method star_perp_sq_mean_curvature global\n"
+            "vertices\n1  0.0 0.0 0.0\n2  1.0 0.0 0.0\nedges\n1   1 2\n")
+    s = Session.load("nofacets.fe", out=io.StringIO(), run_read=False, text=text)
+    assert s.surface.evaluate().energy == 0.0
