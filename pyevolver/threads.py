@@ -64,29 +64,41 @@ def _control():
 
 
 _depth = 0
+_generation = 0
 
 
 @contextmanager
 def limited():
     """Context manager: BLAS limited to :func:`setting` threads inside
     (nested uses inside the first one change nothing: the steps of one
-    ``g n`` run under one limit, set once)."""
-    global _depth
+    ``g n`` run under one limit, set once).
+
+    The depth count survives an interrupted nested use: a time limit
+    (:mod:`pyevolver.session.deadline`) may stop a command between a nested
+    use's entry and the ``with`` statement's exit, leaving its generator
+    to be finished by the garbage collector later, after the outer use
+    ended; such a late exit belongs to an older outer use (its
+    ``generation``) and changes nothing."""
+    global _depth, _generation
     if _depth:
+        mine = _generation
         _depth += 1
         try:
             yield
         finally:
-            _depth -= 1
+            if _generation == mine and _depth > 1:
+                _depth -= 1
         return
     n = setting()
     ctl = _control() if n is not None else None
     with (nullcontext() if ctl is None else ctl.limit(limits=n, user_api="blas")):
-        _depth = 1
         try:
+            _generation += 1
+            _depth = 1
             yield
         finally:
             _depth = 0
+            _generation += 1
 
 
 def blas_limited(fn: F) -> F:

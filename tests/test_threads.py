@@ -80,3 +80,27 @@ def test_controller_made_again_after_new_imports(monkeypatch):
     assert TH._control() is first
     monkeypatch.setitem(sys.modules, "pyevolver_test_new_module", types.ModuleType("x"))
     assert TH._control() is not first
+
+
+def test_interrupted_nested_use_finished_late_changes_nothing(monkeypatch):
+    """A time limit can stop a command after a nested use entered and
+    before its exit ran; its generator is then closed by the garbage
+    collector after the outer use ended.  That late exit must not make the
+    depth negative (which made the next `g` steps each set the limit again
+    and the next `hessian` run outside it)."""
+    import gc
+    monkeypatch.setenv(TH.ENV, "off")
+    with TH.limited():
+        orphan = TH.limited()
+        orphan.__enter__()                  # (never exited: the interrupted use)
+        assert TH._depth == 2
+    assert TH._depth == 0
+    del orphan
+    gc.collect()
+    assert TH._depth == 0
+    with TH.limited():
+        assert TH._depth == 1
+        with TH.limited():
+            assert TH._depth == 2
+        assert TH._depth == 1
+    assert TH._depth == 0
