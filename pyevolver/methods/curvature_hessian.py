@@ -43,7 +43,8 @@ def _elements(nv, verts, H, basis):
 
 def _rows(nrows, ridx, verts, blocks, nv, basis):
     """Sparse (nrows, 3nv or basis.n) matrix from per-element row blocks:
-    ``ridx`` (m, r) row numbers, ``verts`` (m, k), ``blocks`` (m, r, k, 3)."""
+    ``ridx`` (m, r) row numbers, ``verts`` (m, k), ``blocks`` (m, r, k, 3);
+    in COO form, its entries not summed (:func:`_add` converts once)."""
     m, r = ridx.shape
     k = verts.shape[1]
     blocks = _finite(blocks)
@@ -51,7 +52,7 @@ def _rows(nrows, ridx, verts, blocks, nv, basis):
         cols = 3 * verts[:, :, None] + np.arange(3)
         rows = np.broadcast_to(ridx[:, :, None, None], (m, r, k, 3))
         cols = np.broadcast_to(cols[:, None], (m, r, k, 3))
-        return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())),
+        return sp.coo_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())),
                              shape=(nrows, 3 * nv))
     Bv = basis.B[verts]                                         # (m, k, 3, d)
     d = Bv.shape[3]
@@ -61,11 +62,11 @@ def _rows(nrows, ridx, verts, blocks, nv, basis):
     rows = np.broadcast_to(ridx[:, :, None, None], (m, r, k, d))
     cols = np.broadcast_to(idx[:, None], (m, r, k, d))
     if (basis.ndof >= d).all():
-        return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())),
+        return sp.coo_matrix((vals.ravel(), (rows.ravel(), cols.ravel())),
                              shape=(nrows, basis.n))
     ok = np.arange(d)[None, None, :] < basis.ndof[verts][:, :, None]
     keep = np.broadcast_to(ok[:, None], (m, r, k, d))
-    return sp.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(nrows, basis.n))
+    return sp.coo_matrix((vals[keep], (rows[keep], cols[keep])), shape=(nrows, basis.n))
 
 
 def _finite(a):
@@ -79,6 +80,7 @@ def _finite(a):
 def _gauss_newton(Jm, M):
     """``Jmᵀ diag(M) Jm`` for per-vertex blocks M (nv, r, r)."""
     nv, r, _ = M.shape
+    Jm = Jm.tocsr()
     Md = sp.bsr_matrix((_finite(M), np.arange(nv), np.arange(nv + 1)),
                        shape=(nv * r, nv * r)).tocsr()
     return (Jm.T @ (Md @ Jm)).tocsr()
