@@ -31,6 +31,7 @@ from . import curvature as C
 from ._common import assemble, facet_points
 from .registry import register_method
 from . import jets as J
+from . import star_rows as SR
 
 # -- assembly ---------------------------------------------------------------------------------
 
@@ -188,6 +189,7 @@ def star_hessian(t, M, dA, dF, dN, basis=None):
     Pall = facet_points(t)
     nf = len(Pall)
     H2parts, Jparts = [], []
+    rows = SR.StarRows(Fall, basis, 7) if SR.applies(basis) else None
     for lo in range(0, max(nf, 1), CHUNK):
         Fc, P = Fall[lo:lo + CHUNK], Pall[lo:lo + CHUNK]
         m = len(Fc)
@@ -207,9 +209,15 @@ def star_hessian(t, M, dA, dF, dN, basis=None):
         for c in range(3):
             blocks[:, c, 1:4, :] = Aj.H[:, 3 * c:3 * c + 3, :]      # ∂F_c/∂x = ∂²A/∂x_c∂x
         blocks[:, :, 4:7, :] = 0.5 * N2.J[:, None]
+        if rows is not None:          # straight into the CSR pattern (star_rows)
+            U = basis.B[Fc][:, :, :, 0]                                   # (m, 3, 3)
+            vals = np.einsum("mcibk,mbk->mcib", _finite(blocks).reshape(m, 3, 7, 3, 3), U)
+            rows.add_chunk(lo, Fc, vals)
+            continue
         ridx = (7 * Fc[:, :, None] + np.arange(7)).reshape(m, 21)
         Jparts.append(_rows(7 * nv, ridx, Fc, blocks.reshape(m, 21, 3, 3), nv, basis))
-    return _gauss_newton(_add(Jparts), M) + _add(H2parts)
+    Jm = rows.matrix() if rows is not None else _add(Jparts)
+    return _gauss_newton(Jm, M) + _add(H2parts)
 
 
 def _add(parts):
