@@ -127,9 +127,8 @@ def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=
     ``K`` directly."""
     n = K.shape[0]
     K = sp.csc_matrix(K)
-    A = K + delta * sp.identity(n, format="csc") if delta else K
-    try:
-        f = LDL(A, ordering(K, points))
+    try:     # (K + δI is not kept: the factors' memory peaks in LDL)
+        f = LDL(K + delta * sp.identity(n, format="csc") if delta else K, ordering(K, points))
     except RuntimeError:
         return None
     k = 0 if B is None else B.shape[1]
