@@ -17,10 +17,13 @@ all :func:`pivots` needs.
 """
 from __future__ import annotations
 
+import importlib.machinery
+import importlib.util
 import os
 import sys
 
 import numpy as np
+import scipy
 
 _MODULE = "scipy.sparse.linalg._dsolve._superlu"
 _direct: list = []          # [module] once loaded, [None] when it cannot be
@@ -58,10 +61,6 @@ def _load():
         mod = sys.modules.get(_MODULE)
         if mod is None:
             try:
-                import importlib.machinery
-                import importlib.util
-
-                import scipy
                 folder = os.path.join(os.path.dirname(scipy.__file__), "sparse", "linalg",
                                       "_dsolve")
                 name = next(f for f in sorted(os.listdir(folder))
