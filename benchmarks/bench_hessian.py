@@ -152,6 +152,11 @@ def measure(programs, f, command, repeat):
     return {k: (statistics.median(cpu[k]), peak[k]) + res[k] for k in programs}
 
 
+def _ratio(a, b):
+    """a / b to two places ("—" when the Evolver's cost measured 0)."""
+    return f"{a / b:.2f}" if b > 0 else "—"
+
+
 def table(rows, label):
     head = (f"| case ({label}) | facets | command | pyevolver CPU [s] | Evolver CPU [s] | ratio "
             "| pyevolver peak [MB] | Evolver peak [MB] | ratio | energy before | "
@@ -159,7 +164,8 @@ def table(rows, label):
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for case, nf, cmd, py, ref, e0 in rows:
         lines.append(f"| {case} | {nf:,} | `{cmd}` | {py[0]:.2f} | {ref[0]:.2f} | "
-                     f"{py[0] / ref[0]:.2f} | {py[1]:.0f} | {ref[1]:.0f} | {py[1] / ref[1]:.2f} | "
+                     f"{_ratio(py[0], ref[0])} | {py[1]:.0f} | {ref[1]:.0f} | "
+                     f"{_ratio(py[1], ref[1])} | "
                      f"{e0:.10g} | {py[2]:.10g} | {ref[2]:.10g} | {py[3]:.1e} | {ref[3]:.1e} |")
     return "\n".join(lines)
 

@@ -382,7 +382,7 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         q.pressure = lam[len(cons.bodies) + k]
         qp[q.name] = q.pressure
     it.cg_history = None
-    t = s.evaluate()
+    # (t: the evaluation the move ended with; the multipliers do not enter it)
     return StepResult(t.energy, t.total_area, scale,
                       b.lagrange.copy() if b.n else np.zeros(0), qp, True, warnings=report,
                       totals=t)

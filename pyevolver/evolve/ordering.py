@@ -75,15 +75,17 @@ def nested_dissection(points, pattern, leaf=64):
         new_part = part.copy()
         new_part[idx] = 2 * part[idx] + right
         # separator: the left-side unknowns coupled to the right side of their
-        # part (each coupling once, either way round); couplings across parts
-        # never matter again
-        keep = active[ei] & active[ej] & (part[ei] == part[ej])
-        ei, ej = ei[keep], ej[keep]
+        # part (each coupling once, either way round; the couplings kept join
+        # two active unknowns of one part, and a part not cut has no right
+        # side); couplings across parts or to a separator never matter again
         si, sj = side[ei], side[ej]
-        inside = cut_all[part[ei]]
-        sep = np.unique(np.concatenate([ei[inside & ~si & sj], ej[inside & si & ~sj]]))
+        sep = np.unique(np.concatenate([ei[~si & sj], ej[si & ~sj]]))
         level[sep] = depth
         active[sep] = False
+        keep = si == sj
+        keep &= active[ei]
+        keep &= active[ej]
+        ei, ej = ei[keep], ej[keep]
         part = new_part
         depth += 1
     key = np.where(level < 0, depth, level)

@@ -41,6 +41,7 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
+from . import superlu
 from .ordering import nested_dissection
 
 #: unknowns below which SuperLU's own minimum-degree order is used
@@ -85,15 +86,13 @@ class LDL:
     when ``A`` is exactly singular."""
 
     def __init__(self, A, perm=None):
-        import scipy.sparse.linalg as spla   # 0.1 s at start-up: when first used
         A = sp.csc_matrix(A)
         self.perm = perm
         if perm is not None:
             A = A.tocsr()[perm][:, perm].tocsc()
-        self._lu = spla.splu(A, permc_spec="NATURAL" if perm is not None else "MMD_AT_PLUS_A",
-                             diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-        lu = self._lu
-        self.pivots = lu.U.diagonal() if np.array_equal(lu.perm_r, lu.perm_c) else None
+        self._lu = superlu.factor(A, natural=perm is not None)
+        del A
+        self.pivots = superlu.pivots(self._lu)
 
     def solve(self, R):
         R = np.asarray(R, float)
@@ -128,9 +127,8 @@ def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=
     ``K`` directly."""
     n = K.shape[0]
     K = sp.csc_matrix(K)
-    A = K + delta * sp.identity(n, format="csc") if delta else K
-    try:
-        f = LDL(A, ordering(K, points))
+    try:     # (K + δI is not kept: the factors' memory peaks in LDL)
+        f = LDL(K + delta * sp.identity(n, format="csc") if delta else K, ordering(K, points))
     except RuntimeError:
         return None
     k = 0 if B is None else B.shape[1]

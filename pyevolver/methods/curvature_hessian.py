@@ -31,6 +31,7 @@ from . import curvature as C
 from ._common import assemble, facet_points
 from .registry import register_method
 from . import jets as J
+from . import star_rows as SR
 
 # -- assembly ---------------------------------------------------------------------------------
 
@@ -43,7 +44,8 @@ def _elements(nv, verts, H, basis):
 
 def _rows(nrows, ridx, verts, blocks, nv, basis):
     """Sparse (nrows, 3nv or basis.n) matrix from per-element row blocks:
-    ``ridx`` (m, r) row numbers, ``verts`` (m, k), ``blocks`` (m, r, k, 3)."""
+    ``ridx`` (m, r) row numbers, ``verts`` (m, k), ``blocks`` (m, r, k, 3);
+    in COO form, its entries not summed (:func:`_add` converts once)."""
     m, r = ridx.shape
     k = verts.shape[1]
     blocks = _finite(blocks)
@@ -51,7 +53,7 @@ def _rows(nrows, ridx, verts, blocks, nv, basis):
         cols = 3 * verts[:, :, None] + np.arange(3)
         rows = np.broadcast_to(ridx[:, :, None, None], (m, r, k, 3))
         cols = np.broadcast_to(cols[:, None], (m, r, k, 3))
-        return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())),
+        return sp.coo_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())),
                              shape=(nrows, 3 * nv))
     Bv = basis.B[verts]                                         # (m, k, 3, d)
     d = Bv.shape[3]
@@ -61,11 +63,11 @@ def _rows(nrows, ridx, verts, blocks, nv, basis):
     rows = np.broadcast_to(ridx[:, :, None, None], (m, r, k, d))
     cols = np.broadcast_to(idx[:, None], (m, r, k, d))
     if (basis.ndof >= d).all():
-        return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())),
+        return sp.coo_matrix((vals.ravel(), (rows.ravel(), cols.ravel())),
                              shape=(nrows, basis.n))
     ok = np.arange(d)[None, None, :] < basis.ndof[verts][:, :, None]
     keep = np.broadcast_to(ok[:, None], (m, r, k, d))
-    return sp.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(nrows, basis.n))
+    return sp.coo_matrix((vals[keep], (rows[keep], cols[keep])), shape=(nrows, basis.n))
 
 
 def _finite(a):
@@ -79,6 +81,7 @@ def _finite(a):
 def _gauss_newton(Jm, M):
     """``Jmᵀ diag(M) Jm`` for per-vertex blocks M (nv, r, r)."""
     nv, r, _ = M.shape
+    Jm = Jm.tocsr()
     Md = sp.bsr_matrix((_finite(M), np.arange(nv), np.arange(nv + 1)),
                        shape=(nv * r, nv * r)).tocsr()
     return (Jm.T @ (Md @ Jm)).tocsr()
@@ -186,6 +189,7 @@ def star_hessian(t, M, dA, dF, dN, basis=None):
     Pall = facet_points(t)
     nf = len(Pall)
     H2parts, Jparts = [], []
+    rows = SR.StarRows(Fall, basis, 7) if SR.applies(basis) else None
     for lo in range(0, max(nf, 1), CHUNK):
         Fc, P = Fall[lo:lo + CHUNK], Pall[lo:lo + CHUNK]
         m = len(Fc)
@@ -205,9 +209,15 @@ def star_hessian(t, M, dA, dF, dN, basis=None):
         for c in range(3):
             blocks[:, c, 1:4, :] = Aj.H[:, 3 * c:3 * c + 3, :]      # ∂F_c/∂x = ∂²A/∂x_c∂x
         blocks[:, :, 4:7, :] = 0.5 * N2.J[:, None]
+        if rows is not None:          # straight into the CSR pattern (star_rows)
+            U = basis.B[Fc][:, :, :, 0]                                   # (m, 3, 3)
+            vals = np.einsum("mcibk,mbk->mcib", _finite(blocks).reshape(m, 3, 7, 3, 3), U)
+            rows.add_chunk(lo, Fc, vals)
+            continue
         ridx = (7 * Fc[:, :, None] + np.arange(7)).reshape(m, 21)
         Jparts.append(_rows(7 * nv, ridx, Fc, blocks.reshape(m, 21, 3, 3), nv, basis))
-    return _gauss_newton(_add(Jparts), M) + _add(H2parts)
+    Jm = rows.matrix() if rows is not None else _add(Jparts)
+    return _gauss_newton(Jm, M) + _add(H2parts)
 
 
 def _add(parts):
