@@ -44,13 +44,32 @@ TRIANGLE = ("vertices\n1 0 0 0\n2 1 0 0\n3 0 1 0\nedges\n1 1 2\n2 2 3\n3 3 1\n"
             "faces\n1 1 2 3\n")
 
 
+class Evolver(str):
+    """The Evolver's program name, given as ``tree`` to the checks it can
+    run too: :func:`run` starts it (``-p1``) instead of pyevolver."""
+
+
 def run(tree, args, stdin, cwd):
-    """(wall seconds, exit status, stdout + stderr) of one pyevolver run."""
-    env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
+    """(wall seconds, exit status, stdout + stderr) of one pyevolver run (of
+    the Evolver when ``tree`` is an :class:`Evolver`; a run past 120 s is
+    stopped: exit status None)."""
+    if isinstance(tree, Evolver):
+        cmd, env, limit = [str(tree), "-p1", *args], None, 120
+    else:
+        cmd = [sys.executable, "-m", "pyevolver", *args]
+        env, limit = dict(os.environ, PYTHONPATH=os.path.abspath(tree)), 600
     t0 = time.perf_counter()
-    p = subprocess.run([sys.executable, "-m", "pyevolver", *args], input=stdin, cwd=cwd,
-                       env=env, capture_output=True, text=True, timeout=600)
-    return time.perf_counter() - t0, p.returncode, p.stdout + p.stderr
+    try:
+        p = subprocess.run(cmd, input=stdin, cwd=cwd, env=env, capture_output=True,
+                           text=True, errors="replace", timeout=limit)
+    except subprocess.TimeoutExpired:
+        _last.append((time.perf_counter() - t0, None))
+        return _last[-1][0], None, ""
+    _last.append((time.perf_counter() - t0, p.returncode))
+    return _last[-1][0], p.returncode, p.stdout + p.stderr
+
+
+_last: list = []          # (seconds, exit status) of the runs of run()
 
 
 def best(repeat, fn):
@@ -144,12 +163,32 @@ CHECKS = [
     ("`timeout=1` on each of three `hessian` steps, 81,920 facets, star_perp", "≤ 10",
      timeout_hessians),
 ]
+#: the checks the Evolver runs as well (the same input; its wall time only)
+WITH_EVOLVER = (long_number, appends_loop, appends_lines, flat_sum)
+
+
+def evolver_time(evolver, fn, work):
+    """The Evolver's wall time on ``fn``'s input, as a table cell (its
+    output is not checked: only pyevolver's is)."""
+    _last.clear()
+    try:
+        fn(Evolver(evolver), work)
+    except (OSError, ValueError):           # (e.g. the appended file not written)
+        pass
+    if not _last:
+        return "—"
+    t, rc = _last[-1]
+    if rc is None:
+        return f"> {t:.0f} (stopped)"
+    return f"{t:.2f}" + ("" if rc == 0 else f" (exit {rc})")
 
 
 def table(rows):
-    out = ["| check | wall [s] | issue 25's limit [s] | result |", "|---|---|---|---|"]
-    for name, limit, (t, ok, note) in rows:
-        out.append(f"| {name} | {t:.2f} | {limit} | {'right' if ok else 'WRONG'}: {note} |")
+    out = ["| check | wall [s] | issue 25's limit [s] | result | Evolver wall [s] |",
+           "|---|---|---|---|---|"]
+    for name, limit, (t, ok, note), ref in rows:
+        out.append(f"| {name} | {t:.2f} | {limit} | {'right' if ok else 'WRONG'}: {note} "
+                   f"| {ref} |")
     return "\n".join(out)
 
 
@@ -159,6 +198,8 @@ def main(argv=None):
     ap.add_argument("--pyevolver", default=REPO, help="checkout whose pyevolver runs")
     ap.add_argument("--only", nargs="+", type=int, help="check numbers (1-based) to run")
     ap.add_argument("--doc", default=None, help="Markdown file to write the table into")
+    ap.add_argument("--evolver", default="evolver-nox-d",
+                    help="the Evolver run on the same inputs where it can ('' : not run)")
     a = ap.parse_args(argv)
     rows = []
     with tempfile.TemporaryDirectory() as work:
@@ -168,7 +209,9 @@ def main(argv=None):
             res = best(a.repeat, lambda: fn(a.pyevolver, work))
             print(f"{name}: {res[0]:.2f} s, {'right' if res[1] else 'WRONG'} ({res[2]})",
                   file=sys.stderr)
-            rows.append((name, limit, res))
+            ref = evolver_time(a.evolver, fn, work) if a.evolver and fn in WITH_EVOLVER \
+                else "—"
+            rows.append((name, limit, res, ref))
     text = table(rows)
     print(text)
     if a.doc:
