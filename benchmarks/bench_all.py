@@ -142,10 +142,13 @@ def plot(doc, label, path, only):
             pts = sorted((nf, py, ref) for c, nf, py, ref in rows if c == case)
             if not pts:
                 continue
-            nf = [p[0] for p in pts]
-            ax.loglog(nf, [p[1] for p in pts], "-" + style, color="C0", label=f"pyevolver, {case}")
-            ax.loglog(nf, [p[2] for p in pts], "--" + style, color="C3",
-                      label=f"evolver-nox-d, {case}")
+            # (a cost measured as the difference of two whole runs can come out
+            # zero or negative where it is below their variation: not drawn)
+            for k, line, colour, who in ((1, "-", "C0", "pyevolver"),
+                                         (2, "--", "C3", "evolver-nox-d")):
+                xy = [(p[0], p[k]) for p in pts if p[k] > 0]
+                ax.loglog([x for x, _ in xy], [y for _, y in xy], line + style, color=colour,
+                          label=f"{who}, {case}")
         ax.set_xlabel("facets")
         ax.set_ylabel("CPU time [s]")
         ax.set_title(title.replace("`", ""))

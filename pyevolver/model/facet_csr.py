@@ -69,3 +69,26 @@ def canonical_csr(vals, rows, cols, shape: tuple) -> PendingCSR:
     indptr = np.zeros(nrow + 1, dtype=idx)
     np.cumsum(np.bincount(r, minlength=nrow), out=indptr[1:])
     return PendingCSR(np.ascontiguousarray(data), c.astype(idx), indptr, (nrow, ncol))
+
+
+def with_copied_columns(M, cols: np.ndarray) -> PendingCSR:
+    """The CSR arrays of ``[M, M[:, cols]]``: ``M`` (a scipy CSR matrix or a
+    :class:`PendingCSR`) with a copy of each column ``cols[j]`` appended as
+    column ``n + j`` (the bodies' facet matrix after a refinement, whose
+    new facets belong to their parents' bodies), as scipy's ``hstack`` and
+    ``tocsr`` would store it; no scipy import."""
+    data, ind, ptr = np.asarray(M.data), np.asarray(M.indices), np.asarray(M.indptr)
+    nrow, ncol = int(M.shape[0]), int(M.shape[1])
+    cols = np.asarray(cols, dtype=np.int64)
+    rows = np.repeat(np.arange(nrow, dtype=np.int64), np.diff(ptr))
+    c = ind.astype(np.int64)
+    by_col = np.argsort(c, kind="stable")              # the entries column by column
+    start = np.zeros(ncol + 1, dtype=np.int64)
+    np.cumsum(np.bincount(c, minlength=ncol), out=start[1:])
+    k = start[cols + 1] - start[cols]                  # entries of each copied column
+    first = np.repeat(start[cols], k)
+    offset = np.arange(int(k.sum()), dtype=np.int64) - np.repeat(np.cumsum(k) - k, k)
+    src = by_col[first + offset]
+    new_cols = np.repeat(ncol + np.arange(len(cols), dtype=np.int64), k)
+    return canonical_csr(np.concatenate([data, data[src]]), np.concatenate([rows, rows[src]]),
+                         np.concatenate([c, new_cols]), (nrow, ncol + len(cols)))

@@ -11,10 +11,10 @@ from __future__ import annotations
 import copy
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..errors import CommandError
 from .. import limits
+from ..model.facet_csr import with_copied_columns
 
 
 def _zeros_like_rows(arr, n):
@@ -191,8 +191,8 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     # -- bodies
     b = copy.copy(s.bodies)
     if b.n:
-        M = s.bodies.facet_matrix.tocsc()
-        b.facet_matrix = sp.hstack([M, M[:, ff]]).tocsr() if nf_new else M.tocsr()
+        # (as CSR arrays: no scipy.sparse import for a refinement, facet_csr)
+        b.facet_matrix = with_copied_columns(s.bodies.facet_csr, ff)
         ob, of, osg = s.bodies.occurrences
         if nf_new:
             # every occurrence of a parent facet gains one of each child

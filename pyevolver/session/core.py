@@ -191,6 +191,7 @@ class Session(SessionAPI):
                                 lines[line - 1] if line and lines and line <= len(lines)
                                 else None) from None
         health.check_loaded(self, scene)       # overflowed coordinates, zero-area facets
+        fresh.mark(self)                       # (a first r, u or V needs no new evaluation)
         for text, line in scene.top_commands:  # top-section procedures and functions
             self.run(text, where=filename, line=line, stop_on_error=False)
         for wline, msg in scene.read_warnings:

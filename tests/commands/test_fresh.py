@@ -88,6 +88,19 @@ def test_remesh_commands_evaluate_once(session, count):
         _exact(session)
 
 
+def test_first_command_after_loading_evaluates_once(tmp_path, count):
+    """A file with no read section: the load's evaluation is marked, so a
+    first V (or r, u) evaluates only the surface it makes."""
+    p = tmp_path / "plain.fe"
+    p.write_text(CUBE)
+    s = Session.load(str(p), out=io.StringIO(), err=io.StringIO())
+    assert fresh.is_fresh(s)
+    del count[:]
+    s.run("V")
+    assert len(count) == 1
+    _exact(s)
+
+
 def test_a_remesh_that_changes_nothing_does_not_evaluate(session, count):
     session.run("r")
     session.run("u")

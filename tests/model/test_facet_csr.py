@@ -5,7 +5,7 @@ import pytest
 import scipy.sparse as sp
 
 from pyevolver.methods._common import csr_matvec
-from pyevolver.model.facet_csr import PendingCSR, canonical_csr
+from pyevolver.model.facet_csr import PendingCSR, canonical_csr, with_copied_columns
 from pyevolver.model.surface import Bodies
 
 
@@ -43,3 +43,21 @@ def test_bodies_make_the_matrix_when_first_read():
     assert b.facet_matrix is M and b.facet_csr is M     # made once
     b.facet_matrix = sp.csr_matrix((1, 3))              # a remesh sets a new one
     assert b.facet_csr.nnz == 0
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_copied_columns_are_scipys_hstack(seed):
+    """[M, M[:, cols]] as scipy's hstack and tocsr store it (the facet matrix
+    after a refinement), from a scipy matrix and from pending arrays."""
+    rng = np.random.default_rng(seed)
+    nb, nf = int(rng.integers(1, 5)), int(rng.integers(1, 30))
+    A = sp.random(nb, nf, density=0.4, random_state=seed, format="csr")
+    A.data = np.where(A.data < 0.5, -1.0, 1.0)
+    cols = rng.integers(0, nf, int(rng.integers(0, 40)))
+    want = sp.hstack([A.tocsc(), A.tocsc()[:, cols]]).tocsr()
+    for M in (A, PendingCSR(A.data, A.indices, A.indptr, A.shape)):
+        got = with_copied_columns(M, cols)
+        assert got.shape == want.shape
+        assert np.array_equal(got.indptr, want.indptr)
+        assert np.array_equal(got.indices, want.indices)
+        assert np.array_equal(got.data, want.data)
