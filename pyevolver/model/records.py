@@ -141,18 +141,24 @@ def vertex_edge_rank(s: Surface) -> np.ndarray:
         if callable(c[1]):
             c = s._rings = (c[0], np.asarray(c[1](), np.int64))
         return c[1]
-    t = np.empty(ne, np.int64)
-    t[np.argsort(s.ids("edge"), kind="stable")] = np.arange(ne)
-    v = s.E.ravel()
+    ids = np.asarray(s.ids("edge"))
+    if ne < 2 or bool(np.all(ids[1:] > ids[:-1])):
+        t = np.arange(ne, dtype=np.int64)          # (ids in order: a loaded file's)
+    else:
+        t = np.empty(ne, np.int64)
+        t[np.argsort(ids, kind="stable")] = np.arange(ne)
+    v = s.E.ravel().astype(np.int64)
     key = np.repeat(t, 2)
     first = np.full(nv, ne, np.int64)
     np.minimum.at(first, v, key)
-    key = np.where(key == first[v], np.iinfo(np.int64).max, key)
-    order = np.lexsort((-key, v))
-    vs = v[order]
-    start = np.searchsorted(vs, np.arange(nv))
+    # at each vertex: its first edge (rank 0), then the others newest first
+    # (ranks ne - key, 1 .. ne); one sort of vertex * (ne + 1) + rank
+    rank = np.where(key == first[v], 0, ne - key)
+    order = np.argsort(v * (ne + 1) + rank, kind="stable")
+    cnt = np.bincount(v, minlength=nv)
+    start = np.cumsum(cnt) - cnt
     pos = np.empty(2 * ne, np.int64)
-    pos[order] = np.arange(2 * ne) - start[vs]
+    pos[order] = np.arange(2 * ne) - start[v[order]]
     pos = pos.reshape(ne, 2)
     pos.flags.writeable = False          # (kept: the next call while E is unchanged)
     record_vertex_rings(s, pos)

@@ -84,3 +84,28 @@ def test_lazy_rings_do_not_chain_surfaces():
     assert not callable(s1._along_first[2]) and callable(s2._along_first[2])
     assert along_first(s2).shape == (s2.ne,) and not callable(s2._along_first[2])
     assert vertex_edge_rank(s2).shape == (s2.ne, 2)
+
+
+def _rings_by_rule(s):
+    """The loaded ring order as the docstring states it, vertex by vertex:
+    the lowest-numbered edge first, then the others newest (highest id)
+    first."""
+    ids = list(s.ids("edge"))
+    want = np.empty((s.ne, 2), np.int64)
+    for v in range(s.nv):
+        ends = [(e, k) for e in range(s.ne) for k in (0, 1) if s.E[e, k] == v]
+        ends.sort(key=lambda ek: ids[ek[0]])
+        ring = ends[:1] + sorted(ends[1:], key=lambda ek: -ids[ek[0]])
+        for pos, (e, k) in enumerate(ring):
+            want[e, k] = pos
+    return want
+
+
+def test_loaded_rings_follow_the_rule_with_ids_in_any_order():
+    s = cube()
+    assert np.array_equal(vertex_edge_rank(s), _rings_by_rule(s))
+    t = cube()
+    ids = np.asarray(t.ids("edge"))
+    perm = np.random.default_rng(3).permutation(len(ids))
+    t.eattr["id"] = (ids[perm] * 7).astype(np.int64)     # (gapped ids, not in order)
+    assert np.array_equal(vertex_edge_rank(t), _rings_by_rule(t))
