@@ -155,10 +155,18 @@ def geometry_of_corners(P, symmetric=False):
     b = D[:, 1]
     # N2T[i] = a[i+1] b[i+2] - a[i+2] b[i+1] (one take for both sides; the
     # row sums below are sequential, (r0 + r1) + r2, as written out)
-    D1 = D.take(_NEXT, axis=0)
-    D2 = D.take(_NEXT2, axis=0)
-    N2T = D1[:, 0] * D2[:, 1]
-    N2T -= D2[:, 0] * D1[:, 1]
+    if P.shape[2] <= _LOW_MEMORY_FACETS:
+        D1 = D.take(_NEXT, axis=0)
+        D2 = D.take(_NEXT2, axis=0)
+        N2T = D1[:, 0] * D2[:, 1]
+        N2T -= D2[:, 0] * D1[:, 1]
+    else:                               # (the same products, row by row: fewer temporaries)
+        N2T = np.empty(a.shape)
+        tmp = np.empty(a.shape[1])
+        for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+            np.multiply(a[j], b[k], out=N2T[i])
+            np.multiply(a[k], b[j], out=tmp)
+            N2T[i] -= tmp
     sq = N2T * N2T
     area = np.sqrt(np.add.reduce(sq, axis=0))
     area *= 0.5
@@ -173,6 +181,9 @@ def geometry_of_corners(P, symmetric=False):
 
 _NEXT = np.array([1, 2, 0])
 _NEXT2 = np.array([2, 0, 1])
+#: above this many facets the area vectors are made row by row: two (3, 2, nf)
+#: copies fewer at the peak of an evaluation (below, the fewer numpy calls win)
+_LOW_MEMORY_FACETS = 20_000
 
 
 def vertex_normals(F, N2, nv, rank=None):

@@ -219,3 +219,17 @@ def test_ordered_vertex_normals_follow_the_rank_bit_for_bit(closed):
     got = G.vertex_normals(F, N2, nv, rank)
     assert np.array_equal(got, _ordered_normals_by_loops(F, N2, nv, rank))
     assert np.array_equal(G.vertex_normals(F, N2.T.copy().T, nv, rank), got)   # strided N2
+
+
+@pytest.mark.parametrize("nf", [7, 20_001])
+def test_corner_geometry_row_by_row_is_the_same_numbers(monkeypatch, nf):
+    """Above _LOW_MEMORY_FACETS the area vectors are made row by row (fewer
+    temporaries); every number is the one the takes of the small path give."""
+    from pyevolver.geometry import kernels as K
+    rng = np.random.default_rng(nf)
+    P = rng.normal(size=(3, 3, nf)) * rng.lognormal(size=(1, 1, nf))
+    want = K.geometry_of_corners(P.copy())
+    big = nf > K._LOW_MEMORY_FACETS
+    monkeypatch.setattr(K, "_LOW_MEMORY_FACETS", 10 ** 9 if big else 0)   # the other path
+    got = K.geometry_of_corners(P.copy())
+    assert all(np.array_equal(x, y) for x, y in zip(want, got))
