@@ -180,8 +180,7 @@ class Session(SessionAPI):
         except DatafileError:
             raise
         except PyEvolverError as exc:
-            # the first evaluation failed (e.g. a method refused on this
-            # surface): located at the quantity's declaration when known
+            # the first evaluation failed (a method refused here...): at its declaration if known
             line = getattr(exc, "line", None)
             metric = getattr(self.surface, "metric", None)
             if line is None and metric is not None:     # e.g. a log of a negative in it
