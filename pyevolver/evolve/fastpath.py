@@ -42,11 +42,9 @@ import numpy as np
 
 from ..geometry.kernels import geometry_of_corners
 from ..methods._common import csr_matvec, finite
+from ..methods.axis_major import NEXT as _NEXT, NEXT2 as _NEXT2, sides as _sides
 from ..methods.totals import Totals
 from . import gradient as GR
-
-_NEXT = np.array([1, 2, 0])
-_NEXT2 = np.array([2, 0, 1])
 
 
 class _Fallback(Exception):
@@ -223,18 +221,6 @@ class _Plan:
         g *= 0.5
         g *= tension
         return self.scatter(g) if scattered else g
-
-
-def _sides(P, a, b):
-    """``facet_points``' corners Q (3 axes, 3 corners, nf) — x0, x0 + a,
-    x0 + b — and the sides opposite each corner, E[c] = Q[c+2] - Q[c+1]."""
-    Q = np.empty_like(P)
-    Q[:, 0] = P[:, 0]
-    np.add(P[:, 0], a, out=Q[:, 1])
-    np.add(P[:, 0], b, out=Q[:, 2])
-    E = Q.take(_NEXT2, axis=1)
-    E -= Q.take(_NEXT, axis=1)
-    return Q, E
 
 
 def _cross(u, v):
