@@ -18,6 +18,7 @@ from ..constraints import project_to_constraints
 from . import attributes as A
 from . import constraints, elements
 from .registry import register
+from .set_columns import COORDS, column_values
 from .values import _KIND, ElemRef, QRef, SessionLike, as_float, as_int
 
 # the coordinates past the third (SPACE_DIMENSION > 3), by column
@@ -50,11 +51,9 @@ def get_attr(session: SessionLike, base, name, idx):
     t = session.totals
     k, i = base.kind, base.i
     elements.check_alive(session, base)
-    eid = float(s.ids(k)[i]) if k in ("vertex", "edge", "facet") else float(i + 1)
-    if name in ("id",):
-        return eid
-    if name == "oid":
-        return eid * base.sign
+    if name in ("id", "oid"):
+        eid = float(s.element_id(k, i)) if k in ("vertex", "edge", "facet") else float(i + 1)
+        return eid if name == "id" else eid * base.sign
     if name == "original":
         arr = {"vertex": s.vattr, "edge": s.eattr, "facet": s.fattr}.get(k, {}).get("original")
         if k == "body":
@@ -219,7 +218,8 @@ def get_attr(session: SessionLike, base, name, idx):
         subs = elements.sub_elements(session, base, kind)
         j = int(idx)
         if j < 1 or j > len(subs):
-            raise ExpressionError(f"{base}.{kind}[{j}] does not exist ({k} {int(eid)} has "
+            eid = s.element_id(k, i) if k in ("vertex", "edge", "facet") else i + 1
+            raise ExpressionError(f"{base}.{kind}[{j}] does not exist ({k} {eid} has "
                                   f"{len(subs)} {kind}{'s' if len(subs) != 1 else ''})")
         return subs[j - 1]
     if name in s.quantities and k in ("vertex", "edge", "facet"):
@@ -422,6 +422,15 @@ def set_elements(session: SessionLike, gen, attr, expr, env, unset, idx=None):
         A.cache(session).touch(session)           # projected vertices moved
         return
     # compute every value first, then assign (like the Evolver's set)
+    if idx is None and attr in COORDS and ("vertex", attr) not in session.surface.extra:
+        col = column_values(session, gen, els, expr, env)     # (plain arithmetic at once)
+        if col is not None:
+            ii, vals = col
+            set_attr(session, els[0], attr, None, float(vals[0]))   # (its checks, once)
+            session.surface.X[ii, COORDS[attr]] = vals
+            project_or_fail(session, session.surface, ii)
+            A.cache(session).touch(session)
+            return
     vals = []
     ix = None if idx is None else session.interp.value(idx)
     for el in els:

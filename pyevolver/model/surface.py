@@ -213,6 +213,13 @@ class Surface:
         a = attrs.get("id")
         return a if a is not None else np.arange(1, n + 1)
 
+    def element_id(self, kind: str, i: int) -> int:
+        """The id of element ``i`` of ``kind`` (``ids(kind)[i]`` without
+        making the whole array: attribute reads element by element)."""
+        attrs = {"vertex": self.vattr, "edge": self.eattr, "facet": self.fattr}[kind]
+        a = attrs.get("id")
+        return int(a[i]) if a is not None else int(i) + 1
+
     @property
     def facet_tension(self):
         return self.fattr["tension"]
