@@ -77,6 +77,8 @@ def with_copied_columns(M, cols: np.ndarray) -> PendingCSR:
     column ``n + j`` (the bodies' facet matrix after a refinement, whose
     new facets belong to their parents' bodies), as scipy's ``hstack`` and
     ``tocsr`` would store it; no scipy import."""
+    if getattr(M, "format", "csr") != "csr":
+        M = M.tocsr()                                  # (another scipy format)
     data, ind, ptr = np.asarray(M.data), np.asarray(M.indices), np.asarray(M.indptr)
     nrow, ncol = int(M.shape[0]), int(M.shape[1])
     cols = np.asarray(cols, dtype=np.int64)
