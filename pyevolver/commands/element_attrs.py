@@ -18,7 +18,7 @@ from ..constraints import project_to_constraints
 from . import attributes as A
 from . import constraints, elements
 from .registry import register
-from .set_columns import COORDS, column_values
+from .columns import COORDS, column_values
 from .values import _KIND, ElemRef, QRef, SessionLike, as_float, as_int
 
 # the coordinates past the third (SPACE_DIMENSION > 3), by column

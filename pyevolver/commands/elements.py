@@ -14,6 +14,7 @@ from ..errors import ExpressionError, UnsupportedError
 from ..geometry.kernels import edge_index
 from ..model import string as SM
 from ..model import records as MS
+from .columns import where_mask
 from .registry import register
 from .values import ElemRef, SessionLike, as_int, is_true
 
@@ -46,6 +47,11 @@ def generate(session: SessionLike, gen, env):
     els = gen_base(session, gen.base, env)
     if gen.where is None:
         return els
+    mask = where_mask(session, gen, els, env)      # (simple conditions: at once)
+    if mask is not None:
+        out = [el for el, keep in zip(els, mask.tolist()) if keep]
+        session.counts["where"] = len(out)
+        return out
     out = []
     tick = session.interp.tick
     for el in els:

@@ -1,5 +1,5 @@
 """``set vertex x expr`` on whole coordinate columns
-(pyevolver.commands.set_columns): the same numbers as the element-by-element
+(pyevolver.commands.columns): the same numbers as the element-by-element
 evaluation, the same errors, and the loop wherever the columns do not apply."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import os
 import numpy as np
 import pytest
 
-from pyevolver.commands import element_attrs, set_columns
+from pyevolver.commands import element_attrs, columns
 from pyevolver.errors import PyEvolverError
 from pyevolver.session.core import Session
 
@@ -29,16 +29,16 @@ def _both(monkeypatch, commands):
     """The coordinates (or the error) after ``commands`` with the columns
     and with the element loop alone."""
     out = []
-    for columns in (True, False):
+    for use_columns in (True, False):
         with monkeypatch.context() as m:
             calls = []
-            real = set_columns.column_values
+            real = columns.column_values
 
             def spy(*a, **k):
                 r = real(*a, **k)
                 calls.append(r is not None)
                 return r
-            m.setattr(element_attrs, "column_values", spy if columns else lambda *a, **k: None)
+            m.setattr(element_attrs, "column_values", spy if use_columns else lambda *a, **k: None)
             s = _session()
             try:
                 s.run(commands)
@@ -93,3 +93,49 @@ def test_element_id_without_the_array():
     assert [s.surface.element_id("vertex", i) for i in range(s.surface.nv)] == list(ids)
     s.surface.vattr["id"] = ids * 3
     assert s.surface.element_id("vertex", 5) == 3 * int(ids[5])
+
+
+def _selected(monkeypatch, use_columns, command):
+    """The vertex indices a ``where`` selects (through ``set vertex z ...``
+    of a marker value: the vertices whose z becomes it) and where_count."""
+    from pyevolver.commands import elements
+    with monkeypatch.context() as m:
+        calls = []
+        real = columns.where_mask
+
+        def spy(*a, **k):
+            r = real(*a, **k)
+            calls.append(r is not None)
+            return r
+        m.setattr(elements, "where_mask", spy if use_columns else lambda *a, **k: None)
+        s = _session()
+        try:
+            s.run(command)
+        except PyEvolverError as exc:
+            return str(exc), None, any(calls)
+        return np.nonzero(s.surface.X[:, 2] == 7.25)[0].tolist(), s.counts.get("where"), \
+            any(calls)
+
+
+@pytest.mark.parametrize("cond", [
+    "id < 20", "z > 0.3 and not (x < 0 or y >= 0.25)", "x*2 - 1 >= y/4 or id == 5",
+    "-x != 0.5", "x < y", "w1 := 0.2; z > w1",
+])
+def test_where_selects_what_the_element_loop_selects(monkeypatch, cond):
+    pre, _, c = cond.rpartition("; ")
+    command = (pre + "; " if pre else "") + f"set vertex z 7.25 where {c}"
+    a = _selected(monkeypatch, True, command)
+    b = _selected(monkeypatch, False, command)
+    assert a[2], "the columns were not used"
+    assert a[:2] == b[:2] and len(a[0]) > 0
+
+
+@pytest.mark.parametrize("cond", [
+    "z > 0.3 and 1/x > 2",                     # a division by a coordinate: the loop
+    "sin(z) > 0.2",                            # functions: the loop
+    "on_constraint 1",
+])
+def test_where_loop_where_the_columns_do_not_apply(monkeypatch, cond):
+    a = _selected(monkeypatch, True, f"set vertex z 7.25 where {cond}")
+    b = _selected(monkeypatch, False, f"set vertex z 7.25 where {cond}")
+    assert not a[2] and a[:2] == b[:2]
