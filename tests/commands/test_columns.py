@@ -25,20 +25,26 @@ def _session():
     return s
 
 
+def _spy(m, module, name, real, use):
+    """Put in ``module.name`` the column function ``real`` (recording whether
+    it applied: the list returned) or, without ``use``, one that never does."""
+    calls = []
+
+    def spy(*a, **k):
+        r = real(*a, **k)
+        calls.append(r is not None)
+        return r
+    m.setattr(module, name, spy if use else lambda *a, **k: None)
+    return calls
+
+
 def _both(monkeypatch, commands):
     """The coordinates (or the error) after ``commands`` with the columns
     and with the element loop alone."""
     out = []
     for use_columns in (True, False):
         with monkeypatch.context() as m:
-            calls = []
-            real = columns.column_values
-
-            def spy(*a, **k):
-                r = real(*a, **k)
-                calls.append(r is not None)
-                return r
-            m.setattr(element_attrs, "column_values", spy if use_columns else lambda *a, **k: None)
+            calls = _spy(m, element_attrs, "column_values", columns.column_values, use_columns)
             s = _session()
             try:
                 s.run(commands)
@@ -100,14 +106,7 @@ def _selected(monkeypatch, use_columns, command):
     of a marker value: the vertices whose z becomes it) and where_count."""
     from pyevolver.commands import elements
     with monkeypatch.context() as m:
-        calls = []
-        real = columns.where_mask
-
-        def spy(*a, **k):
-            r = real(*a, **k)
-            calls.append(r is not None)
-            return r
-        m.setattr(elements, "where_mask", spy if use_columns else lambda *a, **k: None)
+        calls = _spy(m, elements, "where_mask", columns.where_mask, use_columns)
         s = _session()
         try:
             s.run(command)
