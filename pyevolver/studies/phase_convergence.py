@@ -168,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
         rows = old + rows
     fits = fits_of(rows)
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "convergence.csv"), "w", newline="") as fh:
+    with open(csv_path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
