@@ -39,6 +39,7 @@ from ..methods.curvature import legacy_gradient
 from ..methods.curvature_hessian import legacy_hessian
 from ..methods.registry import lookup
 from . import gradient as GR
+from . import normal_assembly as NB
 from . import quadratic_hessian as QH
 from .iterate import _Constraints
 from .ordering import nested_dissection
@@ -161,7 +162,12 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
     (``H`` is None), with ``gradient=False`` only the Hessian (``g`` is None).
     """
     parts = []                       # (hessian function, args) of each analytic term
-    parts.append((facet_area_hessian, (t, s.facet_tension)))
+    # one direction per vertex: the facet terms' 3 × 3 blocks summed, assembled once
+    blocks = NB.applies(t, basis) if hessian else None
+    if blocks is not None:
+        blocks.area(s.facet_tension)
+    else:
+        parts.append((facet_area_hessian, (t, s.facet_tension)))
     g = GR.corner_scatter(t, GR.facet_area_grad(t), s.facet_tension) if gradient else None
     complete = set(t.terms) <= {"facet_tension", "edge_tension", "gravity", "sq_curvature"}
     et = s.eattr.get("tension")
@@ -206,18 +212,28 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
             for k, i in enumerate(cons.bodies):
                 w[i] = -lam[k]
             fw = b.facet_matrix.T @ w
-            parts.append((facet_volume_hessian, (t, fw, s.symmetric_content)))
+            if blocks is not None:
+                blocks.volume(fw, s.symmetric_content)
+            else:
+                parts.append((facet_volume_hessian, (t, fw, s.symmetric_content)))
             if gradient:
                 g = g + GR.corner_scatter(t, GR.facet_volume_grad(t, s.symmetric_content), fw)
         else:
             complete = False
-    H = _sum([fn(*args, basis=basis) for fn, args in parts]) if hessian else None
+    H = None
+    if hessian:
+        mats = [fn(*args, basis=basis) for fn, args in parts]
+        if blocks is not None:
+            mats.append(blocks.matrix())
+        H = _sum(mats)
     return H, g, complete
 
 
 def _sum(mats):
     """CSR sum of sparse matrices of one shape: their COO entries
     concatenated and converted once (duplicates summed)."""
+    if len(mats) == 1 and sp.isspmatrix_csr(mats[0]) and mats[0].has_canonical_format:
+        return mats[0]
     coo = [m.tocoo() for m in mats]
     if len(coo) == 1:
         return coo[0].tocsr()
@@ -554,7 +570,9 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
     lam = np.zeros(len(cons))
     gs = []
     if len(cons):
-        gs, _, _ = it._constrained_dirs(t, cons, mobile)     # zero on fixed vertices
+        gs = cons.gradients(t)
+        for g in gs:
+            g[~mobile] = 0.0                                    # zero on fixed vertices
         # The Evolver's Hessian of the Lagrangian uses the multipliers stored
         # by the previous g or hessian step (the printed pressures), not ones
         # fitted to the current gradient: with these, hessian on mound.fe
