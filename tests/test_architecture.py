@@ -32,6 +32,11 @@ OPTIONAL = {"matplotlib", "tqdm", "prompt_toolkit", "sksparse", "dask", "distrib
 HEAVY = {"scipy.special", "scipy.sparse.linalg", "scipy.sparse.csgraph",
          "meshio",             # (imported where used: start-up time, issue 24)
          "lark.lark", "lark.utils"}    # (pyevolver.startup: lark imported without regex)
+#: pyevolver's own modules that are imported where first used, to keep them
+#: out of the start-up (issue 24): the Hessian's and eigenvalue commands'
+#: modules, pictures, movies and the HTML viewer
+DEFERRED = {"..evolve.bfgs", "..evolve.eigen", "..evolve.newton", "..evolve.hessian",
+            "..io.render", "..io.movie", "..io.viewer"}
 MAX_LINES = 800
 
 
@@ -131,16 +136,23 @@ def _function_imports(path: pathlib.Path):
         for node in ast.walk(fn):
             if isinstance(node, ast.Import):
                 for a in node.names:
-                    yield node.lineno, a.name
+                    yield node.lineno, a.name, ()
             elif isinstance(node, ast.ImportFrom):
-                yield node.lineno, "." * node.level + (node.module or "")
+                yield (node.lineno, "." * node.level + (node.module or ""),
+                       tuple(a.name for a in node.names))
+
+
+def _deferred(mod, names):
+    """Whether ``from mod import names`` imports only :data:`DEFERRED` modules."""
+    return mod in DEFERRED or bool(names) and all(f"{mod}.{n}" in DEFERRED for n in names)
 
 
 def test_imports_inside_functions_only_for_optional_dependencies():
     bad = []
     for path in sorted(PKG.rglob("*.py")):
-        for line, mod in _function_imports(path):
-            if mod.split(".")[0] not in OPTIONAL and mod not in HEAVY:
+        for line, mod, names in _function_imports(path):
+            if mod.split(".")[0] not in OPTIONAL and mod not in HEAVY \
+                    and not _deferred(mod, names):
                 bad.append(f"{path.relative_to(ROOT)}:{line}: {mod}")
     assert not bad, "\n".join(bad)
 

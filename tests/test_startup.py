@@ -14,7 +14,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 HEAVY = ["meshio", "scipy.sparse.linalg", "scipy.linalg", "numpy.f2py.crackfortran", "unittest",
          "scipy.sparse.csgraph", "scipy.sparse._csr", "scipy._lib", "regex._regex_core",
-         "numpy.random._generator"]
+         "numpy.random._generator",
+         # pyevolver's Hessian, pictures and viewer: imported where first used
+         "pyevolver.evolve.hessian", "pyevolver.evolve.eigen", "pyevolver.evolve.newton",
+         "pyevolver.evolve.bfgs", "pyevolver.io.render", "pyevolver.io.viewer", "pyevolver.io.movie"]
 
 USE = ("import numpy as np\n"
        "print(np.random.default_rng(0).integers(10, size=3).tolist())\n"

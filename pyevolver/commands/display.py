@@ -13,7 +13,6 @@ from __future__ import annotations
 import os
 
 from ..errors import UnsupportedError
-from ..io.viewer import write_viewer
 from .registry import register
 
 #: What to use instead of the Evolver's graphics output.
@@ -34,6 +33,7 @@ def _show(interp, raw, arg):
     s = interp.session
     path = viewer_path(s)
     title = os.path.basename(getattr(s, "filename", "") or "") or "pyevolver"
+    from ..io.viewer import write_viewer     # (imported when first used)
     write_viewer(s.surface, path, title=title)
     s.write(f"Wrote the viewer {os.path.abspath(path)} (open it in a web browser).\n")
 

@@ -13,8 +13,6 @@ from typing import Any
 import numpy as np
 
 from ..errors import CommandError, dimension_error
-from ..evolve import eigen as EG
-from ..evolve.hessian import hessian_system
 from ..evolve.iterate import _Constraints
 from . import registry
 from .registry import Command
@@ -29,6 +27,8 @@ LANCZOS_SYNTAX = "Syntax: lanczos rexpr   or   lanczos(expr,count)"
 def _system(session: Any, what: str):
     """The constrained Hessian of the session's surface (hessian_system),
     after REF's checks: vertices, valid pressures."""
+    from ..evolve import eigen as EG        # (the Hessian's modules: when first used)
+    from ..evolve.hessian import hessian_system
     s = session.surface
     if s is None or s.nv == 0:
         raise CommandError(f"{what}: the surface has no vertices")
@@ -59,6 +59,7 @@ def _mix(session: Any) -> float | None:
 def note_beyond(session: Any) -> None:
     """Say once per session and reason (stderr) where the Hessian commands go
     further than the Evolver (:func:`pyevolver.evolve.eigen.beyond_reference`)."""
+    from ..evolve import eigen as EG        # (the Hessian's modules: when first used)
     seen = session.__dict__.setdefault("_beyond_noted", set())
     for note in EG.beyond_reference(session.surface):
         if note not in seen:
@@ -89,6 +90,7 @@ def eigenprobe(session: Any, shift: float, iterations: int | None = None) -> Any
     """``eigenprobe λ``: print the inertia of the Hessian relative to λ;
     ``eigenprobe(λ, n)``: then at most n inverse iterations towards the
     eigenvalue nearest λ (stored in ``last_eigenvalue``)."""
+    from ..evolve import eigen as EG        # (the Hessian's modules: when first used)
     _, hs = _system(session, "eigenprobe")
     eps = _eps(session)
     if iterations is None:
@@ -108,6 +110,7 @@ def eigenprobe(session: Any, shift: float, iterations: int | None = None) -> Any
 def ritz(session: Any, shift: float, count: int, lanczos: bool = False) -> Any:
     """``ritz(λ, n)`` (and ``lanczos``): the inertia relative to λ and the n
     eigenvalues nearest λ, ascending (as REF prints them)."""
+    from ..evolve import eigen as EG        # (the Hessian's modules: when first used)
     what = "lanczos" if lanczos else "ritz"
     _, hs = _system(session, what)
     if count < 0:
@@ -127,6 +130,7 @@ def ritz(session: Any, shift: float, count: int, lanczos: bool = False) -> Any:
 def saddle(session: Any, max_step: float | None = None) -> Any:
     """``saddle [max]``: move down along the eigenvector of the lowest
     eigenvalue when it is negative."""
+    from ..evolve import eigen as EG        # (the Hessian's modules: when first used)
     if max_step is not None and math.isnan(max_step):
         raise CommandError("the step limit of saddle is not a number")
     it, _ = _system(session, "saddle")

@@ -25,8 +25,7 @@ import numpy as np
 
 from ..datafile.writer import DumpSettings
 from ..errors import UnsupportedError
-from ..io import meshio_plugin, render, viewer
-from ..io.movie import Movie
+from ..io import meshio_plugin
 
 #: ``progress=None`` shows a bar for runs of at least this many steps.
 PROGRESS_MIN_STEPS = 100
@@ -96,6 +95,7 @@ class SessionAPI:
         (:func:`pyevolver.io.render.snapshot`; the camera looks along the
         session's ``view_matrix``, turned oblique while it has no rotation,
         unless ``view`` is given; framed on the surface every time)."""
+        from ..io import render            # (pictures: imported when first drawn)
         if view is None:
             view = render.oblique(self.arrays.get("view_matrix"))
         return render.snapshot(self.surface, path, field=field, view=view, **kwargs)
@@ -112,6 +112,8 @@ class SessionAPI:
         (:class:`pyevolver.io.movie.Movie`).  Returns ``path``."""
         if every < 1 or steps < 0:
             raise ValueError(f"movie: every must be >= 1 and steps >= 0 (got {every}, {steps})")
+        from ..io import render
+        from ..io.movie import Movie
         Movie.check_path(path, fps)                   # refused before the run, not after
         if view is None:
             view = render.oblique(self.arrays.get("view_matrix"))
@@ -133,9 +135,11 @@ class SessionAPI:
         surf = getattr(self, "surface", None)
         if surf is None or surf.nf == 0 or surf.X.shape[1] > 3:
             return None
+        from ..io import viewer
         return viewer.notebook_html(surf, title=repr(self))
 
     def plot_history(self, path: str, **kwargs: Any) -> str:
         """Plot the energy of every ``g`` step so far
         (:func:`pyevolver.io.render.plot_history`)."""
+        from ..io import render
         return render.plot_history(self.history, path, **kwargs)

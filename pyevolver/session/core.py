@@ -29,17 +29,13 @@ from ..datafile.reader import read_datafile
 from ..datafile.writer import DumpSettings, dump as write_dump
 from ..errors import (CommandError, DatafileError, InternalError, PyEvolverError,
                       UnsupportedError)
-from ..evolve.bfgs import check_free, minimize_surface
-from ..evolve.eigen import beyond_reference
 from ..evolve.iterate import IterateSettings, Iterator, _Constraints, progress_line
-from ..evolve.newton import damped_newton, hessian_step
 from ..expr import nodes as N
 from ..limits import MAX_EXPANDED_LINE
 from ..threads import limited
 from ..model.build import build_surface
 from ..remesh.quadratic import from_listed
 from ..remesh.string import split_edges
-
 
 # motion options that change what g does; refused rather than ignored
 UNSUPPORTED_MOTION = ()
@@ -587,6 +583,7 @@ class Session(SessionAPI):
         s = self.surface
         if s is None or s.nv == 0:
             raise CommandError("bfgs: no surface loaded")
+        from ..evolve.bfgs import check_free, minimize_surface   # (imported when first used)
         check_free(s)
         X0 = state(s)
 
@@ -637,6 +634,7 @@ class Session(SessionAPI):
                                % (n - r.nit, self.totals.total_area, r.energy, r.delta))
                 return flag["hit"] or (callback is not None and callback(r))
             X0 = state(s)
+            from ..evolve.newton import damped_newton
             try:
                 r = damped_newton(self.iterator, n, callback=cb)
             except Exception:
@@ -662,6 +660,8 @@ class Session(SessionAPI):
         if not it.pressures_valid and len(_Constraints(self.surface)):
             raise CommandError("Pressures invalid. Do regular iteration before Hessian "
                                "to set pressures.")
+        from ..evolve.eigen import beyond_reference   # (the Hessian's modules: when first used)
+        from ..evolve.newton import hessian_step
         seen = self.__dict__.setdefault("_beyond_noted", set())
         for note in beyond_reference(self.surface) if echo else ():
             if note not in seen:            # where REF refuses (once per session)

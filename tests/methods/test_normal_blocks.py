@@ -1,10 +1,7 @@
-"""Per-facet normal-direction Hessian blocks (methods/normal_blocks.py) and
-their one-pass assembly (evolve/normal_assembly.py).
-
-The blocks are checked against central differences of the analytic area and
-volume gradients along the chosen directions, and the assembled matrix
-against Tᵀ H T of the full (3nv, 3nv) Hessians of methods/basic.py.
-"""
+"""Per-facet normal-direction Hessian blocks (methods/normal_blocks.py),
+checked against central differences of the analytic area and volume
+gradients along the chosen directions (the assembly:
+tests/evolve/test_normal_assembly.py)."""
 import io
 
 import numpy as np
@@ -13,8 +10,6 @@ import pytest
 from conftest import example
 from pyevolver import Session
 from pyevolver.evolve import gradient as GR
-from pyevolver.evolve import hessian as H
-from pyevolver.evolve.normal_assembly import applies
 from pyevolver.methods.normal_blocks import area_blocks, volume_blocks
 
 
@@ -103,33 +98,3 @@ def test_zero_area_facet_gives_zero_block():
     P[0, 2, 0] = 2.0                      # three collinear corners
     U = np.ones((3, 3, 1))
     assert not np.any(area_blocks(P, U, np.ones(1)))
-
-
-@pytest.mark.parametrize("symmetric", [False, True])
-def test_assembly_equals_TtHT(rough_cube, symmetric):
-    """Area plus volume assembled in one pass equals Tᵀ (H_A + H_V) T, with
-    some vertices fixed (no unknown) and the others along one direction."""
-    S = rough_cube
-    t = S.evaluate()
-    rng = np.random.default_rng(8)
-    ndof = (rng.random(S.nv) < 0.8).astype(int)
-    B = rng.standard_normal((S.nv, 3, 1))
-    basis = H.Basis(B, ndof)
-    T = basis.matrix()
-    wa, wv = np.linspace(0.5, 2.0, S.nf), np.linspace(-1.0, 1.0, S.nf)
-    fb = applies(t, basis)
-    assert fb is not None
-    fb.area(wa)
-    fb.volume(wv, symmetric)
-    M = fb.matrix()
-    full = (H.facet_area_hessian(t, wa) + H.facet_volume_hessian(t, wv, symmetric)).toarray()
-    ref = T.T @ full @ T
-    assert M.shape == ref.shape
-    assert np.abs(M.toarray() - ref).max() <= 1e-12 * np.abs(ref).max()
-
-
-def test_general_bases_take_the_other_path(rough_cube):
-    t = rough_cube.evaluate()
-    basis = H.Basis(np.zeros((rough_cube.nv, 3, 2)) + 1.0, np.full(rough_cube.nv, 2))
-    assert applies(t, basis) is None
-    assert applies(t, None) is None
