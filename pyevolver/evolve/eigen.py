@@ -47,6 +47,7 @@ from ..constraints import restore_state, state
 from ..errors import CommandError, UnsupportedError, dimension_error
 from .hessian import HessianSystem, _cholmod, hessian_system
 from . import symfactor as SF
+from . import string_hessian  # noqa: F401  (installs the string model's Hessian)
 
 #: below this many unknowns the eigenvalues come from the dense matrix
 DENSE_MAX = 800
