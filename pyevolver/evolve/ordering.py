@@ -79,7 +79,9 @@ def nested_dissection(points, pattern, leaf=64):
         # two active unknowns of one part, and a part not cut has no right
         # side); couplings across parts or to a separator never matter again
         si, sj = side[ei], side[ej]
-        sep = np.unique(np.concatenate([ei[~si & sj], ej[si & ~sj]]))
+        sep = np.zeros(n, bool)
+        sep[ei[~si & sj]] = True
+        sep[ej[si & ~sj]] = True
         level[sep] = depth
         active[sep] = False
         keep = si == sj
