@@ -111,7 +111,64 @@ CLAIMS = [
      lambda: [_pct(_f4("NormalCur+harmonic", "stomatocyte", "rel_error"), "+.2f"),
               f"{_f4('NormalCur+harmonic', 'stomatocyte', 'height_width'):.3f}",
               f"{_v(F4, 'height_width', method='axisymmetric reference', shape='stomatocyte'):.3f}"]),
+    ("paper.md", "(prolate at 162: {} here, {} there; W {} and {})",
+     lambda: [_row(F4, method="StarPerp+Evolver recipe", shape="prolate", resolution="162")["cycles"],
+              _row(F4, method="StarPerp+Evolver recipe (REF)", shape="prolate",
+                   resolution="162")["cycles"],
+              f"{_f4('StarPerp+Evolver recipe', 'prolate', 'energy', '162'):.6f}",
+              f"{_f4('StarPerp+Evolver recipe (REF)', 'prolate', 'energy', '162'):.6f}"]),
+    ("paper.md", "Reference shapes: prolate height/width {}; discocyte height/width {} with "
+                 "dimples {} of the height deep on both sides; stomatocyte height/width {} with "
+                 "its inner pole {} of the height below the mouth.",
+     lambda: [f"{_ref4(s, 'height_width'):.3f}" for s in ("prolate", "discocyte")]
+     + [f"{_ref4('discocyte', 'pole_depth_max'):.3f}", f"{_ref4('stomatocyte', 'height_width'):.3f}",
+        f"{_ref4('stomatocyte', 'pole_depth_max'):.3f}"]),
+    ("paper.md", "price on the stomatocyte ({} s, {} Newton steps at 2,562)",
+     lambda: [f"{_f4('NormalCur+harmonic+u', 'stomatocyte', 'seconds'):.0f}",
+              re.search(r"/(\d+)/u", _row(F4, method="NormalCur+harmonic+u", shape="stomatocyte",
+                                          resolution="2562")["continuation"]).group(1)]),
+    ("paper.md", "(the 642-vertex stage flips {} edges at λ = 0.5; W drops from {} to {})",
+     lambda: [re.search(r"^0\.5:[^ ]*/u(\d+)", _row(F4, method="NormalCur+harmonic+u",
+                                                    shape="stomatocyte",
+                                                    resolution="642")["continuation"]).group(1),
+              f"{_f4('NormalCur+harmonic', 'stomatocyte', 'energy', '642'):.2f}",
+              f"{_f4('NormalCur+harmonic+u', 'stomatocyte', 'energy', '642'):.2f}"]),
+    ("paper.md", "discocyte at 642: {} > {} at 162)",
+     lambda: [f"{_f4('StarPerp+Evolver recipe', 'discocyte', 'energy', r):.2f}"
+              for r in ("642", "162")]),
+    ("paper.md", "the sampled Clifford torus has W_NormalCur = {} ({}) on it against {} ({}) "
+                 "on the one-diagonal 10×16 grid",
+     lambda: [v for g in ("offset", "paper") for v in
+              (f"{_sampled('NormalCur', g):.3f}", _pct(_sampled('NormalCur', g) / CLIFFORD - 1,
+                                                       "+.1f"))]),
+    ("paper.md", "the sampled Clifford torus itself has W {} (EffArea) and {} (NormalCur)",
+     lambda: [_pct(_sampled(e, "offset") / CLIFFORD - 1, "+.2f") for e in (EA, NC)]),
+    ("paper.md", "√((R/r)² − 1) = n√3/(2m), R/r = {} for 10×16",
+     lambda: [f"{math.sqrt(1 + (16 * math.sqrt(3) / 20) ** 2):.2f}"]),
+    ("paper.md", "every torus has W ≥ 2π² = {}", lambda: [f"{CLIFFORD:.6f}"]),
+    ("paper.md", "It decreases monotonically to 4π = {} as the hole closes",
+     lambda: [f"{4 * math.pi:.9f}"]),
 ]
+
+
+def _ref4(shape, column):
+    return _v(F4, column, method="axisymmetric reference", shape=shape)
+
+
+_SAMPLED = {}
+
+
+def _sampled(energy, grid):
+    """W of the sampled Clifford torus on the 10×16 grid (the datafile as loaded)."""
+    if (energy, grid) not in _SAMPLED:
+        import io
+        import tempfile
+        from pyevolver import Session
+        from pyevolver.studies import fig3_torus as F3
+        with tempfile.TemporaryDirectory() as d:
+            s = Session.load(F3.datafile(10, 16, energy, False, grid, d), out=io.StringIO())
+            _SAMPLED[energy, grid] = s.value("total_energy")
+    return _SAMPLED[energy, grid]
 
 
 def _text(name):
@@ -211,3 +268,94 @@ def test_guide_fig4_summary_holds():
     errs += [_f4("NormalCur+harmonic", s, "rel_error") for s in ("prolate", "discocyte")]
     errs.append(_f4("NormalCur+harmonic+u", "stomatocyte", "rel_error"))
     assert max(abs(e) for e in errs) < 0.005, errs
+
+
+def test_fixed_lambda_runs_between_the_table_rows_regenerated(tmp_path):
+    """paper.md: the 10×16 fixed-λ runs quoted beside the consistency table."""
+    from pyevolver.studies.fig3_torus import newton_run
+    got = {}
+    for energy, lam in ((EA, 0.27), (EA, 0.3), (NC, 0.2), (NC, 0.22)):
+        r = newton_run(10, 16, energy, lam, directory=str(tmp_path), moebius=False)
+        got[energy, lam] = (_pct(r["rel_error"], "+.2f"), f"{r['R_over_r']:.3f}")
+    want = ("runs from the sampled torus: EffArea λ = 0.27 W {}, R/r {}; λ = 0.3 {}, {}; "
+            "NormalCur λ = 0.2 {}, {}; λ = 0.22 {}, {})").format(
+        *got[EA, 0.27], *got[EA, 0.3], *got[NC, 0.2], *got[NC, 0.22])
+    assert want in _text("paper.md"), want
+
+
+@pytest.mark.slow
+def test_unregularized_collapse_of_the_discocyte_regenerated():
+    """paper.md, Figure 4: 40 Newton steps at λ = 0 from the 162-vertex
+    discocyte's λ = 1 minimiser (the run of tests/studies/test_fig4_vesicles.py)."""
+    from pyevolver import Session
+    import io
+    from pyevolver.studies import fig4_vesicles as F4
+    s = Session.load(F4.datafile("discocyte", "normal"), out=io.StringIO())
+    F4.newton_lm(s)
+    w1, a1 = s.totals.quantity_values["willmore"], F4.min_angle(s.surface.X, s.surface.F)
+    s.surface.quantities["harm"].modulus = 0.0
+    s.recalc()
+    F4.newton_lm(s, maxit=40)
+    w0, a0 = s.totals.quantity_values["willmore"], F4.min_angle(s.surface.X, s.surface.F)
+    want = (f"from its λ = 1 minimiser (W = {w1:.2f}, smallest angle {a1:.1f}°), 40 Newton "
+            f"steps at λ = 0 reach W = {w0:.2f}, far below the smooth minimum "
+            f"{F4.reference('discocyte').W:.2f}, with a smallest angle of {a0:.2f}°")
+    assert want in _text("paper.md"), want
+
+
+def _sine_table():
+    rows = [ln for ln in _text_lines("paper.md") if ln.startswith(("| sine modes n |", "| W |",
+                                                                   "| closure multiplier |"))]
+    cells = [[c.strip() for c in r.strip("|").split("|")][1:] for r in rows[:3]]
+    return list(zip(*cells))
+
+
+def _text_lines(name):
+    with open(os.path.join(D.DOCS, name), encoding="utf-8") as fh:
+        return fh.read().splitlines()
+
+
+@pytest.mark.parametrize("n, W, mult", [pytest.param(*c, marks=pytest.mark.slow)
+                                        if int(c[0]) >= 128 else c for c in _sine_table()])
+def test_sine_mode_table_regenerated(n, W, mult):
+    """paper.md: the stomatocyte's reference W and closure multiplier per
+    number of sine modes (n ≥ 128 takes seconds to minutes: slow)."""
+    from pyevolver.studies.axisymmetric import canham_reference
+    r = canham_reference(0.5, "stomatocyte", n=int(n))
+    assert f"{r.W:.9f}" == W
+    assert re.sub(r"e([+-])0", r"e\1", f"{abs(r.lagrange[0]):.1e}") == mult
+
+
+@pytest.mark.slow
+def test_sine_mode_convergence_quoted():
+    from pyevolver.studies.axisymmetric import canham_reference
+    a = canham_reference(0.5, "stomatocyte", n=128)
+    b = canham_reference(0.5, "stomatocyte", n=256)
+    want = f"W(128) is within {abs(a.W - b.W) / b.W:.1e} (relative) of W(256)"
+    assert want.replace("e-0", "e-") in _text("paper.md"), want
+
+
+def _guide_row(v0, branch, n):
+    from pyevolver.studies.axisymmetric import canham_reference
+    ref = canham_reference(v0, branch, n=n)
+    return f"| {ref.n} | {ref.W:.12f}", f"| {ref.W / (4 * math.pi):.12f} |", ref
+
+
+def test_guide_sphere_reference_regenerated():
+    """guide §8: v0 = 1 (any branch at n = 8 is the round sphere, W = 4π)."""
+    row, ratio, ref = _guide_row(1.0, "prolate", 8)
+    assert f"{ref.W:.12f}" == f"{4 * math.pi:.12f}"
+    assert row + " (= 4π) | 1 |" in _text("guide.md")
+
+
+@pytest.mark.slow
+def test_guide_stomatocyte_reference_regenerated():
+    row, ratio, _ = _guide_row(0.5, "stomatocyte", 256)
+    assert f"{row} {ratio}" in _text("guide.md"), (row, ratio)
+
+
+def test_guide_closed_forms():
+    text = _text("guide.md")
+    assert f"the Clifford torus 2π² = {CLIFFORD:.3f} is the lower bound" in text
+    assert f"(√2 = {math.sqrt(2):.4f})" in text
+    assert f"All are far below 2π² ≈ {CLIFFORD:.2f}" in text
