@@ -108,9 +108,17 @@ def fig1_table(docs: str = DOCS) -> str:
 # -- Figure 3 and Proposition 1 ------------------------------------------------------------------
 
 def _rr(r: dict) -> str:
+    """R/r (fit deviation); for a continued mesh that is a cyclide (the plain
+    fit's deviation above 0.1, the Möbius-normalized one less than half of
+    it) the Möbius-normalized ratio, marked."""
     if not r.get("R_over_r"):
         return ""
-    return f"{float(r['R_over_r']):.3f} ({float(r['revolution_dev']):.3f})"
+    dev = float(r["revolution_dev"])
+    if ("(cont.)" in r["label"] and dev > 0.1 and r.get("moebius_dev")
+            and float(r["moebius_dev"]) < dev / 2):
+        return (f"{float(r['R_over_r_moebius']):.3f} ({float(r['moebius_dev']):.3f}) Möbius; "
+                f"plain fit dev {dev:.2f}")
+    return f"{float(r['R_over_r']):.3f} ({dev:.3f})"
 
 
 def fig3_table(docs: str = DOCS, mesh: str = "10x16") -> str:

@@ -55,8 +55,12 @@ seconds and iterations.
 Proposition 1: :func:`almost_spherical_torus` and :func:`proposition1`.
 
     python -m pyevolver.studies.fig3_torus [--size small|full] [--out DIR]
+        [--meshes 20x32,40x64] [--runs continuation,recipe] [--no-evolver]
 
-writes ``fig3_torus.csv`` (one row per run), ``fig3_stages.csv`` (the
+(``--meshes`` runs the listed grids instead of a size's, ``--runs`` a subset
+of unregularized, fixed, continuation, consistency, recipe; ``python -m
+pyevolver.studies.doc_numbers --merge DIR`` then puts the rows into the
+CSVs in ``docs/``) writes ``fig3_torus.csv`` (one row per run), ``fig3_stages.csv`` (the
 continuation stages), ``fig3_recipe.csv`` (the recipe, both programs, per
 round), ``fig3_prop1.csv``, ``fig3_chart.csv`` (the :func:`chart_records` of
 these runs) and ``fig3_torus.png``.

@@ -299,7 +299,7 @@ def _doc(name):
 def _pattern(template):
     """A regex matching ``template`` with any number where a field stands."""
     parts = re.split(r"\{[^{}]*\}", _norm(template))
-    return r"-?\d[\d,]*(?:\.\d+)?(?:e[+-]?\d+)?".join(re.escape(p) for p in parts)
+    return r"[+-]?\d[\d,]*(?:\.\d+)?(?:e[+-]?\d+)?%?".join(re.escape(p) for p in parts)
 
 
 def _significant(tok):
