@@ -1,10 +1,17 @@
 """Every study number in docs/ is the study's own: the tables between
 ``<!-- doc_numbers NAME -->`` markers are what pyevolver.studies.doc_numbers
 writes from the committed CSVs, the numbers the prose quotes are the CSVs'
-(CLAIMS below), and cases of the studies are regenerated live and agree
-with the CSVs (in the default run Proposition 1 at 5×10 and the
-axisymmetric references; Figure 1, Figure 3 at 5×10, the 162-vertex
-prolate of Figure 4 and the Loop torus are marked slow)."""
+or closed forms (CLAIMS below), and cases of the studies are regenerated
+live and agree with the CSVs or the text (in the default run Proposition 1
+at 5×10, the axisymmetric references, the sampled tori, the fixed-λ runs
+and the recipe's first rounds at 10×16; Figure 1, Figure 3 at 5×10, the
+162-vertex prolate and the λ = 0 collapse of Figure 4, the sine-mode table
+and the Loop torus are marked slow).  ``test_every_number_of_the_prose_is_
+regenerated`` keeps it complete for paper.md, guide.md and tutorial.md:
+outside the generated blocks every number of three or more significant
+digits must lie in a claim's text (CLAIMS, LIVE) or be an input listed in
+NOT_MEASURED.  The numbers of differences.md and supported.md (REF's and
+pyevolver's outputs) are test_reference_numbers.py's."""
 import math
 import os
 import re
