@@ -563,3 +563,17 @@ def test_every_number_of_the_prose_is_regenerated(doc):
     left = sorted({t for t in _NUM.findall(text) if ("." in t or "e" in t)
                    and _significant(t) >= 3} - set(NOT_MEASURED[doc]))
     assert not left, f"{doc}: numbers no script or test regenerates: {left}"
+
+
+def test_paper_fig4_bounds_hold():
+    """paper.md's bounds on Figure 4 at 2,562 vertices, against the CSV."""
+    text = _text("paper.md")
+    assert "StarPerp+recipe+Newton (≤ 40 s at 2,562 vertices)" in text
+    assert max(_f4("StarPerp+recipe+Newton", s, "seconds") for s in D.SHAPE_ORDER) <= 40
+    assert "NormalCur+harmonic+u, within 0.25% at 2,562 vertices" in text
+    errs = [_f4("NormalCur+harmonic", s, "rel_error") for s in ("prolate", "discocyte")]
+    errs.append(_f4("NormalCur+harmonic+u", "stomatocyte", "rel_error"))
+    assert max(abs(e) for e in errs) < 0.0025, errs
+    assert "smallest angle ≥ 14°), at a" in text
+    assert min(_f4("NormalCur+harmonic", s, "min_angle_deg") for s in ("prolate", "discocyte")
+               ) >= 14 and _f4("NormalCur+harmonic+u", "stomatocyte", "min_angle_deg") >= 14
