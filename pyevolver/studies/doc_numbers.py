@@ -15,6 +15,11 @@ copy its CSV into ``docs/`` and run
     python -m pyevolver.studies.doc_numbers            # rewrite the blocks
     python -m pyevolver.studies.doc_numbers --check    # exit 1 if a block is stale
     python -m pyevolver.studies.doc_numbers --figures  # also redraw fig4_vesicles.png
+    python -m pyevolver.studies.doc_numbers --merge results/  # merge a run's fig3 CSVs first
+
+(``--merge`` replaces the rows of the meshes the run covered, so the 20×32
+and 40×64 rows of ``python -m pyevolver.studies.fig3_torus --meshes
+20x32,40x64`` join the committed 5×10 and 10×16 ones.)
 
 ``tests/docs/test_documented_numbers.py`` checks that every block is what
 its CSV gives, that the numbers quoted in the prose are the CSV's, and
@@ -33,7 +38,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DOCS = os.path.normpath(os.path.join(HERE, "..", "..", "docs"))
 CLIFFORD = 2 * math.pi ** 2
 
-__all__ = ["DOCS", "BLOCKS", "read_csv", "render", "blocks_in", "update", "main",
+__all__ = ["DOCS", "BLOCKS", "MERGED", "read_csv", "merge_csv", "render", "blocks_in", "update", "main",
            "pct", "fig1_table", "fig3_table", "fig3_stages_table", "fig3_loop_stages_table",
            "prop1_table",
            "fig4_table", "fig4_figure", "fig4_continuation_table", "chart_table"]
@@ -43,6 +48,27 @@ def read_csv(name: str, docs: str = DOCS) -> list[dict]:
     """The rows of ``docs/<name>`` as dicts of strings."""
     with open(os.path.join(docs, name), newline="", encoding="utf-8") as fh:
         return list(csv.DictReader(fh))
+
+
+def merge_csv(name: str, src: str, docs: str = DOCS, key: str = "mesh") -> int:
+    """Merge the study's ``src`` CSV into ``docs/<name>``: the rows of
+    ``docs/<name>`` whose ``key`` value (the mesh, the shape) occurs in
+    ``src`` are replaced by ``src``'s rows, the others kept in their order;
+    the columns are the union of both files'.  Returns the number of rows
+    written from ``src``."""
+    new = read_csv(os.path.basename(src), os.path.dirname(os.path.abspath(src)))
+    path = os.path.join(docs, name)
+    old = read_csv(name, docs) if os.path.exists(path) else []
+    keys_new = {r.get(key) for r in new}
+    rows = [r for r in old if r.get(key) not in keys_new] + new
+    fields: list[str] = []
+    for r in old + new:
+        fields += [k for k in r if k not in fields]
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields, restval="")
+        w.writeheader()
+        w.writerows(rows)
+    return len(new)
 
 
 def pct(x: float, digits: int = 3) -> str:
@@ -82,9 +108,17 @@ def fig1_table(docs: str = DOCS) -> str:
 # -- Figure 3 and Proposition 1 ------------------------------------------------------------------
 
 def _rr(r: dict) -> str:
+    """R/r (fit deviation); for a continued mesh that is a cyclide (the plain
+    fit's deviation above 0.1, the Möbius-normalized one less than half of
+    it) the Möbius-normalized ratio, marked."""
     if not r.get("R_over_r"):
         return ""
-    return f"{float(r['R_over_r']):.3f} ({float(r['revolution_dev']):.3f})"
+    dev = float(r["revolution_dev"])
+    if ("(cont.)" in r["label"] and dev > 0.1 and r.get("moebius_dev")
+            and float(r["moebius_dev"]) < dev / 2):
+        return (f"{float(r['R_over_r_moebius']):.3f} ({float(r['moebius_dev']):.3f}) Möbius; "
+                f"plain fit dev {dev:.2f}")
+    return f"{float(r['R_over_r']):.3f} ({dev:.3f})"
 
 
 def fig3_table(docs: str = DOCS, mesh: str = "10x16") -> str:
@@ -119,12 +153,20 @@ def fig3_stages_table(docs: str = DOCS, mesh: str = "10x16", rule: str = "consis
 
 
 def fig3_loop_stages_table(docs: str = DOCS, mesh: str = "10x16") -> str:
-    """paper.md: the Loop-guided continuation's stages on ``mesh``
-    (``fig3_stages.csv``): λ: W, W_Loop (errors to 2π², the kept stage's
-    W_Loop in bold), smallest angle; runs of undone stages as one item."""
+    """paper.md: the Loop-guided continuation's stages on ``mesh`` (or on
+    several meshes, comma-separated) (``fig3_stages.csv``): λ: W, W_Loop
+    (errors to 2π², the kept stage's W_Loop in bold), smallest angle; runs
+    of undone stages as one item."""
     rows = []
-    data = [r for r in read_csv("fig3_stages.csv", docs)
-            if r["mesh"] == mesh and r.get("rule", "loop") == "loop"]
+    meshes = mesh.split(",")
+    allrows = [r for r in read_csv("fig3_stages.csv", docs) if r.get("rule", "loop") == "loop"]
+    for m in meshes:
+        rows += _loop_stage_rows([r for r in allrows if r["mesh"] == m], m)
+    return _table(["mesh", "energy", "λ: W, W_Loop, min angle"], rows)
+
+
+def _loop_stage_rows(data: list[dict], mesh: str) -> list[list[str]]:
+    rows = []
 
     def p2(x: float) -> str:
         return f"{100 * x:+.2f}%".replace("-", "−")
@@ -149,7 +191,7 @@ def fig3_loop_stages_table(docs: str = DOCS, mesh: str = "10x16") -> str:
             items.append(f"{float(r['lambda']):.4g}: {p2(float(r['W']) / CLIFFORD - 1)}, "
                          f"{loop}, {float(r['minangle']):.1f}°")
         rows.append([mesh.replace("x", "×"), energy, " · ".join(items)])
-    return _table(["mesh", "energy", "λ: W, W_Loop, min angle"], rows)
+    return rows
 
 
 def prop1_table(docs: str = DOCS) -> str:
@@ -332,6 +374,9 @@ def fig4_figure(png: str, docs: str = DOCS) -> str:
 
 # -- the blocks ----------------------------------------------------------------------------------
 
+#: the study CSVs ``--merge`` takes → the column whose values key the rows it replaces
+MERGED = {"fig3_torus.csv": "mesh", "fig3_stages.csv": "mesh", "fig3_chart.csv": "resolution"}
+
 #: block name → the function writing it from the CSVs in a docs folder
 BLOCKS: dict[str, Callable[[str], str]] = {
     "fig1": fig1_table,
@@ -339,6 +384,9 @@ BLOCKS: dict[str, Callable[[str], str]] = {
     "fig3_5x10": lambda docs: fig3_table(docs, "5x10"),
     "fig3_consistency": fig3_stages_table,
     "fig3_loop_stages": fig3_loop_stages_table,
+    "fig3_20x32": lambda docs: fig3_table(docs, "20x32"),
+    "fig3_40x64": lambda docs: fig3_table(docs, "40x64"),
+    "fig3_loop_stages_full": lambda docs: fig3_loop_stages_table(docs, "20x32,40x64"),
     "prop1": prop1_table,
     "fig4": fig4_table,
     "fig4_continuation": fig4_continuation_table,
@@ -389,7 +437,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--docs", default=DOCS)
     ap.add_argument("--figures", action="store_true",
                     help="also redraw fig4_vesicles.png from its CSV")
+    ap.add_argument("--merge", metavar="DIR",
+                    help="first merge a study's output CSVs in DIR into docs/ (the rows of "
+                         "the meshes it ran replace the old ones)")
     a = ap.parse_args(argv)
+    if a.merge and not a.check:
+        for name, key in MERGED.items():
+            if os.path.exists(os.path.join(a.merge, name)):
+                n = merge_csv(name, os.path.join(a.merge, name), a.docs, key)
+                print(f"merged {n} rows into {name}")
     stale = update(a.docs, check=a.check)
     if a.figures and not a.check:
         print("wrote", fig4_figure(os.path.join(a.docs, "fig4_vesicles.png"), a.docs))

@@ -55,8 +55,12 @@ seconds and iterations.
 Proposition 1: :func:`almost_spherical_torus` and :func:`proposition1`.
 
     python -m pyevolver.studies.fig3_torus [--size small|full] [--out DIR]
+        [--meshes 20x32,40x64] [--runs continuation,recipe] [--no-evolver]
 
-writes ``fig3_torus.csv`` (one row per run), ``fig3_stages.csv`` (the
+(``--meshes`` runs the listed grids instead of a size's, ``--runs`` a subset
+of unregularized, fixed, continuation, consistency, recipe; ``python -m
+pyevolver.studies.doc_numbers --merge DIR`` then puts the rows into the
+CSVs in ``docs/``) writes ``fig3_torus.csv`` (one row per run), ``fig3_stages.csv`` (the
 continuation stages), ``fig3_recipe.csv`` (the recipe, both programs, per
 round), ``fig3_prop1.csv``, ``fig3_chart.csv`` (the :func:`chart_records` of
 these runs) and ``fig3_torus.png``.
@@ -93,6 +97,8 @@ LAMBDA_DEFAULT = 0.25
 # mesh sizes (minor × major grid points); the offset grid needs an even major count
 SIZES = {"small": [(5, 10), (10, 16)], "full": [(5, 10), (10, 16), (20, 32), (40, 64)]}
 FIXED_LAMBDAS = [1.0, 0.5, 0.25, 0.12]
+# the runs of the study, in order (the --runs choices)
+RUNS = ("unregularized", "fixed", "continuation", "consistency", "recipe")
 
 
 # -- meshes and datafiles -------------------------------------------------------------------
@@ -562,10 +568,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=".")
     ap.add_argument("--no-evolver", action="store_true",
                     help="do not run the recipe in evolver-nox-d")
+    ap.add_argument("--meshes", default=None,
+                    help="comma-separated grids instead of --size's, e.g. 20x32,40x64")
+    ap.add_argument("--runs", default=",".join(RUNS),
+                    help=f"comma-separated subset of {','.join(RUNS)} (default: all)")
     a = ap.parse_args(argv)
     os.makedirs(a.out, exist_ok=True)
     full = a.size == "full"
     sizes = SIZES[a.size]
+    if a.meshes:
+        sizes = [tuple(int(v) for v in g.split("x")) for g in a.meshes.split(",")]
+        full = True
+    runs = set(a.runs.split(","))
+    if runs - set(RUNS):
+        ap.error(f"unknown runs {sorted(runs - set(RUNS))} (choose from {', '.join(RUNS)})")
     rows, stages, recs = [], [], []
 
     def show(r, key=None, s=None):
@@ -574,25 +590,27 @@ def main(argv: list[str] | None = None) -> int:
 
     for m, n in sizes:
         for energy in ENERGIES:
-            if m <= 20:                                                      # (a)
+            if m <= 20 and "unregularized" in runs:                          # (a)
                 show(newton_run(m, n, energy, None, directory=a.out))
-            if (m, n) == (10, 16) or (full and (m, n) == (20, 32)):
+            if ((m, n) == (10, 16) or (full and (m, n) == (20, 32))) and "fixed" in runs:
                 for lam in FIXED_LAMBDAS:                                    # (b)
                     show(newton_run(m, n, energy, lam, directory=a.out))
                     if (m, n) == (10, 16):
                         show(newton_run(m, n, energy, lam, grid="paper", directory=a.out))
-            row, st = continuation_run(m, n, energy, directory=a.out)       # (c)
-            show(row)
-            stages += st
-            row, st = continuation_run(m, n, energy, directory=a.out,       # (c')
-                                       rule="consistency")
-            show(row)
-            stages += st
-            rr, rc = recipe_run(m, n, energy, rounds=_recipe_rounds(m),      # (d)
-                                evolver=not a.no_evolver, directory=a.out)
-            for r in rr:
-                show(r)
-            recs += rc
+            if "continuation" in runs:                                       # (c)
+                row, st = continuation_run(m, n, energy, directory=a.out)
+                show(row)
+                stages += st
+            if "consistency" in runs:                                        # (c')
+                row, st = continuation_run(m, n, energy, directory=a.out, rule="consistency")
+                show(row)
+                stages += st
+            if "recipe" in runs:                                             # (d)
+                rr, rc = recipe_run(m, n, energy, rounds=_recipe_rounds(m),
+                                    evolver=not a.no_evolver, directory=a.out)
+                for r in rr:
+                    show(r)
+                recs += rc
     prop = proposition1()
     print(f"2 pi^2 = {CLIFFORD:.6f}, 4 pi = {4 * math.pi:.6f}")
     for p in prop:

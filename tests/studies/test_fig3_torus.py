@@ -269,3 +269,8 @@ def test_the_figure_is_readable():
     assert all("10^" not in t.get_text() and "times" not in t.get_text()
                for t in fig.axes[0].get_xticklabels())
     plt.close(fig)
+
+
+def test_cli_refuses_an_unknown_run(tmp_path):
+    with pytest.raises(SystemExit):
+        F3.main(["--meshes", "5x10", "--runs", "recipe,bogus", "--out", str(tmp_path)])
