@@ -144,7 +144,7 @@ def equiangulate(s, threshold=-0.001, only=None):
     flips = sum(len(m[0]) for m in moves)
     if flips:
         # an edge's facet loop keeps its start through the flips (REF, ee.facet)
-        copies = (t.FE.copy(), t.E.copy())    # (one copy for both records)
+        copies = (t.FE, t.E)    # (t's own arrays, never written again: refine.split_edges)
         record_along_first(t, c.first, copies)
         _flip_rings(s, t, moves, copies[1])
     t.topology_version = getattr(s, "topology_version", 0) + 1
