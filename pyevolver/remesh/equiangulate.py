@@ -55,7 +55,12 @@ def _flip_rings(s, t, moves, E=None):
 
 
 def _rings_after_flips(s, E, nv, moves):
-    """The rank of :func:`_flip_rings` (``E``, ``nv``: the new surface's)."""
+    """The rank of :func:`_flip_rings` (``E``, ``nv``: the new surface's).
+
+    The flips are replayed in rounds: a flip goes in a round when no
+    earlier flip not yet replayed has one of its four vertices (changes of
+    the rings of distinct vertices commute, so this is the replay in id
+    order)."""
     g = Rings(s, len(E), nv)
     I = np.concatenate([m[0] for m in moves])
     o = np.argsort(I, kind="stable")
@@ -63,19 +68,19 @@ def _rings_after_flips(s, E, nv, moves):
     p = np.concatenate([m[1] for m in moves])[o]
     q = np.concatenate([m[2] for m in moves])[o]
     x, y = E[I, 0], E[I, 1]
-    quads = np.stack([p, q, x, y], 1).tolist()
-    start, used = 0, set()
-    for k in range(len(I) + 1):
-        if k < len(I) and not used.intersection(quads[k]):
-            used.update(quads[k])
-            continue
-        b = slice(start, k)
+    V = np.stack([p, q, x, y], 1)
+    low = np.empty(nv, np.int64)
+    pend = np.arange(len(I))
+    while len(pend):
+        W = V[pend]
+        low[W.ravel()[::-1]] = np.repeat(pend, 4)[::-1]     # (the last write wins: the lowest)
+        ready = (low[W] == pend[:, None]).all(axis=1)
+        b = pend[ready]
+        pend = pend[~ready]
         g.remove(p[b], 2 * I[b])
         g.remove(q[b], 2 * I[b] + 1)
         g.insert(x[b], 2 * I[b])
         g.insert(y[b], 2 * I[b] + 1)
-        if k < len(I):
-            start, used = k, set(quads[k])
     return g.rank()
 
 

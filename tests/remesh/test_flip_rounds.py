@@ -253,3 +253,32 @@ def test_initial_criterion_is_the_visits_sum():
             with np.errstate(all="ignore"):
                 tot = tot + (b * b + c * c - a * a) / (b * c)
         assert (got[e] == tot) or (np.isnan(got[e]) and np.isnan(tot))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_rings_replayed_in_rounds_as_one_by_one(tmp_path, monkeypatch, seed):
+    """equiangulate._rings_after_flips replays the flips' ring changes in
+    rounds of flips with no vertex in common: the rings of one flip after
+    the other in id order."""
+    from pyevolver.remesh.rings import Rings
+    seen = []
+    real = EQ._flip_rings
+    monkeypatch.setattr(EQ, "_flip_rings", lambda s, t, moves, E=None: (
+        seen.append((s, t, moves)), real(s, t, moves, E))[1])
+    s = _surface(3, 300 + seed, jitter=0.5, tmp_path=tmp_path)
+    t, n = EQ.equiangulate(s)
+    assert n > 20 and len(seen) == 1
+    s, t, moves = seen[0]
+    got = EQ._rings_after_flips(s, t.E, t.nv, moves)
+    g = Rings(s, t.ne, t.nv)
+    I = np.concatenate([m[0] for m in moves])
+    p = np.concatenate([m[1] for m in moves])
+    q = np.concatenate([m[2] for m in moves])
+    for k in np.argsort(I, kind="stable"):
+        e = I[k:k + 1]
+        g.remove(p[k:k + 1], 2 * e)
+        g.remove(q[k:k + 1], 2 * e + 1)
+        g.insert(t.E[e, 0], 2 * e)
+        g.insert(t.E[e, 1], 2 * e + 1)
+    assert np.array_equal(got, g.rank())
+    assert np.array_equal(vertex_edge_rank(t), got)
