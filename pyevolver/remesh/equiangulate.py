@@ -92,6 +92,19 @@ def _flat(a):
     return memoryview(a.reshape(-1))
 
 
+def _edge_lengths(X, E):
+    """Edge lengths, axis by axis: the numbers of
+    ``np.linalg.norm(X[E[:, 1]] - X[E[:, 0]], axis=1)`` (the squares summed
+    in axis order), without its (ne, 3) temporaries."""
+    e0, e1 = E[:, 0], E[:, 1]
+    acc = None
+    for c in range(X.shape[1]):
+        x = X[e1, c] - X[e0, c]
+        x *= x
+        acc = x if acc is None else np.add(acc, x, out=acc)
+    return np.sqrt(acc, out=acc)
+
+
 def _signature(s):
     """Per edge and per facet, an integer key of constraint/boundary sets."""
     ek = np.zeros(s.ne, np.int64)
@@ -171,9 +184,10 @@ def _prepare(s, threshold, only):
     ef, ekk, val = edge_facets(s)          # (s: its topology is cached; the same as t's)
     wv = t.wrap_shift()
     group = group_of(t)
-    if group is None:
-        d = G.edge_vectors(t.X, E, wv)
-        lengths = np.linalg.norm(d, axis=1)
+    if group is None and wv is None and t.X.shape[1] == 3:
+        lengths = _edge_lengths(t.X, E)
+    elif group is None:
+        lengths = np.linalg.norm(G.edge_vectors(t.X, E, wv), axis=1)
     else:                       # a symmetry group's codes (model.groups): sequential pass
         wrap = t.eattr["wrap_code"] = s.eattr["wrap_code"].copy()
         lengths = np.linalg.norm(_group_vectors(t, group, np.arange(t.ne)), axis=1)
