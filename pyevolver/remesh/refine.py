@@ -8,6 +8,8 @@ one is.  New vertices on boundary edges are placed on the boundary curve
 """
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from ..methods import metric as MT
@@ -15,6 +17,7 @@ from ..geometry import kernels as G
 from ..constraints import constrained_vertices, project_to_constraints
 from ..model.records import (along_first, record_along_first, record_vertex_rings,
                              settle_records)
+from ..model.facet_csr import PendingCSR
 from ..model.groups import group_of
 from . import group_refine as GR
 from .grow import grow, reorder_new_edges
@@ -310,7 +313,15 @@ def _split_every_edge(s):
     nv, ne, nf = s.nv, s.ne, s.nf
     R = np.arange(ne)
     par = np.repeat(np.arange(nf), 3)
-    t = grow(s, v_from_edge=R, e_from_edge=R, e_from_facet=par, f_from_facet=par)
+    bodies = _split_bodies(s.bodies, nf)
+    if bodies is None:
+        t = grow(s, v_from_edge=R, e_from_edge=R, e_from_facet=par, f_from_facet=par)
+    else:           # (grow without the bodies, made here: no sort of the matrix)
+        s0 = copy.copy(s)
+        s0.bodies = copy.copy(s.bodies)
+        s0.bodies.n = 0
+        t = grow(s0, v_from_edge=R, e_from_edge=R, e_from_facet=par, f_from_facet=par)
+        t.bodies = bodies
     del par
     # -- midpoints and edge halves: edge e keeps its tail half, its head half
     # is edge ne + e, its midpoint vertex nv + e
@@ -358,6 +369,51 @@ def _split_every_edge(s):
     if len(sel):
         project_to_constraints(t, sel)
     return t
+
+
+def _split_bodies(b, nf):
+    """The bodies of the surface :func:`_split_every_edge` makes, as
+    :func:`pyevolver.remesh.grow.grow` makes them (every facet's three new
+    children, facets ``nf + 3f + j``, in its bodies with its sign), built
+    row by row from the canonical facet matrix (None when the matrix is
+    not canonical: grow's way then)."""
+    M = b.facet_csr
+    if not b.n or M is None or getattr(M, "format", None) != "csr" or b.occurrences is None:
+        return None
+    data, ind, ptr = np.asarray(M.data), np.asarray(M.indices), np.asarray(M.indptr)
+    nrow, ncol = int(M.shape[0]), int(M.shape[1])
+    if ncol != nf or data.dtype.kind not in "f":
+        return None
+    cnt = np.diff(ptr).astype(np.int64)
+    rows = np.repeat(np.arange(nrow), cnt)
+    c = ind.astype(np.int64)
+    if len(c) > 1 and not np.all((c[1:] > c[:-1]) | (rows[1:] != rows[:-1])):
+        return None                     # (unsorted or repeated columns in a row)
+    start = ptr[:-1].astype(np.int64)
+    off = np.arange(len(c)) - start[rows]          # place in its row
+    n = len(c)
+    base = 4 * start[rows] + cnt[rows]             # the row's children after its facets
+    new_c = np.empty(4 * n, np.int64)
+    new_d = np.empty(4 * n, data.dtype)
+    keep = np.arange(n) + 3 * start[rows]
+    new_c[keep] = c
+    new_d[keep] = data
+    for j in range(3):
+        at = base + 3 * off + j
+        new_c[at] = nf + 3 * c + j
+        new_d[at] = data
+    idx = np.int32 if max(nrow, 4 * ncol, 4 * n) <= np.iinfo(np.int32).max else np.int64
+    indptr = np.zeros(nrow + 1, idx)
+    np.cumsum(4 * cnt, out=indptr[1:])
+    out = copy.copy(b)
+    out.facet_matrix = PendingCSR(new_d, new_c.astype(idx), indptr, (nrow, 4 * ncol))
+    ob, of, osg = b.occurrences
+    out.occurrences = (np.concatenate([ob, np.repeat(ob, 3)]),
+                       np.concatenate([of, nf + 3 * np.repeat(of, 3) + np.tile(np.arange(3),
+                                                                           len(of))]),
+                       np.concatenate([osg, np.repeat(osg, 3)]))
+    out.volume = None
+    return out
 
 
 def _split_loops(s, t, R, half, copies=None):

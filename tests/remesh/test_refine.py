@@ -102,6 +102,19 @@ def _same_surface(a, b):
         assert x.keys() == y.keys() and all(np.array_equal(x[k], y[k]) for k in x), d
     assert np.array_equal(along_first(a), along_first(b))
     assert np.array_equal(vertex_edge_rank(a), vertex_edge_rank(b))
+    x, y = a.bodies, b.bodies
+    assert x.n == y.n and (x.volume is None) == (y.volume is None)
+    if x.n:
+        for k in ("data", "indices", "indptr"):
+            p, q = np.asarray(getattr(x.facet_csr, k)), np.asarray(getattr(y.facet_csr, k))
+            assert p.dtype == q.dtype and np.array_equal(p, q), k
+        assert x.facet_csr.shape == y.facet_csr.shape
+        for p, q in zip(x.occurrences, y.occurrences):
+            assert p.dtype == q.dtype and np.array_equal(p, q)
+    for k in vars(y):
+        if k not in ("_facet_matrix", "occurrences", "volume"):
+            p, q = getattr(x, k), getattr(y, k)
+            assert (p is q) or np.array_equal(p, q, equal_nan=True), k
 
 
 def test_refine_every_edge_is_split_edges_general_path(monkeypatch):
