@@ -47,8 +47,9 @@ def _flip_rings(s, t, moves, E=None):
     The pass flips in edge id order; each flip takes the edge out of the
     rings of its old ends and puts it in those of its new ends (measured
     with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
-    Runs of flips with no vertex in common are replayed at once.  The rings
-    are computed when first read (:func:`record_vertex_rings`)."""
+    Flips with no vertex in common are replayed at once
+    (:func:`_rings_after_flips`).  The rings are computed when first read
+    (:func:`record_vertex_rings`)."""
     settle_records(s)                     # (no chain of surfaces kept for later)
     E, nv = t.E.copy() if E is None else E, t.nv
     record_vertex_rings(t, lambda: _rings_after_flips(s, E, nv, moves), E)

@@ -124,7 +124,8 @@ def _reference(s, threshold=-0.001, only=None):
         if np.isfinite(threshold):
             a, lb, lc, ld, le = L[e], L[u(b1)], L[u(c1)], L[u(b2)], L[u(c2)]
             with np.errstate(all="ignore"):
-                crit = (lb * lb + lc * lc - a * a) / (lb * lc) + (ld * ld + le * le - a * a) / (ld * le)
+                crit = ((lb * lb + lc * lc - a * a) / (lb * lc)
+                        + (ld * ld + le * le - a * a) / (ld * le))
             if not crit < threshold:
                 continue
         r, sv = head(b1), head(b2)
