@@ -90,11 +90,13 @@ def along_first(s: Surface) -> np.ndarray:
     first = edge_first_facet(s)
     if first is None:
         return out
-    idx, sgn, _ = s.topology()
     known = np.nonzero(first >= 0)[0]
-    f = first[known]
-    hit = idx[f] == known[:, None]
-    out[known] = (sgn[f] * hit).sum(axis=1) >= 0
+    # the edge's occurrences in its first facet: forwards minus backwards
+    FEf = s.FE[first[known]]
+    k = known[:, None]
+    d = (FEf == k).astype(np.int8)
+    d -= FEf == ~k
+    out[known] = ((d[:, 0] + d[:, 1] + d[:, 2]) if d.shape[1] == 3 else d.sum(axis=1)) >= 0
     return out
 
 
@@ -294,20 +296,17 @@ def edge_facets(s: Surface) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Rows are filled for edges with exactly two facets (first and last
     occurrence in facet order), ``-1`` elsewhere.
     """
-    idx, sgn, _ = s.topology()
+    idx = s.topology()[0]
     flat_e = idx.ravel()
-    flat_f = np.repeat(np.arange(s.nf), 3)
-    flat_k = np.tile(np.arange(3), s.nf)
+    k = idx.shape[1] if idx.ndim == 2 else 3
     val = np.bincount(flat_e, minlength=s.ne)
-    first_f = np.full(s.ne, -1, np.int64)
-    first_k = np.full(s.ne, -1, np.int64)
-    first_f[flat_e[::-1]] = flat_f[::-1]          # later writes win: the first occurrence
-    first_k[flat_e[::-1]] = flat_k[::-1]
-    last_f = np.full(s.ne, -1, np.int64)
-    last_k = np.full(s.ne, -1, np.int64)
-    last_f[flat_e] = flat_f
-    last_k[flat_e] = flat_k
-    two = val == 2
-    ef = np.where(two[:, None], np.stack([first_f, last_f], 1), -1)
-    ek = np.where(two[:, None], np.stack([first_k, last_k], 1), -1)
+    j = np.arange(len(flat_e))
+    at = np.empty((s.ne, 2), np.int64)         # first and last place in FE's flat order
+    at[flat_e[::-1], 0] = j[::-1]              # (later writes win: the first occurrence)
+    at[flat_e, 1] = j
+    del j
+    other = val != 2
+    ef, ek = np.divmod(at, k)
+    ef[other] = -1
+    ek[other] = -1
     return ef, ek, val

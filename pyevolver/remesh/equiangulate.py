@@ -7,15 +7,19 @@ opposite sides (b, c) and (d, e), is flipped to the other diagonal when
 
 i.e. when its two opposite angles sum to more than about π (the Delaunay
 criterion, Dyn–Hormann–Kim–Levin 2001; the Evolver's "equiangulation").
-The criterion is evaluated for every edge at once; only the edges that pass
-it, and the edges whose facets a flip changed, are then visited one by one
-in id order, so the result is that of the Evolver's sequential pass.
+The criterion is evaluated for every edge at once; the pass then runs in
+rounds of visits that cannot influence each other
+(:mod:`pyevolver.remesh.flip_rounds`), or, on a torus, with a symmetry
+group and where the rounds cannot tell, visits the edges that pass and the
+edges whose facets a flip changed one by one in id order: either way the
+result is that of the Evolver's sequential pass.
 """
 from __future__ import annotations
 
 import copy
 import heapq
 import math
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -23,6 +27,7 @@ from ..geometry import kernels as G
 from ..model.groups import group_of
 from ..model.records import (along_first, edge_facets, record_along_first,
                              record_vertex_rings, settle_records)
+from .flip_rounds import flip_rounds, initial_criterion
 from .rings import Rings
 
 
@@ -42,15 +47,21 @@ def _flip_rings(s, t, moves, E=None):
     The pass flips in edge id order; each flip takes the edge out of the
     rings of its old ends and puts it in those of its new ends (measured
     with ``vv.edge`` after ``u`` on catbody.fe, column.fe and quad.fe).
-    Runs of flips with no vertex in common are replayed at once.  The rings
-    are computed when first read (:func:`record_vertex_rings`)."""
+    Flips with no vertex in common are replayed at once
+    (:func:`_rings_after_flips`).  The rings are computed when first read
+    (:func:`record_vertex_rings`)."""
     settle_records(s)                     # (no chain of surfaces kept for later)
     E, nv = t.E.copy() if E is None else E, t.nv
     record_vertex_rings(t, lambda: _rings_after_flips(s, E, nv, moves), E)
 
 
 def _rings_after_flips(s, E, nv, moves):
-    """The rank of :func:`_flip_rings` (``E``, ``nv``: the new surface's)."""
+    """The rank of :func:`_flip_rings` (``E``, ``nv``: the new surface's).
+
+    The flips are replayed in rounds: a flip goes in a round when no
+    earlier flip not yet replayed has one of its four vertices (changes of
+    the rings of distinct vertices commute, so this is the replay in id
+    order)."""
     g = Rings(s, len(E), nv)
     I = np.concatenate([m[0] for m in moves])
     o = np.argsort(I, kind="stable")
@@ -58,19 +69,19 @@ def _rings_after_flips(s, E, nv, moves):
     p = np.concatenate([m[1] for m in moves])[o]
     q = np.concatenate([m[2] for m in moves])[o]
     x, y = E[I, 0], E[I, 1]
-    quads = np.stack([p, q, x, y], 1).tolist()
-    start, used = 0, set()
-    for k in range(len(I) + 1):
-        if k < len(I) and not used.intersection(quads[k]):
-            used.update(quads[k])
-            continue
-        b = slice(start, k)
+    V = np.stack([p, q, x, y], 1)
+    low = np.empty(nv, np.int64)
+    pend = np.arange(len(I))
+    while len(pend):
+        W = V[pend]
+        low[W.ravel()[::-1]] = np.repeat(pend, 4)[::-1]     # (the last write wins: the lowest)
+        ready = (low[W] == pend[:, None]).all(axis=1)
+        b = pend[ready]
+        pend = pend[~ready]
         g.remove(p[b], 2 * I[b])
         g.remove(q[b], 2 * I[b] + 1)
         g.insert(x[b], 2 * I[b])
         g.insert(y[b], 2 * I[b] + 1)
-        if k < len(I):
-            start, used = k, set(quads[k])
     return g.rank()
 
 
@@ -82,50 +93,17 @@ def _flat(a):
     return memoryview(a.reshape(-1))
 
 
-def _quads(E, FE, ef, edges):
-    """For each edge of ``edges`` (two facets of opposite orientations): its
-    facets ``fa`` (running along the edge) and ``fb``, the other sides
-    ``b1, c1`` of fa and ``b2, c2`` of fb (signed, in facet order after the
-    edge) and the opposite vertices ``r`` (of fa) and ``sv`` (of fb).
-    Edges whose facets do not run opposite ways are dropped (None if none)."""
-    fa, fb = ef[edges, 0], ef[edges, 1]
-    A = np.where(FE[fa] >= 0, FE[fa], ~FE[fa])
-    ka = np.argmax(A == edges[:, None], axis=1)
-    B = np.where(FE[fb] >= 0, FE[fb], ~FE[fb])
-    kb = np.argmax(B == edges[:, None], axis=1)
-    sa = FE[fa, ka]
-    swap = sa < 0
-    fa, fb = np.where(swap, fb, fa), np.where(swap, fa, fb)
-    ka, kb = np.where(swap, kb, ka), np.where(swap, ka, kb)
-    if not (np.all(FE[fa, ka] >= 0) and np.all(FE[fb, kb] < 0)):
-        return None
-    b1, c1 = FE[fa, (ka + 1) % 3], FE[fa, (ka + 2) % 3]
-    b2, c2 = FE[fb, (kb + 1) % 3], FE[fb, (kb + 2) % 3]
-
-    def head(x):
-        return np.where(x >= 0, E[np.where(x >= 0, x, 0), 1], E[np.where(x < 0, ~x, 0), 0])
-    return fa, fb, b1, c1, b2, c2, head(b1), head(b2)
-
-
-def _passes(FEabs, ef, edges, lengths, threshold, ek=None):
-    """The flip criterion of each edge of ``edges`` (bool), from the facets'
-    unsigned edges ``FEabs`` and the edge lengths; always true for
-    ``threshold = inf``.  ``ek``
-    (the edges' sides in their facets, from :func:`edge_facets`) saves the
-    search when the facets are those ``edge_facets`` saw."""
-    if not np.isfinite(threshold):
-        return np.ones(len(edges), bool)
-    a = lengths[edges]
-    tot = np.zeros(len(edges))
-    rows = np.arange(len(edges))
-    for j in (0, 1):
-        A = FEabs[ef[edges, j]]
-        k = ek[edges, j] if ek is not None else np.argmax(A == edges[:, None], axis=1)
-        b = lengths[A[rows, (k + 1) % 3]]
-        c = lengths[A[rows, (k + 2) % 3]]
-        with np.errstate(all="ignore"):
-            tot += (b * b + c * c - a * a) / (b * c)
-    return tot < threshold
+def _edge_lengths(X, E):
+    """Edge lengths, axis by axis: the numbers of
+    ``np.linalg.norm(X[E[:, 1]] - X[E[:, 0]], axis=1)`` (the squares summed
+    in axis order), without its (ne, 3) temporaries."""
+    e0, e1 = E[:, 0], E[:, 1]
+    acc = None
+    for c in range(X.shape[1]):
+        x = X[e1, c] - X[e0, c]
+        x *= x
+        acc = x if acc is None else np.add(acc, x, out=acc)
+    return np.sqrt(acc, out=acc)
 
 
 def _signature(s):
@@ -162,9 +140,39 @@ def equiangulate(s, threshold=-0.001, only=None):
     With ``only`` (a (ne,) bool mask) just those edges are candidates, and
     with ``threshold=inf`` they are flipped whatever the angles
     (``edgeswap``); the topological conditions are the same.
+
+    A surface without torus wraps or a symmetry group goes through the pass
+    in rounds of independent visits (:mod:`pyevolver.remesh.flip_rounds`);
+    the others, and the rare surfaces the rounds cannot decide, visit the
+    candidates one by one.
     """
     if s.nf == 0:
         return s, 0
+    t, c = _prepare(s, threshold, only)
+    if c is None:
+        return s, 0
+    moves = None
+    if c.wrap is None and c.group is None:
+        moves = flip_rounds(t.X, t.E, t.FE, c.ef, c.val, c.cand_items, c.first, c.lengths,
+                            threshold, c.maybe)
+        if moves is None:               # (the rounds could not tell: one by one)
+            t, c = _prepare(s, threshold, only)
+    if moves is None:
+        moves = _sequential(t, c, threshold)
+    t.__dict__.pop("_topo", None)          # E and FE were changed
+    flips = sum(len(m[0]) for m in moves)
+    if flips:
+        # an edge's facet loop keeps its start through the flips (REF, ee.facet)
+        copies = (t.FE, t.E)    # (t's own arrays, never written again: refine.split_edges)
+        record_along_first(t, c.first, copies)
+        _flip_rings(s, t, moves, copies[1])
+    t.topology_version = getattr(s, "topology_version", 0) + 1
+    return t, flips
+
+
+def _prepare(s, threshold, only):
+    """A copy ``t`` of ``s`` whose ``E``, ``FE`` (and wraps) the pass may
+    change, and the pass's arrays (None when no edge passes the test)."""
     t = copy.copy(s)
     t.E = s.E.copy()
     t.FE = s.FE.copy()
@@ -172,13 +180,14 @@ def equiangulate(s, threshold=-0.001, only=None):
     if "wrap" in s.eattr:
         t.eattr["wrap"] = s.eattr["wrap"].copy()
     t.__dict__.pop("_lift_cache", None)
-    E, FE = t.E, t.FE
+    E = t.E
     wrap = t.eattr.get("wrap")
     ef, ekk, val = edge_facets(s)          # (s: its topology is cached; the same as t's)
-    first = along_first(s)
     wv = t.wrap_shift()
     group = group_of(t)
-    if group is None:
+    if group is None and wv is None and t.X.shape[1] == 3:
+        lengths = _edge_lengths(t.X, E)
+    elif group is None:
         lengths = np.linalg.norm(G.edge_vectors(t.X, E, wv), axis=1)
     else:                       # a symmetry group's codes (model.groups): sequential pass
         wrap = t.eattr["wrap_code"] = s.eattr["wrap_code"].copy()
@@ -194,64 +203,33 @@ def equiangulate(s, threshold=-0.001, only=None):
     ok = eligible & (f0 >= 0)
     ok[ok] &= np.abs(tension[f0[ok]] - tension[f1[ok]]) <= 1e-10
     ok[ok] &= (fsig[f0[ok]] == esig[ok]) & (fsig[f1[ok]] == esig[ok])
-    cand = np.nonzero(ok)[0]
-    if len(cand):
-        cand = cand[_passes(s.topology()[0], ef, cand, lengths, threshold, ekk)]
+    items = np.nonzero(ok)[0]
+    FEabs = s.topology()[0]
+    if not np.isfinite(threshold):
+        passing = np.ones(len(items), bool)
+    else:
+        with np.errstate(all="ignore"):
+            passing = initial_criterion(FEabs, ef, ekk, items, lengths) < threshold
+    cand = items[passing]
     if not len(cand):
-        return s, 0
+        return t, None
+    maybe = np.zeros(t.ne, bool)
+    maybe[cand] = True
+    return t, SimpleNamespace(ef=ef, val=val, ok=ok, cand_items=items, cand=cand,
+                              maybe=maybe, first=along_first(s), lengths=lengths,
+                              wrap=wrap, wv=wv, group=group)
 
-    # Candidates whose quadrilaterals share no vertex with another
-    # candidate's cannot interact with any other visit of the pass (their
-    # flips change only facets and edges among their own four vertices), so
-    # they are flipped at once; the rest go through the sequential pass.
-    nv = t.nv
-    heap = cand
-    flips_at_once = 0
-    moves = []              # (edges, old tails, old heads) in the order flipped
+
+def _sequential(t, c, threshold):
+    """The pass visiting the candidates one by one in id order, changing
+    ``t`` (and ``c``'s arrays) in place; returns the flips as one block
+    (edges, old tails, old heads)."""
+    E, FE, ef, val, ok, first = t.E, t.FE, c.ef, c.val, c.ok, c.first
+    wrap, wv, group, nv = c.wrap, c.wv, c.group, t.nv
+    lengths = c.lengths
     # adjacency for the "already joined" test
     pairs = set((np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])).tolist())
-    if wrap is None:
-        quad = _quads(E, FE, ef, cand)
-        if quad is not None:
-            fa, fb, b1, c1, b2, c2, r, sv = quad
-            use = np.bincount(np.concatenate([E[cand, 0], E[cand, 1], r, sv]), minlength=nv)
-            iso = ((use[E[cand, 0]] == 1) & (use[E[cand, 1]] == 1) & (use[r] == 1)
-                   & (use[sv] == 1) & (r != sv))
-            k = np.minimum(r, sv) * nv + np.maximum(r, sv)
-            iso &= np.array([x not in pairs for x in k.tolist()], bool)   # r, sv not joined
-            if iso.any():
-                I = cand[iso]
-                fa, fb, b1, c1, b2, c2, r, sv = (x[iso] for x in quad)
-                moves.append((I, E[I, 0].copy(), E[I, 1].copy()))
-                pairs.difference_update((np.minimum(E[I, 0], E[I, 1]) * nv
-                                         + np.maximum(E[I, 0], E[I, 1])).tolist())
-                pairs.update(k[iso].tolist())
-                al = first[I][:, None]
-                E[I, 0], E[I, 1] = np.where(al[:, 0], sv, r), np.where(al[:, 0], r, sv)
-                FE[fa] = np.where(al, np.stack([I, c1, b2], 1), np.stack([I, c2, b1], 1))
-                FE[fb] = np.where(al, np.stack([~I, c2, b1], 1), np.stack([~I, c1, b2], 1))
-                mv1, mv2 = np.where(al[:, 0], b1, c1), np.where(al[:, 0], b2, c2)
-                for side, old, new in ((mv1, fa, fb), (mv2, fb, fa)):
-                    i = np.where(side >= 0, side, ~side)
-                    two = val[i] == 2
-                    i, old, new = i[two], old[two], new[two]
-                    ef[i, 0] = np.where(ef[i, 0] == old, new, ef[i, 0])
-                    ef[i, 1] = np.where(ef[i, 1] == old, new, ef[i, 1])
-                lengths[I] = np.linalg.norm(t.X[r] - t.X[sv], axis=1)
-                flips_at_once = len(I)
-                # their outer sides, visited after them, are visited again
-                # if they pass now (if not, only a later flip next to them
-                # can make them pass, and that flip puts them back)
-                outer = np.stack([c1, b2, c2, b1], 1)
-                outer = np.where(outer >= 0, outer, ~outer)
-                later = outer > I[:, None]
-                again = np.sort(outer[later])         # (repeats: skipped when popped)
-                okd = np.zeros(len(again), bool)
-                sel = ok[again]
-                okd[sel] = _passes(np.where(FE >= 0, FE, ~FE), ef, again[sel], lengths,
-                                    threshold)
-                heap = np.concatenate([cand[~iso], again[okd]])
-
+    heap = c.cand
     heap = np.asarray(heap).tolist()
     heapq.heapify(heap)
     flips = 0
@@ -370,14 +348,7 @@ def equiangulate(s, threshold=-0.001, only=None):
             i = x if x >= 0 else ~x
             if i > ed:                # not yet visited (visits go in id order)
                 push(heap, i)
-    t.__dict__.pop("_topo", None)          # E and FE were changed
-    if flips + flips_at_once:
-        # an edge's facet loop keeps its start through the flips (REF, ee.facet)
-        copies = (t.FE.copy(), t.E.copy())    # (one copy for both records)
-        record_along_first(t, first, copies)
-        if seq_moves:               # (one block, in the order flipped)
-            sm = np.array(seq_moves, dtype=np.int64).reshape(-1, 3)
-            moves.append((sm[:, 0], sm[:, 1], sm[:, 2]))
-        _flip_rings(s, t, moves, copies[1])
-    t.topology_version = getattr(s, "topology_version", 0) + 1
-    return t, flips + flips_at_once
+    if not seq_moves:
+        return []
+    sm = np.array(seq_moves, dtype=np.int64).reshape(-1, 3)
+    return [(sm[:, 0], sm[:, 1], sm[:, 2])]

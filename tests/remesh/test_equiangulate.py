@@ -80,3 +80,12 @@ def test_unequal_tension_is_not_flipped():
     s = _diamond(0.1)
     s.fattr["tension"] = np.array([1.0, 2.0])
     assert equiangulate(s)[1] == 0
+
+
+def test_edge_lengths_are_the_norms_to_the_bit():
+    from pyevolver.remesh.equiangulate import _edge_lengths
+    rng = np.random.default_rng(1)
+    X = rng.normal(size=(500, 3)) * 10.0 ** rng.uniform(-6, 6, (500, 1))
+    E = rng.integers(0, 500, (20000, 2))
+    want = np.linalg.norm(X[E[:, 1]] - X[E[:, 0]], axis=1)
+    assert np.array_equal(_edge_lengths(X, E), want)
