@@ -80,3 +80,75 @@ def ade_header(c0: float = 0.0, alpha: float = 0.0, m0: float = 1.0, area: float
                   "method_instance mci method mean_curvature_integral global",
                   "quantity ade energy function ade_k*(mci.value - ade_m0)^2"]
     return "\n".join(lines) + "\n"
+
+
+# -- the axisymmetric models and their relations --------------------------------------------
+
+def reduced_area_difference(res: CanhamResult) -> float:
+    """``Δa = M / (4π R0)`` of a reference shape (area ``4π``: ``R0 = 1``);
+    1 for the sphere (Seifert, Berndl & Lipowsky 1991, Eq. (2.6))."""
+    return res.mean_curvature / (4 * np.pi)
+
+
+def effective_c0(model: Helfrich, m: float) -> float:
+    """``c0_eff = c0 − 2π α (m − m0)``: the spontaneous curvature whose SC
+    problem has the ADE shape of reduced area difference ``m`` as a critical
+    point (the ADE term's derivative ``2πα/A (M − 4π m0)`` with respect to
+    ``M``, at ``A = 4π``, joins the SC term's ``−c0``)."""
+    return model.c0 - 2 * np.pi * model.alpha * (m - model.m0)
+
+
+def ade_energy_from_bc(w_bc: float, m: float, model: Helfrich) -> float:
+    """``E_ADE = W_BC − 4π c0 m + π c0² + 4π² α (m − m0)²`` (area ``4π``),
+    the ADE energy of the BC critical point of ``∫H² dA = w_bc`` at
+    ``M = 4π m``."""
+    return (w_bc - 4 * np.pi * model.c0 * m + np.pi * model.c0 ** 2
+            + 4 * np.pi ** 2 * model.alpha * (m - model.m0) ** 2)
+
+
+def bilayer_couple(v0: float, m: float, branch: str, n: int = 32, c0: float = 0.0,
+                   coef0: np.ndarray | None = None, tol: float = 1e-12, maxit: int = 60,
+                   max_step: float = 0.5) -> tuple[CanhamResult, float]:
+    """The bilayer-couple critical point of ``∫H² dA`` at area ``4π``,
+    reduced volume ``v0`` and ``M = ∫H dA = 4π m`` on ``branch``.
+
+    It is the spontaneous-curvature critical point whose ``c0`` (the
+    multiplier of ``M``, SBL 1991 Sec. II) gives ``M = 4π m``: the secant
+    method on ``c0`` from ``c0`` (steps at most ``max_step``, halved while
+    the SC solve fails), each SC problem solved by :func:`canham_reference`
+    from the previous shape (``coef0`` first).  ``M`` changes slowly with
+    ``c0`` (``∂²W_BC/∂M²`` is large), hence the step limit.
+
+    Returns
+    -------
+    (result, c0)
+        The SC result at the final ``c0`` (``result.willmore`` is ``W_BC``)
+        and ``c0 = ∂W_BC/∂M``.
+    """
+    def solve(c, a0):
+        with np.errstate(invalid="ignore", over="ignore"):
+            return canham_reference(v0, branch, n=n, coef0=a0, model=Helfrich(c0=c))
+    target = 4 * np.pi * m
+    r1 = solve(c0, coef0)
+    f1 = r1.mean_curvature - target
+    c_prev, f_prev = None, None
+    for _ in range(maxit):
+        if abs(f1) < tol * target:
+            return r1, c0
+        if c_prev is None or f1 == f_prev:
+            step = -np.sign(f1) * 0.05
+        else:
+            step = -f1 * (c0 - c_prev) / (f1 - f_prev)
+        step = float(np.clip(step, -max_step, max_step))
+        for _ in range(8):
+            try:
+                r2 = solve(c0 + step, r1.coef)
+                break
+            except (RuntimeError, np.linalg.LinAlgError):
+                step *= 0.5
+        else:
+            break
+        c_prev, f_prev = c0, f1
+        c0, r1 = c0 + step, r2
+        f1 = r1.mean_curvature - target
+    raise RuntimeError(f"bilayer couple at v0={v0}, m={m}: M off by {f1:.2e}")
