@@ -43,6 +43,11 @@ Evolver's ``h_zero`` (a mean curvature: ``h_zero = c0/2``); evolver-nox-d
 """
 from __future__ import annotations
 
+import io
+import os
+import tempfile
+import time
+
 import numpy as np
 
 from .axisymmetric import CanhamResult, Helfrich, canham_reference
@@ -152,3 +157,112 @@ def bilayer_couple(v0: float, m: float, branch: str, n: int = 32, c0: float = 0.
         c0, r1 = c0 + step, r2
         f1 = r1.mean_curvature - target
     raise RuntimeError(f"bilayer couple at v0={v0}, m={m}: M off by {f1:.2e}")
+
+
+# -- discrete ADE points -------------------------------------------------------------------
+
+def _point_session(X, F, v, lam, directory, c0, mu, method):
+    """A point's session: the bending energy with ``h_zero = c0/2``, the
+    harmonic regularization ``λE``, ``μ·M`` (an energy quantity ``mcq`` of
+    the method ``mean_curvature_integral``, linear in M) and ``M`` itself
+    (``mci``, info only); area ``4π`` and volume ``v·4π/3`` fixed."""
+    from ..session.core import Session
+    from .meshes import write_fe
+    path = os.path.join(directory, "ade_point.fe")
+    hdr = "\n".join([
+        "// discrete ADE point (pyevolver.studies.phase_ade)",
+        f"parameter v0 = {float(v)!r}",
+        f"parameter c0 = {float(c0)!r}",
+        "parameter h_zero = c0/2",
+        f"quantity willmore energy method {method} global",
+        "quantity surf fixed = 4*pi method facet_area global",
+        f"quantity harm energy modulus {float(lam)!r} method harmonic_energy global",
+        f"quantity mcq energy modulus {float(mu)!r} method mean_curvature_integral global",
+        "quantity mci info_only method mean_curvature_integral global"])
+    write_fe(path, X, F, header=hdr, face_attrs="tension 0")
+    with open(path, "a") as fh:
+        fh.write("\nbodies\n1 " + " ".join(str(i + 1) for i in range(len(F)))
+                 + " volume v0*4*pi/3\n")
+    return Session.load(path, out=io.StringIO(), err=io.StringIO())
+
+
+def _linear_solve(X, F, v, lam, c0, mu, method, maxit):
+    """Minimise ``W + λE + μM`` from the mesh ``(X, F)``: ``(converged, X,
+    W, M)``."""
+    from .phase_newton import restore
+    from .vesicle_newton import newton_lm
+    with tempfile.TemporaryDirectory() as tmp:
+        s = _point_session(X, F, v, lam, tmp, c0, mu, method)
+        restore(s)
+        ok, _, _ = newton_lm(s, maxit=maxit)
+        q = s.totals.quantity_values
+        return ok, s.surface.X.copy(), float(q["willmore"]), float(q["mci"])
+
+
+def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
+                    lam: float | None = None, method: str = "normal_sq_mean_curvature",
+                    maxit: int = 60, tol: float = 1e-10, outer: int = 20
+                    ) -> tuple[dict, np.ndarray, np.ndarray]:
+    """The discrete ADE minimiser on ``branch`` at reduced volume ``v``.
+
+    The discrete ADE energy is ``W + k (M − M0)²`` (``k = πα/A``,
+    ``A = 4π``, ``M0 = 4π m0``; W with ``h_zero = c0/2``; ``M`` the exact
+    ``∫H dA`` of the polyhedron, ``mean_curvature_integral``), the energy of
+    :func:`ade_header`, with the study's regularization ``λE`` added.  Its
+    critical points are those of ``W + λE + μM`` with ``μ = 2k(M − M0)``
+    (the ADE term linearised at its own ``M``: the effective spontaneous
+    curvature of the smooth theory, ``c0_eff = c0 − μ``).  Each inner
+    problem, μ fixed, is a spontaneous-curvature problem, minimised by
+    the phase study's damped Newton (a linear term in the well-conditioned
+    variable: ``M`` hardly moves with μ on the prolate branch, where fixing
+    ``M`` instead — the bilayer couple — is very stiff); the outer
+    iteration solves ``μ = 2k(M(μ) − M0)`` by the secant method.  Every
+    solve starts from the previous mesh, the first from the axisymmetric
+    ADE reference ``ref`` revolved into about ``nv`` vertices
+    (:func:`~pyevolver.studies.phase_mesh.revolve`); λ(h) is the study's
+    (:func:`~pyevolver.studies.phase_study.lam_for`).
+
+    Returns ``(row, X, F)``: the row has ``W`` (the discrete ADE energy,
+    without λE), ``W_ref``, ``rel_err``, the discrete and the reference
+    ``m = M/4π``, ``c0_eff`` and ``converged`` (every inner solve converged
+    and ``|μ − 2k(M − M0)|`` below ``tol``); ``X, F`` the final mesh.
+    """
+    from .phase_mesh import revolve
+    from .phase_reference import follow
+    from .phase_study import lam_for
+    t0 = time.perf_counter()
+    if ref is None:
+        ref = follow(branch, [v], model)[0].result
+    lam = lam_for(nv) if lam is None else lam
+    X, F = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi)
+    k = np.pi * model.alpha / (4 * np.pi)
+    M0 = 4 * np.pi * model.m0
+    ok_all = True
+
+    def f(mu, X):
+        ok, X1, W, M = _linear_solve(X, F, v, lam, model.c0, mu, method, maxit)
+        return ok, X1, W, M, mu - 2 * k * (M - M0)
+    mu_a = 2 * k * (float(ref.mean_curvature) - M0)
+    ok, X, W, M, fa = f(mu_a, X)
+    ok_all &= ok
+    mu_b = mu_a - fa                                  # one fixed-point step first
+    converged = abs(fa) < tol
+    mu = mu_a
+    for _ in range(outer):
+        if converged:
+            break
+        ok, X, W, M, fb = f(mu_b, X)
+        ok_all &= ok
+        mu = mu_b
+        if abs(fb) < tol or fb == fa:
+            converged = abs(fb) < tol
+            break
+        mu_a, fa, mu_b = mu_b, fb, mu_b - fb * (mu_b - mu_a) / (fb - fa)
+    E = W + k * (M - M0) ** 2
+    row = {"branch": branch, "v": float(v), "c0": model.c0, "alpha": model.alpha,
+           "m0": model.m0, "nv": len(X), "W": E, "W_ref": float(ref.W),
+           "rel_err": E / ref.W - 1.0, "m": M / (4 * np.pi),
+           "m_ref": float(ref.mean_curvature) / (4 * np.pi), "c0_eff": model.c0 - mu,
+           "lambda": lam, "method": method, "converged": bool(converged and ok_all),
+           "seconds": time.perf_counter() - t0}
+    return row, X, F
