@@ -200,7 +200,7 @@ def _linear_solve(X, F, v, lam, c0, mu, method, maxit):
 
 
 def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
-                    lam: float | None = None, method: str = "normal_sq_mean_curvature",
+                    lam: float | None = None, method: str | None = None,
                     maxit: int = 60, tol: float = 1e-10, outer: int = 20
                     ) -> tuple[dict, np.ndarray, np.ndarray]:
     """The discrete ADE minimiser on ``branch`` at reduced volume ``v``.
@@ -220,7 +220,8 @@ def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
     solve starts from the previous mesh, the first from the axisymmetric
     ADE reference ``ref`` revolved into about ``nv`` vertices
     (:func:`~pyevolver.studies.phase_mesh.revolve`); λ(h) is the study's
-    (:func:`~pyevolver.studies.phase_study.lam_for`).
+    (:func:`~pyevolver.studies.phase_study.lam_for`), and so is the
+    default ``method`` (:func:`~pyevolver.studies.phase_study.method_for`).
 
     Returns ``(row, X, F)``: the row has ``W`` (the discrete ADE energy,
     without λE), ``W_ref``, ``rel_err``, the discrete and the reference
@@ -229,8 +230,9 @@ def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
     """
     from .phase_mesh import revolve
     from .phase_reference import follow
-    from .phase_study import lam_for
+    from .phase_study import lam_for, method_for
     t0 = time.perf_counter()
+    method = method_for(model.c0, method)
     if ref is None:
         ref = follow(branch, [v], model)[0].result
     lam = lam_for(nv) if lam is None else lam
@@ -266,3 +268,106 @@ def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
            "lambda": lam, "method": method, "converged": bool(converged and ok_all),
            "seconds": time.perf_counter() - t0}
     return row, X, F
+
+
+# -- the table of docs/phase.md ----------------------------------------------------------------
+
+#: (branch, v, model) of the ADE table
+POINTS = [("prolate", 1.0, Helfrich(c0=0.5, alpha=1.4, m0=1.05)),
+          ("prolate", 0.85, Helfrich(c0=0.5, alpha=1.4, m0=1.05)),
+          ("prolate", 0.85, Helfrich(c0=0.0, alpha=5.0, m0=1.1)),
+          ("oblate", 0.65, Helfrich(c0=0.0, alpha=1.4, m0=1.02)),
+          ("stomatocyte", 0.55, Helfrich(c0=-0.5, alpha=1.4, m0=1.0))]
+ADE_COLUMNS = ["branch", "v", "c0", "alpha", "m0", "E_ref", "m_ref", "c0_eff", "sc_rel_diff",
+               "bc_rel_diff", "bc_start", "closed_form_rel_diff", "nv", "E", "m", "rel_err",
+               "converged", "method"]
+
+
+def table(nv: int = 642, points=POINTS, log=print) -> list[dict]:
+    """One row per point: the axisymmetric ADE reference ``E_ref`` (and
+    ``m_ref``, ``c0_eff``), the relative differences of the two relations
+    (``sc_rel_diff``: ``∫H² dA`` of the SC solve at ``c0_eff`` started from
+    the ``c0 = 0`` shape against the ADE shape's; ``bc_rel_diff``:
+    :func:`ade_energy_from_bc` of a :func:`bilayer_couple` solve against
+    ``E_ref``), the sphere's closed form (v = 1), and with ``nv > 0`` the
+    discrete point (:func:`solve_ade_point`)."""
+    from .phase_reference import follow
+    rows = []
+    for branch, v, model in points:
+        row = {"branch": branch, "v": v, "c0": model.c0, "alpha": model.alpha, "m0": model.m0}
+        if v == 1.0:
+            ref = canham_reference(1.0, branch, n=8, model=model)
+            exact = (4 * np.pi * (1 - model.c0 / 2) ** 2
+                     + 4 * np.pi ** 2 * model.alpha * (1 - model.m0) ** 2)
+            row["closed_form_rel_diff"] = ref.W / exact - 1.0
+            plain = canham_reference(1.0, branch, n=8)
+        else:
+            ref = follow(branch, [v], model)[0].result
+            plain = follow(branch, [v])[0].result
+        m = reduced_area_difference(ref)
+        ce = effective_c0(model, m)
+        n = ref.n
+        sc = canham_reference(v, branch, n=n, coef0=plain.coef, model=Helfrich(c0=ce))
+        try:
+            bc, _ = bilayer_couple(v, m, branch, n=n, coef0=plain.coef)
+        except RuntimeError:        # the secant from c0 = 0 left the branch: from c0_eff
+            bc, _ = bilayer_couple(v, m, branch, n=n, c0=ce, coef0=plain.coef)
+            row["bc_start"] = "c0_eff"
+        row.update(E_ref=ref.W, m_ref=m, c0_eff=ce,
+                   sc_rel_diff=sc.willmore / ref.willmore - 1.0,
+                   bc_rel_diff=ade_energy_from_bc(bc.willmore, m, model) / ref.W - 1.0)
+        if nv and v < 1.0:
+            d, _, _ = solve_ade_point(branch, v, model, nv, ref=ref)
+            row.update(nv=d["nv"], E=d["W"], m=d["m"], rel_err=d["rel_err"],
+                       converged=d["converged"], method=d["method"])
+        log(", ".join(f"{k}={row[k]:.6g}" if isinstance(row[k], float) else f"{k}={row[k]}"
+                      for k in row))
+        rows.append(row)
+    return rows
+
+
+def markdown(rows: list[dict]) -> str:
+    """The table of docs/phase.md (energies as ``E/4π``)."""
+    def f(x, spec):
+        return "—" if x is None or x == "" else format(x, spec)
+    out = ["| branch | v | c0 | α | m0 | E_ref/4π | Δa = m_ref | c0_eff | SC at c0_eff | "
+           "BC + terms | closed form | vertices | E/4π | rel. error |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        conv = r.get("converged")
+        err = ("not converged" if conv is False else f(r.get("rel_err"), "+.3%"))
+        out.append(
+            f"| {r['branch']} | {r['v']:.3f} | {r['c0']:g} | {r['alpha']:g} | {r['m0']:g} | "
+            f"{r['E_ref'] / (4 * np.pi):.6f} | {r['m_ref']:.6f} | {r['c0_eff']:.5f} | "
+            f"{f(r['sc_rel_diff'], '.1e')} | {f(r['bc_rel_diff'], '.1e')} | "
+            f"{f(r.get('closed_form_rel_diff'), '.1e')} | {f(r.get('nv'), 'd')} | "
+            f"{f(r['E'] / (4 * np.pi) if r.get('E') is not None else None, '.5f')} | {err} |")
+    return "\n".join(out) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m pyevolver.studies.phase_ade [--nv 642] [--out DIR]``:
+    writes ``DIR/ade.csv`` and ``DIR/ade.md`` (the table of docs/phase.md)."""
+    import argparse
+    import csv
+    p = argparse.ArgumentParser(prog="python -m pyevolver.studies.phase_ade",
+                                description="ADE reference relations and discrete points")
+    p.add_argument("--nv", type=int, default=642, help="vertices of the discrete points "
+                   "(0: the axisymmetric reference only)")
+    p.add_argument("--out", default=".")
+    args = p.parse_args(argv)
+    rows = table(args.nv, log=lambda t: print(t, flush=True))
+    os.makedirs(args.out, exist_ok=True)
+    with open(os.path.join(args.out, "ade.csv"), "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=ADE_COLUMNS)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{r[k]:.10g}" if isinstance(r.get(k), float) else r.get(k, ""))
+                        for k in ADE_COLUMNS})
+    with open(os.path.join(args.out, "ade.md"), "w") as fh:
+        fh.write(markdown(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

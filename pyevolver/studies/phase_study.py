@@ -3,8 +3,9 @@
 The reduced volume ``v`` is swept on three branches (prolate,
 oblate/discocyte, stomatocyte), at spontaneous curvature ``c0`` (reduced,
 ``C0·R0``; default 0).  Each point minimises the discrete bending energy
-``W = Σ_v (h_v − c0/2)² A_v/3`` (``normal_sq_mean_curvature`` with the
-Evolver's ``h_zero = c0/2``; at ``c0 = 0`` a sphere gives 4π; the smooth
+``W = Σ_v (h_v − c0/2)² A_v/3`` with the Evolver's ``h_zero = c0/2``
+(``normal_sq_mean_curvature`` at ``c0 = 0``, where a sphere gives 4π, and
+``star_perp_sq_mean_curvature`` otherwise, :func:`method_for`; the smooth
 energy is ``∫(H − c0/2)² dA``, SBL's ``F/(2κ)``) plus the paper's harmonic regularization ``λ E`` (``E = (1/√3)
 Σ_edges |e|²``) over all vertex coordinates, at fixed area ``4π`` and
 volume ``v·4π/3`` (damped Newton, :func:`~pyevolver.studies.vesicle_newton.newton_lm`).
@@ -75,8 +76,22 @@ TYPES = {"prolate": {"prolate", "sphere"}, "oblate": {"oblate", "discocyte", "sp
 COLUMNS = ["branch", "c0", "v", "nv", "W", "W_ref", "rel_err", "stable", "eig1", "eig2",
            "eig3", "lambda", "min_angle_deg", "aspect", "h", "type", "start", "converged",
            "newton_steps", "seconds", "method"]
-#: the bending energy's method (the squared mean curvature methods that take h_zero)
+#: the bending energy's method at c0 = 0 (the paper's) and at c0 != 0: with h_zero the
+#: normal estimate h = 3F·F/(2F·N) is singular where F -> 0 (flat parts, the
+#: discocyte's dimples: Hessian eigenvalues of -2e5 and failed points at c0 = -0.5),
+#: star_perp's h = 3F·N/(2N·N) is not (the manual's "pretty good formula")
 METHOD = "normal_sq_mean_curvature"
+METHOD_C0 = "star_perp_sq_mean_curvature"
+
+
+def method_for(c0: float, method: str | None = None) -> str:
+    """The bending energy's method: ``method``, or by default
+    :data:`METHOD` at ``c0 = 0`` and :data:`METHOD_C0` otherwise."""
+    method = method or (METHOD if c0 == 0 else METHOD_C0)
+    if method not in HZERO_METHODS:
+        raise ValueError(f"{method}: the study's bending energy must take h_zero, one of "
+                         f"{HZERO_METHODS}")
+    return method
 MIN_ANGLE = 10.0
 
 
@@ -104,16 +119,14 @@ def _session(X, F, v, lam, directory, c0=0.0, method=METHOD):
 
 def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
                 start: tuple[np.ndarray, np.ndarray] | None = None, maxit: int = 60,
-                eigen: bool = True, c0: float = 0.0, method: str = METHOD
+                eigen: bool = True, c0: float = 0.0, method: str | None = None
                 ) -> tuple[dict, np.ndarray, np.ndarray]:
     """One point of a branch: minimise W + λE from ``start`` (a mesh; default
     the reference ``ref`` revolved), falling back as the module docstring
     says; ``c0`` the spontaneous curvature (``ref`` must be the reference at
-    the same ``c0``); ``method`` the bending energy, one of
-    :data:`phase_ade.HZERO_METHODS`.  Returns ``(row, X, F)``."""
-    if method not in HZERO_METHODS:
-        raise ValueError(f"{method}: the study's bending energy must take h_zero, one of "
-                         f"{HZERO_METHODS}")
+    the same ``c0``); ``method`` the bending energy (:func:`method_for`).
+    Returns ``(row, X, F)``."""
+    method = method_for(c0, method)
     lam = lam_for(nv) if lam is None else lam
     t0 = time.perf_counter()
     rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi)
@@ -205,7 +218,7 @@ def write_rows(path: str, rows: list[dict]) -> None:
 
 def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[dict],
                log: Callable[[str], Any] = print, eigen: bool = True, c0: float = 0.0,
-               method: str = METHOD) -> None:
+               method: str | None = None) -> None:
     """Solve the branch's points of ``volumes`` (those with a reference in
     ``refs``, v -> BranchPoint) by continuation from its seed outwards,
     appending to ``rows`` and rewriting ``out/phase.csv`` after each point;
@@ -306,17 +319,15 @@ def references(volumes, branches=BRANCHES, modes: int | None = None,
 def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
         c0: float = 0.0, plot: bool = True, eigen: bool = True,
         log: Callable[[str], Any] = print, modes: int | None = None,
-        method: str = METHOD) -> tuple[list[dict], list[dict]]:
+        method: str | None = None) -> tuple[list[dict], list[dict]]:
     """The study (see the module docstring); returns ``(rows, transitions)``.
     ``modes``: sine modes of the references (default per branch, see
     :data:`phase_reference.MODES`; fewer for quick runs); ``c0`` the
     reduced spontaneous curvature (the references are solved at the same
     ``c0``; published transitions exist for ``c0 = 0`` only); ``method``
-    the bending energy (:data:`phase_ade.HZERO_METHODS`)."""
-    if method not in HZERO_METHODS:
-        raise ValueError(f"{method}: the study's bending energy must take h_zero, one of "
-                         f"{HZERO_METHODS}")
+    the bending energy (:func:`method_for`)."""
     c0 = float(c0)
+    method = method_for(c0, method)
     model = Helfrich(c0=c0) if c0 else None
     for b in branches:
         if b not in BRANCHES:
@@ -378,8 +389,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--c0", type=float, default=0.0,
                    help="reduced spontaneous curvature C0*R0 (default 0)")
     p.add_argument("--branches", default=",".join(BRANCHES))
-    p.add_argument("--method", default=METHOD, choices=list(HZERO_METHODS),
-                   help=f"bending energy (default {METHOD})")
+    p.add_argument("--method", default=None, choices=list(HZERO_METHODS),
+                   help=f"bending energy (default {METHOD} at c0 = 0, {METHOD_C0} otherwise)")
     p.add_argument("--out", default="phase_out", help="output folder")
     p.add_argument("--no-plot", dest="plot", action="store_false")
     p.add_argument("--no-eigen", dest="eigen", action="store_false",

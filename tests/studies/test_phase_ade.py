@@ -148,4 +148,5 @@ def test_discrete_ade_point_is_stationary_and_near_the_reference(tmp_path):
     assert abs(row["m"] - row["m_ref"]) < 0.01
     # μ = 2k(M − M0) is the effective spontaneous curvature's shift
     assert row["c0_eff"] == pytest.approx(PA.effective_c0(model, row["m"]), abs=1e-8)
-    assert _stationarity(tmp_path, X, F, model, row["lambda"]) < 1e-6
+    assert row["method"] == "star_perp_sq_mean_curvature"     # the default at c0 != 0
+    assert _stationarity(tmp_path, X, F, model, row["lambda"], row["method"]) < 1e-6
