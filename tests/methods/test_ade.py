@@ -96,3 +96,12 @@ def test_ade_header_without_alpha_is_plain_helfrich():
 def test_ade_header_refuses_methods_without_h_zero():
     with pytest.raises(ValueError, match="h_zero"):
         ade_header(method="star_sq_mean_curvature")
+
+
+def test_docs_example_is_the_headers_output():
+    import os
+    here = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    with open(os.path.join(here, "docs", "phase.md")) as fh:
+        text = fh.read()
+    block = "\n".join("    " + ln for ln in ade_header(0.8, 1.5, 1.1).splitlines())
+    assert block in text

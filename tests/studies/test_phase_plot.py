@@ -51,7 +51,8 @@ def _read_transitions(path):
             out.append({"from": r["from"], "to": r["to"],
                         "v": float(r["v"]) if r["v"] else None,
                         "v_ref": float(r["v_ref"]) if r["v_ref"] else None,
-                        "v_published": float(r["v_published"])})
+                        "v_published": (float(r["v_published"]) if r["v_published"]
+                                        else None)})
         return out
 
 
