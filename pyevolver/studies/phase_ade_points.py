@@ -147,18 +147,20 @@ POINTS = [("prolate", 1.0, Helfrich(c0=0.5, alpha=1.4, m0=1.05)),
           ("oblate", 0.65, Helfrich(c0=0.0, alpha=1.4, m0=1.02)),
           ("stomatocyte", 0.55, Helfrich(c0=-0.5, alpha=1.4, m0=1.0))]
 ADE_COLUMNS = ["branch", "v", "c0", "alpha", "m0", "E_ref", "m_ref", "c0_eff", "sc_rel_diff",
-               "bc_rel_diff", "bc_start", "closed_form_rel_diff", "nv", "E", "m", "rel_err",
+               "bc_rel_diff", "start", "closed_form_rel_diff", "nv", "E", "m", "rel_err",
                "converged", "method"]
 
 
 def table(nv: int = 642, points=POINTS, log=print) -> list[dict]:
     """One row per point: the axisymmetric ADE reference ``E_ref`` (and
     ``m_ref``, ``c0_eff``), the relative differences of the two relations
-    (``sc_rel_diff``: ``∫H² dA`` of the SC solve at ``c0_eff`` started from
-    the ``c0 = 0`` shape against the ADE shape's; ``bc_rel_diff``:
-    :func:`ade_energy_from_bc` of a :func:`bilayer_couple` solve against
-    ``E_ref``), the sphere's closed form (v = 1), and with ``nv > 0`` the
-    discrete point (:func:`solve_ade_point`)."""
+    (``sc_rel_diff``: ``∫H² dA`` of the SC solve at ``c0_eff`` against the
+    ADE shape's; ``bc_rel_diff``: :func:`ade_energy_from_bc` of a
+    :func:`bilayer_couple` solve against ``E_ref``; both solves started
+    from the ``c0 = 0`` shape, ``start = "c0=0"``, or where that reaches
+    another critical point from the ADE shape, ``start = "ade"``), the
+    sphere's closed form (v = 1), and with ``nv > 0`` the discrete point
+    (:func:`solve_ade_point`)."""
     rows = []
     for branch, v, model in points:
         row = {"branch": branch, "v": v, "c0": model.c0, "alpha": model.alpha, "m0": model.m0}
@@ -174,14 +176,21 @@ def table(nv: int = 642, points=POINTS, log=print) -> list[dict]:
         m = reduced_area_difference(ref)
         ce = effective_c0(model, m)
         n = ref.n
-        sc = canham_reference(v, branch, n=n, coef0=plain.coef, model=Helfrich(c0=ce))
+        start = "c0=0"
         try:
+            sc = canham_reference(v, branch, n=n, coef0=plain.coef, model=Helfrich(c0=ce))
             bc, _ = bilayer_couple(v, m, branch, n=n, coef0=plain.coef)
+            ok = abs(sc.willmore / ref.willmore - 1) < 1e-6
         except RuntimeError:
-            # the secant from c0 = 0 left the branch (the stomatocyte): from
-            # the SC solve at c0_eff, which it then confirms in one step
-            bc, _ = bilayer_couple(v, m, branch, n=n, c0=ce, coef0=sc.coef)
-            row["bc_start"] = "sc"
+            ok = False
+        if not ok:
+            # from the c0 = 0 shape the solves reach another critical point
+            # (the stomatocyte): the relations are then checked from the ADE
+            # shape itself (Newton on the SC and BC problems there)
+            start = "ade"
+            sc = canham_reference(v, branch, n=n, coef0=ref.coef, model=Helfrich(c0=ce))
+            bc, _ = bilayer_couple(v, m, branch, n=n, c0=ce, coef0=ref.coef)
+        row["start"] = start
         row.update(E_ref=ref.W, m_ref=m, c0_eff=ce,
                    sc_rel_diff=sc.willmore / ref.willmore - 1.0,
                    bc_rel_diff=ade_energy_from_bc(bc.willmore, m, model) / ref.W - 1.0)
@@ -200,15 +209,15 @@ def markdown(rows: list[dict]) -> str:
     def f(x, spec):
         return "—" if x is None or x == "" else format(x, spec)
     out = ["| branch | v | c0 | α | m0 | E_ref/4π | Δa = m_ref | c0_eff | SC at c0_eff | "
-           "BC + terms | closed form | vertices | E/4π | rel. error |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "BC + terms | solves from | closed form | vertices | E/4π | rel. error |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         conv = r.get("converged")
         err = ("not converged" if conv is False else f(r.get("rel_err"), "+.3%"))
         out.append(
             f"| {r['branch']} | {r['v']:.3f} | {r['c0']:g} | {r['alpha']:g} | {r['m0']:g} | "
             f"{r['E_ref'] / (4 * np.pi):.6f} | {r['m_ref']:.6f} | {r['c0_eff']:.5f} | "
-            f"{f(r['sc_rel_diff'], '.1e')} | {f(r['bc_rel_diff'], '.1e')} | "
+            f"{f(r['sc_rel_diff'], '.1e')} | {f(r['bc_rel_diff'], '.1e')} | {r['start']} | "
             f"{f(r.get('closed_form_rel_diff'), '.1e')} | {f(r.get('nv'), 'd')} | "
             f"{f(r['E'] / (4 * np.pi) if r.get('E') is not None else None, '.5f')} | {err} |")
     return "\n".join(out) + "\n"
@@ -226,7 +235,7 @@ def read_table(path: str) -> list[dict]:
                     continue
                 if val in ("True", "False"):
                     row[k] = val == "True"
-                elif k in ("branch", "bc_start", "method"):
+                elif k in ("branch", "start", "method"):
                     row[k] = val
                 elif k == "nv":
                     row[k] = int(val)
