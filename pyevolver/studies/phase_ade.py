@@ -3,7 +3,7 @@ form of the energy and the relations between the three vesicle models.
 
 The energy (Miao, Seifert, Wortis & Döbereiner 1994, *Budding transitions
 of fluid-bilayer vesicles: the effect of area-difference elasticity*,
-Phys. Rev. E 49, 5389, Eq. (2.1))
+Phys. Rev. E 49, 5389)
 
     F = (κ/2) ∮ (C1 + C2 − C0)² dA + (κ̄ π / (2 A D²)) (ΔA − ΔA0)²,
 
@@ -20,8 +20,8 @@ preferred area difference (1 for the sphere).  It is the model of
 
 The spontaneous-curvature (SC), bilayer-couple (BC) and ADE models are
 related by Legendre-type transforms (Miao et al. 1994, Sec. II; Seifert
-1997, *Configurations of fluid membranes and vesicles*, Adv. Phys. 46, 13,
-Sec. 4): with ``W_BC(v, m)`` the critical values of ``∫H² dA`` at fixed
+1997, *Configurations of fluid membranes and vesicles*, Adv. Phys. 46, 13):
+with ``W_BC(v, m)`` the critical values of ``∫H² dA`` at fixed
 area, reduced volume ``v`` and ``M = 4π m``,
 
 * SC: ``E_SC = ∫H² dA − c0 M + π c0²``; its critical points are BC critical
@@ -87,7 +87,7 @@ def ade_header(c0: float = 0.0, alpha: float = 0.0, m0: float = 1.0, area: float
 
 def reduced_area_difference(res: CanhamResult) -> float:
     """``Δa = M / (4π R0)`` of a reference shape (area ``4π``: ``R0 = 1``);
-    1 for the sphere (Seifert, Berndl & Lipowsky 1991, Eq. (2.6))."""
+    1 for the sphere (Seifert, Berndl & Lipowsky 1991)."""
     return res.mean_curvature / (4 * np.pi)
 
 
@@ -114,7 +114,7 @@ def bilayer_couple(v0: float, m: float, branch: str, n: int = 32, c0: float = 0.
     reduced volume ``v0`` and ``M = ∫H dA = 4π m`` on ``branch``.
 
     It is the spontaneous-curvature critical point whose ``c0`` (the
-    multiplier of ``M``, SBL 1991 Sec. II) gives ``M = 4π m``: the secant
+    multiplier of ``M``) gives ``M = 4π m``: the secant
     method on ``c0`` from ``c0`` (steps at most ``max_step``, halved while
     the SC solve fails), each SC problem solved by :func:`canham_reference`
     from the previous shape (``coef0`` first).  ``M`` changes slowly with

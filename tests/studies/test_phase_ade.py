@@ -1,7 +1,7 @@
 """The axisymmetric ADE reference against the exact relations between the
 spontaneous-curvature (SC), bilayer-couple (BC) and ADE models
 (pyevolver.studies.phase_ade; Miao, Seifert, Wortis & Döbereiner 1994,
-Sec. II; Seifert 1997, Sec. 4).
+Sec. II; Seifert 1997, Adv. Phys. 46, 13).
 
 Expected values: closed forms (the sphere: Δa = 1, E = 4π(1 − c0/2)² +
 4π²α(1 − m0)²) and the relations, each checked between solves of
@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from pyevolver.studies import phase_ade as PA
+from pyevolver.studies import phase_ade_points as PP
 from pyevolver.studies import phase_reference as PR
 from pyevolver.studies.axisymmetric import Helfrich, canham_reference
 
@@ -142,7 +143,7 @@ def test_discrete_ade_point_is_stationary_and_near_the_reference(tmp_path):
     quantity, evaluated separately) and its energy is within 2% above the
     axisymmetric ADE reference (c0 = 0 at this size: +1.2%)."""
     model = Helfrich(c0=0.5, alpha=1.4, m0=1.05)
-    row, X, F = PA.solve_ade_point("prolate", 0.85, model, 120)
+    row, X, F = PP.solve_ade_point("prolate", 0.85, model, 120)
     assert row["converged"] is True
     assert 0 < row["rel_err"] < 0.02
     assert abs(row["m"] - row["m_ref"]) < 0.01
@@ -150,3 +151,22 @@ def test_discrete_ade_point_is_stationary_and_near_the_reference(tmp_path):
     assert row["c0_eff"] == pytest.approx(PA.effective_c0(model, row["m"]), abs=1e-8)
     assert row["method"] == "star_perp_sq_mean_curvature"     # the default at c0 != 0
     assert _stationarity(tmp_path, X, F, model, row["lambda"], row["method"]) < 1e-6
+
+
+def test_docs_table_is_the_committed_csv():
+    """docs/phase.md quotes docs/phase/ade.md, which is markdown() of the
+    committed docs/phase/ade.csv (written by python -m
+    pyevolver.studies.phase_ade_points --nv 642 --out docs/phase); its relation
+    columns are at round-off and its discrete points within 1%."""
+    import os
+    docs = os.path.join(os.path.dirname(__file__), "..", "..", "docs")
+    rows = PP.read_table(os.path.join(docs, "phase", "ade.csv"))
+    text = PP.markdown(rows)
+    with open(os.path.join(docs, "phase", "ade.md")) as fh:
+        assert fh.read() == text
+    with open(os.path.join(docs, "phase.md")) as fh:
+        assert text in fh.read()
+    for r in rows:
+        assert abs(r["sc_rel_diff"]) < 1e-9 and abs(r["bc_rel_diff"]) < 1e-9
+        if r.get("converged") is True:
+            assert 0 < r["rel_err"] < 0.01
