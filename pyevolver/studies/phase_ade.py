@@ -48,9 +48,10 @@ import numpy as np
 
 from .axisymmetric import CanhamResult, Helfrich, canham_reference
 
-#: the squared mean curvature methods of the phase study that honour h_zero
+#: the squared mean curvature methods of the phase study that honour h_zero (the
+#: MDSB cotangent energy is pyevolver's own: its datafiles do not run in the Evolver)
 HZERO_METHODS = ("normal_sq_mean_curvature", "star_perp_sq_mean_curvature",
-                 "star_normal_sq_mean_curvature")
+                 "star_normal_sq_mean_curvature", "cotan_sq_mean_curvature")
 
 
 def ade_header(c0: float = 0.0, alpha: float = 0.0, m0: float = 1.0, area: float = 4 * np.pi,

@@ -78,13 +78,22 @@ def test_run_writes_the_tables_and_resumes(tmp_path):
     assert [t["v"] for t in mtrans] == [None, None]
 
 
-@pytest.mark.parametrize("method", ["normal_sq_mean_curvature", "star_perp_sq_mean_curvature"])
+#: per method: the range of rel_err at 120 vertices and the tolerance of the c0 effect
+#: (the MDSB energy lies below the smooth one on coarse meshes, docs/paper.md; at 300
+#: vertices its errors halve: -2.3% at c0 = 0, the c0 effect -1.2%)
+C0_TOL = {"normal_sq_mean_curvature": ((0.0, 0.02), 0.02),
+          "star_perp_sq_mean_curvature": ((0.0, 0.02), 0.02),
+          "cotan_sq_mean_curvature": ((-0.1, 0.0), 0.04)}
+
+
+@pytest.mark.parametrize("method", sorted(C0_TOL))
 def test_spontaneous_curvature_against_the_reference(method):
     """c0 = ±0.8 (h_zero = c0/2) on 120-vertex prolates at v = 0.9: each
-    point within 2% of the axisymmetric reference at the same c0
-    (∫(H − c0/2)² dA), and the change of W with c0 within 2% of the
-    reference's change (the spontaneous curvature term, not only the
-    bending, is right)."""
+    point near the axisymmetric reference at the same c0 (∫(H − c0/2)² dA;
+    within 2% above it for the Evolver's methods) and the change of W with
+    c0 within 2% (4% for MDSB) of the reference's change (the spontaneous
+    curvature term, not only the bending, is right)."""
+    (lo, hi), dtol = C0_TOL[method]
     W, Wref = {}, {}
     for c0 in (0.0, 0.8, -0.8):
         model = Helfrich(c0=c0) if c0 else None
@@ -92,11 +101,11 @@ def test_spontaneous_curvature_against_the_reference(method):
         row, X, F = PS.solve_point("prolate", 0.9, p.result, 120, eigen=False, c0=c0,
                                    method=method)
         assert row["converged"] is True and row["c0"] == c0 and row["method"] == method
-        assert 0 < row["rel_err"] < 0.02
+        assert lo < row["rel_err"] < hi
         W[c0], Wref[c0] = row["W"], row["W_ref"]
     for c0 in (0.8, -0.8):
         d, dref = W[c0] - W[0.0], Wref[c0] - Wref[0.0]
-        assert abs(d / dref - 1) < 0.02
+        assert abs(d / dref - 1) < dtol
     # smooth: dW/dc0 = −M + 2π c0 < 0 here (M ≈ 4π): c0 > 0 lowers W on a prolate
     assert Wref[0.8] < Wref[0.0] < Wref[-0.8]
 
@@ -116,7 +125,7 @@ def test_run_at_nonzero_c0_keeps_its_own_rows(tmp_path):
 
 def test_methods_without_h_zero_are_refused(tmp_path):
     with pytest.raises(ValueError, match="h_zero"):
-        PS.run(out=str(tmp_path / "x"), method="cotan_sq_mean_curvature")
+        PS.run(out=str(tmp_path / "x"), method="star_sq_mean_curvature")
     assert not os.path.exists(tmp_path / "x")
 
 
