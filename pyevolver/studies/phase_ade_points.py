@@ -29,8 +29,9 @@ from .phase_ade import (ade_energy_from_bc, bilayer_couple, effective_c0,
                         reduced_area_difference)
 from .phase_mesh import revolve
 from .phase_newton import restore
-from .phase_reference import follow
-from .phase_study import lam_for, method_for
+from .phase_reference import crossing, follow
+from .phase_study import TYPES, crossing_linear, lam_for, method_for
+from .vesicle_shapes import mesh_descriptors
 from .vesicle_newton import newton_lm
 
 
@@ -96,8 +97,9 @@ def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
 
     Returns ``(row, X, F)``: the row has ``W`` (the discrete ADE energy,
     without λE), ``W_ref``, ``rel_err``, the discrete and the reference
-    ``m = M/4π``, ``c0_eff`` and ``converged`` (every inner solve converged
-    and ``|μ − 2k(M − M0)|`` below ``tol``); ``X, F`` the final mesh.
+    ``m = M/4π``, ``c0_eff``, the mesh's shape ``type`` and ``converged``
+    (every inner solve converged, ``|μ − 2k(M − M0)|`` below ``tol`` and
+    the shape still of its branch); ``X, F`` the final mesh.
     """
     t0 = time.perf_counter()
     method = method_for(model.c0, method)
@@ -129,11 +131,13 @@ def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
             break
         mu_a, fa, mu_b = mu_b, fb, mu_b - fb * (mu_b - mu_a) / (fb - fa)
     E = W + k * (M - M0) ** 2
+    kind = mesh_descriptors(X, F)["type"]
     row = {"branch": branch, "v": float(v), "c0": model.c0, "alpha": model.alpha,
            "m0": model.m0, "nv": len(X), "W": E, "W_ref": float(ref.W),
            "rel_err": E / ref.W - 1.0, "m": M / (4 * np.pi),
            "m_ref": float(ref.mean_curvature) / (4 * np.pi), "c0_eff": model.c0 - mu,
-           "lambda": lam, "method": method, "converged": bool(converged and ok_all),
+           "lambda": lam, "method": method, "type": kind,
+           "converged": bool(converged and ok_all and kind in TYPES[branch]),
            "seconds": time.perf_counter() - t0}
     return row, X, F
 
@@ -245,15 +249,78 @@ def read_table(path: str) -> list[dict]:
     return out
 
 
+SWEEP_COLUMNS = ["branch", "v", "c0", "alpha", "m0", "nv", "W", "W_ref", "rel_err", "m",
+                 "m_ref", "c0_eff", "lambda", "method", "type", "converged", "seconds"]
+
+
+def sweep(volumes, model: Helfrich, nv: int, branches=("prolate", "oblate", "stomatocyte"),
+          out: str | None = None, log=print) -> tuple[list[dict], list[dict]]:
+    """The ADE branches on ``volumes``: the axisymmetric ADE reference
+    followed along each branch (:func:`~pyevolver.studies.phase_reference.follow`),
+    each point solved by :func:`solve_ade_point` from its reference; the
+    crossings of the discrete branches (converged points, linear
+    interpolation) and of the reference's (Brent's method).  No stability
+    marks: the ADE Hessian has the rank-one term ``2k ∇M ∇Mᵀ`` that the
+    eigenvalue solver of the study does not take.  With ``out``, writes
+    ``out/ade_phase.csv`` and ``out/ade_transitions.csv``.  Returns
+    ``(rows, transitions)``."""
+    refs = {b: {p.v: p for p in follow(b, volumes, model)} for b in branches}
+    rows = []
+    for b in branches:
+        for v, p in sorted(refs[b].items()):
+            row, _, _ = solve_ade_point(b, v, model, nv, ref=p.result)
+            rows.append(row)
+            log(f"{b} v={v:.4f} E={row['W']:.6f} rel_err={row['rel_err']:+.5f} "
+                f"m={row['m']:.5f} converged={row['converged']} {row['seconds']:.1f}s")
+    trans = []
+    for fa, fb in (("prolate", "oblate"), ("oblate", "stomatocyte")):
+        if fa not in branches or fb not in branches:
+            continue
+        pa = [(r["v"], r["W"]) for r in rows if r["branch"] == fa and r["converged"]]
+        pb = [(r["v"], r["W"]) for r in rows if r["branch"] == fb and r["converged"]]
+        vref = crossing(list(refs[fa].values()), list(refs[fb].values()), model)
+        trans.append({"c0": model.c0, "alpha": model.alpha, "m0": model.m0, "from": fa,
+                      "to": fb, "v": crossing_linear(pa, pb), "v_ref": vref})
+    if out is not None:
+        os.makedirs(out, exist_ok=True)
+        for name, cols, data in (("ade_phase.csv", SWEEP_COLUMNS, rows),
+                                 ("ade_transitions.csv", list(trans[0]) if trans else [],
+                                  trans)):
+            with open(os.path.join(out, name), "w", newline="") as fh:
+                w = csv.DictWriter(fh, fieldnames=cols, extrasaction="ignore")
+                w.writeheader()
+                for r in data:
+                    w.writerow({k: ("" if r.get(k) is None else
+                                    (f"{r[k]:.10g}" if isinstance(r[k], float) else r[k]))
+                                for k in cols})
+    return rows, trans
+
+
 def main(argv: list[str] | None = None) -> int:
     """``python -m pyevolver.studies.phase_ade_points [--nv 642] [--out DIR]``:
-    writes ``DIR/ade.csv`` and ``DIR/ade.md`` (the table of docs/phase.md)."""
+    writes ``DIR/ade.csv`` and ``DIR/ade.md`` (the table of docs/phase.md);
+    with ``--sweep --alpha A --m0 M [--c0 C] [--volumes v1,v2,...]
+    [--branches ...]`` the ADE branches instead (:func:`sweep`)."""
     p = argparse.ArgumentParser(prog="python -m pyevolver.studies.phase_ade_points",
                                 description="ADE reference relations and discrete points")
     p.add_argument("--nv", type=int, default=642, help="vertices of the discrete points "
                    "(0: the axisymmetric reference only)")
     p.add_argument("--out", default=".")
+    p.add_argument("--sweep", action="store_true", help="sweep the ADE branches")
+    p.add_argument("--c0", type=float, default=0.0)
+    p.add_argument("--alpha", type=float, default=1.4)
+    p.add_argument("--m0", type=float, default=1.0)
+    p.add_argument("--volumes", default="0.55,0.6,0.65,0.7,0.75,0.8,0.85,0.9")
+    p.add_argument("--branches", default="prolate,oblate,stomatocyte")
     args = p.parse_args(argv)
+    if args.sweep:
+        _, trans = sweep([float(x) for x in args.volumes.split(",")],
+                         Helfrich(args.c0, args.alpha, args.m0), args.nv,
+                         tuple(args.branches.split(",")), args.out,
+                         log=lambda t: print(t, flush=True))
+        for tr in trans:
+            print(f"transition {tr['from']}/{tr['to']}: v = {tr['v']} (reference {tr['v_ref']})")
+        return 0
     rows = table(args.nv, log=lambda t: print(t, flush=True))
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "ade.csv"), "w", newline="") as fh:

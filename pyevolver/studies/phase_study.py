@@ -6,8 +6,8 @@ oblate/discocyte, stomatocyte), at spontaneous curvature ``c0`` (reduced,
 ``W = Σ_v (h_v − c0/2)² A_v/3`` with the Evolver's ``h_zero = c0/2``
 (``normal_sq_mean_curvature`` at ``c0 = 0``, where a sphere gives 4π, and
 ``star_perp_sq_mean_curvature`` otherwise, :func:`method_for`; the smooth
-energy is ``∫(H − c0/2)² dA``, SBL's ``F/(2κ)``) plus the paper's harmonic regularization ``λ E`` (``E = (1/√3)
-Σ_edges |e|²``) over all vertex coordinates, at fixed area ``4π`` and
+energy is ``∫(H − c0/2)² dA``, SBL's ``F/(2κ)``) plus the paper's
+harmonic regularization ``λ E`` (``E = (1/√3) Σ_edges |e|²``) over all vertex coordinates, at fixed area ``4π`` and
 volume ``v·4π/3`` (damped Newton, :func:`~pyevolver.studies.vesicle_newton.newton_lm`).
 λ(h) = ``LAMBDA_642 · 642/nv`` (∝ h²; 0.3 at 642 vertices).
 
@@ -418,8 +418,8 @@ def _print_transitions(trans):
     for t in trans:
         v = "none" if t["v"] is None else f"{t['v']:.4f}"
         vr = "none" if t["v_ref"] is None else f"{t['v_ref']:.4f}"
-        print(f"transition {t['from']}/{t['to']}: v = {v} (reference {vr}, "
-              f"published {t['v_published']})")
+        pub = "none" if t["v_published"] is None else t["v_published"]
+        print(f"transition {t['from']}/{t['to']}: v = {v} (reference {vr}, published {pub})")
 
 
 if __name__ == "__main__":

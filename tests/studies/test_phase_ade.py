@@ -170,3 +170,20 @@ def test_docs_table_is_the_committed_csv():
         assert abs(r["sc_rel_diff"]) < 1e-9 and abs(r["bc_rel_diff"]) < 1e-9
         if r.get("converged") is True:
             assert 0 < r["rel_err"] < 0.01
+
+
+def test_ade_sweep_writes_its_tables(tmp_path):
+    """Two 60-vertex ADE prolates (α = 1.4, m0 = 1.05): converged, within
+    5% of the reference, the tables written."""
+    import csv
+    import os
+    model = Helfrich(alpha=1.4, m0=1.05)
+    rows, trans = PP.sweep([0.85, 0.9], model, 60, branches=("prolate",), out=str(tmp_path),
+                           log=lambda t: None)
+    assert [r["v"] for r in rows] == [0.85, 0.9]
+    for r in rows:
+        assert r["converged"] is True and r["type"] == "prolate" and abs(r["rel_err"]) < 0.05
+    assert trans == []                                   # one branch: no crossing
+    with open(os.path.join(tmp_path, "ade_phase.csv")) as fh:
+        table = list(csv.DictReader(fh))
+    assert [float(r["alpha"]) for r in table] == [1.4, 1.4]
