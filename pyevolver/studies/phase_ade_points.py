@@ -44,7 +44,7 @@ def _point_session(X, F, v, lam, directory, c0, mu, method):
     (``mci``, info only); area ``4π`` and volume ``v·4π/3`` fixed."""
     path = os.path.join(directory, "ade_point.fe")
     hdr = "\n".join([
-        "// discrete ADE point (pyevolver.studies.phase_ade)",
+        "// discrete ADE point (pyevolver.studies.phase_ade_points)",
         f"parameter v0 = {float(v)!r}",
         f"parameter c0 = {float(c0)!r}",
         "parameter h_zero = c0/2",
