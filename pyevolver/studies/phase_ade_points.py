@@ -239,7 +239,7 @@ def read_table(path: str) -> list[dict]:
                     continue
                 if val in ("True", "False"):
                     row[k] = val == "True"
-                elif k in ("branch", "start", "method"):
+                elif k in ("branch", "start", "method", "type", "from", "to"):
                     row[k] = val
                 elif k == "nv":
                     row[k] = int(val)
@@ -294,6 +294,26 @@ def sweep(volumes, model: Helfrich, nv: int, branches=("prolate", "oblate", "sto
                                     (f"{r[k]:.10g}" if isinstance(r[k], float) else r[k]))
                                 for k in cols})
     return rows, trans
+
+
+def sweep_markdown(rows: list[dict], trans: list[dict]) -> str:
+    """The tables of an ADE sweep (rows and transitions as :func:`read_table`
+    reads ``ade_phase.csv`` and ``ade_transitions.csv``), energies as E/4π."""
+    def f(x, spec):
+        return "—" if x is None or x == "" else format(x, spec)
+    out = ["| transition | discrete | axisymmetric reference |", "|---|---|---|"]
+    for tr in trans:
+        out.append(f"| {tr['from']}/{tr['to']} | {f(tr.get('v'), '.4f')} | "
+                   f"{f(tr.get('v_ref'), '.4f')} |")
+    out += ["", "| branch | v | vertices | E/4π | E_ref/4π | rel. error | Δa | Δa_ref | "
+            "c0_eff | shape |", "|---|---|---|---|---|---|---|---|---|---|"]
+    order = ["prolate", "oblate", "stomatocyte"]
+    for r in sorted(rows, key=lambda r: (order.index(r["branch"]), r["v"])):
+        err = f"{r['rel_err']:+.3%}" if r.get("converged") is True else "not converged"
+        out.append(f"| {r['branch']} | {r['v']:.3f} | {r['nv']} | "
+                   f"{r['W'] / (4 * np.pi):.5f} | {r['W_ref'] / (4 * np.pi):.5f} | {err} | "
+                   f"{r['m']:.5f} | {r['m_ref']:.5f} | {r['c0_eff']:.4f} | {r.get('type', '—')} |")
+    return "\n".join(out) + "\n"
 
 
 def main(argv: list[str] | None = None) -> int:

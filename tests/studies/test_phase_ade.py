@@ -187,3 +187,6 @@ def test_ade_sweep_writes_its_tables(tmp_path):
     with open(os.path.join(tmp_path, "ade_phase.csv")) as fh:
         table = list(csv.DictReader(fh))
     assert [float(r["alpha"]) for r in table] == [1.4, 1.4]
+    md = PP.sweep_markdown(PP.read_table(os.path.join(tmp_path, "ade_phase.csv")),
+                           PP.read_table(os.path.join(tmp_path, "ade_transitions.csv")))
+    assert "| prolate | 0.850 |" in md and "| prolate | 0.900 |" in md
