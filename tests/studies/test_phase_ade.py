@@ -190,3 +190,14 @@ def test_ade_sweep_writes_its_tables(tmp_path):
     md = PP.sweep_markdown(PP.read_table(os.path.join(tmp_path, "ade_phase.csv")),
                            PP.read_table(os.path.join(tmp_path, "ade_transitions.csv")))
     assert "| prolate | 0.850 |" in md and "| prolate | 0.900 |" in md
+
+
+def test_docs_sweep_table_is_the_committed_csv():
+    import os
+    d = os.path.join(os.path.dirname(__file__), "..", "..", "docs", "phase", "ade_sweep")
+    md = PP.sweep_markdown(PP.read_table(os.path.join(d, "ade_phase.csv")),
+                           PP.read_table(os.path.join(d, "ade_transitions.csv")))
+    with open(os.path.join(d, "summary.md")) as fh:
+        assert fh.read() == md
+    with open(os.path.join(d, "..", "..", "phase.md")) as fh:
+        assert md in fh.read()
