@@ -649,15 +649,39 @@ def _cotan_parts(t):
     return P, cot, cg, Am, Amg, Sv, Av
 
 
+def _cotan_normals(t, Fc):
+    """Unit area-weighted vertex normals ``n̂_v = N_v/|N_v|``, ``N_v = Σ_f ½ N2_f``
+    over the star, and ``|N_v|`` (the normal of the spontaneous-curvature term)."""
+    s = t.surface
+    N = _scatter(s.nv, Fc.ravel(), 0.5 * np.repeat(t.facet_N2, 3, axis=0))
+    nN = np.linalg.norm(N, axis=1)
+    with np.errstate(all="ignore"):
+        return np.nan_to_num(N / nN[:, None]), nN
+
+
 def cotan_values(ctx, m, idx):
     """``cotan_sq_mean_curvature``: Σ_v H_v² A_v with the cotangent mean
     curvature normal K = S/(2A) = 2H n and mixed areas A (MDSB 2003), i.e.
-    ``|S_v|² / (16 A_v)``; pyevolver's own method (paper's W_MDSB)."""
+    ``|S_v|² / (16 A_v)``; pyevolver's own method (paper's W_MDSB).
+
+    With ``h_zero`` (parameter or vertex attribute) the vertex energy is
+    ``A_v |K_v/2 − h0 n̂_v|² = |S_v|²/(16 A_v) − (h0/2) S_v·n̂_v + h0² A_v``,
+    ``n̂_v`` the unit area-weighted vertex normal: the Helfrich energy
+    ``∫(H − h0)² dA`` written with the mean curvature vector ``K/2 = H n``
+    of Meyer et al. 2003 (pyevolver's own form, no reference program has
+    it), equal to
+    ``(H_v − h0)² A_v`` where ``K_v ∥ n̂_v`` and to the h_zero-less energy
+    at ``h0 = 0``.  Sign: ``S_v·n̂_v > 0`` on a sphere with outward facets
+    (H > 0, the Evolver's convention for h_zero)."""
     s = ctx.surface
     _check_closed(s, "cotan_sq_mean_curvature")
     _, _, _, _, _, Sv, Av = _cotan_parts(ctx)
     with np.errstate(all="ignore"):
         E = np.nan_to_num(np.einsum("ij,ij->i", Sv, Sv) / (16.0 * Av))
+    h0 = _h_zero(s, "cotan_sq_mean_curvature")
+    if h0 is not None:
+        nh, _ = _cotan_normals(ctx, s.F)
+        E = E - 0.5 * h0 * np.einsum("ij,ij->i", Sv, nh) + h0 * h0 * Av
     return E[idx]
 
 
@@ -670,6 +694,17 @@ def cotan_gradient(t, m, idx, w):
         uS = np.nan_to_num(Sv / (8.0 * Av)[:, None]) * wv[:, None]
         uA = np.nan_to_num(-np.einsum("ij,ij->i", Sv, Sv) / (16.0 * Av * Av)) * wv
     Fc = s.F
+    h0 = _h_zero(s, "cotan_sq_mean_curvature")
+    gN = None
+    if h0 is not None:
+        # − (h0/2) S·n̂ + h0² A: through S, A and n̂ = N/|N| (N = Σ ½ N2_f)
+        nh, nN = _cotan_normals(t, Fc)
+        uS = uS - (0.5 * h0 * wv)[:, None] * nh
+        uA = uA + h0 * h0 * wv
+        with np.errstate(all="ignore"):
+            S_perp = Sv - nh * np.einsum("ij,ij->i", nh, Sv)[:, None]    # (I − n̂n̂ᵀ) S
+            dN = np.nan_to_num(S_perp / nN[:, None]) * (-0.5 * h0 * wv)[:, None]
+        gN = 0.5 * n2_grad_dot(P, dN[Fc].sum(axis=1))
     U = uS[Fc]                                             # (nf, 3, 3)
     g = np.zeros_like(P)
     for k in range(3):
@@ -680,6 +715,8 @@ def cotan_gradient(t, m, idx, w):
         g[:, a] += cot[:, k, None] * dU
         g[:, b] -= cot[:, k, None] * dU
     g += np.einsum("fc,fcpk->fpk", uA[Fc], Amg)
+    if gN is not None:
+        g += gN
     return corner_scatter(t, g)
 
 

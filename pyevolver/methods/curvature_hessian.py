@@ -344,14 +344,17 @@ def sq_gauss_hessian(t, m, idx, w, basis=None):
 # -- cotan_sq_mean_curvature ---------------------------------------------------------------------
 
 def cotan_hessian(t, m, idx, w, basis=None):
-    """Hessian of ``Σ_v w_v |S_v|² / (16 A_v)`` (MDSB; see :func:`curvature.cotan_values`)."""
+    """Hessian of ``Σ_v w_v φ_v`` with ``φ = |S|²/(16 A)`` (MDSB; see
+    :func:`curvature.cotan_values`) and, with ``h_zero``, ``− (h0/2) S·N/|N|
+    + h0² A`` (N the star's area vector ``Σ_f ½ N2_f``): star sums
+    ``y = (S, A)`` or ``(S, A, N)``."""
     s = t.surface
     C._check_closed(s, "cotan_sq_mean_curvature")
     P, cot, _, _, _, Sv, Av = C._cotan_parts(t)
     nv, Fc = s.nv, s.F
     nf = len(P)
     wv = C.vertex_weights(nv, idx, w)
-    x, _, _, Aj = _facet_jets(P)
+    x, N2, _, Aj = _facet_jets(P)
     cj = []
     for a in range(3):
         u = x[(a + 1) % 3] - x[a]
@@ -369,26 +372,50 @@ def cotan_hessian(t, m, idx, w, basis=None):
         Am.append(J.S(np.where(any_obt, frac * Aj.v, vor.v),
                       np.where(any_obt[:, None], frac[:, None] * Aj.g, vor.g),
                       np.where(any_obt[:, None, None], frac[:, None, None] * Aj.H, vor.H)))
+    h0 = C._h_zero(s, "cotan_sq_mean_curvature")
+    r = 4 if h0 is None else 7
     with np.errstate(all="ignore"):
         SS = np.einsum("ij,ij->i", Sv, Sv)
         dS = Sv / (8 * Av)[:, None] * wv[:, None]
         dA = -SS / (16 * Av * Av) * wv
     dS, dA = np.nan_to_num(dS), np.nan_to_num(dA)
+    if h0 is not None:
+        nh, nN = C._cotan_normals(t, Fc)
+        Sn = np.einsum("ij,ij->i", Sv, nh)
+        dS = dS - (0.5 * h0 * wv)[:, None] * nh
+        dA = dA + h0 * h0 * wv
+        with np.errstate(all="ignore"):
+            dN = np.nan_to_num((Sv - nh * Sn[:, None]) / nN[:, None]) * (-0.5 * h0 * wv)[:, None]
     H = np.zeros((nf, 9, 9))
     for c in range(3):
         H += Sc[c].hc(dS[Fc[:, c]]) + dA[Fc[:, c]][:, None, None] * Am[c].H
+    if h0 is not None:                                  # N_v = Σ_f ½ N2_f at every corner
+        H += N2.hc(0.5 * dN[Fc].sum(axis=1))
     H2 = _elements(nv, Fc, H, basis)
-    blocks = np.empty((nf, 3, 4, 9))
+    blocks = np.zeros((nf, 3, r, 9))
     for c in range(3):
         blocks[:, c, :3, :] = Sc[c].J
         blocks[:, c, 3, :] = Am[c].g
-    ridx = (4 * Fc[:, :, None] + np.arange(4)).reshape(nf, 12)
-    Jm = _rows(4 * nv, ridx, Fc, blocks.reshape(nf, 12, 3, 3), nv, basis)
-    M = np.zeros((nv, 4, 4))
+        if h0 is not None:
+            blocks[:, c, 4:, :] = 0.5 * N2.J
+    ridx = (r * Fc[:, :, None] + np.arange(r)).reshape(nf, 3 * r)
+    Jm = _rows(r * nv, ridx, Fc, blocks.reshape(nf, 3 * r, 3, 3), nv, basis)
+    M = np.zeros((nv, r, r))
     with np.errstate(all="ignore"):
         M[:, :3, :3] = (1 / (8 * Av))[:, None, None] * np.eye(3)
         M[:, :3, 3] = M[:, 3, :3] = -Sv / (8 * Av ** 2)[:, None]
         M[:, 3, 3] = SS / (8 * Av ** 3)
+        if h0 is not None:
+            # −(h0/2) S·n̂: ∂²/∂S∂N = −(h0/2)(I − n̂n̂ᵀ)/|N|, and ∂²/∂N² = −(h0/2) ∇²(S·N/|N|)
+            # with ∇²(S·N/|N|) = [3(S·n̂) n̂n̂ᵀ − (S·n̂) I − S n̂ᵀ − n̂ Sᵀ] / |N|²
+            eye = np.eye(3)
+            Pn = eye - nh[:, :, None] * nh[:, None, :]
+            M[:, :3, 4:] = (-0.5 * h0 / nN)[:, None, None] * Pn
+            M[:, 4:, :3] = M[:, :3, 4:]
+            SnT = Sv[:, :, None] * nh[:, None, :]
+            M[:, 4:, 4:] = (-0.5 * h0 / nN ** 2)[:, None, None] * (
+                3 * Sn[:, None, None] * nh[:, :, None] * nh[:, None, :]
+                - Sn[:, None, None] * eye - SnT - SnT.transpose(0, 2, 1))
     return _gauss_newton(Jm, M * wv[:, None, None]) + H2
 
 

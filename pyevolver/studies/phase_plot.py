@@ -50,8 +50,9 @@ def plot(stem: str, rows: list[dict], refs: dict, trans: list[dict]) -> list[str
     ax.plot([], [], ":", color="0.6", label="published (SBL 1991)")
     nv = sorted({int(r["nv"]) for r in rows})
     ax.set_ylabel("W / 4π")
-    ax.set_title(f"discrete phase study, c0 = 0 (about {nv[len(nv) // 2] if nv else '?'} "
-                 "vertices)")
+    c0 = sorted({float(r.get("c0") or 0.0) for r in rows}) or [0.0]
+    ax.set_title(f"discrete phase study, c0 = {', '.join(f'{c:g}' for c in c0)} "
+                 f"(about {nv[len(nv) // 2] if nv else '?'} vertices)")
     ax.legend(fontsize=7, loc="upper right")
     ax2.axhline(0, color="0.7", lw=0.5)
     ax2.set_xlabel("reduced volume v")
@@ -76,7 +77,7 @@ def summary_markdown(rows: list[dict], trans: list[dict]) -> str:
            "|---|---|---|---|"]
     for t in trans:
         out.append(f"| {t['from']}/{t['to']} | {_fmt(t['v'], '.4f')} | "
-                   f"{_fmt(t['v_ref'], '.4f')} | {t['v_published']} |")
+                   f"{_fmt(t['v_ref'], '.4f')} | {_fmt(t['v_published'], '')} |")
     out += ["", "| branch | v | vertices | W/4π | W_ref/4π | rel. error | lowest eigenvalue "
             "| stable | λ | min angle | solver |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in sorted(rows, key=lambda r: (list(COLORS).index(r["branch"]), r["v"])):

@@ -29,6 +29,11 @@ from .axisymmetric import BRANCHES, CanhamResult, Helfrich, canham_reference
 SEEDS = {"prolate": 0.85, "oblate": 0.70, "stomatocyte": 0.55}
 #: sine modes per branch: the stomatocyte's neck needs many
 MODES = {"prolate": 32, "oblate": 32, "stomatocyte": 64}
+#: the shape types (:func:`~pyevolver.studies.axisymmetric.descriptors`) of each branch:
+#: a continuation that reaches another type has left the branch (with ADE the
+#: "stomatocyte" start can converge to the discocyte)
+BRANCH_TYPES = {"prolate": {"prolate", "sphere"}, "oblate": {"oblate", "discocyte", "sphere"},
+                "stomatocyte": {"stomatocyte"}}
 
 
 @dataclass
@@ -48,7 +53,8 @@ def follow(branch: str, volumes, model: Helfrich | None = None, n: int | None = 
     branch's initial shape; the others by continuation outwards from it,
     halving the step in ``v`` when Newton's iteration does not converge.
     Points the continuation cannot reach (the branch ends, or its shape
-    changes type) are left out.
+    changes type: not in :data:`BRANCH_TYPES`) are left out, the seed too
+    when it is not of its branch's type.
 
     Parameters
     ----------
@@ -71,11 +77,13 @@ def follow(branch: str, volumes, model: Helfrich | None = None, n: int | None = 
     start = canham_reference(seed, branch, n=n, model=model)
     vs = np.unique(np.asarray(volumes, dtype=float))
     out = {}
+    if start.descriptors["type"] not in BRANCH_TYPES[branch]:
+        return []
     for side in (vs[vs >= seed], vs[vs < seed][::-1]):
         prev, v_prev = start, seed
         for v in side:
             res = _step(branch, v_prev, v, prev, model, n, max_halvings)
-            if res is None:
+            if res is None or res.descriptors["type"] not in BRANCH_TYPES[branch]:
                 break
             out[float(v)] = BranchPoint(branch, float(v), res.W, res)
             prev, v_prev = res, float(v)

@@ -1,10 +1,13 @@
 """The discrete vesicle phase study (issue 27): branches, stability, transitions.
 
-For ``c0 = 0`` the reduced volume ``v`` is swept on three branches
-(prolate, oblate/discocyte, stomatocyte).  Each point minimises the discrete
-bending energy ``W = Σ_v h_v² A_v/3`` (``normal_sq_mean_curvature``, a
-sphere: 4π) plus the paper's harmonic regularization ``λ E`` (``E = (1/√3)
-Σ_edges |e|²``) over all vertex coordinates, at fixed area ``4π`` and
+The reduced volume ``v`` is swept on three branches (prolate,
+oblate/discocyte, stomatocyte), at spontaneous curvature ``c0`` (reduced,
+``C0·R0``; default 0).  Each point minimises the discrete bending energy
+``W = Σ_v (h_v − c0/2)² A_v/3`` with the Evolver's ``h_zero = c0/2``
+(``normal_sq_mean_curvature`` at ``c0 = 0``, where a sphere gives 4π, and
+``star_perp_sq_mean_curvature`` otherwise, :func:`method_for`; the smooth
+energy is ``∫(H − c0/2)² dA``, SBL's ``F/(2κ)``) plus the paper's
+harmonic regularization ``λ E`` (``E = (1/√3) Σ_edges |e|²``) over all vertex coordinates, at fixed area ``4π`` and
 volume ``v·4π/3`` (damped Newton, :func:`~pyevolver.studies.vesicle_newton.newton_lm`).
 λ(h) = ``LAMBDA_642 · 642/nv`` (∝ h²; 0.3 at 642 vertices).
 
@@ -30,7 +33,7 @@ Hessian of W (normal vertex motions, mass-weighted, rigid motions removed;
 above −10⁻³.
 
     pyevolver study phase [--nv 642] [--vmin 0.5 --vmax 0.95 --step 0.025]
-        [--branches prolate,oblate,stomatocyte] [--out DIR] [--no-plot]
+        [--c0 0] [--branches prolate,oblate,stomatocyte] [--out DIR] [--no-plot]
 
 writes ``DIR/phase.csv`` (one row per branch and v), ``DIR/transitions.csv``
 (the crossings of the discrete branches, linearly interpolated, with the
@@ -52,11 +55,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import UnsupportedError
 from ..session.core import Session
 from . import phase_plot, phase_reference as PR
-from .axisymmetric import BRANCHES
+from .axisymmetric import BRANCHES, Helfrich
 from .meshes import write_fe
+from .phase_ade import HZERO_METHODS
 from .phase_mesh import mesh_quality, revolve
 from .phase_newton import newton_critical, restore
 from .phase_stability import lowest_eigenvalues, stability
@@ -72,7 +75,23 @@ TYPES = {"prolate": {"prolate", "sphere"}, "oblate": {"oblate", "discocyte", "sp
          "stomatocyte": {"stomatocyte"}}
 COLUMNS = ["branch", "c0", "v", "nv", "W", "W_ref", "rel_err", "stable", "eig1", "eig2",
            "eig3", "lambda", "min_angle_deg", "aspect", "h", "type", "start", "converged",
-           "newton_steps", "seconds"]
+           "newton_steps", "seconds", "method"]
+#: the bending energy's method at c0 = 0 (the paper's) and at c0 != 0: with h_zero the
+#: normal estimate h = 3F·F/(2F·N) is singular where F -> 0 (flat parts, the
+#: discocyte's dimples: Hessian eigenvalues of -2e5 and failed points at c0 = -0.5),
+#: star_perp's h = 3F·N/(2N·N) is not (the manual's "pretty good formula")
+METHOD = "normal_sq_mean_curvature"
+METHOD_C0 = "star_perp_sq_mean_curvature"
+
+
+def method_for(c0: float, method: str | None = None) -> str:
+    """The bending energy's method: ``method``, or by default
+    :data:`METHOD` at ``c0 = 0`` and :data:`METHOD_C0` otherwise."""
+    method = method or (METHOD if c0 == 0 else METHOD_C0)
+    if method not in HZERO_METHODS:
+        raise ValueError(f"{method}: the study's bending energy must take h_zero, one of "
+                         f"{HZERO_METHODS}")
+    return method
 MIN_ANGLE = 10.0
 
 
@@ -81,12 +100,14 @@ def lam_for(nv: int) -> float:
     return LAMBDA_642 * 642.0 / nv
 
 
-def _session(X, F, v, lam, directory):
+def _session(X, F, v, lam, directory, c0=0.0, method=METHOD):
     path = os.path.join(directory, "point.fe")
     hdr = "\n".join([
         "// discrete phase study point (pyevolver.studies.phase_study)",
-        f"parameter v0 = {v!r}",
-        "quantity willmore energy method normal_sq_mean_curvature global",
+        f"parameter v0 = {v!r}"]
+        # the Evolver's h_zero is a mean curvature: H0 = C0/2 (phase_ade)
+        + ([f"parameter c0 = {c0!r}", "parameter h_zero = c0/2"] if c0 else []) + [
+        f"quantity willmore energy method {method} global",
         "quantity surf fixed = 4*pi method facet_area global",
         f"quantity harm energy modulus {lam!r} method harmonic_energy global"])
     write_fe(path, X, F, header=hdr, face_attrs="tension 0")
@@ -98,10 +119,14 @@ def _session(X, F, v, lam, directory):
 
 def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
                 start: tuple[np.ndarray, np.ndarray] | None = None, maxit: int = 60,
-                eigen: bool = True) -> tuple[dict, np.ndarray, np.ndarray]:
+                eigen: bool = True, c0: float = 0.0, method: str | None = None
+                ) -> tuple[dict, np.ndarray, np.ndarray]:
     """One point of a branch: minimise W + λE from ``start`` (a mesh; default
     the reference ``ref`` revolved), falling back as the module docstring
-    says.  Returns ``(row, X, F)``."""
+    says; ``c0`` the spontaneous curvature (``ref`` must be the reference at
+    the same ``c0``); ``method`` the bending energy (:func:`method_for`).
+    Returns ``(row, X, F)``."""
+    method = method_for(c0, method)
     lam = lam_for(nv) if lam is None else lam
     t0 = time.perf_counter()
     rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi)
@@ -121,7 +146,7 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
                 or mesh_descriptors(surf.X, surf.F)["type"] in TYPES[branch])
     with tempfile.TemporaryDirectory() as tmp:
         for kind, (X, F), lam_k, solver in attempts:
-            s = _session(X, F, v, lam_k, tmp)
+            s = _session(X, F, v, lam_k, tmp, c0, method)
             restore(s)
             if solver == "min":
                 ok, n, _ = newton_lm(s, maxit=maxit, guard=on_branch)
@@ -139,13 +164,13 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
                 break
         W = float(s.totals.quantity_values["willmore"])
         eig = lowest_eigenvalues(s, k=3) if (eigen and good) else np.full(3, np.nan)
-    row = {"branch": branch, "c0": 0.0, "v": float(v), "nv": len(X1), "W": W,
+    row = {"branch": branch, "c0": float(c0), "v": float(v), "nv": len(X1), "W": W,
            "W_ref": float(ref.W), "rel_err": W / ref.W - 1.0,
            "stable": (stability(eig) if good and eigen else ""),
            "eig1": eig[0], "eig2": eig[1], "eig3": eig[2], "lambda": lam_k,
            "min_angle_deg": q["min_angle_deg"], "aspect": q["aspect"], "h": q["h"],
            "type": kind_shape, "start": f"{kind}/{solver}", "converged": bool(good),
-           "newton_steps": steps, "seconds": time.perf_counter() - t0}
+           "newton_steps": steps, "seconds": time.perf_counter() - t0, "method": method}
     return row, X1, F1
 
 
@@ -155,8 +180,8 @@ def grid(vmin: float = 0.5, vmax: float = 0.95, step: float = 0.025) -> np.ndarr
     return np.round(np.arange(vmin, vmax + 0.5 * step, step), 10)
 
 
-def _key(branch, v, nv_target):
-    return f"{branch}_{v:.4f}_{nv_target}"
+def _key(branch, v, nv_target, c0=0.0):
+    return f"{branch}_{v:.4f}_{nv_target}" + (f"_c0_{c0:+.4f}" if c0 else "")
 
 
 def read_rows(path: str) -> list[dict]:
@@ -170,7 +195,7 @@ def read_rows(path: str) -> list[dict]:
             for k, val in r.items():
                 if val in ("True", "False"):
                     row[k] = val == "True"
-                elif k in ("branch", "type", "start") or val == "":
+                elif k in ("branch", "type", "start", "method") or val == "":
                     row[k] = val
                 else:
                     row[k] = float(val)
@@ -179,7 +204,8 @@ def read_rows(path: str) -> list[dict]:
 
 
 def write_rows(path: str, rows: list[dict]) -> None:
-    rows = sorted(rows, key=lambda r: (BRANCHES.index(r["branch"]), r["v"]))
+    rows = sorted(rows, key=lambda r: (float(r.get("c0") or 0.0), BRANCHES.index(r["branch"]),
+                                       r["v"]))
     tmp = path + ".tmp"
     with open(tmp, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=COLUMNS + ["nv_target"], extrasaction="ignore")
@@ -191,13 +217,16 @@ def write_rows(path: str, rows: list[dict]) -> None:
 
 
 def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[dict],
-               log: Callable[[str], Any] = print, eigen: bool = True) -> None:
+               log: Callable[[str], Any] = print, eigen: bool = True, c0: float = 0.0,
+               method: str | None = None) -> None:
     """Solve the branch's points of ``volumes`` (those with a reference in
     ``refs``, v -> BranchPoint) by continuation from its seed outwards,
     appending to ``rows`` and rewriting ``out/phase.csv`` after each point;
     converged points already in ``rows`` are skipped, failed ones solved
     again.  The fallback start of a point is the last converged point's
-    mesh on its side of the seed."""
+    mesh on its side of the seed.  ``c0``: the spontaneous curvature (rows
+    of other ``c0`` are left alone); ``method`` the bending energy (one
+    output folder per method: the rows do not key on it)."""
     mesh_dir = os.path.join(out, "meshes")
     os.makedirs(mesh_dir, exist_ok=True)
     vs = np.array(sorted(v for v in volumes if float(v) in refs))
@@ -207,23 +236,24 @@ def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[d
 
     def mine(r, v):
         return (r["branch"] == branch and round(r["v"], 6) == round(float(v), 6)
-                and int(r.get("nv_target", 0)) == nv)
+                and int(r.get("nv_target", 0)) == nv
+                and round(float(r.get("c0") or 0.0), 9) == round(c0, 9))
     for side in (vs[vs >= seed], vs[vs < seed][::-1]):
         start = None
         for v in side:
-            key = os.path.join(mesh_dir, _key(branch, v, nv) + ".npz")
+            key = os.path.join(mesh_dir, _key(branch, v, nv, c0) + ".npz")
             if any(mine(r, v) and r["converged"] is True for r in rows) and os.path.exists(key):
                 with np.load(key) as z:
                     start = (z["X"], z["F"])
                 continue
             rows[:] = [r for r in rows if not mine(r, v)]       # a failed point: again
             if start is None and side[0] != seed and v == side[0]:
-                sk = os.path.join(mesh_dir, _key(branch, seed, nv) + ".npz")
+                sk = os.path.join(mesh_dir, _key(branch, seed, nv, c0) + ".npz")
                 if os.path.exists(sk):
                     with np.load(sk) as z:
                         start = (z["X"], z["F"])
             row, X, F = solve_point(branch, float(v), refs[float(v)].result, nv, start=start,
-                                    eigen=eigen)
+                                    eigen=eigen, c0=c0, method=method)
             row["nv_target"] = nv
             rows.append(row)
             if row["converged"]:
@@ -250,20 +280,22 @@ def crossing_linear(a: list[tuple[float, float]], b: list[tuple[float, float]]) 
     return None
 
 
-def transitions(rows: list[dict], refs: dict | None = None) -> list[dict]:
+def transitions(rows: list[dict], refs: dict | None = None, c0: float = 0.0,
+                model: Helfrich | None = None) -> list[dict]:
     """Crossings prolate/oblate and oblate/stomatocyte of the discrete
     branches (converged points only), of the reference (exact, by
-    :func:`phase_reference.crossing`, when ``refs`` is given) and the
-    published values."""
+    :func:`phase_reference.crossing` with ``model``, when ``refs`` is
+    given) and the published values (``c0 = 0`` only)."""
     out = []
     for (fa, fb), pub in PUBLISHED.items():
+        pub = pub if c0 == 0.0 else None
         pa = [(r["v"], r["W"]) for r in rows if r["branch"] == fa and r["converged"] is True]
         pb = [(r["v"], r["W"]) for r in rows if r["branch"] == fb and r["converged"] is True]
         v = crossing_linear(pa, pb)
         vref = None
         if refs is not None and refs.get(fa) and refs.get(fb):
-            vref = PR.crossing(list(refs[fa].values()), list(refs[fb].values()))
-        out.append({"c0": 0.0, "from": fa, "to": fb, "v": v, "v_ref": vref, "v_published": pub})
+            vref = PR.crossing(list(refs[fa].values()), list(refs[fb].values()), model)
+        out.append({"c0": float(c0), "from": fa, "to": fb, "v": v, "v_ref": vref, "v_published": pub})
     return out
 
 
@@ -276,37 +308,42 @@ def write_transitions(path: str, trans: list[dict]) -> None:
                                                      else val)) for k, val in t.items()})
 
 
-def references(volumes, branches=BRANCHES, modes: int | None = None) -> dict:
+def references(volumes, branches=BRANCHES, modes: int | None = None,
+               model: Helfrich | None = None) -> dict:
     """branch -> {v: BranchPoint} of the axisymmetric reference on ``volumes``
-    (``modes`` sine modes; default :data:`phase_reference.MODES`)."""
-    return {b: {p.v: p for p in PR.follow(b, volumes, n=modes)} for b in branches}
+    (``modes`` sine modes; default :data:`phase_reference.MODES`) for the
+    energy ``model`` (default ``∫H² dA``)."""
+    return {b: {p.v: p for p in PR.follow(b, volumes, model, n=modes)} for b in branches}
 
 
 def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
         c0: float = 0.0, plot: bool = True, eigen: bool = True,
-        log: Callable[[str], Any] = print, modes: int | None = None
-        ) -> tuple[list[dict], list[dict]]:
+        log: Callable[[str], Any] = print, modes: int | None = None,
+        method: str | None = None) -> tuple[list[dict], list[dict]]:
     """The study (see the module docstring); returns ``(rows, transitions)``.
     ``modes``: sine modes of the references (default per branch, see
-    :data:`phase_reference.MODES`; fewer for quick runs)."""
-    if c0 != 0.0:
-        raise UnsupportedError("the discrete phase study at c0 != 0",
-                               "normal_sq_mean_curvature has no spontaneous curvature "
-                               "term; only c0 = 0 is swept (the axisymmetric reference, "
-                               "phase_reference, takes any c0)")
+    :data:`phase_reference.MODES`; fewer for quick runs); ``c0`` the
+    reduced spontaneous curvature (the references are solved at the same
+    ``c0``; published transitions exist for ``c0 = 0`` only); ``method``
+    the bending energy (:func:`method_for`)."""
+    c0 = float(c0)
+    method = method_for(c0, method)
+    model = Helfrich(c0=c0) if c0 else None
     for b in branches:
         if b not in BRANCHES:
             raise ValueError(f"unknown branch {b!r}; expected one of {BRANCHES}")
     volumes = grid() if volumes is None else np.asarray(volumes, dtype=float)
     os.makedirs(out, exist_ok=True)
-    refs = references(volumes, branches, modes)
+    refs = references(volumes, branches, modes, model)
     rows = read_rows(os.path.join(out, "phase.csv"))
     for b in branches:
-        run_branch(b, volumes, nv, out, refs[b], rows, log=log, eigen=eigen)
+        run_branch(b, volumes, nv, out, refs[b], rows, log=log, eigen=eigen, c0=c0,
+                   method=method)
     # the tables as written (the summary is then exactly the CSV's)
     rows = [r for r in read_rows(os.path.join(out, "phase.csv"))
-            if int(r.get("nv_target", 0)) == nv and r["branch"] in branches]
-    trans = transitions(rows, refs)
+            if int(r.get("nv_target", 0)) == nv and r["branch"] in branches
+            and round(float(r.get("c0") or 0.0), 9) == round(c0, 9)]
+    trans = transitions(rows, refs, c0, model)
     write_transitions(os.path.join(out, "transitions.csv"), trans)
     with open(os.path.join(out, "summary.md"), "w") as fh:
         fh.write(phase_plot.summary_markdown(rows, trans))
@@ -325,7 +362,9 @@ def merge(sources: list[str], out: str) -> tuple[list[dict], list[dict]]:
     os.makedirs(out, exist_ok=True)
     write_rows(os.path.join(out, "phase.csv"), rows)
     rows = read_rows(os.path.join(out, "phase.csv"))
-    trans = transitions(rows)
+    trans = []
+    for c0 in sorted({float(r.get("c0") or 0.0) for r in rows}) or [0.0]:
+        trans += transitions([r for r in rows if float(r.get("c0") or 0.0) == c0], c0=c0)
     write_transitions(os.path.join(out, "transitions.csv"), trans)
     with open(os.path.join(out, "summary.md"), "w") as fh:
         fh.write(phase_plot.summary_markdown(rows, trans))
@@ -347,8 +386,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--step", type=float, default=0.025)
     p.add_argument("--volumes", default=None,
                    help="comma-separated reduced volumes (instead of the grid)")
-    p.add_argument("--c0", type=float, default=0.0, help="only 0 is supported")
+    p.add_argument("--c0", type=float, default=0.0,
+                   help="reduced spontaneous curvature C0*R0 (default 0)")
     p.add_argument("--branches", default=",".join(BRANCHES))
+    p.add_argument("--method", default=None, choices=list(HZERO_METHODS),
+                   help=f"bending energy (default {METHOD} at c0 = 0, {METHOD_C0} otherwise)")
     p.add_argument("--out", default="phase_out", help="output folder")
     p.add_argument("--no-plot", dest="plot", action="store_false")
     p.add_argument("--no-eigen", dest="eigen", action="store_false",
@@ -366,7 +408,7 @@ def run_args(args: argparse.Namespace) -> int:
                else [float(x) for x in args.volumes.split(",")])
     rows, trans = run(nv=args.nv, volumes=volumes,
                       branches=tuple(args.branches.split(",")), out=args.out, c0=args.c0,
-                      plot=args.plot, eigen=args.eigen,
+                      plot=args.plot, eigen=args.eigen, method=args.method,
                       log=lambda t: print(t, flush=True))
     _print_transitions(trans)
     return 0 if all(r["converged"] is True for r in rows) else 1
@@ -376,8 +418,8 @@ def _print_transitions(trans):
     for t in trans:
         v = "none" if t["v"] is None else f"{t['v']:.4f}"
         vr = "none" if t["v_ref"] is None else f"{t['v_ref']:.4f}"
-        print(f"transition {t['from']}/{t['to']}: v = {v} (reference {vr}, "
-              f"published {t['v_published']})")
+        pub = "none" if t["v_published"] is None else t["v_published"]
+        print(f"transition {t['from']}/{t['to']}: v = {v} (reference {vr}, published {pub})")
 
 
 if __name__ == "__main__":

@@ -51,15 +51,17 @@ def _read_transitions(path):
             out.append({"from": r["from"], "to": r["to"],
                         "v": float(r["v"]) if r["v"] else None,
                         "v_ref": float(r["v_ref"]) if r["v_ref"] else None,
-                        "v_published": float(r["v_published"])})
+                        "v_published": (float(r["v_published"]) if r["v_published"]
+                                        else None)})
         return out
 
 
 def test_committed_study_tables_are_the_committed_csv():
-    """docs/phase/summary.md, docs/phase/n2562/summary.md and the tables
+    """docs/phase/summary.md, docs/phase/n2562/summary.md,
+    docs/phase/c0_m0.5/summary.md and the tables
     quoted in docs/phase.md are what summary_markdown writes from the
     committed CSV files next to them."""
-    for sub in ("phase", os.path.join("phase", "n2562")):
+    for sub in ("phase", os.path.join("phase", "n2562"), os.path.join("phase", "c0_m0.5")):
         rows = read_rows(os.path.join(DOCS, sub, "phase.csv"))
         trans = _read_transitions(os.path.join(DOCS, sub, "transitions.csv"))
         text = summary_markdown(rows, trans)
