@@ -28,12 +28,10 @@ try:
     from . import methods as _methods  # noqa: E402,F401  (installs the model's evaluate/method hooks)
     from .session.core import Session  # noqa: E402
     from .io.meshio_plugin import register_when_imported as _register_meshio  # noqa: E402
-    from .memory import huge_pages_off as _huge_pages_off  # noqa: E402
     from .memory import tune_allocator as _tune_allocator  # noqa: E402
 
     _register_meshio()          # meshio.read("cube.fe") / meshio.write("out.fe", mesh)
     _tune_allocator()           # large numpy temporaries stay in the heap (pyevolver.memory)
-    _huge_pages_off()           # no compaction stalls on fresh large arrays (pyevolver.memory)
 finally:
     if hasattr(_gc, "freeze"):
         _gc.freeze()            # the modules' objects go to the oldest generation at once,

@@ -23,16 +23,6 @@ for the 81,920-facet sphere, 88 MB with these blocks mmapped, the Evolver
 58 MB).  :func:`loading` (a decorator of the reader and of the surface
 build) therefore lowers both thresholds to glibc's initial 128 KiB while it
 runs and restores the settings above after.
-
-numpy asks the kernel for transparent huge pages on every array of 4 MB or
-more (``madvise``).  Where the kernel compacts memory to serve such a
-request at the page fault (``/sys/kernel/mm/transparent_hugepage/defrag``
-= ``madvise``, a common default), the fresh arrays of ``r`` and of a load
-wait for that compaction: ``r`` on the 81,920-facet sphere took 0.23–0.29 s
-of CPU with the requests and 0.20 s without, and ``g`` and ``hessian`` did
-not change measurably.  :func:`huge_pages_off` therefore turns numpy's
-requests off at ``import pyevolver``, unless the environment sets
-``NUMPY_MADVISE_HUGEPAGE`` (the user's choice wins) or ``PYEVOLVER_MALLOC=0``.
 """
 from __future__ import annotations
 
@@ -51,7 +41,6 @@ TRIM_THRESHOLD = 64 * 1024 * 1024
 LOAD_THRESHOLD = 128 * 1024     # glibc's initial mmap threshold
 
 _done: bool | None = None
-_huge: bool | None = None
 _mallopt: Any = None
 _depth = 0
 
@@ -101,30 +90,6 @@ def _loading() -> Iterator[None]:
         _depth -= 1
         _mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)
         _mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD)
-
-
-def huge_pages_off() -> bool:
-    """Turn numpy's huge-page requests off (see the module docstring).
-
-    Returns
-    -------
-    bool
-        True when numpy's setting was changed (now or at an earlier call).
-    """
-    global _huge
-    if _huge is not None:
-        return _huge
-    _huge = False
-    if "NUMPY_MADVISE_HUGEPAGE" in os.environ or os.environ.get("PYEVOLVER_MALLOC") == "0" \
-            or not sys.platform.startswith("linux"):
-        return False
-    import numpy
-    core = getattr(numpy, "_core", None) or getattr(numpy, "core", None)
-    setter = getattr(getattr(core, "multiarray", None), "_set_madvise_hugepage", None)
-    if callable(setter):
-        setter(False)
-        _huge = True
-    return _huge
 
 
 def loading(fn: Callable) -> Callable:
