@@ -15,9 +15,16 @@ def test_arguments():
     assert a.branches == "prolate,oblate,stomatocyte"
 
 
-def test_nonzero_c0_is_refused(tmp_path, capsys):
-    code = main(["study", "phase", "--c0", "0.5", "--out", str(tmp_path / "o")])
+def test_spontaneous_curvature_and_method_are_options():
+    parser = argparse.ArgumentParser()
+    study.add_args(parser)
+    a = parser.parse_args(["phase", "--c0", "0.5", "--method", "star_perp_sq_mean_curvature"])
+    assert (a.c0, a.method) == (0.5, "star_perp_sq_mean_curvature")
+
+
+def test_unknown_branch_is_refused_by_name(tmp_path, capsys):
+    code = main(["study", "phase", "--branches", "prolate,bogus", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert code == 1
-    assert "not supported in pyevolver" in err and "c0" in err
+    assert "unknown branch 'bogus'" in err and err.startswith("pyevolver study: ")
     assert "Traceback" not in err

@@ -33,3 +33,6 @@ def main(argv):
     except PyEvolverError as exc:
         sys.stderr.write(f"{exc}\n")
         return 1
+    except (ValueError, OSError) as exc:     # bad options the tool found itself, unreadable files
+        sys.stderr.write(f"pyevolver {name}: {exc}\n")
+        return 1
