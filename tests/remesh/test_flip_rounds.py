@@ -14,21 +14,11 @@ import pyevolver
 import pyevolver.remesh.equiangulate as EQ
 from pyevolver.model.records import along_first, vertex_edge_rank
 from pyevolver.remesh import flip_rounds as FR
+from pyevolver.studies.meshes import icosahedron
 
 
 def _icosphere(level):
-    p = (1.0 + 5.0 ** 0.5) / 2.0
-    X = np.array([[-1, p, 0], [1, p, 0], [-1, -p, 0], [1, -p, 0], [0, -1, p], [0, 1, p],
-                  [0, -1, -p], [0, 1, -p], [p, 0, -1], [p, 0, 1], [-p, 0, -1], [-p, 0, 1]],
-                 float)
-    X /= np.linalg.norm(X, axis=1)[:, None]
-    F = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9],
-                  [5, 11, 4], [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2],
-                  [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10],
-                  [8, 6, 7], [9, 8, 1]])
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    out = np.einsum("ij,ij->i", np.cross(b - a, c - a), a + b + c) < 0
-    F[out] = F[out][:, ::-1]                    # all counter-clockwise from outside
+    X, F = icosahedron()                        # all counter-clockwise from outside
     for _ in range(level):
         X = list(map(tuple, X))
         mid = {}
