@@ -33,6 +33,19 @@ def example(name):
     return os.path.join(EXAMPLES, name)
 
 
+def jittered_surface(name, seed, scale):
+    """The surface of the example ``name`` refined once, its vertices moved
+    by Gaussian noise of size ``scale`` (seed ``seed``): no symmetry left to
+    hide a wrong sign in a Hessian or gradient test."""
+    import io
+    import numpy as np
+    from pyevolver import Session
+    s = Session.load(example(name), out=io.StringIO())
+    s.refine(echo=False)
+    s.surface.X += scale * np.random.default_rng(seed).standard_normal(s.surface.X.shape)
+    return s.surface
+
+
 # ---------------------------------------------------------------------------
 # nightly-style runs and the fuzz counts
 

@@ -10,7 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 import pytest
 
-from conftest import example
+from conftest import example, jittered_surface
 from reference import run_reference
 from pyevolver import Session
 from pyevolver.evolve import gradient as GR
@@ -19,11 +19,7 @@ from pyevolver.evolve import hessian as H
 
 @pytest.fixture(scope="module")
 def rough_cube():
-    s = Session.load(example("cube.fe"), out=io.StringIO())
-    s.refine(echo=False)
-    rng = np.random.default_rng(7)
-    s.surface.X += 0.05 * rng.standard_normal(s.surface.X.shape)
-    return s.surface
+    return jittered_surface("cube.fe", 7, 0.05)
 
 
 def _fd(S, gfun, h=1e-6):

@@ -6,7 +6,7 @@ import io
 import numpy as np
 import pytest
 
-from conftest import example
+from conftest import example, jittered_surface
 from pyevolver import Session
 from pyevolver.evolve import hessian as H
 from pyevolver.evolve import normal_assembly as NA
@@ -14,11 +14,7 @@ from pyevolver.evolve import normal_assembly as NA
 
 @pytest.fixture(scope="module")
 def bumpy_mound():
-    s = Session.load(example("mound.fe"), out=io.StringIO())
-    s.refine(echo=False)
-    rng = np.random.default_rng(12)
-    s.surface.X += 0.03 * rng.standard_normal(s.surface.X.shape)
-    return s.surface
+    return jittered_surface("mound.fe", 12, 0.03)
 
 
 @pytest.mark.parametrize("symmetric", [False, True])

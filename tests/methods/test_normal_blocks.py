@@ -2,24 +2,17 @@
 checked against central differences of the analytic area and volume
 gradients along the chosen directions (the assembly:
 tests/evolve/test_normal_assembly.py)."""
-import io
 
 import numpy as np
 import pytest
 
-from conftest import example
-from pyevolver import Session
-from pyevolver.evolve import gradient as GR
+from conftest import jittered_surface
 from pyevolver.methods.normal_blocks import area_blocks, volume_blocks
 
 
 @pytest.fixture(scope="module")
 def rough_cube():
-    s = Session.load(example("cube.fe"), out=io.StringIO())
-    s.refine(echo=False)
-    rng = np.random.default_rng(3)
-    s.surface.X += 0.05 * rng.standard_normal(s.surface.X.shape)
-    return s.surface
+    return jittered_surface("cube.fe", 3, 0.05)
 
 
 def _axis_major(S, V):
