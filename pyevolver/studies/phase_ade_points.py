@@ -30,7 +30,7 @@ from .phase_ade import (ade_energy_from_bc, bilayer_couple, effective_c0,
 from .phase_mesh import revolve
 from .phase_newton import restore
 from .phase_reference import crossing, follow
-from .phase_study import TYPES, crossing_linear, lam_for, method_for
+from .phase_study import TYPES, crossing_linear, lam_for, method_for, read_rows
 from .vesicle_shapes import mesh_descriptors
 from .vesicle_newton import newton_lm
 
@@ -228,25 +228,10 @@ def markdown(rows: list[dict]) -> str:
 
 
 def read_table(path: str) -> list[dict]:
-    """The rows of an ``ade.csv`` (numbers as floats, booleans as bool,
-    empty cells left out), for :func:`markdown`."""
-    out = []
-    with open(path, newline="") as fh:
-        for r in csv.DictReader(fh):
-            row: dict = {}
-            for k, val in r.items():
-                if val == "":
-                    continue
-                if val in ("True", "False"):
-                    row[k] = val == "True"
-                elif k in ("branch", "start", "method", "type", "from", "to"):
-                    row[k] = val
-                elif k == "nv":
-                    row[k] = int(val)
-                else:
-                    row[k] = float(val)
-            out.append(row)
-    return out
+    """The rows of an ``ade.csv`` (:func:`~.phase_study.read_rows`, with
+    empty cells left out and ``nv`` an integer), for :func:`markdown`."""
+    return [{k: int(val) if k == "nv" else val for k, val in r.items() if val != ""}
+            for r in read_rows(path)]
 
 
 SWEEP_COLUMNS = ["branch", "v", "c0", "alpha", "m0", "nv", "W", "W_ref", "rel_err", "m",

@@ -195,7 +195,7 @@ def read_rows(path: str) -> list[dict]:
             for k, val in r.items():
                 if val in ("True", "False"):
                     row[k] = val == "True"
-                elif k in ("branch", "type", "start", "method") or val == "":
+                elif k in ("branch", "type", "start", "method", "from", "to") or val == "":
                     row[k] = val
                 else:
                     row[k] = float(val)
