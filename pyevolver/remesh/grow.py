@@ -50,7 +50,7 @@ def _new_ids(ids, n):
 
 
 def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
-         f_from_facet=()):
+         f_from_facet=(), bodies=None):
     """A copy of ``s`` with new vertices, edges and facets appended.
 
     Parameters
@@ -63,6 +63,10 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
         Parents of the new edges (same ordering rule).
     f_from_facet : (k,) int array
         Parents of the new facets.
+    bodies : Bodies, optional
+        The new surface's bodies when the caller has made them (``r``:
+        :func:`pyevolver.remesh.refine._split_bodies`); by default every
+        occurrence of a parent facet gains one of each of its children.
 
     Returns
     -------
@@ -189,8 +193,8 @@ def grow(s, v_from_edge=(), v_from_facet=(), e_from_edge=(), e_from_facet=(),
     t.extra = extra
 
     # -- bodies
-    b = copy.copy(s.bodies)
-    if b.n:
+    b = copy.copy(s.bodies) if bodies is None else bodies
+    if b.n and bodies is None:
         # (as CSR arrays: no scipy.sparse import for a refinement, facet_csr)
         b.facet_matrix = with_copied_columns(s.bodies.facet_csr, ff)
         ob, of, osg = s.bodies.occurrences

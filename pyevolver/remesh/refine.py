@@ -313,15 +313,9 @@ def _split_every_edge(s):
     nv, ne, nf = s.nv, s.ne, s.nf
     R = np.arange(ne)
     par = np.repeat(np.arange(nf), 3)
-    bodies = _split_bodies(s.bodies, nf)
-    if bodies is None:
-        t = grow(s, v_from_edge=R, e_from_edge=R, e_from_facet=par, f_from_facet=par)
-    else:           # (grow without the bodies, made here: no sort of the matrix)
-        s0 = copy.copy(s)
-        s0.bodies = copy.copy(s.bodies)
-        s0.bodies.n = 0
-        t = grow(s0, v_from_edge=R, e_from_edge=R, e_from_facet=par, f_from_facet=par)
-        t.bodies = bodies
+    # (the bodies made here when there are any: no sort of the facet matrix)
+    t = grow(s, v_from_edge=R, e_from_edge=R, e_from_facet=par, f_from_facet=par,
+             bodies=_split_bodies(s.bodies, nf))
     del par
     # -- midpoints and edge halves: edge e keeps its tail half, its head half
     # is edge ne + e, its midpoint vertex nv + e
