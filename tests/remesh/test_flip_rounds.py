@@ -189,6 +189,19 @@ def test_rounds_equal_the_sequential_pass(tmp_path, monkeypatch, counted, seed):
     assert counted["calls"] >= 1
 
 
+def _swap_passes(s, rng, passes, share, monkeypatch):
+    """``passes`` edgeswap-style passes (every flip that passes the
+    topological tests, on a random ``share`` of the edges), each checked
+    against the plain and the sequential pass; the last surface."""
+    for _ in range(passes):
+        only = rng.random(s.ne) < share
+        ref = _reference(s, np.inf, only)
+        t, n = EQ.equiangulate(s, threshold=np.inf, only=only)
+        _same(s, t, n, ref, _sequential_only(monkeypatch, s, threshold=np.inf, only=only))
+        s = t
+    return s
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_rounds_on_irregular_meshes_and_edgeswap(tmp_path, monkeypatch, counted, seed):
     """Random swaps make vertices of low valence, where a new diagonal may
@@ -196,12 +209,7 @@ def test_rounds_on_irregular_meshes_and_edgeswap(tmp_path, monkeypatch, counted,
     order: the rounds either agree or leave the pass to the visits."""
     rng = np.random.default_rng(100 + seed)
     s = _surface(2, 50 + seed, jitter=0.5, tmp_path=tmp_path)
-    for k in range(3):
-        only = rng.random(s.ne) < 0.6
-        ref = _reference(s, np.inf, only)
-        t, n = EQ.equiangulate(s, threshold=np.inf, only=only)
-        _same(s, t, n, ref, _sequential_only(monkeypatch, s, threshold=np.inf, only=only))
-        s = t
+    s = _swap_passes(s, rng, 3, 0.6, monkeypatch)
     for k in range(2):
         t, n = EQ.equiangulate(s)
         _same(s, t, n, _reference(s), _sequential_only(monkeypatch, s))
@@ -214,12 +222,7 @@ def test_some_passes_are_left_to_the_visits(tmp_path, monkeypatch, counted):
     for seed in range(8):
         rng = np.random.default_rng(seed)
         s = _surface(1, 200 + seed, jitter=0.4, tmp_path=tmp_path)
-        for k in range(4):
-            only = rng.random(s.ne) < 0.8
-            ref = _reference(s, np.inf, only)
-            t, n = EQ.equiangulate(s, threshold=np.inf, only=only)
-            _same(s, t, n, ref, _sequential_only(monkeypatch, s, threshold=np.inf, only=only))
-            s = t
+        _swap_passes(s, rng, 4, 0.8, monkeypatch)
     assert counted["undecided"] >= 1
     assert counted["undecided"] < counted["calls"]
 
