@@ -10,6 +10,10 @@ from typing import Any  # noqa: E402
 
 import gc as _gc  # noqa: E402
 
+from .threads import program_start as _program_start  # noqa: E402
+
+_program_start()            # the pyevolver program: one BLAS thread (pyevolver.threads)
+
 _gc_enabled = _gc.isenabled()
 _gc.disable()               # importing creates ~10^5 objects: no collections meanwhile (start-up)
 try:

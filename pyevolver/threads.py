@@ -65,6 +65,85 @@ def _control():
 
 _depth = 0
 _generation = 0
+_late: list = []        # limits set inside a step on libraries loaded during it
+_process = False        # the pyevolver program: limits, once set, stay (process_wide)
+_kept: Any = None       # the controller whose libraries are limited for good
+
+
+_BLAS_ENV = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def is_program() -> bool:
+    """Whether this process is the ``pyevolver`` program (its console
+    script, or ``python -m pyevolver``), not Python code importing it."""
+    argv = list(getattr(sys, "orig_argv", None) or [])
+    if "-m" in argv[:-1]:
+        return argv[argv.index("-m") + 1].split(".")[0] == "pyevolver"
+    return bool(sys.argv) and os.path.basename(sys.argv[0]) == "pyevolver"
+
+
+def program_start() -> None:
+    """Run by ``import pyevolver`` before numpy loads: in the ``pyevolver``
+    program, ``OPENBLAS_NUM_THREADS`` is set to :func:`setting` unless the
+    user set a BLAS thread count (``OPENBLAS_NUM_THREADS``,
+    ``GOTO_NUM_THREADS``, ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS``) or
+    ``PYEVOLVER_BLAS_THREADS=0``.  OpenBLAS starts its worker threads when
+    it loads, and each spins for a while before sleeping (0.06 s of CPU
+    time after ``import numpy`` here), again when scipy's own OpenBLAS
+    loads with the first ``hessian``.  (Child processes inherit the
+    variable.)"""
+    if "numpy" in sys.modules or not is_program():
+        return
+    n = setting()
+    if n is None or any(v in os.environ for v in _BLAS_ENV):
+        return
+    os.environ["OPENBLAS_NUM_THREADS"] = str(n)
+
+
+def process_wide() -> None:
+    """The ``pyevolver`` program owns its process: the limit is set at once
+    and stays for the whole run instead of being lifted between steps.
+    OpenBLAS's idle worker threads spin for a while after each product they
+    shared, so numpy's products outside the steps (loading, evaluations,
+    printing) cost CPU time of their own and woke the workers into the next
+    step (in a ``hessian`` at 81,920 facets, a worker thread spent 0.1 s of
+    CPU time, a quarter of the step's, while the step computed the
+    nested-dissection order, which uses no BLAS).  (In Python, the API
+    limits only inside the steps.)"""
+    global _process
+    _process = True
+    n = setting()
+    ctl = _control() if n is not None else None
+    if ctl is not None:
+        _keep(ctl, n)
+
+
+def _keep(ctl, n) -> None:
+    global _kept
+    if ctl is not _kept:
+        ctl.limit(limits=n, user_api="blas")      # (never restored)
+        _kept = ctl
+
+
+def libraries_loaded() -> None:
+    """Note that a module linking its own BLAS was just loaded (scipy's
+    SuperLU and linear algebra bring scipy's OpenBLAS, apart from numpy's):
+    the next step's limit covers it, and a step running now limits it at
+    once."""
+    global _controller
+    if _controller is False:
+        return
+    _controller = None
+    n = setting() if _depth or _process else None
+    if n is None:
+        return
+    ctl = _control()
+    if ctl is None:
+        return
+    if _process:
+        _keep(ctl, n)
+    else:
+        _late.append(ctl.limit(limits=n, user_api="blas"))
 
 
 @contextmanager
@@ -91,12 +170,17 @@ def limited():
         return
     n = setting()
     ctl = _control() if n is not None else None
+    if ctl is not None and _process:
+        _keep(ctl, n)
+        ctl = None
     with (nullcontext() if ctl is None else ctl.limit(limits=n, user_api="blas")):
         try:
             _generation += 1
             _depth = 1
             yield
         finally:
+            while _late:                 # (before the outer limit restores its own)
+                _late.pop().restore_original_limits()
             _depth = 0
             _generation += 1
 

@@ -104,3 +104,98 @@ def test_interrupted_nested_use_finished_late_changes_nothing(monkeypatch):
             assert TH._depth == 2
         assert TH._depth == 1
     assert TH._depth == 0
+
+
+@pytest.mark.parametrize("orig,argv0,want", [
+    (["python", "-m", "pyevolver", "cube.fe"], "-m", True),
+    (["python", "-m", "pyevolver.cli.main"], "-m", True),
+    (["python", "-m", "pytest", "-q"], "/x/pytest/__main__.py", False),
+    (["/venv/bin/python", "/venv/bin/pyevolver", "cube.fe"], "/venv/bin/pyevolver", True),
+    (["python", "-c", "import pyevolver"], "-c", False),
+    (["python", "run.py"], "run.py", False)])
+def test_is_program(monkeypatch, orig, argv0, want):
+    monkeypatch.setattr(sys, "orig_argv", orig, raising=False)
+    monkeypatch.setattr(sys, "argv", [argv0])
+    assert TH.is_program() is want
+
+
+def _fresh(code, env):
+    import os
+    import subprocess
+    full = {k: v for k, v in os.environ.items() if k not in TH._BLAS_ENV and k != TH.ENV}
+    full.update(env)
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=full, check=True).stdout.split()
+
+
+PROGRAM = ("import sys; sys.orig_argv = ['python', '-m', 'pyevolver']\n"
+           "import os, pyevolver\n"
+           "from threadpoolctl import threadpool_info\n"
+           "print(os.environ.get('OPENBLAS_NUM_THREADS', '-'),"
+           " *sorted({i['num_threads'] for i in threadpool_info()"
+           " if i['internal_api'] == 'openblas'}))\n")
+
+
+def test_program_starts_openblas_with_one_thread():
+    # the program (not a user's script) sets OPENBLAS_NUM_THREADS before numpy
+    # loads, unless the user chose a count or PYEVOLVER_BLAS_THREADS=0
+    out = _fresh(PROGRAM, {})
+    if len(out) == 1:
+        pytest.skip("numpy's BLAS is not OpenBLAS")
+    assert out == ["1", "1"]
+    assert _fresh(PROGRAM, {TH.ENV: "2"}) == ["2", "2"]
+    assert _fresh(PROGRAM, {"OPENBLAS_NUM_THREADS": "2"})[0] == "2"
+    assert _fresh(PROGRAM, {TH.ENV: "0"})[0] == "-"
+    script = PROGRAM.replace("sys.orig_argv = ['python', '-m', 'pyevolver']", "pass")
+    assert _fresh(script, {})[0] == "-"
+
+
+def test_process_wide_limit_stays_after_steps(monkeypatch):
+    import numpy  # noqa: F401  (loads the BLAS)
+    before = _blas_threads()
+    if not before:
+        pytest.skip("no BLAS library that threadpoolctl knows")
+    monkeypatch.delenv(TH.ENV, raising=False)
+    monkeypatch.setattr(TH, "_process", False)
+    monkeypatch.setattr(TH, "_kept", None)
+    try:
+        TH.process_wide()
+        assert set(_blas_threads()) == {1}
+        with TH.limited():
+            assert set(_blas_threads()) == {1}
+        assert set(_blas_threads()) == {1}          # not lifted between steps
+    finally:
+        TH._process = False
+        TH._controller = None
+        from threadpoolctl import threadpool_limits
+        for n in set(before):
+            threadpool_limits(n, user_api="blas")
+    assert _blas_threads() == before
+
+
+def test_library_loaded_inside_a_step_is_limited_at_once_and_restored(monkeypatch):
+    """scipy's SuperLU brings scipy's OpenBLAS when the first hessian loads
+    it, inside the step's limit: it is limited from then to the step's end."""
+    import numpy  # noqa: F401
+    if not _blas_threads():
+        pytest.skip("no BLAS library that threadpoolctl knows")
+    monkeypatch.delenv(TH.ENV, raising=False)
+    made = []
+    real = TH._control
+
+    class Spy:
+        def __init__(self, ctl):
+            self.ctl = ctl
+
+        def limit(self, **kw):
+            lim = self.ctl.limit(**kw)
+            made.append(lim)
+            return lim
+
+    monkeypatch.setattr(TH, "_control", lambda: Spy(real()))
+    with TH.limited():
+        assert len(made) == 1
+        TH.libraries_loaded()           # (as superlu._load does)
+        assert len(made) == 2 and len(TH._late) == 1
+        assert set(_blas_threads()) == {1}
+    assert TH._late == []

@@ -14,7 +14,7 @@ import sys
 
 import numpy as np
 
-from .. import __version__
+from .. import __version__, threads
 from ..commands import interpreter as I
 from ..commands.variables import READ_ONLY
 from ..errors import InternalError, PyEvolverError
@@ -106,6 +106,7 @@ def _main(argv=None):
     args = build_parser().parse_args(argv)
     np.seterr(all="ignore")        # overflows are reported as Evolver warnings, not numpy's
     deadline.handle_sigterm()      # SIGTERM: as Ctrl-C (the command undone, exit 143)
+    threads.process_wide()         # BLAS limited from the first step on (pyevolver.threads)
     path = _find_datafile(args.datafile)
     if path is None:
         sys.stderr.write(f"pyevolver: cannot open datafile '{args.datafile}': no such file\n")
