@@ -53,3 +53,34 @@ def test_loading_runs_the_step_and_restores():
     assert memory._depth == 0
     on = memory._mallopt is not None        # (glibc: the thresholds lowered once, nested too)
     assert calls == ([1, 1, 1] if on else [0, 0, 0])
+
+
+GIVE_BACK = """
+import numpy as np, pyevolver, pyevolver.memory as m
+def rss():
+    return int(open('/proc/self/status').read().split('VmRSS:')[1].split()[0]) // 1024
+blocks, keep = [], []
+for _ in range(400):           # 1 MB blocks in the heap (below 32 MiB), each followed
+    blocks.append(np.ones(1 << 17))      # by a small block that stays: holes,
+    keep.append(np.ones(512))            # not a free top that free() trims
+del blocks
+held = rss()
+m.give_back()
+print(held, rss(), m._trim is not False)
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc_trim")
+def test_give_back_returns_freed_heap_pages():
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PYEVOLVER_MALLOC", "MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_")}
+    env["PYTHONPATH"] = ROOT
+    out = subprocess.run([sys.executable, "-c", GIVE_BACK], capture_output=True, text=True,
+                         env=env, timeout=120, check=True).stdout.split()
+    held, after, active = int(out[0]), int(out[1]), out[2] == "True"
+    assert active
+    assert held - after > 200, (held, after)      # (MB: most of the 400 freed)
+    env["PYEVOLVER_MALLOC"] = "0"                  # the user's allocator: left alone
+    out = subprocess.run([sys.executable, "-c", GIVE_BACK], capture_output=True, text=True,
+                         env=env, timeout=120, check=True).stdout.split()
+    assert out[2] == "False"

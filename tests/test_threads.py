@@ -152,12 +152,15 @@ def test_program_starts_openblas_with_one_thread():
 
 def test_process_wide_limit_stays_after_steps(monkeypatch):
     import numpy  # noqa: F401  (loads the BLAS)
+    from threadpoolctl import ThreadpoolController
     before = _blas_threads()
     if not before:
         pytest.skip("no BLAS library that threadpoolctl knows")
     monkeypatch.delenv(TH.ENV, raising=False)
     monkeypatch.setattr(TH, "_process", False)
     monkeypatch.setattr(TH, "_kept", None)
+    guard = ThreadpoolController()
+    original = [(lib, lib.num_threads) for lib in guard.lib_controllers]
     try:
         TH.process_wide()
         assert set(_blas_threads()) == {1}
@@ -167,9 +170,8 @@ def test_process_wide_limit_stays_after_steps(monkeypatch):
     finally:
         TH._process = False
         TH._controller = None
-        from threadpoolctl import threadpool_limits
-        for n in set(before):
-            threadpool_limits(n, user_api="blas")
+        for lib, n in original:
+            lib.set_num_threads(n)
     assert _blas_threads() == before
 
 

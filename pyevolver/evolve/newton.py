@@ -36,8 +36,10 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from .. import memory
 from ..constraints import restore_state, state
 from ..errors import UnsupportedError, dimension_error
+from . import fastpath as FP
 from . import gradient as GR
 from . import hessian_nd
 from .eigen import ShiftedFactor
@@ -302,7 +304,13 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
         ``totals`` the evaluation after the step.
     """
     s = it.surface
+    FP.forget(it)
+    memory.give_back()         # (the g steps' freed blocks out of the resident size)
     hs = hessian_nd.system(it, normal)
+    # the evaluation K was formed at: only its energy is needed from here on
+    # (its cached geometry, 60 MB at 81,920 facets, goes before the factorization)
+    e0 = (hs.totals if hs.totals is not None else s.evaluate()).energy
+    hs.totals = None
     n = hs.K.shape[0]
     got = None
     piv: list = []
@@ -337,7 +345,6 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
             report.append(f"WARNING 1825: Hessian not positive definite. Index: {index}\n")
     targets = cons.targets(s)
     X0 = state(s)
-    e0 = (hs.totals if hs.totals is not None else s.evaluate()).energy
 
     def E(scale, report=None):
         e = it._move(X0, dx, scale, cons, None, None, mobile, targets, report).energy

@@ -151,3 +151,16 @@ def test_the_same_energies_as_the_evolver(tmp_path, evolver):
         s = Session.load(path, out=io.StringIO())
         s.run("g 10")
         assert s.total_energy == pytest.approx(want, rel=1e-12)
+
+
+def test_hessian_drops_the_plan_and_the_next_g_makes_it_again():
+    # (the plan's index arrays need not stay beside the Hessian's factors;
+    # the step moves the surface, so the next g could not use the plan)
+    s = Session.load(example("cube.fe"), out=io.StringIO())
+    s.run("r; r; g 3")
+    it = s.iterator
+    assert it.__dict__.get("_fast_plan") is not None
+    s.hessian(echo=False)
+    assert "_fast_plan" not in it.__dict__ and "_end" not in it.__dict__
+    s.g(1)
+    assert it.__dict__.get("_fast_plan") is not None
