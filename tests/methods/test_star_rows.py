@@ -49,6 +49,26 @@ def test_chunks_add_up_to_the_coo_assembly(fixed):
     assert rows.matrix().nnz == np.count_nonzero(_coo(F, basis, r, np.ones_like(vals)))
 
 
+@pytest.mark.parametrize("fixed", [[], [0, 3]])
+def test_block_product_is_the_block_diagonal_product(fixed):
+    # diag(M) J with per-vertex (r, r) blocks: the sparse product's numbers
+    F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
+                  [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    ndof = np.ones(6, np.int64)
+    ndof[fixed] = 0
+    basis = _Basis(ndof)
+    r = 3
+    rng = np.random.default_rng(2)
+    rows = SR.StarRows(F, basis, r)
+    rows.add_chunk(0, F, rng.standard_normal((len(F), 3, r, 3)))
+    M = rng.standard_normal((6, r, r))
+    J = rows.matrix().toarray()
+    want = sp.block_diag(list(M)).toarray() @ J
+    got = rows.block_product(M)
+    assert np.allclose(got.toarray(), want, rtol=0, atol=1e-13)
+    assert np.array_equal(got.indices, rows.matrix().indices)
+
+
 def test_bending_hessian_same_as_the_coo_path(tmp_path, monkeypatch):
     """star_perp_sq_mean_curvature + area + volume on a 320-facet icosphere
     (hessian_normal): the Hessian system with the CSR path equals the COO
