@@ -36,7 +36,6 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from .. import memory
 from ..constraints import restore_state, state
 from ..errors import UnsupportedError, dimension_error
 from . import fastpath as FP
@@ -305,7 +304,6 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     """
     s = it.surface
     FP.forget(it)
-    memory.give_back()         # (the g steps' freed blocks out of the resident size)
     hs = hessian_nd.system(it, normal)
     # the evaluation K was formed at: only its energy is needed from here on
     # (its cached geometry, 60 MB at 81,920 facets, goes before the factorization)
