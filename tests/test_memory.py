@@ -59,12 +59,9 @@ GIVE_BACK = """
 import numpy as np, pyevolver, pyevolver.memory as m
 def rss():
     return int(open('/proc/self/status').read().split('VmRSS:')[1].split()[0]) // 1024
-blocks, keep = [], []
-for _ in range(400):           # 1 MB blocks in the heap (below 32 MiB), each followed
-    blocks.append(np.ones(1 << 17))      # by a small block that stays: holes,
-    keep.append(np.ones(512))            # not a free top that free() trims
-del blocks
-held = rss()
+blocks = [np.ones(1 << 17) for _ in range(400)]   # 1 MB blocks in the heap (below 32 MiB)
+del blocks[::2]                 # every other one freed: holes between kept blocks,
+held = rss()                    # not a free top that free() itself trims
 m.give_back()
 print(held, rss(), m._trim is not False)
 """
@@ -79,7 +76,7 @@ def test_give_back_returns_freed_heap_pages():
                          env=env, timeout=120, check=True).stdout.split()
     held, after, active = int(out[0]), int(out[1]), out[2] == "True"
     assert active
-    assert held - after > 200, (held, after)      # (MB: most of the 400 freed)
+    assert held - after > 150, (held, after)      # (MB: most of the 200 freed)
     env["PYEVOLVER_MALLOC"] = "0"                  # the user's allocator: left alone
     out = subprocess.run([sys.executable, "-c", GIVE_BACK], capture_output=True, text=True,
                          env=env, timeout=120, check=True).stdout.split()
