@@ -31,8 +31,10 @@ def _coo(F, basis, r, vals):
                          shape=(r * len(basis.ndof), basis.n)).toarray()
 
 
+@pytest.mark.parametrize("fast", [True, False])        # np.add.at, or one bincount a chunk
 @pytest.mark.parametrize("fixed", [[], [0, 3]])
-def test_chunks_add_up_to_the_coo_assembly(fixed):
+def test_chunks_add_up_to_the_coo_assembly(fixed, fast, monkeypatch):
+    monkeypatch.setattr(SR, "_FAST_ADD_AT", fast)
     # a small closed surface: the octahedron
     F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
                   [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
