@@ -79,7 +79,8 @@ def is_program() -> bool:
     argv = list(getattr(sys, "orig_argv", None) or [])
     if "-m" in argv[:-1]:
         return argv[argv.index("-m") + 1].split(".")[0] == "pyevolver"
-    return bool(sys.argv) and os.path.basename(sys.argv[0]) == "pyevolver"
+    name = os.path.splitext(os.path.basename(sys.argv[0]))[0] if sys.argv else ""
+    return name in ("pyevolver", "pyevolver-script")       # (the latter: Windows launchers)
 
 
 def program_start() -> None:
