@@ -31,16 +31,22 @@ def _coo(F, basis, r, vals):
                          shape=(r * len(basis.ndof), basis.n)).toarray()
 
 
+#: a small closed surface: the octahedron
+OCTAHEDRON = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
+                       [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+
+
+def _octahedron_basis(fixed):
+    ndof = np.ones(6, np.int64)
+    ndof[fixed] = 0
+    return OCTAHEDRON, _Basis(ndof)
+
+
 @pytest.mark.parametrize("fast", [True, False])        # np.add.at, or one bincount a chunk
 @pytest.mark.parametrize("fixed", [[], [0, 3]])
 def test_chunks_add_up_to_the_coo_assembly(fixed, fast, monkeypatch):
     monkeypatch.setattr(SR, "_FAST_ADD_AT", fast)
-    # a small closed surface: the octahedron
-    F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
-                  [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
-    ndof = np.ones(6, np.int64)
-    ndof[fixed] = 0
-    basis = _Basis(ndof)
+    F, basis = _octahedron_basis(fixed)
     r = 4
     vals = np.random.default_rng(1).standard_normal((len(F), 3, r, 3))
     rows = SR.StarRows(F, basis, r)
@@ -54,11 +60,7 @@ def test_chunks_add_up_to_the_coo_assembly(fixed, fast, monkeypatch):
 @pytest.mark.parametrize("fixed", [[], [0, 3]])
 def test_block_product_is_the_block_diagonal_product(fixed):
     # diag(M) J with per-vertex (r, r) blocks: the sparse product's numbers
-    F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
-                  [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
-    ndof = np.ones(6, np.int64)
-    ndof[fixed] = 0
-    basis = _Basis(ndof)
+    F, basis = _octahedron_basis(fixed)
     r = 3
     rng = np.random.default_rng(2)
     rows = SR.StarRows(F, basis, r)
