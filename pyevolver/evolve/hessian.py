@@ -289,7 +289,8 @@ def _quantity_hessian(t, q, weight, lowrank=None):
                             f"hessian with the nonlinear quantity FUNCTION of {q.name}",
                             f"{n} has no analytic Hessian")
                     return None
-                out.extend(part)
+                if di:                  # (with di = 0 only checked: no zero matrices)
+                    out.extend(part)
         return out
     for m, etype, idx, sign in q.methods:
         w = np.ones(len(idx)) if sign is None else np.asarray(sign, float)

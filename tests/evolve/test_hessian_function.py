@@ -118,7 +118,8 @@ def test_border_solve_and_inertia_equal_dense(signs):
 
 def test_other_hessians_refuse_a_nonlinear_function(tmp_path):
     """The damped ``newton`` (its Levenberg–Marquardt factorization has no
-    border for the rank term) refuses by name; ``hessian`` steps."""
+    border for the rank term) refuses by name; ``hessian`` and
+    ``hessian_seek`` step."""
     s = _session(tmp_path, TOPS["ade"])
     s.run("g 2")
     with pytest.raises(CommandError, match="not supported in pyevolver: this Hessian with "
@@ -126,4 +127,7 @@ def test_other_hessians_refuse_a_nonlinear_function(tmp_path):
         s.run("newton 1")
     e0 = s.value("total_energy")
     s.run("hessian")
-    assert s.value("total_energy") != e0
+    e1 = s.value("total_energy")
+    assert e1 != e0
+    s.run("hessian_seek")                       # (the same system, a line search)
+    assert s.value("total_energy") <= e1
