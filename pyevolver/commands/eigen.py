@@ -39,7 +39,7 @@ def _system(session: Any, what: str):
     note_beyond(session)
     if s.X.shape[1] > 3:
         raise dimension_error(s.sdim, "the Hessian's eigenvalues", "need")
-    hs = hessian_system(it, normal=it.settings.hessian_normal)
+    hs = hessian_system(it, normal=it.settings.hessian_normal, lowrank=True)
     mix = _mix(session)
     if mix is not None:
         EG.metric(hs, s, mix)

@@ -133,14 +133,17 @@ class ShiftedFactor:
     fallback, unless ``nudge``: then σ is moved by up to 1e-4 of K's mean
     diagonal until it factors (``self.sigma``), for shift-and-invert.
     ``points`` (n, d), where each unknown sits, lets large systems be
-    factored in :mod:`.symfactor`'s nested-dissection order.
+    factored in :mod:`.symfactor`'s nested-dissection order.  ``D`` (k,),
+    the border's diagonal block (:meth:`.hessian.HessianSystem.border`;
+    None: zeros): the inertia is then that of ``A + W diag(±1) Wᵀ`` on
+    the constraints.
     """
 
     def __init__(self, K, B, sigma: float, eps: float, M=None, nudge: bool = False,
-                 points=None):
+                 points=None, D=None):
         n = K.shape[0]
         Mm = sp.identity(n, format="csc") if M is None else M
-        self.n, self.B, self.eps = n, B, eps
+        self.n, self.B, self.eps, self.D = n, B, eps, D
         self.solve: Callable
         self.pivots = None
         A = (K - sigma * Mm).tocsc()
@@ -172,13 +175,14 @@ class ShiftedFactor:
         self._bordered = None
         if B is not None:
             self.ZB = np.asarray(self.solve(np.asarray(B, float)))
-            self.S = B.T @ self.ZB                      # (k, k) Bᵀ A⁻¹ B
+            self.S = B.T @ self.ZB - (0.0 if D is None else np.diag(D))  # Bᵀ A⁻¹ B − D
             d = np.abs(np.asarray(self.pivots))
             if len(d) and d.min() <= 1e-10 * d.max():
                 # A (nearly) singular, the bordered matrix perhaps not (a mode of
                 # K that the constraints remove): solve with the bordered matrix
                 import scipy.sparse.linalg as spla
-                M = sp.bmat([[A, sp.csc_matrix(B)], [sp.csc_matrix(B.T), None]],
+                M = sp.bmat([[A, sp.csc_matrix(B)], [sp.csc_matrix(B.T),
+                                                      None if D is None else sp.diags(D)]],
                             format="csc")
                 try:
                     self._bordered = spla.splu(M)
@@ -194,9 +198,11 @@ class ShiftedFactor:
         if self.B is not None:
             s = np.linalg.eigvalsh(-0.5 * (self.S + self.S.T))
             k = len(s)
-            below += int(np.sum(s < -self.eps)) - k
+            npos = 0 if self.D is None else int(np.sum(np.asarray(self.D) > 0))
+            nneg = 0 if self.D is None else int(np.sum(np.asarray(self.D) < 0))
+            below += int(np.sum(s < -self.eps)) - (k - npos)
             equal += int(np.sum(np.abs(s) <= self.eps))
-            above += int(np.sum(s > self.eps)) - k
+            above += int(np.sum(s > self.eps)) - (k - nneg)
             if below < 0 or above < 0:        # a degenerate border: count what is left
                 below, above = max(below, 0), max(above, 0)
         return Inertia(below, equal, above)
@@ -221,6 +227,14 @@ def _null_basis(B, n):
     return Q[:, rank:]
 
 
+def _factor(hs: HessianSystem, sigma: float, eps: float) -> ShiftedFactor:
+    """:class:`ShiftedFactor` of ``hs`` at ``σ`` (nudged off an eigenvalue),
+    its border with the low-rank term of a nonlinear FUNCTION quantity
+    (:meth:`.hessian.HessianSystem.border`)."""
+    B, _, D = hs.border()
+    return ShiftedFactor(hs.K, B, sigma, eps, hs.M, nudge=True, points=hs.points, D=D)
+
+
 def _dim(hs: HessianSystem) -> int:
     return hs.K.shape[0] - (0 if hs.B is None else hs.B.shape[1])
 
@@ -237,6 +251,8 @@ def _dense(hs: HessianSystem):
     (with a metric: of ``Zᵀ K Z w = μ Zᵀ M Z w``, the vectors M-orthonormal)."""
     Z = _null_basis(hs.B, hs.K.shape[0])
     Kd = hs.K.toarray()
+    if hs.W is not None:
+        Kd += (hs.W * hs.Wsign) @ hs.W.T
     Md = None if hs.M is None else hs.M.toarray()
     if Z is not None:
         Kd = Z.T @ Kd @ Z
@@ -263,7 +279,7 @@ def _near(hs: HessianSystem, shift: float, m: int, eps: float, dense_max: int, s
         w, V = _dense(hs)
         return _order(w, V, shift, m)
     import scipy.sparse.linalg as spla   # when first used (start-up time)
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True, points=hs.points)
+    fac = _factor(hs, shift, eps)
     v0 = fac.op(np.random.default_rng(seed).standard_normal(n))
     op = spla.LinearOperator((n, n), matvec=fac.op, dtype=float)
     try:
@@ -321,8 +337,7 @@ def inertia(hs: HessianSystem, shift: float, eps: float = 1e-10,
     pts = np.sort(np.concatenate([[shift - rmax, shift - eps], vals[vals < shift - eps]]))
     gap = int(np.argmax(np.diff(pts)))
     sigma = 0.5 * (pts[gap] + pts[gap + 1])
-    below = ShiftedFactor(hs.K, hs.B, sigma, 0.0, hs.M, nudge=True,
-                          points=hs.points).inertia().below
+    below = _factor(hs, sigma, 0.0).inertia().below
     below += int(np.sum((vals >= sigma) & (vals < shift - eps)))
     return Inertia(below, equal, max(dim - below - equal, 0))
 
@@ -367,6 +382,8 @@ def lowest(hs: HessianSystem, eps: float = 1e-10, dense_max: int = DENSE_MAX,
     diag = K.diagonal()
     off = np.asarray(abs(K).sum(axis=1)).ravel() - np.abs(diag)
     lb = float(np.min(diag - off))                 # λ_min(K) ≥ lb (Gershgorin)
+    if hs.W is not None:                           # W diag(±1) Wᵀ ≥ −Σ_{−1} |w|²
+        lb -= float(np.sum(hs.W[:, hs.Wsign < 0] ** 2))
     if hs.M is not None:
         # μ_min ≥ min(lb, 0) / λ_min(M), with λ_min(M) ≥ hs.M_floor > 0
         lb = min(lb, 0.0) / hs.M_floor
@@ -402,7 +419,7 @@ def inverse_iteration(hs: HessianSystem, shift: float, maxit: int, eps: float = 
     n = hs.K.shape[0]
     if n == 0:
         return ProbeResult(Inertia(0, 0, 0), math.nan, np.zeros(0), 0, [], hs)
-    fac = ShiftedFactor(hs.K, hs.B, shift, eps, hs.M, nudge=True, points=hs.points)
+    fac = _factor(hs, shift, eps)
     inert = inertia(hs, shift, eps)
     Mx = (lambda v: v) if hs.M is None else (lambda v: hs.M @ v)
     rng = np.random.default_rng(seed)
@@ -500,7 +517,7 @@ def saddle_step(it, normal: bool = True, max_step: float | None = None,
     """
     if it.surface.X.shape[1] > 3:
         raise dimension_error(it.surface.sdim, "the Hessian's eigenvalues", "need")
-    hs = hessian_system(it, normal)
+    hs = hessian_system(it, normal, lowrank=True)
     if mix is not None:
         metric(hs, it.surface, mix)
     low = lowest(hs, eps, m=4)

@@ -153,14 +153,19 @@ def fd_hessian(fun, s, h=None, adjacency=None):
     return 0.5 * (H + H.T)
 
 
-def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
+def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True, lowrank=None):
     """Analytic Hessian and gradient of the parts that have closed forms,
     and whether they cover the whole Lagrangian.
 
     The Hessian is (3nv, 3nv), or projected on ``basis`` (see
     :func:`pyevolver.methods._common.assemble`); with ``hessian=False`` only the gradient is formed
     (``H`` is None), with ``gradient=False`` only the Hessian (``g`` is None).
+    ``lowrank``: the list that receives the dense low-rank terms of the
+    FUNCTION quantities nonlinear in their instances' values (see
+    :func:`_quantity_hessian`); None refuses such quantities.
     """
+    if not hessian and lowrank is None:
+        lowrank = []                 # (only the gradients: the rank terms are not formed)
     parts = []                       # (hessian function, args) of each analytic term
     # one direction per vertex: the facet terms' 3 × 3 blocks summed, assembled once
     blocks = NB.applies(t, basis) if hessian else None
@@ -199,7 +204,7 @@ def _analytic_parts(s, t, cons, lam, basis=None, hessian=True, gradient=True):
     weighted = [(q, 1.0) for q in s.quantities.values() if q.kind == "energy" and q.modulus]
     weighted += [(q, -lam[len(cons.bodies) + k]) for k, q in enumerate(cons.quantities)]
     for q, wq in weighted:
-        hq = _quantity_hessian(t, q, wq)
+        hq = _quantity_hessian(t, q, wq, lowrank)
         if hq is None:
             complete = False
             continue
@@ -242,27 +247,50 @@ def _sum(mats):
                            np.concatenate([c.col for c in coo]))), shape=coo[0].shape)
 
 
-def _quantity_hessian(t, q, weight):
+def _function_derivatives(t, q):
+    """``(names, ∂f/∂v (m,), ∂²f/∂v∂v (m, m))`` of the FUNCTION of ``q`` at
+    the evaluation ``t``, ``names`` its m ``instance.value`` names."""
+    env = t.instance_values(q)
+    names = list(env)
+    params = t.surface.param_env()
+    return (names, q.function.gradient(params, env, 1, names)[0],
+            q.function.hessian(params, env, 1, names)[0])
+
+
+def _quantity_hessian(t, q, weight, lowrank=None):
     """Hessian terms ``[(function, args)]`` of ``weight × q``, or None when
-    one of its methods has no analytic Hessian."""
+    one of its methods has no analytic Hessian.
+
+    A FUNCTION quantity ``f(v_1 .. v_m)`` of instance values has the Hessian
+    ``Σ_i ∂f/∂v_i H_i + Σ_ij ∂²f/∂v_i∂v_j ∇v_i ∇v_jᵀ``.  The first sum is
+    returned; the second, dense but of rank at most m, is appended to
+    ``lowrank`` as ``(instance names, weight × modulus × ∂²f/∂v∂v (m, m))``
+    (:func:`lowrank_border` forms it); with ``lowrank`` None a nonlinear
+    FUNCTION is refused.  Its instances then need analytic Hessians: the
+    central differences over a vertex colouring assume local couplings.
+    """
     s = t.surface
     out = []
     if q.function is not None:
-        # Σ_i ∂f/∂v_i H_i; the rank terms ∂²f/∂v_i∂v_j ∇v_i ∇v_jᵀ would be dense
-        env = t.instance_values(q)
-        names = list(env)
-        params = s.param_env()
-        second = q.function.hessian(params, env, 1, names)[0]
-        if np.any(second != 0):
-            raise UnsupportedError(f"hessian with the quantity FUNCTION of {q.name}",
-                                   "only functions linear in the instance values")
-        d = q.function.gradient(params, env, 1, names)[0]
+        names, d, second = _function_derivatives(t, q)
+        nonlinear = bool(np.any(second != 0))
+        if nonlinear:
+            if lowrank is None:
+                raise UnsupportedError(f"this Hessian with the quantity FUNCTION of {q.name}",
+                                       "only functions linear in the instance values here; "
+                                       "hessian and hessian_seek take nonlinear ones")
+            lowrank.append(([n[:-6] for n in names], weight * q.modulus * second))
         for di, n in zip(d, names):
-            if di:
+            if di or nonlinear:
                 part = _quantity_hessian(t, s.quantities[n[:-6]], weight * q.modulus * di)
                 if part is None:
+                    if nonlinear:
+                        raise UnsupportedError(
+                            f"hessian with the nonlinear quantity FUNCTION of {q.name}",
+                            f"{n} has no analytic Hessian")
                     return None
-                out.extend(part)
+                if di:                  # (with di = 0 only checked: no zero matrices)
+                    out.extend(part)
         return out
     for m, etype, idx, sign in q.methods:
         w = np.ones(len(idx)) if sign is None else np.asarray(sign, float)
@@ -278,6 +306,30 @@ def _quantity_hessian(t, q, weight):
     return out
 
 
+def lowrank_border(t, lowrank, T):
+    """The low-rank terms of :func:`_quantity_hessian` on the free
+    coordinates ``dy`` (``dx = T dy``) as ``W diag(sign) Wᵀ``.
+
+    Each term ``(names, C)`` is ``G C Gᵀ`` with ``G`` (3nv, m) the gradients
+    of the instances ``names``; with ``C = Q Λ Qᵀ`` its columns are
+    ``Tᵀ G Q |Λ|^½`` and its signs ``sign Λ`` (zero eigenvalues dropped).
+    Returns ``(W (n, r), sign (r,))``, or None when there is no term.
+    """
+    s = t.surface
+    cols, signs = [], []
+    for names, C in lowrank:
+        w, Q = np.linalg.eigh(0.5 * (C + C.T))
+        keep = np.abs(w) > 1e-14 * np.abs(w).max(initial=0.0)
+        if not keep.any():
+            continue
+        G = np.stack([GR.quantity_gradient(t, s.quantities[n]).ravel() for n in names], axis=1)
+        cols.append(np.asarray(T.T @ G) @ (Q[:, keep] * np.sqrt(np.abs(w[keep]))))
+        signs.append(np.sign(w[keep]))
+    if not cols:
+        return None
+    return np.hstack(cols), np.concatenate(signs)
+
+
 def lagrangian_gradient(cons, lam):
     """``grad_L(t) -> (nv, 3)``: the gradient of E − Σ λ_i g_i at an
     evaluation ``t`` (the ``grad_fn`` of :func:`lagrangian_hessian`)."""
@@ -289,14 +341,23 @@ def lagrangian_gradient(cons, lam):
     return grad_L
 
 
-def lagrangian_hessian(s, cons, lam, grad_fn, basis=None, t=None):
+def lagrangian_hessian(s, cons, lam, grad_fn, basis=None, t=None, lowrank=None):
     """Sparse Hessian of E − Σ λ_i g_i (level-set terms excluded): (3nv, 3nv),
     or ``Tᵀ H T`` on a :class:`Basis`; ``t`` the surface's current
-    evaluation when the caller has it."""
+    evaluation when the caller has it.  ``lowrank``, a list, receives the
+    low-rank terms of nonlinear FUNCTION quantities, which the sparse
+    matrix leaves out (:func:`_quantity_hessian`); without it they are
+    refused (UnsupportedError)."""
     if getattr(s, "order", 1) == 2:         # the quadratic model's hook
+        t = s.evaluate() if t is None else t
+        for q in s.quantities.values():     # (its differences assume local couplings)
+            if q.function is not None and q.kind in ("energy", "fixed") and \
+                    np.any(_function_derivatives(t, q)[2] != 0):
+                raise UnsupportedError(f"hessian in the quadratic model with the nonlinear "
+                                       f"quantity FUNCTION of {q.name}")
         return QH.lagrangian_hessian(s, grad_fn, basis, fd_hessian)
     t = s.evaluate() if t is None else t
-    H, _, complete = _analytic_parts(s, t, cons, lam, basis, gradient=False)
+    H, _, complete = _analytic_parts(s, t, cons, lam, basis, gradient=False, lowrank=lowrank)
     if complete:
         return H
 
@@ -458,8 +519,8 @@ def _cholmod():
     return cholmod
 
 
-def solve_bordered(K, B, r, d, method=None, points=None, pivots=None):
-    """Solve ``[[K, B], [Bᵀ, 0]] [y; μ] = [r; d]``.
+def solve_bordered(K, B, r, d, method=None, points=None, pivots=None, D=None):
+    """Solve ``[[K, B], [Bᵀ, diag(D)]] [y; μ] = [r; d]`` (D None: zeros).
 
     K : sparse symmetric (n, n); B : (n, k) dense or None; r : (n,); d : (k,).
     Returns the stacked solution (n + k,).  ``method`` "cholmod" factors K
@@ -472,8 +533,10 @@ def solve_bordered(K, B, r, d, method=None, points=None, pivots=None):
     :func:`~pyevolver.evolve.ordering.nested_dissection` instead of its
     own AMD order (about half the factorization time on large surfaces).
     ``pivots``, a list: when CHOLMOD solved, it receives the LDLᵀ pivots of
-    K and the Schur complement ``Bᵀ K⁻¹ B`` (None without a border), from
-    which :mod:`.eigen` reads the inertia at no extra cost.
+    K and the Schur complement ``Bᵀ K⁻¹ B − diag(D)`` (None without a
+    border), from which :mod:`.eigen` reads the inertia at no extra cost.
+    ``D`` (k,): the border's diagonal block (:meth:`HessianSystem.border`:
+    nonzero for the auxiliary unknowns of a low-rank term).
     """
     chol = _cholmod() if method in (None, "cholmod") else None
     if method == "cholmod" and chol is None:
@@ -498,7 +561,7 @@ def solve_bordered(K, B, r, d, method=None, points=None, pivots=None):
                 if B is None:
                     sol = Z[:, 0]
                 else:
-                    S = B.T @ Z[:, 1:]
+                    S = B.T @ Z[:, 1:] - (0.0 if D is None else np.diag(D))
                     mu = np.linalg.solve(S, B.T @ Z[:, 0] - d)
                     y = Z[:, 0] - Z[:, 1:] @ mu
                     sol = np.concatenate([y, mu])
@@ -511,7 +574,8 @@ def solve_bordered(K, B, r, d, method=None, points=None, pivots=None):
     if B is None:
         M, rhs = K.tocsc(), r
     else:
-        M = sp.bmat([[K, sp.csc_matrix(B)], [sp.csc_matrix(B.T), None]], format="csc")
+        M = sp.bmat([[K, sp.csc_matrix(B)], [sp.csc_matrix(B.T), None if D is None
+                                               else sp.diags(D)]], format="csc")
         rhs = np.concatenate([r, d])
     try:
         import scipy.sparse.linalg as spla   # 0.1 s and 8 MB at start-up: when first used
@@ -545,15 +609,42 @@ class HessianSystem:
         self.M = None               # the eigenvalue metric (n, n); None: the identity
         self.M_floor = 1.0          # a lower bound of the eigenvalues of M
         self.totals = None          # the evaluation K was formed at, when kept
+        self.W = None               # (n, r) low-rank term W diag(Wsign) Wᵀ of K, when any
+        self.Wsign = None           # (r,) ±1
+
+    def border(self):
+        """``(B, d, D)`` of the bordered system with the low-rank term as
+        auxiliary unknowns ``z = diag(Wsign) Wᵀ y``:
+
+            [ K    B   W          ] [ y  ]   [ rhs ]
+            [ Bᵀ   0   0          ] [ −λ ] = [ d   ]
+            [ Wᵀ   0   −diag(Wsign)] [ z  ]   [ 0   ]
+
+        whose elimination of ``z`` leaves ``K + W diag(Wsign) Wᵀ``:
+        ``B`` (n, k + r) the border, ``d`` (k + r,), ``D`` (k + r,) its
+        diagonal block, None without a low-rank term (then ``B``, ``d`` are
+        the system's own).  The multipliers are the first k of the border's
+        unknowns.
+        """
+        if self.W is None:
+            return self.B, self.d, None
+        k = 0 if self.B is None else self.B.shape[1]
+        B = self.W if self.B is None else np.hstack([self.B, self.W])
+        d = np.zeros(self.W.shape[1]) if self.B is None else \
+            np.concatenate([self.d, np.zeros(self.W.shape[1])])
+        return B, d, np.concatenate([np.zeros(k), -self.Wsign])
 
 
-def hessian_system(it, normal: bool = True) -> HessianSystem:
+def hessian_system(it, normal: bool = True, lowrank: bool = False) -> HessianSystem:
     """The Hessian of the Lagrangian on the free motions of the surface of
     the :class:`~pyevolver.evolve.iterate.Iterator` ``it`` and its border
     (the bordered system in this module's docstring).
 
     ``normal``: each vertex moves along its normal only (``hessian_normal``).
     The multipliers are those stored by the last ``g`` or ``hessian``.
+    ``lowrank``: FUNCTION quantities nonlinear in their instances' values
+    are taken, their low-rank terms in ``W``, ``Wsign``
+    (:meth:`HessianSystem.border`); without it they are refused.
     """
     s = it.surface
     if s.X.shape[1] > 3:     # SPACE_DIMENSION 4..9: hessian_nd.system
@@ -589,7 +680,8 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
     else:
         basis, grads = tangent_basis(s, mobile, normal=normal, t=t)
         T = basis.matrix()
-        K = lagrangian_hessian(s, cons, lam, grad_L, basis, t=t)
+        terms = [] if lowrank else None
+        K = lagrangian_hessian(s, cons, lam, grad_L, basis, t=t, lowrank=terms)
     gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))
     Hc = constraint_curvature(s, grads, gL)
     if Hc is not None:
@@ -603,6 +695,8 @@ def hessian_system(it, normal: bool = True) -> HessianSystem:
         d = cons.targets(s) - cons.values(t)
     hs = HessianSystem(K, B, rhs, d, T, basis, lam, cons, mobile, s.X)
     hs.totals = t
+    if model is None and terms:
+        hs.W, hs.Wsign = lowrank_border(t, terms, T) or (None, None)
     return hs
 
 
@@ -614,10 +708,12 @@ def newton_direction(it, normal: bool = True):
     Returns ``(dx, lam_new, cons, mobile)``.  The move restores the fixed
     values along the constraint gradients at the moved positions.
     """
-    hs = hessian_system(it, normal)
+    hs = hessian_system(it, normal, lowrank=True)
     K = hs.K
-    sol = solve_bordered(K, hs.B, hs.rhs, hs.d, points=hs.points)
-    dy = sol[:K.shape[0]]
-    lam_new = -sol[K.shape[0]:] if len(hs.cons) else hs.lam
+    B, d, D = hs.border()
+    sol = solve_bordered(K, B, hs.rhs, d, points=hs.points, D=D)
+    n = K.shape[0]
+    lam_new = -sol[n:n + len(hs.cons)] if len(hs.cons) else hs.lam
+    dy = sol[:n]
     dx = (hs.T @ dy).reshape(it.surface.X.shape)
     return dx, lam_new, hs.cons, hs.mobile

@@ -183,9 +183,10 @@ def hessian_system_nd(it, normal: bool = True) -> HessianSystem:
     return HessianSystem(K, None, rhs, None, T, basis, np.zeros(0), cons, mobile, s.X[:, :3])
 
 
-def system(it, normal: bool = True) -> HessianSystem:
+def system(it, normal: bool = True, lowrank: bool = False) -> HessianSystem:
     """The Hessian system of ``hessian`` in any dimension: this module's in
-    ``d > 3``, :func:`.hessian.hessian_system` in 3."""
+    ``d > 3`` (which refuses FUNCTION quantities), :func:`.hessian.hessian_system`
+    (with ``lowrank``) in 3."""
     if it.surface.X.shape[1] > 3:
         return hessian_system_nd(it, normal)
-    return hessian_system(it, normal)
+    return hessian_system(it, normal, lowrank=lowrank)

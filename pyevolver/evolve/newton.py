@@ -225,23 +225,27 @@ def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
     return res
 
 
-def _index(hs, piv, eps):
+def _index(hs, piv, eps, B=None, D=None):
     """The number of negative eigenvalues of the constrained Hessian, for
     REF's warning 1825.  The pivots of the step's own LDLᵀ (CHOLMOD) count
     them at no cost; when they find some (their signs can err for
     eigenvalues within round-off of 0: rigid motions) the count is that of
-    one factorization at −δ, δ = max(eps, 1e-8 × the mean |diagonal|)."""
+    one factorization at −δ, δ = max(eps, 1e-8 × the mean |diagonal|).
+    ``B``, ``D``: the border of :meth:`.hessian.HessianSystem.border` (by
+    default the system's own, without a low-rank term)."""
+    B = hs.B if B is None else B
     if piv:
         d, S = piv
         below = int(np.sum(np.asarray(d) < 0))
         if S is not None:
-            below += int(np.sum(np.linalg.eigvalsh(-0.5 * (S + S.T)) < 0)) - S.shape[0]
+            below += int(np.sum(np.linalg.eigvalsh(-0.5 * (S + S.T)) < 0)) - \
+                SF.border_negatives(S, D)
         if below <= 0:
             return 0
     delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
     try:
-        return ShiftedFactor(hs.K, hs.B, -delta, 0.0, nudge=True,
-                             points=hs.points).inertia().below
+        return ShiftedFactor(hs.K, B, -delta, 0.0, nudge=True,
+                             points=hs.points, D=D).inertia().below
     except UnsupportedError:       # (singular where it cannot be resolved: no warning)
         return 0
 
@@ -304,7 +308,7 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     """
     s = it.surface
     FP.forget(it)
-    hs = hessian_nd.system(it, normal)
+    hs = hessian_nd.system(it, normal, lowrank=True)
     # the evaluation K was formed at: only its energy is needed from here on
     # (its cached geometry, 60 MB at 81,920 facets, goes before the factorization)
     e0 = (hs.totals if hs.totals is not None else s.evaluate()).energy
@@ -312,23 +316,24 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
     n = hs.K.shape[0]
     got = None
     piv: list = []
+    B, d, D = hs.border()       # (with a nonlinear FUNCTION's rank term: D, see there)
     if n > SF.ND_MIN:
         # one LDLᵀ of K + δI gives the index and, refined, the step with K
         # (small systems: the direct solve and, when its pivots find negative
         # ones, a second factorization for the index; they cost nothing there)
         delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
-        got = newton_solve(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, delta=delta)
+        got = newton_solve(hs.K, B, hs.rhs, d, points=hs.points, delta=delta, D=D)
         if got is None:          # an eigenvalue near −δ: factor K itself
-            got = newton_solve(hs.K, hs.B, hs.rhs, hs.d, points=hs.points)
+            got = newton_solve(hs.K, B, hs.rhs, d, points=hs.points, D=D)
             if got is not None:
                 got = (got[0], None)     # (K's pivots are not the index's)
     if got is not None:
         sol, index = got
     else:
-        sol = solve_bordered(hs.K, hs.B, hs.rhs, hs.d, points=hs.points, pivots=piv)
+        sol = solve_bordered(hs.K, B, hs.rhs, d, points=hs.points, pivots=piv, D=D)
         index = None
     if index is None and n:
-        index = _index(hs, piv, eps)
+        index = _index(hs, piv, eps, B, D)
     report: list[str] = []
     absurd = _absurd_step(hs, s, sol)
     if absurd:
@@ -336,7 +341,7 @@ def hessian_step(it: Iterator, seek: bool = False, max_scale: float | None = Non
                       "a force along them): the Newton step would move the surface "
                       f"{np.abs(sol[:n]).max():.3g} and is not taken.\n")
     cons, mobile = hs.cons, hs.mobile
-    lam = hs.lam if absurd or not len(cons) else -sol[n:]
+    lam = hs.lam if absurd or not len(cons) else -sol[n:n + len(cons)]
     dx = np.zeros(s.X.shape) if absurd else (hs.T @ sol[:n]).reshape(s.X.shape)
     if n:
         if index:

@@ -103,21 +103,33 @@ class LDL:
         return out
 
 
-def negative_count(pivots, S, eps):
+def border_negatives(S, D=None) -> int:
+    """The negative eigenvalues a border adds to the inertia of a bordered
+    matrix ``[[A, B], [Bᵀ, diag(D)]]`` (D None: zeros) beyond those of the
+    matrix it stands for: one per constraint column (D = 0) and one per
+    auxiliary unknown of a positive low-rank term (D < 0, see
+    :meth:`.hessian.HessianSystem.border`), i.e. ``k − #(D > 0)``."""
+    return S.shape[0] - (0 if D is None else int(np.sum(np.asarray(D) > 0)))
+
+
+def negative_count(pivots, S, eps, D=None):
     """Eigenvalues below ``−eps`` of a matrix on ``Bᵀ y = 0`` from the pivots
-    of its LDLᵀ and the Schur complement ``S = Bᵀ A⁻¹ B`` (None: no border):
-    the inertia of the bordered matrix less the k negative ones the border
-    adds (the rule of :meth:`.eigen.ShiftedFactor.inertia`)."""
+    of its LDLᵀ and the Schur complement ``S = Bᵀ A⁻¹ B − diag(D)`` (None:
+    no border): the inertia of the bordered matrix (Haynsworth: that of
+    ``A`` plus that of ``−S``) less the negative ones the border adds
+    (:func:`border_negatives`; the rule of :meth:`.eigen.ShiftedFactor.inertia`).
+    With auxiliary unknowns (``D``) the count is that of ``A + W diag(±1) Wᵀ``."""
     below = int(np.sum(np.asarray(pivots) < -eps))
     if S is not None:
         s = np.linalg.eigvalsh(-0.5 * (S + S.T))
-        below += int(np.sum(s < -eps)) - len(s)
+        below += int(np.sum(s < -eps)) - border_negatives(S, D)
     return max(below, 0)
 
 
 def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=1e-12,
-                 passes=10):
-    """Solve the bordered system with ``K`` by refinement on one factorization
+                 passes=10, D=None):
+    """Solve the bordered system with ``K`` (lower block ``diag(D)``, zeros
+    when None) by refinement on one factorization
     of ``K + δI``; returns ``(solution (n + k,), index)`` with ``index`` the
     number of eigenvalues of ``K + δI`` on ``Bᵀ y = 0`` below ``−eps``
     (None when the pivots do not tell), or None when the refinement does
@@ -134,7 +146,7 @@ def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=
     k = 0 if B is None else B.shape[1]
     if k:
         ZB = f.solve(B)
-        S = B.T @ ZB
+        S = B.T @ ZB - (0.0 if D is None else np.diag(D))
         try:
             Sinv = np.linalg.inv(S)
         except np.linalg.LinAlgError:
@@ -151,11 +163,13 @@ def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=
     def apply(z):
         if not k:
             return K @ z
-        return np.concatenate([K @ z[:n] + B @ z[n:], B.T @ z[:n]])
+        return np.concatenate([K @ z[:n] + B @ z[n:],
+                               B.T @ z[:n] + (0.0 if D is None else D * z[n:])])
     # normwise backward error ‖res‖ / (‖M‖ ‖z‖ + ‖rhs‖), ‖M‖ the largest row sum
     normM = float(abs(K).sum(axis=1).max()) if n else 0.0
     if k:
-        normM = max(normM, float(np.abs(B).sum(axis=1).max() + np.abs(B).sum(axis=0).max()))
+        normM = max(normM, float(np.abs(B).sum(axis=1).max() + np.abs(B).sum(axis=0).max()
+                                 + (0.0 if D is None else np.abs(D).max())))
     with np.errstate(all="ignore"):
         z = precond(rhs)
         best, best_err = None, np.inf
@@ -176,5 +190,5 @@ def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=
     z = best
     index = None
     if f.pivots is not None:
-        index = negative_count(f.pivots, S if k else None, eps)
+        index = negative_count(f.pivots, S if k else None, eps, D)
     return z, index

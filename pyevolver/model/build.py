@@ -7,7 +7,7 @@ import numpy as np
 from .facet_csr import canonical_csr
 
 from ..errors import DatafileError, PyEvolverError, UnsupportedError
-from ..expr.nodes import Formula
+from ..expr.nodes import CONSTANTS, Formula
 from ..limits import MAX_ARRAY_ENTRIES
 from ..memory import loading
 from .formulas import located
@@ -718,14 +718,13 @@ class _Builder:
             for m in qd.methods:
                 self._check_string_method(m, f"quantity {name}", qd.line)
             if qd.function is not None:
-                for v in qd.function.names():
-                    inst = v[:-len(".value")] if v.endswith(".value") else None
-                    if inst is None or inst not in sc.method_instances:
-                        if v in sc.parameters:
-                            continue
-                        raise self.error(f"quantity {name}: FUNCTION uses {v!r}; expected "
-                                         "method_instance values (name.value) and parameters",
-                                         qd.line)
+                for v in qd.function.names():      # (REF: also other quantities' values)
+                    ref = v[:-len(".value")] if v.endswith(".value") else None
+                    if not (ref in sc.method_instances or v in sc.parameters or v in CONSTANTS
+                            or ref in sc.quantities and sc.quantities[ref].function is None):
+                        raise self.error(f"quantity {name}: FUNCTION uses {v!r}; expected values "
+                                         "(name.value) of method instances and of quantities "
+                                         "without a FUNCTION, parameters and constants", qd.line)
                 q.function = Formula(qd.function)
             s.quantities[name] = q
         # declared attributes that no element set still exist

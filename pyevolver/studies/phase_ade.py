@@ -73,8 +73,8 @@ def ade_header(c0: float = 0.0, alpha: float = 0.0, m0: float = 1.0, area: float
              f"quantity {bend} energy method {method} global"]
     if alpha:
         r0 = float(np.sqrt(area / (4 * np.pi)))
-        # (pyevolver's FUNCTION quantities take parameters and instance
-        # values only, so the constants are parameters computed here)
+        # (the constants as parameters computed here: pyevolver's FUNCTION
+        # quantities took no ``pi`` when this was written; they do now)
         lines += [f"parameter alpha = {alpha!r}   // kappa_bar/kappa",
                   f"parameter m0 = {m0!r}   // reduced preferred area difference",
                   f"parameter ade_k = {np.pi * alpha / area!r}   // pi*alpha/A",

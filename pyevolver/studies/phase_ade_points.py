@@ -30,6 +30,7 @@ from .phase_ade import (ade_energy_from_bc, bilayer_couple, effective_c0,
 from .phase_mesh import revolve
 from .phase_newton import restore
 from .phase_reference import crossing, follow
+from .phase_stability import lowest_eigenvalues, stability
 from .phase_study import TYPES, crossing_linear, lam_for, method_for, read_rows
 from .vesicle_shapes import mesh_descriptors
 from .vesicle_newton import newton_lm
@@ -71,10 +72,22 @@ def _linear_solve(X, F, v, lam, c0, mu, method, maxit):
         return ok, s.surface.X.copy(), float(q["willmore"]), float(q["mci"])
 
 
+def ade_eigenvalues(X, F, v, lam, c0, mu, k, method, count=3):
+    """The ``count`` lowest eigenvalues of the constrained, mass-weighted
+    Hessian of the discrete ADE energy at the mesh ``(X, F)`` solved with
+    the term linearised (``W + μM``, :func:`_point_session`): the phase
+    study's (:func:`~pyevolver.studies.phase_stability.lowest_eigenvalues`,
+    λE left out) with the ADE term's second derivative ``2k ∇M ∇Mᵀ`` added
+    as a rank-one term."""
+    with tempfile.TemporaryDirectory() as tmp:
+        s = _point_session(X, F, v, lam, tmp, c0, mu, method)
+        return lowest_eigenvalues(s, k=count, extra=(("mci", 2.0 * k),))
+
+
 def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
                     lam: float | None = None, method: str | None = None,
-                    maxit: int = 60, tol: float = 1e-10, outer: int = 20
-                    ) -> tuple[dict, np.ndarray, np.ndarray]:
+                    maxit: int = 60, tol: float = 1e-10, outer: int = 20,
+                    eigen: bool = True) -> tuple[dict, np.ndarray, np.ndarray]:
     """The discrete ADE minimiser on ``branch`` at reduced volume ``v``.
 
     The discrete ADE energy is ``W + k (M − M0)²`` (``k = πα/A``,
@@ -99,7 +112,10 @@ def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
     without λE), ``W_ref``, ``rel_err``, the discrete and the reference
     ``m = M/4π``, ``c0_eff``, the mesh's shape ``type`` and ``converged``
     (every inner solve converged, ``|μ − 2k(M − M0)|`` below ``tol`` and
-    the shape still of its branch); ``X, F`` the final mesh.
+    the shape still of its branch), and with ``eigen`` for a converged
+    point ``eig1`` and ``stable`` (:func:`ade_eigenvalues`; stable: the
+    lowest eigenvalue above −10⁻³, as the phase study marks its points);
+    ``X, F`` the final mesh.
     """
     t0 = time.perf_counter()
     method = method_for(model.c0, method)
@@ -138,7 +154,11 @@ def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
            "m_ref": float(ref.mean_curvature) / (4 * np.pi), "c0_eff": model.c0 - mu,
            "lambda": lam, "method": method, "type": kind,
            "converged": bool(converged and ok_all and kind in TYPES[branch]),
-           "seconds": time.perf_counter() - t0}
+           "eig1": None, "stable": None}
+    if eigen and row["converged"]:
+        eig = ade_eigenvalues(X, F, v, lam, model.c0, mu, k, method)
+        row.update(eig1=float(eig[0]), stable=stability(eig))
+    row["seconds"] = time.perf_counter() - t0
     return row, X, F
 
 
@@ -199,7 +219,7 @@ def table(nv: int = 642, points=POINTS, log=print) -> list[dict]:
                    sc_rel_diff=sc.willmore / ref.willmore - 1.0,
                    bc_rel_diff=ade_energy_from_bc(bc.willmore, m, model) / ref.W - 1.0)
         if nv and v < 1.0:
-            d, _, _ = solve_ade_point(branch, v, model, nv, ref=ref)
+            d, _, _ = solve_ade_point(branch, v, model, nv, ref=ref, eigen=False)
             row.update(nv=d["nv"], E=d["W"], m=d["m"], rel_err=d["rel_err"],
                        converged=d["converged"], method=d["method"])
         log(", ".join(f"{k}={row[k]:.6g}" if isinstance(row[k], float) else f"{k}={row[k]}"
@@ -235,7 +255,8 @@ def read_table(path: str) -> list[dict]:
 
 
 SWEEP_COLUMNS = ["branch", "v", "c0", "alpha", "m0", "nv", "W", "W_ref", "rel_err", "m",
-                 "m_ref", "c0_eff", "lambda", "method", "type", "converged", "seconds"]
+                 "m_ref", "c0_eff", "lambda", "method", "type", "converged", "eig1", "stable",
+                 "seconds"]
 
 
 def sweep(volumes, model: Helfrich, nv: int, branches=("prolate", "oblate", "stomatocyte"),
@@ -244,9 +265,9 @@ def sweep(volumes, model: Helfrich, nv: int, branches=("prolate", "oblate", "sto
     followed along each branch (:func:`~pyevolver.studies.phase_reference.follow`),
     each point solved by :func:`solve_ade_point` from its reference; the
     crossings of the discrete branches (converged points, linear
-    interpolation) and of the reference's (Brent's method).  No stability
-    marks: the ADE Hessian has the rank-one term ``2k ∇M ∇Mᵀ`` that the
-    eigenvalue solver of the study does not take.  With ``out``, writes
+    interpolation) and of the reference's (Brent's method); each converged
+    point marked stable or not (:func:`ade_eigenvalues`, with the ADE
+    Hessian's rank-one term ``2k ∇M ∇Mᵀ``).  With ``out``, writes
     ``out/ade_phase.csv`` and ``out/ade_transitions.csv``.  Returns
     ``(rows, transitions)``."""
     refs = {b: {p.v: p for p in follow(b, volumes, model)} for b in branches}
@@ -281,6 +302,10 @@ def sweep(volumes, model: Helfrich, nv: int, branches=("prolate", "oblate", "sto
     return rows, trans
 
 
+def _mark(stable) -> str:
+    return {True: "yes", False: "no (saddle)"}.get(stable, "—")
+
+
 def sweep_markdown(rows: list[dict], trans: list[dict]) -> str:
     """The tables of an ADE sweep (rows and transitions as :func:`read_table`
     reads ``ade_phase.csv`` and ``ade_transitions.csv``), energies as E/4π."""
@@ -291,13 +316,15 @@ def sweep_markdown(rows: list[dict], trans: list[dict]) -> str:
         out.append(f"| {tr['from']}/{tr['to']} | {f(tr.get('v'), '.4f')} | "
                    f"{f(tr.get('v_ref'), '.4f')} |")
     out += ["", "| branch | v | vertices | E/4π | E_ref/4π | rel. error | Δa | Δa_ref | "
-            "c0_eff | shape |", "|---|---|---|---|---|---|---|---|---|---|"]
+            "c0_eff | shape | lowest eigenvalue | stable |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     order = ["prolate", "oblate", "stomatocyte"]
     for r in sorted(rows, key=lambda r: (order.index(r["branch"]), r["v"])):
         err = f"{r['rel_err']:+.3%}" if r.get("converged") is True else "not converged"
         out.append(f"| {r['branch']} | {r['v']:.3f} | {r['nv']} | "
                    f"{r['W'] / (4 * np.pi):.5f} | {r['W_ref'] / (4 * np.pi):.5f} | {err} | "
-                   f"{r['m']:.5f} | {r['m_ref']:.5f} | {r['c0_eff']:.4f} | {r.get('type', '—')} |")
+                   f"{r['m']:.5f} | {r['m_ref']:.5f} | {r['c0_eff']:.4f} | {r.get('type', '—')} | "
+                   f"{f(r.get('eig1'), '.4g')} | {_mark(r.get('stable'))} |")
     return "\n".join(out) + "\n"
 
 

@@ -25,7 +25,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ..evolve import gradient as GR
-from ..evolve.hessian import lagrangian_gradient, lagrangian_hessian, vertex_normals
+from ..errors import UnsupportedError
+from ..evolve.hessian import (lagrangian_gradient, lagrangian_hessian, lowrank_border,
+                              vertex_normals)
 from ..evolve.iterate import _Constraints
 from ..session.core import Session
 from .vesicle_newton import _rigid_motions
@@ -33,14 +35,31 @@ from .vesicle_newton import _rigid_motions
 
 def constrained_hessian(session: Session, normal: bool = True, without: tuple = ("harm",)
                         ) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray]:
-    """``(H, B, m)``: the Lagrangian's Hessian (sparse), the removed
+    """``(H, B, m)`` of :func:`constrained_system`, refused when the
+    Hessian has a low-rank term (a FUNCTION quantity nonlinear in its
+    instances' values: :func:`lowest_eigenvalues` takes it)."""
+    H, B, m, W, _ = constrained_system(session, normal, without)
+    if W is not None:
+        raise UnsupportedError("constrained_hessian with a nonlinear FUNCTION quantity",
+                               "its low-rank term is not in the sparse matrix")
+    return H, B, m
+
+
+def constrained_system(session: Session, normal: bool = True, without: tuple = ("harm",),
+                       extra: tuple = ()) -> tuple:
+    """``(H, B, m, W, sign)``: the Lagrangian's Hessian (sparse), the removed
     directions ``B`` (constraint gradients and rigid motions, as columns)
     and the lumped masses ``m``, in the coordinates of vertex motions along
     the vertex normals (``normal``, nv coordinates) or of all vertex
     coordinates (3nv).  The energy quantities named in ``without`` (the
     regularization) are left out: their modulus is 0 while the Hessian is
     computed.  The multipliers are the least squares fit of the energy's
-    gradient on the constraints' (in the same coordinates)."""
+    gradient on the constraints' (in the same coordinates).  The Hessian is
+    ``H + W diag(sign) Wᵀ`` (W (n, r), None when r = 0): the low-rank terms
+    of FUNCTION quantities nonlinear in their instances' values
+    (:func:`~pyevolver.evolve.hessian.lowrank_border`) and ``c ∇q ∇qᵀ`` for
+    each ``(q, c)`` of ``extra`` (the ADE term ``2k ∇M ∇Mᵀ`` of a point
+    solved with the term linearised, :mod:`.phase_ade_points`)."""
     s = session.surface
     saved = {}
     for name in without:
@@ -62,8 +81,12 @@ def constrained_hessian(session: Session, normal: bool = True, without: tuple = 
         C = np.stack([g.ravel() for g in cons.gradients(t)], 1)
         lam = np.linalg.lstsq(T.T @ C, T.T @ gE.ravel(), rcond=None)[0]
 
-        H = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam)).tocsc()
+        terms: list = []
+        H = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam),
+                               lowrank=terms).tocsc()
         H = T.T @ (0.5 * (H + H.T)) @ T
+        terms += [([name], np.array([[float(c)]])) for name, c in extra]
+        W, sign = lowrank_border(t, terms, T) or (None, None)
         m = np.bincount(s.F.ravel(), weights=np.repeat(t.facet_area, 3), minlength=nv) / 3.0
         if not normal:
             m = np.repeat(m, 3)
@@ -72,7 +95,7 @@ def constrained_hessian(session: Session, normal: bool = True, without: tuple = 
         for name, mod in saved.items():
             s.quantities[name].modulus = mod
         session.recalc()
-    return sp.csc_matrix(H), B, m
+    return sp.csc_matrix(H), B, m, W, sign
 
 
 def _basis(B, tol=1e-8):
@@ -84,7 +107,7 @@ def _basis(B, tol=1e-8):
 
 
 def lowest_eigenvalues(session: Session, k: int = 4, normal: bool = True,
-                       tol: float = 1e-8) -> np.ndarray:
+                       tol: float = 1e-8, extra: tuple = ()) -> np.ndarray:
     """The ``k`` smallest eigenvalues (ascending) of the constrained,
     mass-weighted Hessian (:func:`constrained_hessian`) of the session's
     surface at its current (converged) shape.
@@ -92,18 +115,25 @@ def lowest_eigenvalues(session: Session, k: int = 4, normal: bool = True,
     A first Lanczos run on the operator itself (smallest algebraic, loose)
     locates the bottom of the spectrum ``e``; the shift-and-invert run then
     uses ``σ = min(e, 0) − 1 − |e|/10`` below it, so no eigenvalue is
-    missed below the shift."""
-    H, B, m = constrained_hessian(session, normal=normal)
+    missed below the shift.  A low-rank term ``W diag(sign) Wᵀ``
+    (:func:`constrained_system`; ``extra`` as there) enters the operator as
+    a product and the bordered system as auxiliary unknowns (the border
+    of :meth:`~pyevolver.evolve.hessian.HessianSystem.border`)."""
+    H, B, m, W, sign = constrained_system(session, normal=normal, extra=extra)
     w = 1.0 / np.sqrt(m)
     Hs = (sp.diags(w) @ H @ sp.diags(w)).tocsc()
     Q = _basis(B / w[:, None])                  # B' = M^{-1/2} B
     n, nb = Hs.shape[0], Q.shape[1]
+    Ws = None if W is None else w[:, None] * W  # M^{-1/2} W
+    r = 0 if Ws is None else Ws.shape[1]
 
     def project(x):
         return x - Q @ (Q.T @ x)
 
     def mv(x):
-        return project(Hs @ project(np.ravel(x)))
+        y = project(np.ravel(x))
+        Hy = Hs @ y if Ws is None else Hs @ y + Ws @ (sign * (Ws.T @ y))
+        return project(Hy)
     A = sla.LinearOperator((n, n), matvec=mv, dtype=float)
     rng = np.random.default_rng(0)
     v0 = project(rng.standard_normal(n))
@@ -113,12 +143,14 @@ def lowest_eigenvalues(session: Session, k: int = 4, normal: bool = True,
     except sla.ArpackNoConvergence as exc:
         e = float(np.min(exc.eigenvalues)) if len(exc.eigenvalues) else 0.0
     sigma = min(e, 0.0) - 1.0 - 0.1 * abs(e)
-    K = sp.bmat([[Hs - sigma * sp.identity(n), sp.csc_matrix(Q)],
-                 [sp.csc_matrix(Q.T), None]], format="csc")
+    border = Q if Ws is None else np.hstack([Q, Ws])
+    D = sp.diags(np.concatenate([np.zeros(nb), -sign])) if r else None
+    K = sp.bmat([[Hs - sigma * sp.identity(n), sp.csc_matrix(border)],
+                 [sp.csc_matrix(border.T), D]], format="csc")
     lu = sla.splu(K)
 
     def inv(x):
-        return lu.solve(np.concatenate([project(np.ravel(x)), np.zeros(nb)]))[:n]
+        return lu.solve(np.concatenate([project(np.ravel(x)), np.zeros(nb + r)]))[:n]
     OP = sla.LinearOperator((n, n), matvec=inv, dtype=float)
     vals = sla.eigsh(A, k=k, sigma=sigma, OPinv=OP, v0=v0, which="LM", tol=tol,
                      return_eigenvectors=False)

@@ -183,6 +183,9 @@ def test_ade_sweep_writes_its_tables(tmp_path):
     assert [r["v"] for r in rows] == [0.85, 0.9]
     for r in rows:
         assert r["converged"] is True and r["type"] == "prolate" and abs(r["rel_err"]) < 0.05
+        # near the sphere the prolate is the stable ADE shape (its eigenvalues
+        # with the rank-one term 2k ∇M ∇Mᵀ: no negative one)
+        assert r["stable"] is True and r["eig1"] > 0
     assert trans == []                                   # one branch: no crossing
     with open(os.path.join(tmp_path, "ade_phase.csv")) as fh:
         table = list(csv.DictReader(fh))
@@ -190,6 +193,7 @@ def test_ade_sweep_writes_its_tables(tmp_path):
     md = PP.sweep_markdown(PP.read_table(os.path.join(tmp_path, "ade_phase.csv")),
                            PP.read_table(os.path.join(tmp_path, "ade_transitions.csv")))
     assert "| prolate | 0.850 |" in md and "| prolate | 0.900 |" in md
+    assert md.count("| yes |") == 2
 
 
 def test_docs_sweep_table_is_the_committed_csv():
