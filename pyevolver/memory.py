@@ -28,7 +28,7 @@ runs and restores the settings above after.
 ``malloc_trim``).  Kept in the heap, the blocks that the ``g`` steps and the
 Hessian's assembly freed count in the resident size while the sparse
 factorization allocates its factors beside them (with its own ``malloc``).
-Called before SuperLU factors a large matrix (pyevolver.evolve.superlu),
+Called before a large matrix is permuted and factored (pyevolver.evolve.symfactor),
 it lowers the peak of ``hessian`` on the 81,920-facet sphere from 246 MB to
 200 MB for a few milliseconds of CPU time (pages faulted in again).
 """

@@ -32,11 +32,7 @@ import sys
 import numpy as np
 import scipy
 
-from .. import memory, threads
-
-#: matrices with this many entries or more: the heap's free pages are given
-#: back before SuperLU allocates (pyevolver.memory.give_back)
-GIVE_BACK_NNZ = 100_000
+from .. import threads
 
 _MODULE = "scipy.sparse.linalg._dsolve._superlu"
 _direct: list = []          # [module] once loaded, [None] when it cannot be
@@ -108,8 +104,6 @@ def factor(A, natural: bool = True):
     mod = None if "scipy.sparse.linalg" in sys.modules else _load()
     n = A.shape[0]
     A.sum_duplicates()                   # (nothing to do on a canonical matrix)
-    if A.nnz >= GIVE_BACK_NNZ:           # (SuperLU mallocs its factors beside the heap's
-        memory.give_back()               # free blocks: those go back first)
     if mod is not None:
         try:
             indices = np.asarray(A.indices, np.intc)

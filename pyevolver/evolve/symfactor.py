@@ -41,11 +41,15 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
+from .. import memory
 from . import superlu
 from .ordering import nested_dissection
 
 #: unknowns below which SuperLU's own minimum-degree order is used
 ND_MIN = 2000
+#: matrices with this many entries or more: the heap's free pages are given
+#: back before the factorization allocates (pyevolver.memory.give_back)
+GIVE_BACK_NNZ = 100_000
 #: sparsity-pattern digest -> nested-dissection permutation (a few recent ones)
 ORDER_CACHE: "OrderedDict[bytes, np.ndarray]" = OrderedDict()
 _CACHE_SIZE = 4
@@ -79,17 +83,21 @@ def ordering(K, points):
 
 
 class LDL:
-    """``A = P L D Lᵀ Pᵀ`` for a symmetric sparse ``A`` (SuperLU in symmetric
-    mode).  ``pivots`` the diagonal of D (None when SuperLU had to pivot off
+    """``A + shift·I = P L D Lᵀ Pᵀ`` for a symmetric sparse ``A`` (SuperLU in
+    symmetric mode).  ``pivots`` the diagonal of D (None when SuperLU had to pivot off
     the diagonal, so that its pivots say nothing about the inertia);
     :meth:`solve` for (n,) or (n, m) right-hand sides.  Raises RuntimeError
     when ``A`` is exactly singular."""
 
-    def __init__(self, A, perm=None):
+    def __init__(self, A, perm=None, shift=0.0):
         A = sp.csc_matrix(A)
+        if A.nnz >= GIVE_BACK_NNZ:   # (the permuted copies and SuperLU's factors are
+            memory.give_back()       # allocated beside the heap's free blocks: those go first)
         self.perm = perm
         if perm is not None:
             A = A.tocsr()[perm][:, perm].tocsc()
+        if shift:                  # (after the permutation: one matrix less at the peak)
+            A = A + shift * sp.identity(A.shape[0], format="csc")
         self._lu = superlu.factor(A, natural=perm is not None)
         del A
         self.pivots = superlu.pivots(self._lu)
@@ -139,8 +147,8 @@ def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=
     ``K`` directly."""
     n = K.shape[0]
     K = sp.csc_matrix(K)
-    try:     # (K + δI is not kept: the factors' memory peaks in LDL)
-        f = LDL(K + delta * sp.identity(n, format="csc") if delta else K, ordering(K, points))
+    try:     # (K + δI is made in LDL, permuted: the factors' memory peaks there)
+        f = LDL(K, ordering(K, points), shift=delta)
     except RuntimeError:
         return None
     k = 0 if B is None else B.shape[1]
