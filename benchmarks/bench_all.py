@@ -187,12 +187,15 @@ def main():
         print(f"== bench_{name}.py", file=sys.stderr, flush=True)
         if subprocess.run(cmd, env=env).returncode != 0:
             failed.append(name)
-    text = summary(a.doc, a.label, [n for n in a.only if n not in failed])
+    # (the summary and the plot read every script's table in --doc: --only
+    # chooses what runs again, not what is summarized)
+    names = [n for n in SCRIPTS if n not in failed]
+    text = summary(a.doc, a.label, names)
     print(text)
     from _common import write_doc
     write_doc(a.doc, f"bench_all {a.label}", text)
     if a.plot:
-        plot(a.doc, a.label, a.plot, [n for n in a.only if n not in failed])
+        plot(a.doc, a.label, a.plot, names)
     if failed:
         print("failed: " + ", ".join(failed), file=sys.stderr)
         sys.exit(2)
