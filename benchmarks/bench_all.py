@@ -187,9 +187,12 @@ def main():
         print(f"== bench_{name}.py", file=sys.stderr, flush=True)
         if subprocess.run(cmd, env=env).returncode != 0:
             failed.append(name)
-    # (the summary and the plot read every script's table in --doc: --only
-    # chooses what runs again, not what is summarized)
-    names = [n for n in SCRIPTS if n not in failed]
+    # (the summary and the plot read every script's table in --doc, also those
+    # of scripts not run again: --only chooses what runs, not what is summarized)
+    with open(a.doc, encoding="utf-8") as fh:
+        text = fh.read()
+    names = [n for n in SCRIPTS if n not in failed
+             and f"<!-- bench_{n} {a.label} -->" in text]
     text = summary(a.doc, a.label, names)
     print(text)
     from _common import write_doc

@@ -55,6 +55,11 @@ def test_bench_all_summarizes_and_plots(evolver, tmp_path):
     assert summary.count("| `") == 2 + 2 * 2 * 4      # g: 2 cases; hessian: 2 × 2 commands × 4 rows
     assert out.rstrip().endswith(summary[summary.index("| goal"):summary.index("<!-- /")].rstrip())
     assert png.stat().st_size > 10000
+    # --only chooses what runs again; the summary still reads every table
+    out = _run([os.path.join(BENCH, "bench_all.py"), "--only", "hessian", "--summary-only",
+                "--label", "t", "--doc", str(doc), "--plot", str(png)], tmp_path)
+    again = doc.read_text()
+    assert again[again.index("<!-- bench_all t -->"):] == summary
 
 
 def test_bench_hessian_runs(evolver, tmp_path):
