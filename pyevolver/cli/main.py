@@ -106,7 +106,7 @@ def _main(argv=None):
     args = build_parser().parse_args(argv)
     np.seterr(all="ignore")        # overflows are reported as Evolver warnings, not numpy's
     deadline.handle_sigterm()      # SIGTERM: as Ctrl-C (the command undone, exit 143)
-    threads.process_wide()         # BLAS limited from the first step on (pyevolver.threads)
+    threads.process_wide()         # BLAS limited for the whole run (pyevolver.threads)
     path = _find_datafile(args.datafile)
     if path is None:
         sys.stderr.write(f"pyevolver: cannot open datafile '{args.datafile}': no such file\n")
