@@ -90,6 +90,13 @@ TRI6_B, TRI6_W = symmetric_rule(TRI6_PARAMS, centre=False, n3=2, n6=1)
 def edge_index(fe):
     """Edge index and orientation sign of encoded signed edges."""
     fe = np.asarray(fe)
+    if fe.dtype.kind == "i":
+        # (two's complement: the sign bit spread is -1 on reversed edges, 0
+        # otherwise; x ^ -1 == ~x.  Half the time of two np.where.)
+        m = fe >> (8 * fe.dtype.itemsize - 1)
+        idx = fe ^ m
+        m |= 1
+        return idx, m.astype(np.float64)
     rev = fe < 0
     return np.where(rev, ~fe, fe), np.where(rev, -1.0, 1.0)
 

@@ -144,23 +144,28 @@ def vertex_edge_rank(s: Surface) -> np.ndarray:
             c = s._rings = (c[0], np.asarray(c[1](), np.int64))
         return c[1]
     ids = np.asarray(s.ids("edge"))
+    v = s.E.ravel()
+    v = v.astype(np.int32 if nv < 2 ** 31 else np.int64, copy=False)
     if ne < 2 or bool(np.all(ids[1:] > ids[:-1])):
-        t = np.arange(ne, dtype=np.int64)          # (ids in order: a loaded file's)
+        # (ids in order: a loaded file's) the flat ends are in edge order,
+        # so a stable sort by vertex lists each vertex's edges oldest first
+        order = np.argsort(v, kind="stable")
+        key = order >> 1
     else:
         t = np.empty(ne, np.int64)
         t[np.argsort(ids, kind="stable")] = np.arange(ne)
-    v = s.E.ravel().astype(np.int64)
-    key = np.repeat(t, 2)
-    first = np.full(nv, ne, np.int64)
-    np.minimum.at(first, v, key)
-    # at each vertex: its first edge (rank 0), then the others newest first
-    # (ranks ne - key, 1 .. ne); one sort of vertex * (ne + 1) + rank
-    rank = np.where(key == first[v], 0, ne - key)
-    order = np.argsort(v * (ne + 1) + rank, kind="stable")
+        order = np.argsort(v.astype(np.int64) * ne + np.repeat(t, 2), kind="stable")
+        key = np.repeat(t, 2)[order]
+    # at each vertex: its first edge (rank 0), then the others newest first:
+    # the j-th oldest (j >= 1) of a vertex's n edges has rank n - j
     cnt = np.bincount(v, minlength=nv)
     start = np.cumsum(cnt) - cnt
+    vs = v[order]
+    j = np.arange(2 * ne) - start[vs]
+    rk = cnt[vs] - j
+    rk[key == key[start[vs]]] = 0            # (both ends of a loop edge that is first)
     pos = np.empty(2 * ne, np.int64)
-    pos[order] = np.arange(2 * ne) - start[v[order]]
+    pos[order] = rk
     pos = pos.reshape(ne, 2)
     pos.flags.writeable = False          # (kept: the next call while E is unchanged)
     record_vertex_rings(s, pos)

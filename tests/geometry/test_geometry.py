@@ -233,3 +233,19 @@ def test_corner_geometry_row_by_row_is_the_same_numbers(monkeypatch, nf):
     monkeypatch.setattr(K, "_LOW_MEMORY_FACETS", 10 ** 9 if big else 0)   # the other path
     got = K.geometry_of_corners(P.copy())
     assert all(np.array_equal(x, y) for x, y in zip(want, got))
+
+
+def test_edge_index_integer_and_other_dtypes():
+    """edge_index: the bit trick on signed integers equals the plain rule
+    (index ~e and sign -1 for a reversed edge), for int32 and int64."""
+    from pyevolver.geometry.kernels import edge_index
+    for dt in (np.int64, np.int32):
+        fe = np.array([[0, -1, 5], [~7, 3, ~0]], dt)
+        idx, sgn = edge_index(fe)
+        assert idx.dtype == dt and sgn.dtype == np.float64
+        assert np.array_equal(idx, np.where(fe < 0, ~fe, fe))
+        assert np.array_equal(sgn, np.where(fe < 0, -1.0, 1.0))
+    idx, sgn = edge_index([3, ~2])
+    assert list(idx) == [3, 2] and list(sgn) == [1.0, -1.0]
+    idx, sgn = edge_index(np.zeros((0, 3), np.int64))
+    assert idx.shape == sgn.shape == (0, 3)
