@@ -8,39 +8,21 @@ import os
 import re
 import subprocess
 
+import numpy as np
 import pytest
 
 import pyevolver
 from conftest import example
 from pyevolver.evolve import hessian as H
+from pyevolver.studies.meshes import fe_text
 from reference import reference_args, run_reference
 
 HERE = os.path.dirname(os.path.dirname(__file__))
 
-TETRA = """
-vertices
-1 0 0 0
-2 1 0 0
-3 0 1 0
-4 0 0 1
-
-edges
-1 1 2
-2 2 3
-3 3 1
-4 1 4
-5 2 4
-6 3 4
-
-faces
-1 -3 -2 -1
-2 1 5 -4
-3 2 6 -5
-4 3 4 -6
-
-bodies
-1 1 2 3 4 volume 0.1666666666666667
-"""
+#: the unit tetrahedron (faces outward) as one body of volume 1/6
+TETRA = "\n" + fe_text(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]),
+                       np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]])) \
+    + "\nbodies\n1 1 2 3 4 volume 0.1666666666666667\n"
 
 #: FUNCTIONs with constants, a quantity's value and built-in functions;
 #: ``mci`` is not GLOBAL (value 0, as the issue's file), ``mcg`` is
