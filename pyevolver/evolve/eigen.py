@@ -198,9 +198,8 @@ class ShiftedFactor:
         if self.B is not None:
             s = np.linalg.eigvalsh(-0.5 * (self.S + self.S.T))
             k = len(s)
-            npos = 0 if self.D is None else int(np.sum(np.asarray(self.D) > 0))
             nneg = 0 if self.D is None else int(np.sum(np.asarray(self.D) < 0))
-            below += int(np.sum(s < -self.eps)) - (k - npos)
+            below += int(np.sum(s < -self.eps)) - SF.border_negatives(self.S, self.D)
             equal += int(np.sum(np.abs(s) <= self.eps))
             above += int(np.sum(s > self.eps)) - (k - nneg)
             if below < 0 or above < 0:        # a degenerate border: count what is left

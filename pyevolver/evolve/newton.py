@@ -234,14 +234,8 @@ def _index(hs, piv, eps, B=None, D=None):
     ``B``, ``D``: the border of :meth:`.hessian.HessianSystem.border` (by
     default the system's own, without a low-rank term)."""
     B = hs.B if B is None else B
-    if piv:
-        d, S = piv
-        below = int(np.sum(np.asarray(d) < 0))
-        if S is not None:
-            below += int(np.sum(np.linalg.eigvalsh(-0.5 * (S + S.T)) < 0)) - \
-                SF.border_negatives(S, D)
-        if below <= 0:
-            return 0
+    if piv and SF.negative_count(piv[0], piv[1], 0.0, D) == 0:
+        return 0
     delta = max(eps, 1e-8 * float(np.abs(hs.K.diagonal()).mean()))
     try:
         return ShiftedFactor(hs.K, B, -delta, 0.0, nudge=True,
