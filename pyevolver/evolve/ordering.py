@@ -43,55 +43,72 @@ def nested_dissection(points, pattern, leaf=16):
     C = sp.coo_matrix(pattern)
     upper = C.row < C.col
     lower = C.row > C.col
-    ei = np.concatenate([C.row[upper], C.col[lower]]).astype(np.int32)
-    ej = np.concatenate([C.col[upper], C.row[lower]]).astype(np.int32)
-    part = np.zeros(n, np.int64)          # part id among the unknowns still active
-    active = np.ones(n, bool)
-    level = np.full(n, -1, np.int64)      # cut at which an unknown became separator
+    ei = np.concatenate([C.row[upper], C.col[lower]]).astype(np.intp)
+    ej = np.concatenate([C.col[upper], C.row[lower]]).astype(np.intp)
+    # ei, ej: each coupling once, as intp (take() on 32-bit indices copies them)
+    PT = np.ascontiguousarray(P.T)
+    # code: an active unknown's part id at this depth (2 × its part's id + its
+    # side after each cut), -1 for a separator; an edge joins two unknowns of
+    # one part cut in two when its codes differ in the last bit only
+    code = np.zeros(n, np.int32)
+    level = np.full(n, -1, np.int32)      # cut at which an unknown became separator
+    final = np.zeros(n, np.int32)         # a separator's part id just after its cut
     depth = 0
     while True:
-        idx = np.flatnonzero(active)
-        size_all = np.bincount(part[idx], minlength=1 << depth)
-        ids = np.flatnonzero(size_all)
-        size = size_all[ids]
-        cut_all = size_all > leaf
-        cut = cut_all[ids]
+        idx = np.flatnonzero(code >= 0)
+        pid = code.take(idx)
+        nparts = 1 << depth
+        size = np.bincount(pid, minlength=nparts)
+        cut = size > leaf
         if not cut.any():
             break
-        lookup = np.zeros(1 << depth, np.int64)
-        lookup[ids] = np.arange(len(ids))
-        inv = lookup[part[idx]]
-        # widest axis of every part; rank along it inside the part
-        o = np.argsort(inv, kind="stable")
-        first = np.concatenate([[0], np.cumsum(size)[:-1]])
-        Q = P[idx[o]]
-        lo, hi = np.minimum.reduceat(Q, first), np.maximum.reduceat(Q, first)
-        axis = np.argmax(hi - lo, axis=1)
-        span = (hi - lo)[np.arange(len(ids)), axis]
-        t = (P[idx, axis[inv]] - lo[inv, axis[inv]]) / np.where(span > 0, span, 1.0)[inv]
-        order = np.argsort(inv + 0.5 * t)
+        into = cut[pid]                   # (parts not cut keep their unknowns on side 0)
+        idx, pid = idx[into], pid[into]
+        # each part's bounding box; its widest axis; the rank along it
+        lo = np.full((3, nparts), np.inf)
+        hi = np.full((3, nparts), -np.inf)
+        X = PT.take(idx, axis=1)
+        for a in range(3):
+            np.minimum.at(lo[a], pid, X[a])
+            np.maximum.at(hi[a], pid, X[a])
+        ext = hi - lo
+        ext[:, ~cut] = 0.0
+        axis = np.argmax(ext, axis=0)
+        span = ext[axis, np.arange(nparts)]
+        span[span <= 0] = 1.0
+        ax = axis[pid]
+        t = X[ax, np.arange(len(idx))]
+        t -= lo[ax, pid]
+        t /= span[pid]
+        t *= 0.5
+        t += pid
+        order = np.argsort(t)
+        first = np.zeros(nparts, np.int64)
+        np.cumsum(np.where(cut, size, 0)[:-1], out=first[1:])
         rank = np.empty(len(idx), np.int64)
-        rank[order] = np.arange(len(idx)) - first[inv[order]]
-        right = (rank >= size[inv] // 2) & cut[inv]
-        side = np.zeros(n, bool)
-        side[idx] = right
-        new_part = part.copy()
-        new_part[idx] = 2 * part[idx] + right
-        # separator: the left-side unknowns coupled to the right side of their
-        # part (each coupling once, either way round; the couplings kept join
-        # two active unknowns of one part, and a part not cut has no right
-        # side); couplings across parts or to a separator never matter again
-        si, sj = side[ei], side[ej]
-        sep = np.zeros(n, bool)
-        sep[ei[~si & sj]] = True
-        sep[ej[si & ~sj]] = True
-        level[sep] = depth
-        active[sep] = False
-        keep = si == sj
-        keep &= active[ei]
-        keep &= active[ej]
-        ei, ej = ei[keep], ej[keep]
-        part = new_part
+        po = pid[order]
+        rank[order] = np.arange(len(idx)) - first[po]
+        right = rank >= size[pid] // 2
+        active = code >= 0
+        code[active] *= 2
+        code[idx] += right
+        # separator: the side-0 end of each edge across a cut (edges that
+        # no longer join one part, or touch a separator, never match again:
+        # they are dropped when a fifth of the list is such)
+        ci = code.take(ei)
+        cj = code.take(ej)
+        x = ci ^ cj
+        cross = np.flatnonzero(x == 1)
+        a, b = ei[cross], ej[cross]
+        left = np.where(ci[cross] & 1 == 0, a, b)
+        final[left] = code[left]
+        level[left] = depth
+        code[left] = -1
+        keep = x == 0
+        keep &= ci >= 0
+        if keep.sum() < 0.8 * len(keep):
+            ei, ej = ei[keep], ej[keep]
         depth += 1
+    part = np.where(level < 0, code, final)
     key = np.where(level < 0, depth, level)
     return np.lexsort((np.arange(n), part, -key)).astype(np.int64)

@@ -152,17 +152,19 @@ def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=
     except RuntimeError:
         return None
     k = 0 if B is None else B.shape[1]
-    if k:
-        ZB = f.solve(B)
+    rhs = r if not k else np.concatenate([r, d])
+    z0 = None
+    if k:       # (the border's columns and the first right-hand side in one solve)
+        Z = f.solve(np.column_stack([B, r]))
+        ZB, z0 = Z[:, :k], Z[:, k]
         S = B.T @ ZB - (0.0 if D is None else np.diag(D))
         try:
             Sinv = np.linalg.inv(S)
         except np.linalg.LinAlgError:
             return None
-    rhs = r if not k else np.concatenate([r, d])
 
-    def precond(res):
-        z = f.solve(res[:n])
+    def precond(res, z=None):
+        z = f.solve(res[:n]) if z is None else z
         if not k:
             return z
         mu = Sinv @ (B.T @ z - res[n:])
@@ -179,7 +181,7 @@ def newton_solve(K, B, r, d, points=None, delta=0.0, eps=0.0, rtol=1e-14, stall=
         normM = max(normM, float(np.abs(B).sum(axis=1).max() + np.abs(B).sum(axis=0).max()
                                  + (0.0 if D is None else np.abs(D).max())))
     with np.errstate(all="ignore"):
-        z = precond(rhs)
+        z = precond(rhs, z0)
         best, best_err = None, np.inf
         for _ in range(passes):
             if not np.all(np.isfinite(z)):

@@ -61,3 +61,25 @@ def test_cholmod_in_this_order_solves_the_bordered_system():
     a = H.solve_bordered(K, B, r, d, method="cholmod", points=X)
     b = H.solve_bordered(K, B, r, d, method="splu")
     assert np.abs(a - b).max() <= 1e-8 * np.abs(b).max()
+
+
+@pytest.mark.parametrize("case", ["no couplings", "one point", "two components"])
+def test_degenerate_inputs_give_a_permutation(case):
+    """Parts whose points coincide (no widest axis), unknowns without
+    couplings (no separators) and a graph in two pieces (edges that stop
+    joining one part) still give a permutation that eliminates every
+    separator after the parts it separates: the factor of the Laplacian + I
+    in that order has no more fill than in the file's order."""
+    X, L = _graph_laplacian(3)
+    n = L.shape[0]
+    if case == "no couplings":
+        M = sp.identity(n, format="csc")
+    elif case == "one point":
+        X = np.zeros_like(X)
+        M = (L + sp.identity(n)).tocsc()
+    else:
+        M = sp.block_diag([L + sp.identity(n), L + sp.identity(n)]).tocsc()
+        X = np.vstack([X, X + 0.5])
+    p = nested_dissection(X, M)
+    assert np.array_equal(np.sort(p), np.arange(M.shape[0]))
+    assert _fill(M[p][:, p]) <= _fill(M)
