@@ -23,7 +23,11 @@ as in ``g``, to the decrease the quadratic model predicts: a step is taken
 only when the energy decreases.  δ > 0 also makes the rigid motions, whose
 Hessian eigenvalues are zero, harmless: the gradient has no component along
 them.  Near a nondegenerate minimum δ → 0 and the steps become Newton
-steps (quadratic convergence).
+steps (quadratic convergence).  A quantity FUNCTION nonlinear in its
+instances' values adds a dense low-rank term ``W diag(±1) Wᵀ`` to ``K``
+(:func:`.hessian.lowrank_border`): it is kept out of the sparse matrix and
+enters the test and the solve through the Schur complement of the bordered
+matrix (:func:`_factor_lowrank`).
 """
 from __future__ import annotations
 
@@ -43,7 +47,7 @@ from . import gradient as GR
 from . import hessian_nd
 from .eigen import ShiftedFactor
 from .hessian import (_cholmod, constraint_curvature, hessian_system, lagrangian_gradient,
-                      lagrangian_hessian, solve_bordered, tangent_basis)
+                      lagrangian_hessian, lowrank_border, solve_bordered, tangent_basis)
 from .iterate import Iterator, StepResult, _Constraints
 from . import symfactor as SF
 from .symfactor import newton_solve
@@ -88,6 +92,37 @@ def _factor(M):
     if np.array_equal(lu.perm_r, lu.perm_c) and np.any(lu.U.diagonal() <= 0):
         return None
     return lu.solve
+
+
+def _factor_lowrank(M, W, sign):
+    """Solve function for ``M + W diag(sign) Wᵀ`` (``M`` sparse, ``W``
+    (n, r) dense: the rank term of a nonlinear FUNCTION quantity, see
+    :func:`.hessian.lowrank_border`) when it is positive definite, None when
+    it is not.  One LDLᵀ of ``M`` (SuperLU in symmetric mode) and the Schur
+    complement ``S = diag(sign) + Wᵀ M⁻¹ W`` of the bordered matrix
+    ``[[M, W], [Wᵀ, −diag(sign)]]``: its inertia is that of ``M + W diag(sign) Wᵀ``
+    plus that of ``−diag(sign)`` (Haynsworth), which gives the count of
+    :func:`.symfactor.negative_count`; solves by the Sherman–Morrison–Woodbury
+    formula ``M⁻¹ − M⁻¹ W S⁻¹ Wᵀ M⁻¹``."""
+    try:
+        f = SF.LDL(M)
+    except RuntimeError:                      # exactly singular
+        return None
+    if f.pivots is None or not np.all(f.pivots != 0):
+        return None                           # (pivoted off the diagonal: no inertia)
+    Z = f.solve(W)
+    S = np.diag(sign) + W.T @ Z
+    if SF.negative_count(f.pivots, S, 0.0, -sign) != 0:
+        return None
+    try:
+        Sinv = np.linalg.inv(S)
+    except np.linalg.LinAlgError:
+        return None
+
+    def solve(R):
+        Y = f.solve(R)
+        return Y - Z @ (Sinv @ (W.T @ Y))
+    return solve
 
 
 def _solve(f, B, r, d):
@@ -151,7 +186,10 @@ def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
             lam = np.linalg.lstsq(B, gy, rcond=None)[0]
             d = cons.targets(s) - cons.values(t)
 
-        K = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam), basis)
+        terms: list = []            # (a nonlinear FUNCTION's rank term W diag(sign) Wᵀ)
+        K = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam), basis, t=t,
+                               lowrank=terms)
+        W, sign = (lowrank_border(t, terms, T) or (None, None)) if terms else (None, None)
         gL = gE - sum((l * g for l, g in zip(lam, gs)), np.zeros_like(gE))
         Hc = constraint_curvature(s, grads, gL)
         if Hc is not None:
@@ -169,12 +207,14 @@ def damped_newton(it: Iterator, n: int, callback: Callable | None = None,
         targets = cons.targets(s)
         accepted = False
         for _trial in range(60):
-            f = _factor(K + delta * sp.identity(K.shape[0], format="csc"))
+            M = K + delta * sp.identity(K.shape[0], format="csc")
+            f = _factor(M) if W is None else _factor_lowrank(M, W, sign)
             if f is None:
                 delta *= 4.0
                 continue
             dy, _ = _solve(f, B, -gy, d)
-            pred = -(gy @ dy + 0.5 * dy @ (K @ dy))
+            Kdy = K @ dy if W is None else K @ dy + W @ (sign * (W.T @ dy))
+            pred = -(gy @ dy + 0.5 * dy @ Kdy)
             if not (pred > 0) or not np.all(np.isfinite(dy)):
                 delta *= 4.0
                 continue
