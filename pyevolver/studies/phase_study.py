@@ -15,8 +15,10 @@ Every point starts from the axisymmetric reference at its ``v`` — itself
 followed along the branch by continuation from the neighbouring point
 (:func:`~pyevolver.studies.phase_reference.follow`) — revolved into a mesh
 of about ``nv`` vertices (:func:`~pyevolver.studies.phase_mesh.revolve`).
-The branch is swept from its seed volume outwards.  A point whose damped
-Newton iteration does not converge, whose mesh degenerates (smallest angle
+The branch is swept from its seed volume outwards.  A damped Newton
+iteration that stops short of its tolerance on the branch is continued by
+plain Newton from where it stopped.  A point whose iteration still does not
+converge, whose mesh degenerates (smallest angle
 below 10°) or whose shape leaves the branch (on the unstable part of a
 branch every descent does) is solved by plain Newton on the critical-point
 equations (:func:`~pyevolver.studies.phase_newton.newton_critical`, which
@@ -152,6 +154,9 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
                 ok, n, _ = newton_lm(s, maxit=maxit, guard=on_branch)
                 if not ok and on_branch(s.surface):     # restart the damping once
                     ok, n2, _ = newton_lm(s, maxit=maxit // 2, guard=on_branch)
+                    n += n2
+                if not ok and on_branch(s.surface):     # then plain Newton from there
+                    ok, n2, _ = newton_critical(s)
                     n += n2
             else:
                 ok, n, _ = newton_critical(s)
