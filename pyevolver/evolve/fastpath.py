@@ -46,6 +46,10 @@ from ..methods.axis_major import NEXT as _NEXT, NEXT2 as _NEXT2, sides as _sides
 from ..methods.totals import Totals
 from . import gradient as GR
 
+#: above this many facets the gradients are scattered axis by axis (no
+#: index arrays of 9 k entries per facet kept; below, one bincount wins)
+_LOW_MEMORY_FACETS = 20_000
+
 
 class _Fallback(Exception):
     """A branch the fast path leaves to the general step."""
@@ -100,9 +104,15 @@ class _Plan:
         self.topo = s.topology()
         self.mode = mode
         self.Fc = s.facet_corners()                 # (3, nf)
-        nv = s.nv
-        flat = s.F.ravel()                          # facet-major, as corner_scatter
-        self.idx3 = np.concatenate((flat, flat + nv, flat + 2 * nv))
+        flat = self.topo[2].ravel()                 # facet-major, as corner_scatter
+        self.flat = flat
+        # small surfaces: the index of every corner coordinate, so that one
+        # bincount scatters all; large ones scatter axis by axis with ``flat``
+        # (the same sums, without index arrays of 9 and 9 k entries per facet)
+        self.idx3 = None
+        if s.nf <= _LOW_MEMORY_FACETS:
+            nv = s.nv
+            self.idx3 = np.concatenate((flat, flat + nv, flat + 2 * nv))
         b = s.bodies
         self.bodies = [i for i in range(b.n) if not math.isnan(b.target[i])]
         self.body_w = []
@@ -131,14 +141,20 @@ class _Plan:
         """Per-corner vectors ``W`` (3 axes, 3 corners, nf) summed into the
         vertices, (nv, 3) C-ordered (the order of corner_scatter's sums)."""
         nv = self.surface.nv
+        if self.idx3 is None:
+            out = np.empty((nv, 3))
+            for ax in range(3):
+                out[:, ax] = np.bincount(self.flat, weights=W[ax].T.ravel(), minlength=nv)
+            return out
         out = np.bincount(self.idx3, weights=W.transpose(0, 2, 1).ravel(), minlength=3 * nv)
         return np.ascontiguousarray(out.reshape(3, nv).T)
 
     def scatter_many(self, Ws):
-        """:meth:`scatter` of several per-corner arrays in one bincount."""
+        """:meth:`scatter` of several per-corner arrays (in one bincount on
+        small surfaces)."""
         k = len(Ws)
-        if k == 1:
-            return [self.scatter(Ws[0])]
+        if k == 1 or self.idx3 is None:
+            return [self.scatter(W) for W in Ws]
         nv = self.surface.nv
         idx = self.__dict__.get(("idx", k))
         if idx is None:
@@ -299,8 +315,7 @@ def _check(plan, s, t0):
 def forget(it) -> None:
     """Drop the iterator's plan and last end state (the ``hessian`` step:
     it moves the surface, so the next ``g`` makes a new plan anyway, and
-    the plan's index arrays, 24 MB at 81,920 facets, need not stay beside
-    the factorization)."""
+    the plan's arrays need not stay beside the factorization)."""
     it.__dict__.pop("_fast_plan", None)
     it.__dict__.pop("_end", None)
 
