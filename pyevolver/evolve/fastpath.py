@@ -380,12 +380,14 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         start_vols = [float(t0.volumes[i]) for i in plan.bodies]
         if gs is None:
             gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE)
+        QE = Ga = None      # (three corner arrays fewer during the line search)
         A = _matrix(gs)
         bvec = [float((f * g).sum()) for g in gs]
         lam = np.array(_coefficients(A, bvec, solve))
         vel = f - _combo(lam, gs)
         Pus = [plan.gather(u) for u in gs]
     else:
+        QE = Ga = None
         lam = np.zeros(0)
         vel = f
         gs, A, Pus, targets = [], np.zeros((0, 0)), [], []
