@@ -42,13 +42,10 @@ import numpy as np
 
 from ..geometry.kernels import geometry_of_corners
 from ..methods._common import csr_matvec, finite
+from ..methods import axis_major as AM
 from ..methods.axis_major import NEXT as _NEXT, NEXT2 as _NEXT2, sides as _sides
 from ..methods.totals import Totals
 from . import gradient as GR
-
-#: above this many facets the gradients are scattered axis by axis (no
-#: index arrays of 9 k entries per facet kept; below, one bincount wins)
-_LOW_MEMORY_FACETS = 20_000
 
 
 class _Fallback(Exception):
@@ -110,7 +107,7 @@ class _Plan:
         # bincount scatters all; large ones scatter axis by axis with ``flat``
         # (the same sums, without index arrays of 9 and 9 k entries per facet)
         self.idx3 = None
-        if s.nf <= _LOW_MEMORY_FACETS:
+        if s.nf <= AM.LOW_MEMORY_FACETS:
             nv = s.nv
             self.idx3 = np.concatenate((flat, flat + nv, flat + 2 * nv))
         b = s.bodies
@@ -142,10 +139,7 @@ class _Plan:
         vertices, (nv, 3) C-ordered (the order of corner_scatter's sums)."""
         nv = self.surface.nv
         if self.idx3 is None:
-            out = np.empty((nv, 3))
-            for ax in range(3):
-                out[:, ax] = np.bincount(self.flat, weights=W[ax].T.ravel(), minlength=nv)
-            return out
+            return AM.scatter_by_axis(self.flat, W, nv)
         out = np.bincount(self.idx3, weights=W.transpose(0, 2, 1).ravel(), minlength=3 * nv)
         return np.ascontiguousarray(out.reshape(3, nv).T)
 

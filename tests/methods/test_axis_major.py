@@ -52,13 +52,17 @@ def test_facet_area_gradient_bit_for_bit(tmp_path, monkeypatch):
     assert new.shape == old.shape == (s.nf, 3, 3) and np.array_equal(new, old)
 
 
-def test_scatter_sums_as_corner_scatter(tmp_path):
+@pytest.mark.parametrize("low_memory", [False, True])
+def test_scatter_sums_as_corner_scatter(tmp_path, monkeypatch, low_memory):
     from pyevolver.methods._common import corner_scatter
+    if low_memory:          # (axis by axis, as on large surfaces)
+        monkeypatch.setattr(AM, "LOW_MEMORY_FACETS", 0)
     s = _surface(tmp_path)
     t = s.evaluate()
     G = np.random.default_rng(0).standard_normal((3, 3, s.nf))
     assert np.array_equal(AM.scatter(s, G), corner_scatter(t, AM.facet_major(G)))
     assert AM.scatter(s, G).flags.c_contiguous
+    assert ("_axis_scatter" in s.__dict__) is not low_memory
 
 
 def test_cached_on_the_evaluation(tmp_path):
