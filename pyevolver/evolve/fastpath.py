@@ -199,7 +199,7 @@ class _Plan:
         Q, E = _sides(P, a, b) if QE is None else QE
         g = np.empty_like(P)
         if symmetric:                   # corner c: Q[c+1] x Q[c+2] / 6
-            g[:] = _cross(Q.take(_NEXT, axis=1), Q.take(_NEXT2, axis=1))
+            g[:] = AM.cross(Q.take(_NEXT, axis=1), Q.take(_NEXT2, axis=1))
             g /= 6.0
         else:
             # _cz_grad times Z: corner c's x part y[c+1] - y[c+2] = -E[y][c],
@@ -227,18 +227,10 @@ class _Plan:
         else:
             with np.errstate(all="ignore"):
                 n = finite(N2T / L)
-        g = _cross(n[:, None, :], E)            # corner c: n x E[c]
+        g = AM.cross(n[:, None, :], E)          # corner c: n x E[c]
         g *= 0.5
         g *= tension
         return self.scatter(g) if scattered else g
-
-
-def _cross(u, v):
-    """Cross products along the first axis (3, ...): component i is
-    u[i+1] v[i+2] - u[i+2] v[i+1] (G.cross's products)."""
-    out = u.take(_NEXT, axis=0) * v.take(_NEXT2, axis=0)
-    out -= u.take(_NEXT2, axis=0) * v.take(_NEXT, axis=0)
-    return out
 
 
 def _totals(s, geom, energy, vols):

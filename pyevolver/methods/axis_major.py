@@ -36,7 +36,15 @@ def available(t) -> bool:
 
 def cross(u, v):
     """Cross products along the first axis (3, ...): component i is
-    ``u[i+1] v[i+2] - u[i+2] v[i+1]`` (the products of geometry.kernels.cross)."""
+    ``u[i+1] v[i+2] - u[i+2] v[i+1]`` (the products of geometry.kernels.cross);
+    on large surfaces component by component (the same products, without
+    four copies of the operands at once)."""
+    if u.shape[-1] > LOW_MEMORY_FACETS:
+        out = np.empty(np.broadcast_shapes(u.shape, v.shape))
+        for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+            np.multiply(u[j], v[k], out=out[i])
+            out[i] -= u[k] * v[j]
+        return out
     out = u.take(NEXT, axis=0) * v.take(NEXT2, axis=0)
     out -= u.take(NEXT2, axis=0) * v.take(NEXT, axis=0)
     return out
@@ -49,6 +57,11 @@ def sides(P, a, b):
     Q[:, 0] = P[:, 0]
     np.add(P[:, 0], a, out=Q[:, 1])
     np.add(P[:, 0], b, out=Q[:, 2])
+    if P.shape[-1] > LOW_MEMORY_FACETS:      # (corner by corner: no copies of Q)
+        E = np.empty_like(Q)
+        for c in range(3):
+            np.subtract(Q[:, NEXT2[c]], Q[:, NEXT[c]], out=E[:, c])
+        return Q, E
     E = Q.take(NEXT2, axis=1)
     E -= Q.take(NEXT, axis=1)
     return Q, E
