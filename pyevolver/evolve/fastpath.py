@@ -403,7 +403,11 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         corrections [(coefficients, directions)])."""
         # (at scale 0 the corners are P0's, to the sign of a zero: the
         # volumes are t0's)
-        P = P0 + scale * Pv if scale != 0 else P0
+        if scale != 0:
+            P = scale * Pv
+            P += P0             # (P0 + scale Pv: one corner array fewer at once)
+        else:
+            P = P0
         X = None if area_mode else X0 + scale * vel
         shifts = []
         if not nb:
@@ -414,7 +418,10 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         cur_us, cur_Pu, cur_A = gs, Pus, A
         for k in range(10):
             delta = _coefficients(cur_A, d, solve)
-            P = P + _combo(delta, cur_Pu)
+            if area_mode and P is not P0:     # (P only in the geometry g, replaced below)
+                P += _combo(delta, cur_Pu)
+            else:
+                P = P + _combo(delta, cur_Pu)
             if X is not None:
                 X = X + _combo(delta, cur_us)
             shifts.append((delta, cur_us))
