@@ -345,13 +345,13 @@ def _step(it, plan, s, settings, t0, result_type, solve):
     QE = _sides(P0, a0, b0)
     nb = len(plan.bodies)
     gs = None
-    if area_mode:
+    if area_mode and nb and plan.idx3 is not None:
+        # (small surfaces: the area and volume gradients in one scatter)
         Ga = plan.area_grad(P0, a0, b0, N2T0, t0.facet_area, tension, QE, scattered=False)
-        if nb:          # (the area and volume gradients in one scatter)
-            f, *gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE, also=Ga)
-            f = -f
-        else:
-            f = -plan.scatter(Ga)
+        f, *gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE, also=Ga)
+        f = -f
+    elif area_mode:     # (large ones: each scattered as soon as made)
+        f = -plan.area_grad(P0, a0, b0, N2T0, t0.facet_area, tension, QE)
     else:
         f = -GR.energy_gradient(t0)
     any_fixed = bool(mobile_off.any())
