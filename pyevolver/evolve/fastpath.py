@@ -8,9 +8,11 @@ tension, fixed body volumes, FIXED vertices, optionally energy quantities —
 this module takes the same step with far fewer calls:
 
 * the trial moves ``X0 + s v`` and the restoring corrections ``+ δ u`` are
-  made on the facet corners gathered once per step (gathering commutes with
-  the element-wise sums, so every coordinate is the same number as the
-  general path's); only the actual move is written back to the vertices;
+  made on the facet corners, the directions gathered once per step (above
+  20,000 facets each move's ``s v`` or ``Σ δ u`` is gathered instead: no
+  corner arrays per direction kept); gathering commutes with the
+  element-wise sums, so every coordinate is the same number as the general
+  path's; only the actual move is written back to the vertices;
 * the volumes after a displacement, before the restoring, are computed
   alone (the energy there is never read);
 * with facet tension alone the energy, the area and volume gradients and
@@ -163,6 +165,17 @@ class _Plan:
     def gather(self, V):
         """(3, 3, nf) corners of the (nv, 3) vectors ``V``."""
         return np.ascontiguousarray(V.T).take(self.Fc, axis=1)
+
+    def gathered(self, V):
+        """The corners of the directions ``V`` (a list), kept during the
+        step; None on large surfaces (:meth:`combo` gathers their sums)."""
+        return None if self.idx3 is None else [self.gather(v) for v in V]
+
+    def combo(self, coef, V, PV):
+        """``Σ c_i v_i`` at the facet corners: of the gathered directions
+        ``PV``, or the gathered sum when None (the same numbers: gathering
+        commutes with the element-wise products and sums)."""
+        return _combo(coef, PV) if PV is not None else self.gather(_combo(coef, V))
 
     def volumes(self, P, symmetric):
         """The constrained bodies' volumes at the corners ``P`` (the facet
@@ -371,14 +384,14 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         bvec = [float((f * g).sum()) for g in gs]
         lam = np.array(_coefficients(A, bvec, solve))
         vel = f - _combo(lam, gs)
-        Pus = [plan.gather(u) for u in gs]
+        Pus = plan.gathered(gs)
     else:
         QE = Ga = None
         lam = np.zeros(0)
         vel = f
         gs, A, Pus, targets = [], np.zeros((0, 0)), [], []
     motion += (vel,)
-    Pv = plan.gather(vel)
+    Pv = plan.gathered([vel])
 
     def evaluate(P, X):
         """(geometry or Totals, energy, body volumes) at the corners ``P``
@@ -404,7 +417,7 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         # (at scale 0 the corners are P0's, to the sign of a zero: the
         # volumes are t0's)
         if scale != 0:
-            P = scale * Pv
+            P = plan.combo((scale,), [vel], Pv)
             P += P0             # (P0 + scale Pv: one corner array fewer at once)
         else:
             P = P0
@@ -419,9 +432,9 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         for k in range(10):
             delta = _coefficients(cur_A, d, solve)
             if area_mode and P is not P0:     # (P only in the geometry g, replaced below)
-                P += _combo(delta, cur_Pu)
+                P += plan.combo(delta, cur_us, cur_Pu)
             else:
-                P = P + _combo(delta, cur_Pu)
+                P = P + plan.combo(delta, cur_us, cur_Pu)
             if X is not None:
                 X = X + _combo(delta, cur_us)
             shifts.append((delta, cur_us))
@@ -443,7 +456,7 @@ def _step(it, plan, s, settings, t0, result_type, solve):
                     N2T = g.facet_N2.T
                 cur_us = plan.volume_grads(P, a, b, N2T, symmetric, mobile_off)
                 cur_A = _matrix(cur_us)
-                cur_Pu = [plan.gather(u) for u in cur_us]
+                cur_Pu = plan.gathered(cur_us)
         raise _Fallback
 
     def E(scale):
