@@ -8,9 +8,11 @@ tension, fixed body volumes, FIXED vertices, optionally energy quantities —
 this module takes the same step with far fewer calls:
 
 * the trial moves ``X0 + s v`` and the restoring corrections ``+ δ u`` are
-  made on the facet corners gathered once per step (gathering commutes with
-  the element-wise sums, so every coordinate is the same number as the
-  general path's); only the actual move is written back to the vertices;
+  made on the facet corners, the directions gathered once per step (above
+  20,000 facets each move's ``s v`` or ``Σ δ u`` is gathered instead: no
+  corner arrays per direction kept); gathering commutes with the
+  element-wise sums, so every coordinate is the same number as the general
+  path's; only the actual move is written back to the vertices;
 * the volumes after a displacement, before the restoring, are computed
   alone (the energy there is never read);
 * with facet tension alone the energy, the area and volume gradients and
@@ -42,6 +44,7 @@ import numpy as np
 
 from ..geometry.kernels import geometry_of_corners
 from ..methods._common import csr_matvec, finite
+from ..methods import axis_major as AM
 from ..methods.axis_major import NEXT as _NEXT, NEXT2 as _NEXT2, sides as _sides
 from ..methods.totals import Totals
 from . import gradient as GR
@@ -100,9 +103,15 @@ class _Plan:
         self.topo = s.topology()
         self.mode = mode
         self.Fc = s.facet_corners()                 # (3, nf)
-        nv = s.nv
-        flat = s.F.ravel()                          # facet-major, as corner_scatter
-        self.idx3 = np.concatenate((flat, flat + nv, flat + 2 * nv))
+        flat = self.topo[2].ravel()                 # facet-major, as corner_scatter
+        self.flat = flat
+        # small surfaces: the index of every corner coordinate, so that one
+        # bincount scatters all; large ones scatter axis by axis with ``flat``
+        # (the same sums, without index arrays of 9 and 9 k entries per facet)
+        self.idx3 = None
+        if s.nf <= AM.LOW_MEMORY_FACETS:
+            nv = s.nv
+            self.idx3 = np.concatenate((flat, flat + nv, flat + 2 * nv))
         b = s.bodies
         self.bodies = [i for i in range(b.n) if not math.isnan(b.target[i])]
         self.body_w = []
@@ -131,14 +140,17 @@ class _Plan:
         """Per-corner vectors ``W`` (3 axes, 3 corners, nf) summed into the
         vertices, (nv, 3) C-ordered (the order of corner_scatter's sums)."""
         nv = self.surface.nv
+        if self.idx3 is None:
+            return AM.scatter_by_axis(self.flat, W, nv)
         out = np.bincount(self.idx3, weights=W.transpose(0, 2, 1).ravel(), minlength=3 * nv)
         return np.ascontiguousarray(out.reshape(3, nv).T)
 
     def scatter_many(self, Ws):
-        """:meth:`scatter` of several per-corner arrays in one bincount."""
+        """:meth:`scatter` of several per-corner arrays (in one bincount on
+        small surfaces)."""
         k = len(Ws)
-        if k == 1:
-            return [self.scatter(Ws[0])]
+        if k == 1 or self.idx3 is None:
+            return [self.scatter(W) for W in Ws]
         nv = self.surface.nv
         idx = self.__dict__.get(("idx", k))
         if idx is None:
@@ -153,6 +165,17 @@ class _Plan:
     def gather(self, V):
         """(3, 3, nf) corners of the (nv, 3) vectors ``V``."""
         return np.ascontiguousarray(V.T).take(self.Fc, axis=1)
+
+    def gathered(self, V):
+        """The corners of the directions ``V`` (a list), kept during the
+        step; None on large surfaces (:meth:`combo` gathers their sums)."""
+        return None if self.idx3 is None else [self.gather(v) for v in V]
+
+    def combo(self, coef, V, PV):
+        """``Σ c_i v_i`` at the facet corners: of the gathered directions
+        ``PV``, or the gathered sum when None (the same numbers: gathering
+        commutes with the element-wise products and sums)."""
+        return _combo(coef, PV) if PV is not None else self.gather(_combo(coef, V))
 
     def volumes(self, P, symmetric):
         """The constrained bodies' volumes at the corners ``P`` (the facet
@@ -189,7 +212,7 @@ class _Plan:
         Q, E = _sides(P, a, b) if QE is None else QE
         g = np.empty_like(P)
         if symmetric:                   # corner c: Q[c+1] x Q[c+2] / 6
-            g[:] = _cross(Q.take(_NEXT, axis=1), Q.take(_NEXT2, axis=1))
+            g[:] = AM.cross(Q.take(_NEXT, axis=1), Q.take(_NEXT2, axis=1))
             g /= 6.0
         else:
             # _cz_grad times Z: corner c's x part y[c+1] - y[c+2] = -E[y][c],
@@ -217,18 +240,10 @@ class _Plan:
         else:
             with np.errstate(all="ignore"):
                 n = finite(N2T / L)
-        g = _cross(n[:, None, :], E)            # corner c: n x E[c]
+        g = AM.cross(n[:, None, :], E)          # corner c: n x E[c]
         g *= 0.5
         g *= tension
         return self.scatter(g) if scattered else g
-
-
-def _cross(u, v):
-    """Cross products along the first axis (3, ...): component i is
-    u[i+1] v[i+2] - u[i+2] v[i+1] (G.cross's products)."""
-    out = u.take(_NEXT, axis=0) * v.take(_NEXT2, axis=0)
-    out -= u.take(_NEXT2, axis=0) * v.take(_NEXT, axis=0)
-    return out
 
 
 def _totals(s, geom, energy, vols):
@@ -299,8 +314,7 @@ def _check(plan, s, t0):
 def forget(it) -> None:
     """Drop the iterator's plan and last end state (the ``hessian`` step:
     it moves the surface, so the next ``g`` makes a new plan anyway, and
-    the plan's index arrays, 24 MB at 81,920 facets, need not stay beside
-    the factorization)."""
+    the plan's arrays need not stay beside the factorization)."""
     it.__dict__.pop("_fast_plan", None)
     it.__dict__.pop("_end", None)
 
@@ -344,13 +358,13 @@ def _step(it, plan, s, settings, t0, result_type, solve):
     QE = _sides(P0, a0, b0)
     nb = len(plan.bodies)
     gs = None
-    if area_mode:
+    if area_mode and nb and plan.idx3 is not None:
+        # (small surfaces: the area and volume gradients in one scatter)
         Ga = plan.area_grad(P0, a0, b0, N2T0, t0.facet_area, tension, QE, scattered=False)
-        if nb:          # (the area and volume gradients in one scatter)
-            f, *gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE, also=Ga)
-            f = -f
-        else:
-            f = -plan.scatter(Ga)
+        f, *gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE, also=Ga)
+        f = -f
+    elif area_mode:     # (large ones: each scattered as soon as made)
+        f = -plan.area_grad(P0, a0, b0, N2T0, t0.facet_area, tension, QE)
     else:
         f = -GR.energy_gradient(t0)
     any_fixed = bool(mobile_off.any())
@@ -365,17 +379,19 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         start_vols = [float(t0.volumes[i]) for i in plan.bodies]
         if gs is None:
             gs = plan.volume_grads(P0, a0, b0, N2T0, symmetric, mobile_off, QE)
+        QE = Ga = None      # (three corner arrays fewer during the line search)
         A = _matrix(gs)
         bvec = [float((f * g).sum()) for g in gs]
         lam = np.array(_coefficients(A, bvec, solve))
         vel = f - _combo(lam, gs)
-        Pus = [plan.gather(u) for u in gs]
+        Pus = plan.gathered(gs)
     else:
+        QE = Ga = None
         lam = np.zeros(0)
         vel = f
         gs, A, Pus, targets = [], np.zeros((0, 0)), [], []
     motion += (vel,)
-    Pv = plan.gather(vel)
+    Pv = plan.gathered([vel])
 
     def evaluate(P, X):
         """(geometry or Totals, energy, body volumes) at the corners ``P``
@@ -400,7 +416,11 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         corrections [(coefficients, directions)])."""
         # (at scale 0 the corners are P0's, to the sign of a zero: the
         # volumes are t0's)
-        P = P0 + scale * Pv if scale != 0 else P0
+        if scale != 0:
+            P = plan.combo((scale,), [vel], Pv)
+            P += P0             # (P0 + scale Pv: one corner array fewer at once)
+        else:
+            P = P0
         X = None if area_mode else X0 + scale * vel
         shifts = []
         if not nb:
@@ -411,7 +431,10 @@ def _step(it, plan, s, settings, t0, result_type, solve):
         cur_us, cur_Pu, cur_A = gs, Pus, A
         for k in range(10):
             delta = _coefficients(cur_A, d, solve)
-            P = P + _combo(delta, cur_Pu)
+            if area_mode and P is not P0:     # (P only in the geometry g, replaced below)
+                P += plan.combo(delta, cur_us, cur_Pu)
+            else:
+                P = P + plan.combo(delta, cur_us, cur_Pu)
             if X is not None:
                 X = X + _combo(delta, cur_us)
             shifts.append((delta, cur_us))
@@ -433,7 +456,7 @@ def _step(it, plan, s, settings, t0, result_type, solve):
                     N2T = g.facet_N2.T
                 cur_us = plan.volume_grads(P, a, b, N2T, symmetric, mobile_off)
                 cur_A = _matrix(cur_us)
-                cur_Pu = [plan.gather(u) for u in cur_us]
+                cur_Pu = plan.gathered(cur_us)
         raise _Fallback
 
     def E(scale):

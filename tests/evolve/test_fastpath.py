@@ -8,6 +8,7 @@ import pytest
 
 from pyevolver import Session
 from pyevolver.evolve import fastpath as FP
+from pyevolver.methods import axis_major as AM
 from pyevolver.studies.meshes import fe_text, icosphere
 
 from conftest import example
@@ -85,6 +86,16 @@ def test_bending_bit_for_bit(tmp_path, monkeypatch):
 def test_two_bodies_none_and_symmetric_content(tmp_path, monkeypatch, kw):
     n = _count(monkeypatch)
     _same(_sphere(tmp_path, **kw), "g 8", monkeypatch)
+    assert n["fast"] == 8
+
+
+@pytest.mark.parametrize("kw", [{}, {"bodies": 2}, {"header": "symmetric_content"}])
+def test_scatter_axis_by_axis_as_on_large_surfaces(tmp_path, monkeypatch, kw):
+    """Above LOW_MEMORY_FACETS the gradients are scattered axis by axis,
+    without the concatenated indexes: the same numbers."""
+    monkeypatch.setattr(AM, "LOW_MEMORY_FACETS", 0)
+    n = _count(monkeypatch)
+    _same(_sphere(tmp_path, **kw), "g 4; fix vertex where id == 3; g 4", monkeypatch)
     assert n["fast"] == 8
 
 

@@ -46,19 +46,37 @@ def test_energy_gradient_bit_for_bit(tmp_path, monkeypatch, method, extra):
     assert np.abs(new).max() > 0
 
 
-def test_facet_area_gradient_bit_for_bit(tmp_path, monkeypatch):
+@pytest.mark.parametrize("low_memory", [False, True])
+def test_facet_area_gradient_bit_for_bit(tmp_path, monkeypatch, low_memory):
+    if low_memory:          # (row by row, as on large surfaces)
+        monkeypatch.setattr(AM, "LOW_MEMORY_FACETS", 0)
     s = _surface(tmp_path)
     new, old = _both(monkeypatch, s, basic.facet_area_grad)
     assert new.shape == old.shape == (s.nf, 3, 3) and np.array_equal(new, old)
 
 
-def test_scatter_sums_as_corner_scatter(tmp_path):
+@pytest.mark.parametrize("low_memory", [False, True])
+def test_scatter_sums_as_corner_scatter(tmp_path, monkeypatch, low_memory):
     from pyevolver.methods._common import corner_scatter
+    if low_memory:          # (axis by axis, as on large surfaces)
+        monkeypatch.setattr(AM, "LOW_MEMORY_FACETS", 0)
     s = _surface(tmp_path)
     t = s.evaluate()
     G = np.random.default_rng(0).standard_normal((3, 3, s.nf))
     assert np.array_equal(AM.scatter(s, G), corner_scatter(t, AM.facet_major(G)))
     assert AM.scatter(s, G).flags.c_contiguous
+    assert ("_axis_scatter" in s.__dict__) is not low_memory
+
+
+def test_low_memory_cross_and_sides_bit_for_bit(monkeypatch):
+    rng = np.random.default_rng(1)
+    u, P = rng.standard_normal((3, 1, 40)), rng.standard_normal((3, 3, 40))
+    v, a, b = rng.standard_normal((3, 3, 40)), P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]
+    want = AM.cross(u, v), AM.cross(v, P), *AM.sides(P, a, b)
+    monkeypatch.setattr(AM, "LOW_MEMORY_FACETS", 0)
+    got = AM.cross(u, v), AM.cross(v, P), *AM.sides(P, a, b)
+    for w, g in zip(want, got):
+        assert w.shape == g.shape and np.array_equal(w, g)
 
 
 def test_cached_on_the_evaluation(tmp_path):
