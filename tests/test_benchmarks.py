@@ -115,3 +115,15 @@ def test_bench_hostile_writes_its_table(tmp_path):
         assert re.fullmatch(r"\d+\.\d\d( \(exit \d+\))?", ref), row
     else:
         assert ref == "—", row                 # (no Evolver installed here)
+
+
+def test_bench_frontal_counts_the_fronts(tmp_path):
+    """The multifrontal estimate (docs/performance.md, "What is left"): on a
+    small sphere every unknown is a pivot of one front, so the factor has at
+    least n entries, and the extend-add volume is printed."""
+    out = _run([os.path.join(BENCH, "bench_frontal.py"), "--level", "3", "--leaf", "16"],
+               tmp_path)
+    n = int(re.search(r"unknowns ([\d,]+)", out).group(1).replace(",", ""))
+    entries = int(re.search(r"factor entries ([\d,]+)", out).group(1).replace(",", ""))
+    assert n == 642 and entries >= n
+    assert "extend-add volume" in out and "np.add.at" in out

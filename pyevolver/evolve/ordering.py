@@ -18,28 +18,12 @@ import numpy as np
 import scipy.sparse as sp
 
 
-def nested_dissection(points, pattern, leaf=16):
-    """Elimination order of the unknowns.
-
-    Parameters
-    ----------
-    points : (n, 3) array
-        A position for each unknown (its vertex).
-    pattern : sparse (n, n) matrix
-        The couplings; only its nonzero pattern is used (symmetrized).
-    leaf : int
-        Parts of at most this many unknowns are not cut further (16: on the
-        81,920-facet spheres 7–12% less fill than 64, deeper cuts gain nothing).
-
-    Returns
-    -------
-    perm : (n,) int array
-        ``A[perm][:, perm]`` is the reordered matrix.
-    """
+def _dissect(points, pattern, leaf):
+    """(part, key) of each unknown: the part id after its last cut and the
+    depth of the cut that made it a separator (the deepest depth for the
+    unknowns of the leaf parts)."""
     P = np.asarray(points, float)
     n = len(P)
-    if n <= leaf:
-        return np.arange(n)
     C = sp.coo_matrix(pattern)
     upper = C.row < C.col
     lower = C.row > C.col
@@ -111,4 +95,40 @@ def nested_dissection(points, pattern, leaf=16):
         depth += 1
     part = np.where(level < 0, code, final)
     key = np.where(level < 0, depth, level)
+    return part, key
+
+
+def nested_dissection(points, pattern, leaf=16):
+    """Elimination order of the unknowns.
+
+    Parameters
+    ----------
+    points : (n, 3) array
+        A position for each unknown (its vertex).
+    pattern : sparse (n, n) matrix
+        The couplings; only its nonzero pattern is used (symmetrized).
+    leaf : int
+        Parts of at most this many unknowns are not cut further (16: on the
+        81,920-facet spheres 7–12% less fill than 64, deeper cuts gain nothing).
+
+    Returns
+    -------
+    perm : (n,) int array
+        ``A[perm][:, perm]`` is the reordered matrix.
+    """
+    n = len(points)
+    if n <= leaf:
+        return np.arange(n)
+    part, key = _dissect(points, pattern, leaf)
     return np.lexsort((np.arange(n), part, -key)).astype(np.int64)
+
+
+def dissection_keys(points, pattern, leaf=16):
+    """(n,) int64: the same number for the unknowns of one separator or one
+    leaf part of :func:`nested_dissection` (its fronts:
+    benchmarks/bench_frontal.py)."""
+    n = len(points)
+    if n <= leaf:
+        return np.zeros(n, np.int64)
+    part, key = _dissect(points, pattern, leaf)
+    return (key.astype(np.int64) << 32) | part.astype(np.int64)
