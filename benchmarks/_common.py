@@ -96,3 +96,24 @@ def write_doc(path, tag, text):
         new = old.rstrip("\n") + "\n\n" + block + "\n"
     with open(path, "w") as fh:
         fh.write(new)
+
+
+def shifted_hessian(path, prefix):
+    """The ``hessian`` step's matrix on the surface of ``path`` after the
+    commands ``prefix``: ``(hs, A, perm, Ap)`` with ``hs`` the system
+    (``hessian_normal``), ``A = K + δI`` (CSC, δ = 1e-8 × the mean |diagonal|),
+    ``perm`` the step's nested-dissection order and ``Ap`` A in that order."""
+    import io
+    import numpy as np
+    import scipy.sparse as sp
+    from pyevolver import Session
+    from pyevolver.evolve import hessian_nd
+    from pyevolver.evolve.ordering import nested_dissection
+    s = Session.load(path, out=io.StringIO())
+    s.run(prefix)
+    hs = hessian_nd.system(s.iterator, True)
+    K = hs.K.tocsc()
+    n = K.shape[0]
+    A = (K + 1e-8 * float(np.abs(K.diagonal()).mean()) * sp.identity(n, format="csc")).tocsc()
+    perm = nested_dissection(hs.points, A)
+    return hs, A, perm, A.tocsr()[perm][:, perm].tocsc()

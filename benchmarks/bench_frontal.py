@@ -21,13 +21,12 @@ after ``g 2``, ``hessian_normal``: one unknown per vertex) the script
     PYTHONPATH=. python benchmarks/bench_frontal.py [--level 6] [--leaf 16 32 64]
 """
 import argparse
-import io
 import time
 
 import numpy as np
 import scipy.sparse as sp
 
-from _common import icosphere_file
+from _common import icosphere_file, shifted_hessian
 
 PREFIX = "set vertex z z*1.5\nset body target body[1].volume\ng 2\n"
 
@@ -68,17 +67,10 @@ def main():
     ap.add_argument("--level", type=int, default=6)
     ap.add_argument("--leaf", type=int, nargs="+", default=[16, 32, 64])
     a = ap.parse_args()
-    from pyevolver import Session
-    from pyevolver.evolve import hessian_nd, superlu
+    from pyevolver.evolve import superlu
     from pyevolver.evolve.ordering import nested_dissection
-    s = Session.load(icosphere_file(a.level), out=io.StringIO())
-    s.run(PREFIX)
-    hs = hessian_nd.system(s.iterator, True)
-    K = hs.K.tocsc()
-    n = K.shape[0]
-    A = (K + 1e-8 * float(np.abs(K.diagonal()).mean()) * sp.identity(n, format="csc")).tocsc()
-    perm = nested_dissection(hs.points, A)
-    Ap = A.tocsr()[perm][:, perm].tocsc()
+    hs, A, perm, Ap = shifted_hessian(icosphere_file(a.level), PREFIX)
+    n = A.shape[0]
     t = []
     for _ in range(3):
         t0 = time.process_time()

@@ -39,7 +39,7 @@ import statistics
 import subprocess
 import sys
 
-from _common import REPO, bending_file, cpu_run, icosphere_file, write_doc
+from _common import HERE, REPO, bending_file, cpu_run, icosphere_file, write_doc
 
 PREFIX = "set vertex z z*1.5\nset body target body[1].volume\ng 2\n"
 PRINT = 'printf "RESULT %.17g %.17g %.17g\\n", total_energy, body[1].volume, body[1].target\n'
@@ -49,17 +49,12 @@ SOLVERS = r"""
 import io, sys, time
 import numpy as np, scipy.sparse as sp
 import scipy.sparse.linalg            # (imported before the clocks start)
-from pyevolver import Session
-from pyevolver.evolve import hessian_nd, symfactor as SF
-from pyevolver.evolve.ordering import nested_dissection
-s = Session.load(sys.argv[1], out=io.StringIO())
-s.run(sys.argv[2])
-hs = hessian_nd.system(s.iterator, True)
+from pyevolver.evolve import symfactor as SF
+sys.path.insert(0, sys.argv[3])
+from _common import shifted_hessian
+hs, A, perm, Ap = shifted_hessian(sys.argv[1], sys.argv[2])
 K = hs.K.tocsc()
 n = K.shape[0]
-A = (K + 1e-8 * float(np.abs(K.diagonal()).mean()) * sp.identity(n, format="csc")).tocsc()
-perm = nested_dissection(hs.points, A)
-Ap = A.tocsr()[perm][:, perm].tocsc()
 
 
 def superlu():
@@ -117,7 +112,7 @@ def solvers(files, env):
     """Markdown table: CPU seconds of one factorization and solve of K + δI."""
     lines = ["| surface | factorization | CPU [s] | result |", "|---|---|---|---|"]
     for case, f in files:
-        p = subprocess.run([sys.executable, "-c", SOLVERS, f, PREFIX], capture_output=True,
+        p = subprocess.run([sys.executable, "-c", SOLVERS, f, PREFIX, HERE], capture_output=True,
                            text=True, env=env, timeout=3600)
         for ln in p.stdout.splitlines():
             if ln.startswith("SOLVER "):
