@@ -33,7 +33,8 @@ PREFIX = "set vertex z z*1.5\nset body target body[1].volume\ng 2\n"
 
 def fronts(A, perm, leaf_of):
     """(pivots p, update sizes u) of the fronts in the order ``perm``;
-    ``leaf_of`` (n,) the front of each position of the permuted matrix."""
+    ``leaf_of`` (n,) the front of each position of the permuted matrix (its
+    runs of one value)."""
     n = A.shape[0]
     pos = np.empty(n, np.int64)
     pos[perm] = np.arange(n)
@@ -68,7 +69,7 @@ def main():
     ap.add_argument("--leaf", type=int, nargs="+", default=[16, 32, 64])
     a = ap.parse_args()
     from pyevolver.evolve import superlu
-    from pyevolver.evolve.ordering import nested_dissection
+    from pyevolver.evolve.ordering import dissection
     hs, A, perm, Ap = shifted_hessian(icosphere_file(a.level), PREFIX)
     n = A.shape[0]
     t = []
@@ -80,11 +81,8 @@ def main():
           f"{min(t):.3f} s CPU (best of 3)")
     volume = None
     for leaf in a.leaf:
-        perm = nested_dissection(hs.points, A, leaf=leaf)
-        # fronts: runs of one separator or leaf in the order (nested_dissection
-        # sorts by cut depth, then part: a new front wherever that key changes)
-        lab = _labels(hs.points, A, leaf, perm)
-        p, u = fronts(A, perm, lab)
+        perm, front = dissection(hs.points, A, leaf=leaf)
+        p, u = fronts(A, perm, front[perm])
         print(f"leaf {leaf}: {len(p):,} fronts, factor entries {(p * (p + 1) // 2 + p * u).sum():,},"
               f" dense flops {((p ** 3) / 3 + p * p * u + p * u * u).sum() / 1e6:.0f} M,"
               f" extend-add volume Σu² {(u * u).sum():,}")
@@ -103,15 +101,6 @@ def main():
     t3 = time.process_time()
     print(f"numpy scatter-add of {m:,} entries: np.add.at {t1 - t0:.3f} s, "
           f"fancy-index += ({len(uniq):,} distinct) {t3 - t2:.3f} s CPU")
-
-
-def _labels(points, A, leaf, perm):
-    """The front of each position of ``perm``: the separator or leaf each
-    unknown belongs to, as nested_dissection's sort keys (recomputed from
-    the order: consecutive unknowns of one key form one front)."""
-    from pyevolver.evolve.ordering import dissection_keys
-    key = dissection_keys(points, A, leaf)
-    return key[perm]
 
 
 if __name__ == "__main__":

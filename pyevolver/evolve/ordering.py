@@ -116,19 +116,16 @@ def nested_dissection(points, pattern, leaf=16):
     perm : (n,) int array
         ``A[perm][:, perm]`` is the reordered matrix.
     """
-    n = len(points)
-    if n <= leaf:
-        return np.arange(n)
-    part, key = _dissect(points, pattern, leaf)
-    return np.lexsort((np.arange(n), part, -key)).astype(np.int64)
+    return dissection(points, pattern, leaf)[0]
 
 
-def dissection_keys(points, pattern, leaf=16):
-    """(n,) int64: the same number for the unknowns of one separator or one
-    leaf part of :func:`nested_dissection` (its fronts:
-    benchmarks/bench_frontal.py)."""
+def dissection(points, pattern, leaf=16):
+    """:func:`nested_dissection`'s order and its fronts: ``(perm, front)``,
+    ``front`` (n,) int64 the same number for the unknowns of one separator
+    or one leaf part (benchmarks/bench_frontal.py)."""
     n = len(points)
     if n <= leaf:
-        return np.zeros(n, np.int64)
+        return np.arange(n), np.zeros(n, np.int64)
     part, key = _dissect(points, pattern, leaf)
-    return (key.astype(np.int64) << 32) | part.astype(np.int64)
+    perm = np.lexsort((np.arange(n), part, -key)).astype(np.int64)
+    return perm, (key.astype(np.int64) << 32) | part.astype(np.int64)
