@@ -494,7 +494,7 @@ def proposition1(grids: tuple = ((5, 10), (10, 20), (20, 40)),
 # -- the chart ----------------------------------------------------------------------------------
 
 def chart_records(full: bool = False, directory: str | None = None, evolver: bool = False,
-                  sizes: list | None = None) -> list[dict]:
+                  sizes: list | None = None, rounds: int | None = None) -> list[dict]:
     """Points for the accuracy-versus-time chart: one per method and mesh
     resolution (5×10, 10×16 with ``full`` False; also 20×32 and 40×64).
 
@@ -506,7 +506,8 @@ def chart_records(full: bool = False, directory: str | None = None, evolver: boo
     (label ``<energy>+harmonic(cont.)``, plus ``... Loop W`` with the Loop
     surface's energy of the same mesh), the Evolver's recipe (d) in pyevolver
     and, with ``evolver``, in evolver-nox-d.  ``sizes``: the (m, n) grids
-    instead (e.g. ``[(5, 10)]`` for the chart CI regenerates).
+    instead (e.g. ``[(5, 10)]`` for the chart CI regenerates); ``rounds``
+    the recipe's rounds (default 50, 30 from 20×32 up).
     """
     directory = directory or tempfile.mkdtemp(prefix="fig3_")
     out = []
@@ -515,7 +516,7 @@ def chart_records(full: bool = False, directory: str | None = None, evolver: boo
             row, _ = continuation_run(m, n, energy, directory=directory, moebius=False)
             out.append(_record(row["label"], row))
             out.append(_record(row["label"] + " Loop W", dict(row, W=row["W_loop"])))
-            rows, _ = recipe_run(m, n, energy, rounds=_recipe_rounds(m), evolver=evolver,
+            rows, _ = recipe_run(m, n, energy, rounds=rounds or _recipe_rounds(m), evolver=evolver,
                                  directory=directory, moebius=False)
             for r in rows:
                 lab = r["label"] + (" [evolver-nox-d]" if r["program"] != "pyevolver" else "")

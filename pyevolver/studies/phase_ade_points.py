@@ -147,7 +147,7 @@ def solve_ade_point(branch: str, v: float, model: Helfrich, nv: int, ref=None,
             break
         mu_a, fa, mu_b = mu_b, fb, mu_b - fb * (mu_b - mu_a) / (fb - fa)
     E = W + k * (M - M0) ** 2
-    kind = mesh_descriptors(X, F)["type"]
+    kind = mesh_descriptors(X, F, (0.0, 0.0, 1.0))["type"]
     row = {"branch": branch, "v": float(v), "c0": model.c0, "alpha": model.alpha,
            "m0": model.m0, "nv": len(X), "W": E, "W_ref": float(ref.W),
            "rel_err": E / ref.W - 1.0, "m": M / (4 * np.pi),

@@ -7,7 +7,8 @@ z axis into a closed triangle mesh of about ``nv`` vertices with
 near-equilateral triangles everywhere, also in a stomatocyte's narrow neck:
 rings of vertices at equal arclength steps (the height of an equilateral
 triangle of side ``h``, ``√3 nv h²/2 ≈ A``), each ring with
-``round(2π r / h)`` vertices (at least 3), consecutive rings joined by the
+``round(2π r / h)`` vertices (at least 3; at least ``min_ring``, with the
+local ``h`` graded down where that is more, in a graded mesh), consecutive rings joined by the
 "zipper" that always advances on the ring whose next vertex comes first in
 angle, and a vertex on each pole joined to its ring by a fan.  The mesh is
 oriented outwards (positive enclosed volume).
@@ -53,7 +54,7 @@ def _zipper(a_idx, a_ang, b_idx, b_ang):
 
 
 def revolve(s: np.ndarray, r: np.ndarray, z: np.ndarray, nv: int,
-            area: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+            area: float | None = None, min_ring: int = 3) -> tuple[np.ndarray, np.ndarray]:
     """Revolve the generating curve ``(r(s), z(s))`` into a closed mesh.
 
     Parameters
@@ -64,6 +65,13 @@ def revolve(s: np.ndarray, r: np.ndarray, z: np.ndarray, nv: int,
         Target number of vertices (the result has about as many).
     area : float, optional
         Scale the mesh to this total area (default: as revolved).
+    min_ring : int, optional
+        Fewest vertices on a ring away from the poles (default 3).  Above
+        3 the mesh is graded: where ``2π r / h`` would give fewer (a
+        stomatocyte's neck narrower than the mesh size), the local edge
+        length drops to ``2π r / min_ring`` and the rings there come closer
+        in proportion, so the triangles stay near-equilateral.  Within
+        ``2h`` of a pole the length stays ``h``.
 
     Returns
     -------
@@ -74,13 +82,22 @@ def revolve(s: np.ndarray, r: np.ndarray, z: np.ndarray, nv: int,
     seg = np.hypot(np.diff(r), np.diff(z))
     A = float(np.sum(np.pi * (r[1:] + r[:-1]) * seg))
     h = math.sqrt(2 * A / (math.sqrt(3) * max(nv, 8)))
-    m = max(2, int(round(L / (h * math.sqrt(3) / 2))))
-    sj = s[0] + L * np.arange(m + 1) / m
+    # the local edge length along the curve and the rings equidistributed
+    # in arclength / (its triangles' height)
+    hloc = np.full(len(s), h)
+    if min_ring > 3:
+        far = np.minimum(s - s[0], s[-1] - s) > 2 * h
+        hloc[far] = np.minimum(h, 2 * np.pi * r[far] / min_ring)
+    rate = 2.0 / (math.sqrt(3) * hloc)                    # rings per unit arclength
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(s))])
+    m = max(2, int(round(cum[-1])))
+    sj = np.interp(cum[-1] * np.arange(m + 1) / m, cum, s)
     rj = np.interp(sj, s, r)
     zj = np.interp(sj, s, z)
+    hj = np.interp(sj, s, hloc)
     pts, rings, angs = [], [], []
     for j in range(m + 1):
-        n = 1 if j in (0, m) else max(3, int(round(2 * np.pi * rj[j] / h)))
+        n = 1 if j in (0, m) else max(min_ring, int(round(2 * np.pi * rj[j] / hj[j])))
         ang = (2 * np.pi * (np.arange(n) + 0.5 * (j % 2)) / n) % (2 * np.pi)
         rr = 0.0 if n == 1 else rj[j]
         first = sum(len(p) for p in pts)

@@ -72,7 +72,9 @@ def _fmt(x, spec):
 def summary_markdown(rows: list[dict], trans: list[dict]) -> str:
     """The study's tables in Markdown (written as ``summary.md`` next to
     ``phase.csv``; docs/phase.md quotes it): the transitions, then one row
-    per point."""
+    per point; where the rows' bending energies differ (a branch solved
+    with another ``--method``) the solver column names each one's."""
+    mixed = len({r["method"] for r in rows if r.get("method")}) > 1
     out = ["| transition | discrete | axisymmetric reference | published (SBL 1991) |",
            "|---|---|---|---|"]
     for t in trans:
@@ -89,5 +91,6 @@ def summary_markdown(rows: list[dict], trans: list[dict]) -> str:
             f"{_fmt(r['eig1'], '.4g')} | "
             + ("yes" if r["stable"] is True else ("no" if r["stable"] is False else "—"))
             + " | "
-            f"{r['lambda']:g} | {r['min_angle_deg']:.1f}° | {r['start']} |")
+            f"{r['lambda']:g} | {r['min_angle_deg']:.1f}° | {r['start']}"
+            + (f", {r.get('method', '')}" if mixed else "") + " |")
     return "\n".join(out) + "\n"

@@ -73,6 +73,8 @@ LAMBDA_642 = 0.3
 #: published transitions at c0 = 0 (Seifert, Berndl & Lipowsky 1991, Fig. 8)
 PUBLISHED = {("prolate", "oblate"): 0.652, ("oblate", "stomatocyte"): 0.592}
 #: shape types accepted on each branch
+#: the axis the reference is revolved about (phase_mesh.revolve), known to the classifier
+AXIS = np.array([0.0, 0.0, 1.0])
 TYPES = {"prolate": {"prolate", "sphere"}, "oblate": {"oblate", "discocyte", "sphere"},
          "stomatocyte": {"stomatocyte"}}
 COLUMNS = ["branch", "c0", "v", "nv", "W", "W_ref", "rel_err", "stable", "eig1", "eig2",
@@ -121,20 +123,24 @@ def _session(X, F, v, lam, directory, c0=0.0, method=METHOD):
 
 def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
                 start: tuple[np.ndarray, np.ndarray] | None = None, maxit: int = 60,
-                eigen: bool = True, c0: float = 0.0, method: str | None = None
-                ) -> tuple[dict, np.ndarray, np.ndarray]:
+                eigen: bool = True, c0: float = 0.0, method: str | None = None,
+                min_ring: int = 3) -> tuple[dict, np.ndarray, np.ndarray]:
     """One point of a branch: minimise W + λE from ``start`` (a mesh; default
     the reference ``ref`` revolved), falling back as the module docstring
     says; ``c0`` the spontaneous curvature (``ref`` must be the reference at
-    the same ``c0``); ``method`` the bending energy (:func:`method_for`).
+    the same ``c0``); ``method`` the bending energy (:func:`method_for`);
+    ``min_ring`` the fewest vertices on a ring of the revolved start
+    (:func:`~pyevolver.studies.phase_mesh.revolve`: above 3 the mesh is
+    graded in a neck narrower than the mesh size; recorded in ``start``).
     Returns ``(row, X, F)``."""
     method = method_for(c0, method)
     lam = lam_for(nv) if lam is None else lam
     t0 = time.perf_counter()
-    rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi)
-    attempts = [("revolved", rev, lam, "min"), ("revolved", rev, lam, "critical"),
-                ("revolved", rev, 2 * lam, "min"), ("revolved", rev, 2 * lam, "critical"),
-                ("revolved", rev, 4 * lam, "min")]
+    rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi, min_ring=min_ring)
+    revolved = "revolved" if min_ring <= 3 else f"revolved-ring{min_ring}"
+    attempts = [(revolved, rev, lam, "min"), (revolved, rev, lam, "critical"),
+                (revolved, rev, 2 * lam, "min"), (revolved, rev, 2 * lam, "critical"),
+                (revolved, rev, 4 * lam, "min")]
     if start is not None:
         attempts += [("continued", start, lam, "min"), ("continued", start, lam, "critical")]
     steps = 0
@@ -145,7 +151,7 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
         if mesh_quality(surf.X, surf.F)["min_angle_deg"] < MIN_ANGLE / 2:
             return False
         return (branch == "stomatocyte"
-                or mesh_descriptors(surf.X, surf.F)["type"] in TYPES[branch])
+                or mesh_descriptors(surf.X, surf.F, AXIS)["type"] in TYPES[branch])
     with tempfile.TemporaryDirectory() as tmp:
         for kind, (X, F), lam_k, solver in attempts:
             s = _session(X, F, v, lam_k, tmp, c0, method)
@@ -163,7 +169,7 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
             steps += n
             X1, F1 = s.surface.X.copy(), s.surface.F.copy()
             q = mesh_quality(X1, F1)
-            kind_shape = mesh_descriptors(X1, F1)["type"]
+            kind_shape = mesh_descriptors(X1, F1, AXIS)["type"]
             good = ok and q["min_angle_deg"] >= MIN_ANGLE and kind_shape in TYPES[branch]
             if good:
                 break
@@ -223,7 +229,7 @@ def write_rows(path: str, rows: list[dict]) -> None:
 
 def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[dict],
                log: Callable[[str], Any] = print, eigen: bool = True, c0: float = 0.0,
-               method: str | None = None) -> None:
+               method: str | None = None, min_ring: int = 3) -> None:
     """Solve the branch's points of ``volumes`` (those with a reference in
     ``refs``, v -> BranchPoint) by continuation from its seed outwards,
     appending to ``rows`` and rewriting ``out/phase.csv`` after each point;
@@ -258,7 +264,7 @@ def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[d
                     with np.load(sk) as z:
                         start = (z["X"], z["F"])
             row, X, F = solve_point(branch, float(v), refs[float(v)].result, nv, start=start,
-                                    eigen=eigen, c0=c0, method=method)
+                                    eigen=eigen, c0=c0, method=method, min_ring=min_ring)
             row["nv_target"] = nv
             rows.append(row)
             if row["converged"]:
@@ -324,13 +330,14 @@ def references(volumes, branches=BRANCHES, modes: int | None = None,
 def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
         c0: float = 0.0, plot: bool = True, eigen: bool = True,
         log: Callable[[str], Any] = print, modes: int | None = None,
-        method: str | None = None) -> tuple[list[dict], list[dict]]:
+        method: str | None = None, min_ring: int = 3) -> tuple[list[dict], list[dict]]:
     """The study (see the module docstring); returns ``(rows, transitions)``.
     ``modes``: sine modes of the references (default per branch, see
     :data:`phase_reference.MODES`; fewer for quick runs); ``c0`` the
     reduced spontaneous curvature (the references are solved at the same
     ``c0``; published transitions exist for ``c0 = 0`` only); ``method``
-    the bending energy (:func:`method_for`)."""
+    the bending energy (:func:`method_for`); ``min_ring`` the fewest
+    vertices on a ring of the revolved starts (:func:`solve_point`)."""
     c0 = float(c0)
     method = method_for(c0, method)
     model = Helfrich(c0=c0) if c0 else None
@@ -343,7 +350,7 @@ def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
     rows = read_rows(os.path.join(out, "phase.csv"))
     for b in branches:
         run_branch(b, volumes, nv, out, refs[b], rows, log=log, eigen=eigen, c0=c0,
-                   method=method)
+                   method=method, min_ring=min_ring)
     # the tables as written (the summary is then exactly the CSV's)
     rows = [r for r in read_rows(os.path.join(out, "phase.csv"))
             if int(r.get("nv_target", 0)) == nv and r["branch"] in branches
@@ -357,22 +364,38 @@ def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
     return rows, trans
 
 
-def merge(sources: list[str], out: str) -> tuple[list[dict], list[dict]]:
+def merge(sources: list[str], out: str, plot: bool = False,
+          modes: int | None = None) -> tuple[list[dict], list[dict]]:
     """Combine the ``phase.csv`` of several runs (e.g. one per branch, run
-    at the same time) into ``out``: its ``phase.csv``, ``transitions.csv``
-    (without the reference's crossings) and ``summary.md``."""
+    at the same time, or one branch with another ``--method``) into ``out``:
+    its ``phase.csv``, ``transitions.csv`` and ``summary.md``.  With
+    ``plot`` the axisymmetric references of the rows' volumes are solved
+    again (``modes`` as in :func:`run`), their crossings enter
+    ``transitions.csv`` and the figure is drawn (one ``c0`` per folder)."""
     rows: list[dict] = []
     for src in sources:
         rows += read_rows(os.path.join(src, "phase.csv"))
     os.makedirs(out, exist_ok=True)
     write_rows(os.path.join(out, "phase.csv"), rows)
     rows = read_rows(os.path.join(out, "phase.csv"))
-    trans = []
-    for c0 in sorted({float(r.get("c0") or 0.0) for r in rows}) or [0.0]:
-        trans += transitions([r for r in rows if float(r.get("c0") or 0.0) == c0], c0=c0)
+    c0s = sorted({float(r.get("c0") or 0.0) for r in rows}) or [0.0]
+    if plot and len(c0s) > 1:
+        raise ValueError(f"rows of several c0 ({c0s}): merge them into one folder each "
+                         "to draw the figure")
+    trans, refs = [], None
+    for c0 in c0s:
+        mine = [r for r in rows if float(r.get("c0") or 0.0) == c0]
+        model = Helfrich(c0=c0) if c0 else None
+        if plot:
+            branches = [b for b in BRANCHES if any(r["branch"] == b for r in mine)]
+            volumes = sorted({float(r["v"]) for r in mine})
+            refs = references(volumes, branches, modes, model)
+        trans += transitions(mine, refs, c0, model)
     write_transitions(os.path.join(out, "transitions.csv"), trans)
     with open(os.path.join(out, "summary.md"), "w") as fh:
         fh.write(phase_plot.summary_markdown(rows, trans))
+    if plot:
+        phase_plot.plot(os.path.join(out, "phase"), rows, refs, trans)
     return rows, trans
 
 
@@ -396,17 +419,22 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--branches", default=",".join(BRANCHES))
     p.add_argument("--method", default=None, choices=list(HZERO_METHODS),
                    help=f"bending energy (default {METHOD} at c0 = 0, {METHOD_C0} otherwise)")
+    p.add_argument("--min-ring", type=int, default=3,
+                   help="fewest vertices on a ring of the revolved start (default 3; more "
+                        "grades the mesh in a stomatocyte's narrow neck)")
     p.add_argument("--out", default="phase_out", help="output folder")
     p.add_argument("--no-plot", dest="plot", action="store_false")
     p.add_argument("--no-eigen", dest="eigen", action="store_false",
                    help="skip the Hessian eigenvalues")
     p.add_argument("--merge", metavar="DIR1,DIR2,...", default=None,
-                   help="only combine these runs' phase.csv into --out (no solving)")
+                   help="only combine these runs' phase.csv into --out (no solving; "
+                        "the references only for the figure and their crossings, "
+                        "skipped with --no-plot)")
 
 
 def run_args(args: argparse.Namespace) -> int:
     if args.merge:
-        rows, trans = merge(args.merge.split(","), args.out)
+        rows, trans = merge(args.merge.split(","), args.out, plot=args.plot)
         _print_transitions(trans)
         return 0
     volumes = (grid(args.vmin, args.vmax, args.step) if args.volumes is None
@@ -414,6 +442,7 @@ def run_args(args: argparse.Namespace) -> int:
     rows, trans = run(nv=args.nv, volumes=volumes,
                       branches=tuple(args.branches.split(",")), out=args.out, c0=args.c0,
                       plot=args.plot, eigen=args.eigen, method=args.method,
+                      min_ring=args.min_ring,
                       log=lambda t: print(t, flush=True))
     _print_transitions(trans)
     return 0 if all(r["converged"] is True for r in rows) else 1

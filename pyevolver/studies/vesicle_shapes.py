@@ -156,6 +156,12 @@ def _line_hits(X, F, o, d):
     return t[keep]
 
 
+#: the largest relative difference of the lateral second moments of a
+#: surface of revolution about a given axis (converged phase-study shapes:
+#: below 0.01; a prolate lying across the axis: 0.75)
+AXISYM_MAX = 0.1
+
+
 def _classify(hw, dlo, dhi):
     """Shape type from height/width and the two pole depths."""
     if max(dlo, dhi) > 0.3 and abs(dhi - dlo) > 0.3:
@@ -169,13 +175,18 @@ def _classify(hw, dlo, dhi):
     return "other"
 
 
-def mesh_descriptors(X: np.ndarray, F: np.ndarray) -> dict:
+def mesh_descriptors(X: np.ndarray, F: np.ndarray, axis: np.ndarray | None = None) -> dict:
     """Symmetry descriptors of a closed mesh, comparable with
     :func:`reference_descriptors`.
 
-    The symmetry axis is the eigenvector of the surface's second-moment
-    tensor (about its area centroid) whose eigenvalue is farthest from the
-    other two.  With ``z`` the coordinate along it and ``r`` the distance
+    The symmetry axis is ``axis`` when given (shape (3,): a mesh revolved
+    about a known axis; a deep stomatocyte's second moments are nearly
+    isotropic, so they cannot find its axis), else the eigenvector of the
+    surface's second-moment tensor (about its area centroid) whose
+    eigenvalue is farthest from the other two.  About a given axis a
+    surface whose lateral moments differ by more than :data:`AXISYM_MAX`
+    (relative) is of type ``other``: not a surface of revolution about it
+    (a prolate lying across the axis is no oblate).  With ``z`` the coordinate along it and ``r`` the distance
     from it:
 
     ``height_width``
@@ -202,9 +213,21 @@ def mesh_descriptors(X: np.ndarray, F: np.ndarray) -> dict:
     D = cen - g
     M = np.einsum("f,fi,fj->ij", fa, D, D) / fa.sum()
     ev, evec = np.linalg.eigh(M)
-    k = 0 if ev[2] - ev[1] < ev[1] - ev[0] else 2
-    axis = evec[:, k]
-    lat = [i for i in range(3) if i != k]
+    given = axis is not None
+    if axis is None:
+        k = 0 if ev[2] - ev[1] < ev[1] - ev[0] else 2
+        axis = evec[:, k]
+        lat = [evec[:, i] for i in range(3) if i != k]
+    else:
+        axis = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+        e = np.eye(3)[np.argmin(np.abs(axis))]
+        u = np.cross(axis, e)
+        u /= np.linalg.norm(u)
+        w = np.cross(axis, u)
+        P = np.array([u, w])                     # the lateral moments, diagonalised
+        ev2, vec2 = np.linalg.eigh(P @ M @ P.T)
+        lat = [vec2[:, 0] @ P, vec2[:, 1] @ P]
+    m_lat = sorted(float(d @ M @ d) for d in lat)
     Y = X - g
     z = Y @ axis
     r = np.linalg.norm(Y - np.outer(z, axis), axis=1)
@@ -216,10 +239,14 @@ def mesh_descriptors(X: np.ndarray, F: np.ndarray) -> dict:
     else:
         dlo = dhi = float("nan")
     hw = H / (2 * r.max())
-    return {"type": _classify(hw, dlo, dhi), "height_width": float(hw),
+    dev = (m_lat[1] - m_lat[0]) / m_lat[1]
+    kind = _classify(hw, dlo, dhi)
+    if given and dev > AXISYM_MAX:
+        kind = "other"                   # not a surface of revolution about that axis
+    return {"type": kind, "height_width": float(hw),
             "pole_depth_min": float(min(dlo, dhi)), "pole_depth_max": float(max(dlo, dhi)),
             "axis_crossings": len(hits),
-            "axisym_dev": float(abs(ev[lat[1]] - ev[lat[0]]) / ev[lat[1]])}
+            "axisym_dev": dev}
 
 
 def reference_descriptors(res: CanhamResult) -> dict:

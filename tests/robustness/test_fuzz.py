@@ -14,7 +14,7 @@ inputs about as much):
   constrained drop and a disc on a parametric boundary, each failing
   command checked to leave the surface arrays as they were.
 
-CI runs ``FUZZ_INPUTS`` (8,000; ``PYEVOLVER_FUZZ_INPUTS`` overrides) inputs
+CI runs ``FUZZ_INPUTS`` (4,000; ``PYEVOLVER_FUZZ_INPUTS`` overrides) inputs
 per target, on the small seed files; ``pytest --nightly`` (or
 ``PYEVOLVER_NIGHTLY=1``) runs ten times as many on every shipped file and on
 four more datafiles, with fresh random seeds.  The counts are printed at the
@@ -38,7 +38,7 @@ from pyevolver.session.core import Session
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
 
 NIGHTLY = os.environ.get("PYEVOLVER_NIGHTLY", "") not in ("", "0")
-FUZZ_INPUTS = int(os.environ.get("PYEVOLVER_FUZZ_INPUTS", "8000"))
+FUZZ_INPUTS = int(os.environ.get("PYEVOLVER_FUZZ_INPUTS", "4000"))
 BATCH = 50                       # inputs per hypothesis example
 
 

@@ -76,6 +76,10 @@ def test_run_writes_the_tables_and_resumes(tmp_path):
     assert [r["W"] for r in merged] == [r["W"] for r in again]
     assert os.path.exists(tmp_path / "merged" / "summary.md")
     assert [t["v"] for t in mtrans] == [None, None]
+    # with the figure: the references solved again, the figure drawn
+    PS.merge([out], str(tmp_path / "drawn"), plot=True, modes=12)
+    for ext in ("png", "pdf"):
+        assert os.path.getsize(tmp_path / "drawn" / f"phase.{ext}") > 1000
 
 
 #: per method: the range of rel_err at 120 vertices and the tolerance of the c0 effect
@@ -121,6 +125,30 @@ def test_run_at_nonzero_c0_keeps_its_own_rows(tmp_path):
     assert all(t["c0"] == 0.5 and t["v_published"] is None for t in trans)
     table = PS.read_rows(os.path.join(out, "phase.csv"))
     assert sorted(r["c0"] for r in table) == [0.0, 0.5]
+    # one figure per c0: merging both with the figure is refused by name
+    with pytest.raises(ValueError, match="several c0"):
+        PS.merge([out], str(tmp_path / "both"), plot=True, modes=12)
+
+
+def test_graded_start_resolves_the_narrow_neck_at_negative_c0():
+    """c0 = -0.5, v = 0.6: the stomatocyte's neck (radius 0.057) is a
+    fifth of the mesh size at 160 vertices.  Revolved with 3 vertices on
+    the neck's ring the neck pinches shut (the axis then crosses the
+    surface four times: no stomatocyte) or the mesh folds up, and the
+    point fails; graded
+    (``min_ring=10``, phase_mesh.revolve) it converges to a stable
+    stomatocyte within 3% above the axisymmetric reference (+0.57% at
+    642 vertices, docs/phase.md)."""
+    p = PR.follow("stomatocyte", [0.6], model=Helfrich(c0=-0.5))[0]
+    kw = dict(eigen=False, c0=-0.5, method="normal_sq_mean_curvature")
+    bad, _, _ = PS.solve_point("stomatocyte", 0.6, p.result, 160, min_ring=3, **kw)
+    assert bad["converged"] is False                 # the neck pinched shut or folded
+    assert bad["type"] != "stomatocyte" or bad["min_angle_deg"] < PS.MIN_ANGLE
+    kw["eigen"] = True
+    row, X, F = PS.solve_point("stomatocyte", 0.6, p.result, 160, min_ring=10, **kw)
+    assert row["converged"] is True and row["type"] == "stomatocyte"
+    assert row["start"] == "revolved-ring10/min" and row["min_angle_deg"] >= PS.MIN_ANGLE
+    assert 0 < row["rel_err"] < 0.03 and row["stable"] is True and row["eig1"] > 0
 
 
 def test_methods_without_h_zero_are_refused(tmp_path):

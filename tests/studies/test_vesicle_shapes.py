@@ -38,3 +38,25 @@ def test_prolate_descriptors():
     d = mesh_descriptors(X * np.array([1.0, 1.0, 2.0]), F)
     assert d["type"] == "prolate" and d["height_width"] == pytest.approx(2.0, rel=1e-2)
     assert d["axis_crossings"] == 2 and d["axisym_dev"] < 1e-2
+
+
+def test_a_given_axis_is_used_instead_of_the_moments():
+    """The known axis of a revolved mesh overrides the second moments (a
+    deep stomatocyte's are nearly isotropic): the same spheroid is a
+    prolate about its long axis, and read about a short one it is as wide
+    as half its height; the lateral moments are those about that axis."""
+    X, F = icosphere(3)
+    Y = X * np.array([1.0, 1.0, 2.0])
+    assert mesh_descriptors(Y, F, (0.0, 0.0, 3.0)) == pytest.approx(mesh_descriptors(Y, F))
+    d = mesh_descriptors(Y, F, (1.0, 0.0, 0.0))
+    assert d["height_width"] == pytest.approx(0.5, rel=1e-2)
+    # lateral moments about x: y² against z², far from equal (about z:
+    # equal): a prolate lying across the axis is no oblate
+    assert d["axisym_dev"] > 0.5 and d["type"] == "other"
+    # an oblate spheroid read about its short axis is one
+    assert mesh_descriptors(X * np.array([2.0, 2.0, 1.0]), F, (0, 0, 1))["type"] == "oblate"
+    # a rotated copy read about its rotated axis: the same numbers
+    c, s = math.cos(0.7), math.sin(0.7)
+    R = np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    assert mesh_descriptors(Y @ R.T, F, R @ np.array([0.0, 0.0, 1.0])) == pytest.approx(
+        mesh_descriptors(Y, F, (0.0, 0.0, 1.0)))
