@@ -54,7 +54,8 @@ def _zipper(a_idx, a_ang, b_idx, b_ang):
 
 
 def revolve(s: np.ndarray, r: np.ndarray, z: np.ndarray, nv: int,
-            area: float | None = None, min_ring: int = 3) -> tuple[np.ndarray, np.ndarray]:
+            area: float | None = None, min_ring: int = 3,
+            rng: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Revolve the generating curve ``(r(s), z(s))`` into a closed mesh.
 
     Parameters
@@ -72,6 +73,11 @@ def revolve(s: np.ndarray, r: np.ndarray, z: np.ndarray, nv: int,
         length drops to ``2π r / min_ring`` and the rings there come closer
         in proportion, so the triangles stay near-equilateral.  Within
         ``2h`` of a pole the length stays ``h``.
+    rng : numpy Generator, optional
+        Rotate each ring by a random angle (uniform over one vertex
+        spacing) instead of every other ring by half a spacing: another
+        triangulation of the same surface (the "zipper" joins the rings
+        differently), for the spread of a result over starting meshes.
 
     Returns
     -------
@@ -98,7 +104,8 @@ def revolve(s: np.ndarray, r: np.ndarray, z: np.ndarray, nv: int,
     pts, rings, angs = [], [], []
     for j in range(m + 1):
         n = 1 if j in (0, m) else max(min_ring, int(round(2 * np.pi * rj[j] / hj[j])))
-        ang = (2 * np.pi * (np.arange(n) + 0.5 * (j % 2)) / n) % (2 * np.pi)
+        shift = 0.5 * (j % 2) if rng is None else rng.uniform()
+        ang = (2 * np.pi * (np.arange(n) + shift) / n) % (2 * np.pi)
         rr = 0.0 if n == 1 else rj[j]
         first = sum(len(p) for p in pts)
         pts.append(np.stack([rr * np.cos(ang), rr * np.sin(ang), np.full(n, zj[j])], 1))

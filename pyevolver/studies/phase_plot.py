@@ -73,18 +73,27 @@ def summary_markdown(rows: list[dict], trans: list[dict]) -> str:
     """The study's tables in Markdown (written as ``summary.md`` next to
     ``phase.csv``; docs/phase.md quotes it): the transitions, then one row
     per point; where the rows' bending energies differ (a branch solved
-    with another ``--method``) the solver column names each one's."""
+    with another ``--method``) the solver column names each one's; with
+    seeds (:mod:`~pyevolver.studies.phase_spread`) a column of the spread
+    over the perturbed starts (the transitions': max − min of the
+    crossings; the points': max − min of W relative to W_ref, and how many
+    of the converged seeds are stable)."""
     mixed = len({r["method"] for r in rows if r.get("method")}) > 1
-    out = ["| transition | discrete | axisymmetric reference | published (SBL 1991) |",
-           "|---|---|---|---|"]
+    seeded = any(r.get("seeds") not in (None, "") for r in rows)
+    out = ["| transition | discrete | axisymmetric reference | published (SBL 1991) |"
+           + (" spread over seeds |" if seeded else ""),
+           "|---|---|---|---|" + ("---|" if seeded else "")]
     for t in trans:
         out.append(f"| {t['from']}/{t['to']} | {_fmt(t['v'], '.4f')} | "
-                   f"{_fmt(t['v_ref'], '.4f')} | {_fmt(t['v_published'], '')} |")
+                   f"{_fmt(t['v_ref'], '.4f')} | {_fmt(t['v_published'], '')} |"
+                   + (f" {_fmt(t.get('v_spread'), '.2g')} |" if seeded else ""))
     out += ["", "| branch | v | vertices | W/4π | W_ref/4π | rel. error | lowest eigenvalue "
-            "| stable | λ | min angle | solver |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+            "| stable | λ | min angle | solver |" + (" spread of W (stable seeds) |" if seeded
+                                                      else ""),
+            "|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if seeded else "")]
     for r in sorted(rows, key=lambda r: (list(COLORS).index(r["branch"]), r["v"])):
         ok = r["converged"] is True
-        out.append(
+        line = (
             f"| {r['branch']} | {r['v']:.3f} | {int(r['nv'])} | "
             f"{r['W'] / (4 * np.pi):.5f} | {r['W_ref'] / (4 * np.pi):.5f} | "
             + (f"{100 * r['rel_err']:+.3f}%" if ok else "not converged") + " | "
@@ -93,4 +102,10 @@ def summary_markdown(rows: list[dict], trans: list[dict]) -> str:
             + " | "
             f"{r['lambda']:g} | {r['min_angle_deg']:.1f}° | {r['start']}"
             + (f", {r.get('method', '')}" if mixed else "") + " |")
+        if seeded:
+            sp = r.get("W_spread")
+            rel = None if sp in (None, "") else 100 * float(sp) / r["W_ref"]
+            line += (f" {_fmt(rel, '.2g')}%" if rel is not None and rel == rel else " —") + (
+                f" ({r['stable_seeds']})" if r.get("stable_seeds") else "") + " |"
+        out.append(line)
     return "\n".join(out) + "\n"

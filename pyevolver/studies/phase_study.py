@@ -58,7 +58,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..session.core import Session
-from . import phase_plot, phase_reference as PR
+from . import phase_plot, phase_reference as PR, phase_spread as SP
 from .axisymmetric import BRANCHES, Helfrich
 from .meshes import write_fe
 from .phase_ade import HZERO_METHODS
@@ -79,7 +79,7 @@ TYPES = {"prolate": {"prolate", "sphere"}, "oblate": {"oblate", "discocyte", "sp
          "stomatocyte": {"stomatocyte"}}
 COLUMNS = ["branch", "c0", "v", "nv", "W", "W_ref", "rel_err", "stable", "eig1", "eig2",
            "eig3", "lambda", "min_angle_deg", "aspect", "h", "type", "start", "converged",
-           "newton_steps", "seconds", "method"]
+           "newton_steps", "seconds", "method", "seed"] + SP.SEED_COLUMNS
 #: the bending energy's method at c0 = 0 (the paper's) and at c0 != 0: with h_zero the
 #: normal estimate h = 3F·F/(2F·N) is singular where F -> 0 (flat parts, the
 #: discocyte's dimples: Hessian eigenvalues of -2e5 and failed points at c0 = -0.5),
@@ -124,19 +124,27 @@ def _session(X, F, v, lam, directory, c0=0.0, method=METHOD):
 def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
                 start: tuple[np.ndarray, np.ndarray] | None = None, maxit: int = 60,
                 eigen: bool = True, c0: float = 0.0, method: str | None = None,
-                min_ring: int = 3) -> tuple[dict, np.ndarray, np.ndarray]:
+                min_ring: int = 3, seed: int | None = None
+                ) -> tuple[dict, np.ndarray, np.ndarray]:
     """One point of a branch: minimise W + λE from ``start`` (a mesh; default
     the reference ``ref`` revolved), falling back as the module docstring
     says; ``c0`` the spontaneous curvature (``ref`` must be the reference at
     the same ``c0``); ``method`` the bending energy (:func:`method_for`);
     ``min_ring`` the fewest vertices on a ring of the revolved start
     (:func:`~pyevolver.studies.phase_mesh.revolve`: above 3 the mesh is
-    graded in a neck narrower than the mesh size; recorded in ``start``).
-    Returns ``(row, X, F)``."""
+    graded in a neck narrower than the mesh size; recorded in ``start``);
+    ``seed``: start from a perturbed mesh instead (:mod:`phase_spread`:
+    random ring rotations and vertex jitter from ``default_rng(seed)``;
+    ``start`` jittered too).  Returns ``(row, X, F)``."""
     method = method_for(c0, method)
     lam = lam_for(nv) if lam is None else lam
     t0 = time.perf_counter()
-    rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi, min_ring=min_ring)
+    rng = None if seed is None else np.random.default_rng(seed)
+    rev = revolve(ref.s, ref.r, ref.z, nv, area=4 * np.pi, min_ring=min_ring, rng=rng)
+    if rng is not None:
+        rev = (SP.jitter(*rev, rng), rev[1])
+        if start is not None:
+            start = (SP.jitter(*start, rng), start[1])
     revolved = "revolved" if min_ring <= 3 else f"revolved-ring{min_ring}"
     attempts = [(revolved, rev, lam, "min"), (revolved, rev, lam, "critical"),
                 (revolved, rev, 2 * lam, "min"), (revolved, rev, 2 * lam, "critical"),
@@ -181,7 +189,8 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
            "eig1": eig[0], "eig2": eig[1], "eig3": eig[2], "lambda": lam_k,
            "min_angle_deg": q["min_angle_deg"], "aspect": q["aspect"], "h": q["h"],
            "type": kind_shape, "start": f"{kind}/{solver}", "converged": bool(good),
-           "newton_steps": steps, "seconds": time.perf_counter() - t0, "method": method}
+           "newton_steps": steps, "seconds": time.perf_counter() - t0, "method": method,
+           "seed": "" if seed is None else int(seed)}
     return row, X1, F1
 
 
@@ -206,7 +215,8 @@ def read_rows(path: str) -> list[dict]:
             for k, val in r.items():
                 if val in ("True", "False"):
                     row[k] = val == "True"
-                elif k in ("branch", "type", "start", "method", "from", "to") or val == "":
+                elif k in ("branch", "type", "start", "method", "from", "to", "seeds",
+                           "W_seeds", "eig1_seeds", "stable_seeds", "v_seeds") or val == "":
                     row[k] = val
                 else:
                     row[k] = float(val)
@@ -229,7 +239,8 @@ def write_rows(path: str, rows: list[dict]) -> None:
 
 def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[dict],
                log: Callable[[str], Any] = print, eigen: bool = True, c0: float = 0.0,
-               method: str | None = None, min_ring: int = 3) -> None:
+               method: str | None = None, min_ring: int = 3, seeds: tuple[int, ...] = ()
+               ) -> None:
     """Solve the branch's points of ``volumes`` (those with a reference in
     ``refs``, v -> BranchPoint) by continuation from its seed outwards,
     appending to ``rows`` and rewriting ``out/phase.csv`` after each point;
@@ -237,7 +248,10 @@ def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[d
     again.  The fallback start of a point is the last converged point's
     mesh on its side of the seed.  ``c0``: the spontaneous curvature (rows
     of other ``c0`` are left alone); ``method`` the bending energy (one
-    output folder per method: the rows do not key on it)."""
+    output folder per method: the rows do not key on it); ``seeds``: each
+    point solved again from the perturbed starts of these seeds, their
+    numbers and the spread in the point's row (:mod:`phase_spread`; a
+    point done without them gets them on the next run)."""
     mesh_dir = os.path.join(out, "meshes")
     os.makedirs(mesh_dir, exist_ok=True)
     vs = np.array(sorted(v for v in volumes if float(v) in refs))
@@ -249,11 +263,26 @@ def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[d
         return (r["branch"] == branch and round(r["v"], 6) == round(float(v), 6)
                 and int(r.get("nv_target", 0)) == nv
                 and round(float(r.get("c0") or 0.0), 9) == round(c0, 9))
+    def with_seeds(row, v, start):
+        """The seeds' solves of a point, into its row."""
+        want = ";".join(str(k) for k in seeds)
+        if not seeds or row.get("seeds", "") == want:
+            return False
+        seed_rows = [solve_point(branch, float(v), refs[float(v)].result, nv, start=start,
+                                 eigen=eigen, c0=c0, method=method, min_ring=min_ring,
+                                 seed=k)[0] for k in seeds]
+        SP.add_seeds(row, list(seeds), seed_rows)
+        log(f"{branch} v={v:.4f} seeds {want}: W {row['W_seeds']} "
+            f"spread {row['W_spread']:.3g} stable {row['stable_seeds']}")
+        return True
     for side in (vs[vs >= seed], vs[vs < seed][::-1]):
         start = None
         for v in side:
             key = os.path.join(mesh_dir, _key(branch, v, nv, c0) + ".npz")
-            if any(mine(r, v) and r["converged"] is True for r in rows) and os.path.exists(key):
+            done = [r for r in rows if mine(r, v) and r["converged"] is True]
+            if done and os.path.exists(key):
+                if with_seeds(done[0], v, start):
+                    write_rows(os.path.join(out, "phase.csv"), rows)
                 with np.load(key) as z:
                     start = (z["X"], z["F"])
                 continue
@@ -266,14 +295,16 @@ def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[d
             row, X, F = solve_point(branch, float(v), refs[float(v)].result, nv, start=start,
                                     eigen=eigen, c0=c0, method=method, min_ring=min_ring)
             row["nv_target"] = nv
-            rows.append(row)
-            if row["converged"]:
-                np.savez(key, X=X, F=F)
-                start = (X, F)          # else the last converged point stays the start
-            write_rows(os.path.join(out, "phase.csv"), rows)
             log(f"{branch} v={v:.4f} W={row['W']:.6f} rel_err={row['rel_err']:+.5f} "
                 f"eig1={row['eig1']:.4g} stable={row['stable']} lambda={row['lambda']:g} "
                 f"{row['start']} {row['type']} {row['seconds']:.1f}s")
+            rows.append(row)
+            write_rows(os.path.join(out, "phase.csv"), rows)
+            if with_seeds(row, v, start):                       # from the same fallback
+                write_rows(os.path.join(out, "phase.csv"), rows)
+            if row["converged"]:
+                np.savez(key, X=X, F=F)
+                start = (X, F)          # else the last converged point stays the start
 
 
 def crossing_linear(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> float | None:
@@ -296,7 +327,9 @@ def transitions(rows: list[dict], refs: dict | None = None, c0: float = 0.0,
     """Crossings prolate/oblate and oblate/stomatocyte of the discrete
     branches (converged points only), of the reference (exact, by
     :func:`phase_reference.crossing` with ``model``, when ``refs`` is
-    given) and the published values (``c0 = 0`` only)."""
+    given) and the published values (``c0 = 0`` only); with seeds
+    (:mod:`phase_spread`) each seed's crossing (``v_seeds``) and the
+    spread over the point's and the seeds' (``v_spread``)."""
     out = []
     for (fa, fb), pub in PUBLISHED.items():
         pub = pub if c0 == 0.0 else None
@@ -306,13 +339,20 @@ def transitions(rows: list[dict], refs: dict | None = None, c0: float = 0.0,
         vref = None
         if refs is not None and refs.get(fa) and refs.get(fb):
             vref = PR.crossing(list(refs[fa].values()), list(refs[fb].values()), model)
-        out.append({"c0": float(c0), "from": fa, "to": fb, "v": v, "v_ref": vref, "v_published": pub})
+        per_seed = SP.crossing_spread(rows, fa, fb, crossing_linear)
+        found = [x for x in [v] + per_seed if x is not None]
+        out.append({"c0": float(c0), "from": fa, "to": fb, "v": v, "v_ref": vref,
+                    "v_published": pub,
+                    "v_seeds": ";".join("" if x is None else f"{x:.10g}" for x in per_seed),
+                    "v_spread": (max(found) - min(found)) if per_seed and len(found) > 1
+                    else None})
     return out
 
 
 def write_transitions(path: str, trans: list[dict]) -> None:
     with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=["c0", "from", "to", "v", "v_ref", "v_published"])
+        w = csv.DictWriter(fh, fieldnames=["c0", "from", "to", "v", "v_ref", "v_published",
+                                           "v_spread", "v_seeds"], extrasaction="ignore")
         w.writeheader()
         for t in trans:
             w.writerow({k: ("" if val is None else (f"{val:.10g}" if isinstance(val, float)
@@ -330,14 +370,17 @@ def references(volumes, branches=BRANCHES, modes: int | None = None,
 def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
         c0: float = 0.0, plot: bool = True, eigen: bool = True,
         log: Callable[[str], Any] = print, modes: int | None = None,
-        method: str | None = None, min_ring: int = 3) -> tuple[list[dict], list[dict]]:
+        method: str | None = None, min_ring: int = 3,
+        seeds: tuple[int, ...] = ()) -> tuple[list[dict], list[dict]]:
     """The study (see the module docstring); returns ``(rows, transitions)``.
     ``modes``: sine modes of the references (default per branch, see
     :data:`phase_reference.MODES`; fewer for quick runs); ``c0`` the
     reduced spontaneous curvature (the references are solved at the same
     ``c0``; published transitions exist for ``c0 = 0`` only); ``method``
     the bending energy (:func:`method_for`); ``min_ring`` the fewest
-    vertices on a ring of the revolved starts (:func:`solve_point`)."""
+    vertices on a ring of the revolved starts (:func:`solve_point`);
+    ``seeds`` the perturbed starts each point is solved from again, for
+    the spread of its numbers and of the transitions (:mod:`phase_spread`)."""
     c0 = float(c0)
     method = method_for(c0, method)
     model = Helfrich(c0=c0) if c0 else None
@@ -350,7 +393,7 @@ def run(nv: int = 642, volumes=None, branches=BRANCHES, out: str = "phase_out",
     rows = read_rows(os.path.join(out, "phase.csv"))
     for b in branches:
         run_branch(b, volumes, nv, out, refs[b], rows, log=log, eigen=eigen, c0=c0,
-                   method=method, min_ring=min_ring)
+                   method=method, min_ring=min_ring, seeds=tuple(seeds))
     # the tables as written (the summary is then exactly the CSV's)
     rows = [r for r in read_rows(os.path.join(out, "phase.csv"))
             if int(r.get("nv_target", 0)) == nv and r["branch"] in branches
@@ -422,6 +465,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--min-ring", type=int, default=3,
                    help="fewest vertices on a ring of the revolved start (default 3; more "
                         "grades the mesh in a stomatocyte's narrow neck)")
+    p.add_argument("--seeds", default="",
+                   help="comma-separated seeds: each point solved again from perturbed "
+                        "starts (random ring rotations and vertex jitter), the spread "
+                        "of W, of the stability marks and of the transitions reported")
     p.add_argument("--out", default="phase_out", help="output folder")
     p.add_argument("--no-plot", dest="plot", action="store_false")
     p.add_argument("--no-eigen", dest="eigen", action="store_false",
@@ -443,6 +490,7 @@ def run_args(args: argparse.Namespace) -> int:
                       branches=tuple(args.branches.split(",")), out=args.out, c0=args.c0,
                       plot=args.plot, eigen=args.eigen, method=args.method,
                       min_ring=args.min_ring,
+                      seeds=tuple(int(k) for k in args.seeds.split(",") if k.strip()),
                       log=lambda t: print(t, flush=True))
     _print_transitions(trans)
     return 0 if all(r["converged"] is True for r in rows) else 1
