@@ -43,6 +43,7 @@ prints W, W/(4π), the constraint residuals and the shape descriptors.
 from __future__ import annotations
 
 import argparse
+import sys
 import warnings
 from dataclasses import dataclass, field
 
@@ -50,6 +51,14 @@ import numpy as np
 from scipy.optimize import BFGS, NonlinearConstraint, minimize
 
 BRANCHES = ("prolate", "oblate", "stomatocyte")
+#: the profile types (:func:`descriptors`) of each branch
+SHAPES_OF = {"prolate": {"prolate", "sphere"}, "oblate": {"oblate", "discocyte", "sphere"},
+             "stomatocyte": {"stomatocyte"}}
+
+
+class NotConverged(RuntimeError):
+    """The reference's minimisation failed (e.g. every trial shape of the
+    branch's initial guess crossed the axis)."""
 
 
 @dataclass(frozen=True)
@@ -395,13 +404,23 @@ def canham_reference(v0: float, branch: str, n: int = 48, n_profile: int = 401,
     n0 = min(n, 16)
     if coef0 is None:
         a = np.zeros(n0) if v0 == 1.0 else _initial_coef(branch, v0, n0)
-        a, _ = _solve(_Basis(n0, 4 * n0, model), v0, a, coarse=True)
+        try:
+            a, _ = _solve(_Basis(n0, 4 * n0, model), v0, a, coarse=True)
+        except ValueError:       # scipy's trust region fed non-finite trial shapes
+            a = np.full(n0, np.nan)
+        if not np.all(np.isfinite(a)):
+            raise NotConverged(
+                f"the {branch} reference at v0 = {v0:g} did not converge from the branch's "
+                "initial shape; start from a converged neighbour (coef0, or "
+                "pyevolver.studies.phase_reference.follow)")
     else:
         a = np.asarray(coef0, dtype=float)
     basis = _Basis(n, oversample * n, model)
     a = np.concatenate([a[:n], np.zeros(max(0, n - len(a)))])
     a, lam = _solve(basis, v0, a, coarse=False)
     W, _, clo, _, v, _, Atil, Vtil = basis.evaluate(a)
+    if not (np.all(np.isfinite(a)) and np.isfinite(W)):
+        raise NotConverged(f"the {branch} reference at v0 = {v0:g} did not converge")
     willmore, mean_int = basis.curvature_integrals(a)
     L = np.sqrt(4 * np.pi / (2 * np.pi * Atil))
     # profile on a uniform grid including the poles, from the spectral interpolants
@@ -435,7 +454,11 @@ def main(argv: list[str] | None = None) -> int:
                    choices=list(BRANCHES) + ["discocyte"])
     p.add_argument("--n", type=int, default=48, help="sine modes (default 48)")
     args = p.parse_args(argv)
-    res = canham_reference(args.v0, args.branch, n=args.n)
+    try:
+        res = canham_reference(args.v0, args.branch, n=args.n)
+    except (NotConverged, ValueError) as exc:
+        print(f"{p.prog}: {exc}", file=sys.stderr)
+        return 1
     print(f"W = {res.W:.12f}")
     print(f"W/(4 pi) = {res.W / (4 * np.pi):.12f}")
     print(f"area - 4 pi = {res.area - 4 * np.pi:.2e}   "
@@ -443,7 +466,13 @@ def main(argv: list[str] | None = None) -> int:
           f"closure r(L) = {res.closure * res.L:.2e}")
     for key, val in res.descriptors.items():
         print(f"{key} = {val}")
+    kind = res.descriptors["type"]
+    if kind not in SHAPES_OF[res.branch]:
+        print(f"note: the minimisation left the {res.branch} branch (the result is a {kind}); "
+              "follow the branch from a converged neighbour "
+              "(python -m pyevolver.studies.phase_reference)", file=sys.stderr)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

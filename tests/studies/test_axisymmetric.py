@@ -127,6 +127,20 @@ def test_cli_prints_w(capsys):
     assert "type = prolate" in out
 
 
+def test_a_failed_or_wandering_reference_is_said(capsys):
+    """The stomatocyte's initial cup at v0 = 0.6 gives the trust region
+    only non-finite trial shapes: a named error (exit status 1 from the
+    command line), no traceback; at v0 = 0.65 it falls to the discocyte,
+    which the command line says."""
+    with pytest.raises(ax.NotConverged, match="stomatocyte reference at v0 = 0.6"):
+        canham_reference(0.6, "stomatocyte", n=16)
+    assert ax.main(["--v0", "0.6", "--branch", "stomatocyte", "--n", "16"]) == 1
+    assert "did not converge" in capsys.readouterr().err
+    assert ax.main(["--v0", "0.65", "--branch", "stomatocyte", "--n", "16"]) == 0
+    cap = capsys.readouterr()
+    assert "type = discocyte" in cap.out and "left the stomatocyte branch" in cap.err
+
+
 # -- spontaneous curvature and area-difference elasticity (issue 27) -----------------------
 
 @pytest.mark.parametrize("c0", [0.5, -1.0, 1.5])
