@@ -11,10 +11,10 @@ import numpy as np
 
 from ..constraints import state
 from ..evolve import gradient as GR
-from ..evolve.hessian import lagrangian_gradient, lagrangian_hessian, solve_bordered
+from ..evolve.hessian import lagrangian_gradient, lagrangian_hessian
 from ..evolve.iterate import _Constraints
 from ..session.core import Session
-from .vesicle_newton import _rigid_motions
+from .vesicle_newton import _rigid_motions, solve_step
 
 
 def restore(session: Session, rounds: int = 5) -> None:
@@ -70,7 +70,7 @@ def newton_critical(session: Session, tol: float = 1e-9, maxit: int = 30
         H = lagrangian_hessian(s, cons, lam, lagrangian_gradient(cons, lam)).tocsc()
         B = np.column_stack([C, _rigid_motions(s.X)])
         d = np.concatenate([resid, np.zeros(B.shape[1] - len(resid))])
-        dx = solve_bordered(H, B, -gL, d)[:H.shape[0]].reshape(-1, 3)
+        dx = solve_step(H, B, -gL, d, np.repeat(s.X, 3, axis=0))[:H.shape[0]].reshape(-1, 3)
         X0 = state(s)
         scale = 1.0
         for _ in range(8):

@@ -12,6 +12,7 @@ import scipy.sparse as sp
 from ..evolve import gradient as GR
 from ..evolve.hessian import _cholmod, lagrangian_gradient, lagrangian_hessian, solve_bordered
 from ..evolve.iterate import _Constraints
+from ..evolve.symfactor import ND_MIN, newton_solve
 from ..constraints import restore_state, state
 from ..model.surface import Surface
 from ..session.core import Session
@@ -32,14 +33,38 @@ def _rigid_motions(X):
     return q
 
 
-def _bordered(K, B, r, d, cache):
+def solve_step(K, B, r, d, points=None):
+    """Solve ``[[K, B], [Bᵀ, 0]] [y; μ] = [r; d]`` (K sparse symmetric,
+    possibly indefinite or singular along directions the border holds, such
+    as the rigid motions); returns the stacked ``(y, μ)``.
+
+    Above :data:`~pyevolver.evolve.symfactor.ND_MIN` unknowns the engine's
+    ``hessian`` solver: one symmetric LDLᵀ of ``K + δI`` in the geometric
+    nested-dissection order of ``points`` (n, 3), the border by its Schur
+    complement, refined to round-off with ``K``
+    (:func:`~pyevolver.evolve.symfactor.newton_solve`; then K itself);
+    SuperLU on the whole bordered matrix only when that fails — with the
+    dense border columns in it that costs 4.6 s against 0.2 s at 2,562
+    vertices.
+    """
+    n = K.shape[0]
+    if n > ND_MIN and points is not None:
+        delta = 1e-8 * float(np.abs(K.diagonal()).mean())
+        got = newton_solve(K, B, r, d, points=points, delta=delta)
+        if got is None:
+            got = newton_solve(K, B, r, d, points=points)
+        if got is not None:
+            return got[0]
+    return solve_bordered(K, B, r, d, points=points)
+
+
+def _bordered(K, B, r, d, cache, points=None):
     """Solve ``[[K, B], [Bᵀ, 0]] [y; μ] = [r; d]`` for the Newton step.
 
     With CHOLMOD, first as a positive definite K (supernodal Cholesky, about
     2.5 times faster than the LDLᵀ factorization; the symbolic analysis is
     kept in ``cache`` for the matrices of one pattern); when K is not
-    positive definite, by the engine's indefinite solver
-    (:func:`~pyevolver.evolve.hessian.solve_bordered`).
+    positive definite, or without CHOLMOD, by :func:`solve_step`.
     """
     chol = _cholmod()
     if chol is not None:
@@ -55,7 +80,7 @@ def _bordered(K, B, r, d, cache):
                 return y
         except (chol.CholmodNotPositiveDefiniteError, np.linalg.LinAlgError):
             pass
-    return solve_bordered(K, B, r, d)[:K.shape[0]]
+    return solve_step(K, B, r, d, points)[:K.shape[0]]
 
 
 def newton_lm(session: Session, tol: float = 1e-9, maxit: int = 80, mu: float = 1e-2,
@@ -108,7 +133,8 @@ def newton_lm(session: Session, tol: float = 1e-9, maxit: int = 80, mu: float = 
         X0 = state(s)
         cache = {}
         while True:
-            dx = _bordered((H + mu * mass).tocsc(), B, -gL, d, cache)
+            dx = _bordered((H + mu * mass).tocsc(), B, -gL, d, cache,
+                           np.repeat(s.X, 3, axis=0))
             pred = -(gL @ dx + 0.5 * dx @ (H @ dx))
             tt = it._move(X0, dx.reshape(-1, 3), 1.0, cons, None, None, mobile, targets,
                           None, trial=True)
