@@ -21,8 +21,9 @@ import scipy.sparse as sp
 
 from pyevolver import Session
 from pyevolver.studies.meshes import icosphere
+from pyevolver.evolve.symfactor import ND_MIN
 from pyevolver.studies.vesicle_newton import (_bordered, _rigid_motions, harmonic_continuation,
-                                              newton_lm)
+                                              newton_lm, solve_step)
 from pyevolver.studies.vesicle_shapes import initial_shape, min_angle, write_datafile
 
 FOURPI = 4 * math.pi
@@ -69,6 +70,46 @@ def test_bordered_solve_matches_the_dense_system(definite):
     expect = np.linalg.solve(full, np.concatenate([r, d]))[:n]
     assert np.allclose(y, expect, rtol=1e-9, atol=1e-11)
     assert np.allclose(B.T @ y, d, atol=1e-11)
+
+
+@pytest.mark.parametrize("singular", [False, True])
+def test_large_bordered_solve_by_the_engine_solver_is_exact(singular, monkeypatch):
+    """Above ND_MIN unknowns :func:`solve_step` takes the engine's
+    hessian solver (nested-dissection LDLᵀ of K + δI, Schur complement of
+    the border, refinement): on 3 coordinates of 900 grid points (2,700
+    unknowns) with an indefinite stencil K — also singular along the
+    translations, which the border holds as the rigid motions do on a
+    closed surface — the solution meets the bordered system to round-off
+    (checked by the residual of the sparse system itself)."""
+    m = 30
+    g = np.stack(np.meshgrid(np.arange(m), np.arange(m), indexing="ij"), -1).reshape(-1, 2)
+    pts = np.column_stack([g, np.zeros(len(g))]).astype(float)
+    L = sp.diags([4.0] * m * m) - sp.diags([1.0] * (m * m - 1), 1) - sp.diags(
+        [1.0] * (m * m - 1), -1) - sp.diags([1.0] * (m * m - m), m) - sp.diags(
+        [1.0] * (m * m - m), -m)
+    L = sp.csr_matrix(L - sp.diags(np.asarray(L.sum(axis=1)).ravel()))   # rows sum to 0
+    K = sp.kron(L - (0.0 if singular else 0.3) * sp.identity(m * m)
+                + 0.05 * sp.diags(np.sin(np.arange(m * m))), sp.identity(3)).tocsc()
+    n = K.shape[0]
+    assert n > ND_MIN
+    rng = np.random.default_rng(4)
+    T = np.zeros((n, 3))
+    for k in range(3):
+        T[k::3, k] = 1 / math.sqrt(m * m)                 # translations
+    B = np.column_stack([T, rng.standard_normal((n, 2))])
+    if singular:                      # K's null space: exactly the translations
+        K = sp.kron(L, sp.identity(3)).tocsc()
+        assert np.abs(K @ T).max() < 1e-12
+    r, d = rng.standard_normal(n), np.concatenate([np.zeros(3), rng.standard_normal(2)])
+    import pyevolver.studies.vesicle_newton as VN
+
+    def no_fallback(*a, **k):
+        raise AssertionError("SuperLU on the bordered matrix")
+    monkeypatch.setattr(VN, "solve_bordered", no_fallback)
+    z = solve_step(K, B, r, d, np.repeat(pts, 3, axis=0))
+    y, mu = z[:n], z[n:]
+    assert np.abs(K @ y + B @ mu - r).max() < 1e-9 * np.abs(r).max()
+    assert np.abs(B.T @ y - d).max() < 1e-11
 
 
 def test_first_steps_lower_the_energy_and_the_residual(prolate42):
