@@ -73,9 +73,9 @@ from .vesicle_shapes import mesh_descriptors
 LAMBDA_642 = 0.3
 #: published transitions at c0 = 0 (Seifert, Berndl & Lipowsky 1991, Fig. 8)
 PUBLISHED = {("prolate", "oblate"): 0.652, ("oblate", "stomatocyte"): 0.592}
-#: shape types accepted on each branch
 #: the axis the reference is revolved about (phase_mesh.revolve), known to the classifier
 AXIS = np.array([0.0, 0.0, 1.0])
+#: shape types accepted on each branch
 TYPES = {"prolate": {"prolate", "sphere"}, "oblate": {"oblate", "discocyte", "sphere"},
          "stomatocyte": {"stomatocyte"}}
 COLUMNS = ["branch", "c0", "v", "nv", "W", "W_ref", "rel_err", "stable", "eig1", "eig2",
@@ -264,6 +264,7 @@ def run_branch(branch: str, volumes, nv: int, out: str, refs: dict, rows: list[d
         return (r["branch"] == branch and round(r["v"], 6) == round(float(v), 6)
                 and int(r.get("nv_target", 0)) == nv
                 and round(float(r.get("c0") or 0.0), 9) == round(c0, 9))
+
     def with_seeds(row, v, start):
         """The seeds' solves of a point, into its row."""
         want = ";".join(str(k) for k in seeds)
