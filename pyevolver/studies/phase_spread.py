@@ -16,7 +16,11 @@ unperturbed start's) and gains the seeds' (:data:`SEED_COLUMNS`):
 ``stable_seeds``
     ``"k/n"``: of the n converged seeds, k marked stable;
 ``W_spread``
-    max − min of W over the point and its converged seeds.
+    max − min of W over the point and its converged seeds;
+``start_seeds``
+    how each seed was solved: its attempt and λ (``revolved/min@0.3``;
+    a seed may succeed with another λ or start than the point, and a
+    larger λ moves W, so this explains the larger spreads).
 
 :func:`crossing_spread` gives each transition per seed, so that the
 crossings carry their spread too.
@@ -29,7 +33,7 @@ import numpy as np
 
 #: the vertex jitter of a perturbed start, in mean edge lengths
 JITTER = 0.05
-SEED_COLUMNS = ["seeds", "W_seeds", "eig1_seeds", "stable_seeds", "W_spread"]
+SEED_COLUMNS = ["seeds", "W_seeds", "eig1_seeds", "stable_seeds", "W_spread", "start_seeds"]
 
 
 def jitter(X: np.ndarray, F: np.ndarray, rng: np.random.Generator,
@@ -65,6 +69,8 @@ def add_seeds(row: dict, seeds: list[int], seed_rows: list[dict]) -> None:
     row["W_seeds"] = ";".join(num(r, "W") for r in seed_rows)
     row["eig1_seeds"] = ";".join(num(r, "eig1") for r in seed_rows)
     row["stable_seeds"] = f"{sum(r['stable'] is True for r in ok)}/{len(ok)}"
+    row["start_seeds"] = ";".join(f"{r['start']}@{r['lambda']:.4g}" if r["converged"] is True
+                                  else "" for r in seed_rows)
     W = [r["W"] for r in ok] + ([row["W"]] if row["converged"] is True else [])
     row["W_spread"] = float(max(W) - min(W)) if len(W) > 1 else float("nan")
 

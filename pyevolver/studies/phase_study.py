@@ -217,7 +217,8 @@ def read_rows(path: str) -> list[dict]:
                 if val in ("True", "False"):
                     row[k] = val == "True"
                 elif k in ("branch", "type", "start", "method", "from", "to", "seeds",
-                           "W_seeds", "eig1_seeds", "stable_seeds", "v_seeds") or val == "":
+                           "W_seeds", "eig1_seeds", "stable_seeds", "v_seeds",
+                           "start_seeds") or val == "":
                     row[k] = val
                 else:
                     row[k] = float(val)

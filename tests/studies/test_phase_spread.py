@@ -49,15 +49,19 @@ def test_random_ring_rotations_triangulate_the_same_surface_otherwise():
 
 def test_add_seeds_fills_the_columns():
     row = {"W": 10.0, "converged": True}
-    seed_rows = [{"W": 10.5, "eig1": 2.0, "converged": True, "stable": True},
-                 {"W": 99.0, "eig1": float("nan"), "converged": False, "stable": ""},
-                 {"W": 9.75, "eig1": -1.0, "converged": True, "stable": False}]
+    seed_rows = [{"W": 10.5, "eig1": 2.0, "converged": True, "stable": True,
+                  "start": "revolved/min", "lambda": 0.3},
+                 {"W": 99.0, "eig1": float("nan"), "converged": False, "stable": "",
+                  "start": "continued/critical", "lambda": 0.3},
+                 {"W": 9.75, "eig1": -1.0, "converged": True, "stable": False,
+                  "start": "continued/min", "lambda": 0.6}]
     SP.add_seeds(row, [4, 5, 6], seed_rows)
     assert row["seeds"] == "4;5;6" and SP.parse_seeds(row["seeds"]) == [4, 5, 6]
     assert SP.values(row, "W_seeds") == [10.5, None, 9.75]
     assert SP.values(row, "eig1_seeds") == [2.0, None, -1.0]
     assert row["stable_seeds"] == "1/2"
     assert row["W_spread"] == pytest.approx(0.75)           # 10.5 - 9.75, not 99
+    assert row["start_seeds"] == "revolved/min@0.3;;continued/min@0.6"
 
 
 def test_crossing_spread_per_seed():
