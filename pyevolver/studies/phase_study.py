@@ -24,7 +24,9 @@ branch every descent does) is solved by plain Newton on the critical-point
 equations (:func:`~pyevolver.studies.phase_newton.newton_critical`, which
 finds saddles), then both again with 2λ and with 4λ (the stomatocyte's
 neck at 2,562 vertices needs 4λ, and so do the oblate saddles there: with
-λ the critical-point Newton lets the triangles collapse), and last minimised and solved by
+λ the critical-point Newton lets the triangles collapse), Newton once more
+with 8λ (the 2,562-vertex oblate at v = 0.5: λ = 0.6, as 2λ at 642
+vertices), and last minimised and solved by
 Newton from the last converged neighbour's mesh.  (Starting every point from its neighbour's
 mesh, the first design, lets the triangulation drift: on the prolate
 branch at 300 vertices the error grew from +0.8% to +3.2% between
@@ -149,7 +151,8 @@ def solve_point(branch: str, v: float, ref, nv: int, lam: float | None = None,
     revolved = "revolved" if min_ring <= 3 else f"revolved-ring{min_ring}"
     attempts = [(revolved, rev, lam, "min"), (revolved, rev, lam, "critical"),
                 (revolved, rev, 2 * lam, "min"), (revolved, rev, 2 * lam, "critical"),
-                (revolved, rev, 4 * lam, "min"), (revolved, rev, 4 * lam, "critical")]
+                (revolved, rev, 4 * lam, "min"), (revolved, rev, 4 * lam, "critical"),
+                (revolved, rev, 8 * lam, "critical")]
     if start is not None:
         attempts += [("continued", start, lam, "min"), ("continued", start, lam, "critical")]
     steps = 0
