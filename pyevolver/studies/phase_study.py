@@ -365,6 +365,20 @@ def write_transitions(path: str, trans: list[dict]) -> None:
                                                      else val)) for k, val in t.items()})
 
 
+def read_transitions(path: str) -> list[dict]:
+    """The rows of a ``transitions.csv`` as :func:`transitions` gives them
+    (numbers as floats, empty as None)."""
+    out = []
+    with open(path, newline="") as fh:
+        for r in csv.DictReader(fh):
+            t: dict[str, Any] = {"c0": float(r.get("c0") or 0.0), "from": r["from"],
+                                 "to": r["to"], "v_seeds": r.get("v_seeds", "")}
+            for k in ("v", "v_ref", "v_published", "v_spread"):
+                t[k] = float(r[k]) if r.get(k) else None
+            out.append(t)
+    return out
+
+
 def references(volumes, branches=BRANCHES, modes: int | None = None,
                model: Helfrich | None = None) -> dict:
     """branch -> {v: BranchPoint} of the axisymmetric reference on ``volumes``

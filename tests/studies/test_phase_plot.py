@@ -1,12 +1,11 @@
 """Direct tests of pyevolver.studies.phase_plot: the figure is written as
 PNG and PDF from rows, references and transitions (synthetic here); the
 tables of docs/phase.md are the committed study output's."""
-import csv
 import os
 from types import SimpleNamespace
 
 from pyevolver.studies.phase_plot import plot, summary_markdown
-from pyevolver.studies.phase_study import read_rows
+from pyevolver.studies.phase_study import read_rows, read_transitions
 
 DOCS = os.path.join(os.path.dirname(__file__), "..", "..", "docs")
 
@@ -44,26 +43,18 @@ def test_summary_tables():
     assert "| 1.00000 |" in lines[-1]
 
 
-def _read_transitions(path):
-    with open(path, newline="") as fh:
-        out = []
-        for r in csv.DictReader(fh):
-            out.append({"from": r["from"], "to": r["to"],
-                        "v": float(r["v"]) if r["v"] else None,
-                        "v_ref": float(r["v_ref"]) if r["v_ref"] else None,
-                        "v_published": (float(r["v_published"]) if r["v_published"]
-                                        else None)})
-        return out
+
 
 
 def test_committed_study_tables_are_the_committed_csv():
     """docs/phase/summary.md, docs/phase/n2562/summary.md,
-    docs/phase/c0_m0.5/summary.md and the tables
+    docs/phase/c0_m0.5/summary.md, docs/phase/c0_p0.5/summary.md and the tables
     quoted in docs/phase.md are what summary_markdown writes from the
     committed CSV files next to them."""
-    for sub in ("phase", os.path.join("phase", "n2562"), os.path.join("phase", "c0_m0.5")):
+    for sub in ("phase", os.path.join("phase", "n2562"), os.path.join("phase", "c0_m0.5"),
+                os.path.join("phase", "c0_p0.5")):
         rows = read_rows(os.path.join(DOCS, sub, "phase.csv"))
-        trans = _read_transitions(os.path.join(DOCS, sub, "transitions.csv"))
+        trans = read_transitions(os.path.join(DOCS, sub, "transitions.csv"))
         text = summary_markdown(rows, trans)
         with open(os.path.join(DOCS, sub, "summary.md")) as fh:
             assert fh.read() == text

@@ -112,3 +112,27 @@ def test_a_seed_is_its_own_start():
     b, Xb, Fb = PS.solve_point("prolate", 0.9, p.result, 60, eigen=False, seed=7)
     assert a["seed"] == "" and b["seed"] == 7 and b["converged"] is True
     assert not np.array_equal(Fa, Fb)
+
+
+def test_transitions_with_their_spread_round_trip(tmp_path):
+    """transitions() gives each seed's crossing and the spread;
+    write_transitions/read_transitions keep them (the summary reads them
+    back from the CSV)."""
+    rows = []
+    for v in (0.5, 0.6, 0.7):
+        rows.append({"branch": "prolate", "v": v, "W": 1 - v, "converged": True,
+                     "W_seeds": f"{1 - v};{1.02 - v}"})
+        rows.append({"branch": "oblate", "v": v, "W": 0.4, "converged": True,
+                     "W_seeds": "0.4;0.4"})
+    trans = PS.transitions(rows)
+    po = trans[0]
+    assert (po["from"], po["to"]) == ("prolate", "oblate")
+    assert po["v"] == pytest.approx(0.6) and po["v_spread"] == pytest.approx(0.02)
+    assert SP.values({"x": po["v_seeds"]}, "x") == [pytest.approx(0.6), pytest.approx(0.62)]
+    assert trans[1]["v"] is None and trans[1]["v_spread"] is None
+    path = str(tmp_path / "transitions.csv")
+    PS.write_transitions(path, trans)
+    back = PS.read_transitions(path)
+    for a, b in zip(trans, back):
+        for k in ("v", "v_ref", "v_published", "v_spread"):
+            assert (a[k] is None and b[k] is None) or a[k] == pytest.approx(b[k], rel=1e-9)
