@@ -7,8 +7,8 @@ z axis into a closed triangle mesh of about ``nv`` vertices with
 near-equilateral triangles everywhere, also in a stomatocyte's narrow neck:
 rings of vertices at equal arclength steps (the height of an equilateral
 triangle of side ``h``, ``√3 nv h²/2 ≈ A``), each ring with
-``round(2π r / h)`` vertices (at least 3; at least ``min_ring``, with the
-local ``h`` graded down where that is more, in a graded mesh), consecutive rings joined by the
+``round(2π r / h)`` vertices (at least 3; a graded mesh, ``min_ring``,
+lowers the local ``h`` where a ring would get fewer than that), consecutive rings joined by the
 "zipper" that always advances on the ring whose next vertex comes first in
 angle, and a vertex on each pole joined to its ring by a fan.  The mesh is
 oriented outwards (positive enclosed volume).
